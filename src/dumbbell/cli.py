@@ -1,0 +1,100 @@
+"""The ``dumbbell`` command. Each subcommand lives in its own module under
+:mod:`dumbbell.commands` and provides ``register(subparsers)``.
+
+Exit status: 0 done; 2 bad input (one line naming the file, key or flag and what is allowed;
+nothing written); 3 a run ended with a verdict other than ``ok``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import math
+import sys
+from collections.abc import Sequence
+
+from .errors import DumbbellError
+
+#: Subcommand modules, in the order ``--help`` lists them.
+COMMANDS = ("run", "simulate")
+
+EXIT_USAGE = 2
+EXIT_VERDICT = 3
+
+
+class Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        sys.exit(EXIT_USAGE)
+
+
+def positive_float(unit: str):
+    """An argparse type: a finite number > 0, in ``unit``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number > 0 ({unit})")
+        return value
+
+    parse.__name__ = f"number in {unit}"
+    return parse
+
+
+def positive_int(what: str):
+    """An argparse type: a whole number >= 1."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = 0
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be a whole number >= 1 ({what})")
+        return value
+
+    parse.__name__ = what
+    return parse
+
+
+def add_quiet(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no progress bar (it is also off when stderr is not a terminal "
+                             "or CI is set)")
+
+
+def build_parser() -> Parser:
+    parser = Parser(
+        prog="dumbbell",
+        description="How a body's mechanical energy is shared between centre-of-mass and "
+                    "internal motion: the bouncing dumbbell of textbook section 13.5.1.",
+        epilog="Exit status: 0 done, 2 bad input, 3 a run ended with a verdict other than ok.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    sub.required = True
+    for name in COMMANDS:
+        importlib.import_module(f"dumbbell.commands.{name}").register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``dumbbell`` console script; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except DumbbellError as exc:
+        sys.stderr.write(f"dumbbell {args.command}: error: {exc}\n")
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        sys.stderr.write(f"dumbbell {args.command}: interrupted; no partial output was kept\n")
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,149 @@
+"""The energy partition: the one module that holds the energy formulas.
+
+1D (textbook section 13.5.1), M = mA + mB, X and V the centre-of-mass position and velocity:
+
+- ``K_cm = 1/2 M V^2``, ``K_int = 1/2 mA (vA - V)^2 + 1/2 mB (vB - V)^2``
+- ``U_g = M g X``, ``U_spring = 1/2 k (xA - xB - b)^2``, ``E`` their sum (J)
+
+2D, with d = rA - rB, L = |d|, u = d/L, w = vA - vB and mu the reduced mass:
+
+- ``K_cm = 1/2 M |V|^2``, ``K_vib = 1/2 mu (w.u)^2``, ``K_rot = 1/2 mu |w x u|^2``
+- ``K_spin = sum 1/2 I_i omega_i^2`` (only where particles may spin)
+- ``U_g = M g R_y``, ``U_spring = 1/2 k (L - b)^2`` (only with a spring)
+
+Where energy can leave the system, ``E_lost = E(0) - E(t)`` so that ``E + E_lost`` stays at E(0).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .scene import Scene
+    from .trajectory import Trajectory
+
+
+def state_columns(scene: Scene) -> list[str]:
+    """Position and velocity columns of a scene (m, m/s), in CSV order."""
+    if scene.dimensions == 1:
+        return ["xA", "vA", "xB", "vB"]
+    return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
+
+
+def spins(scene: Scene) -> bool:
+    """True when the particles may spin about their own centres (2D pymunk with spin on)."""
+    return scene.dimensions == 2 and bool(scene.pymunk.spin)
+
+
+def energy_columns(scene: Scene) -> list[str]:
+    """The energy terms (J) a scene can have, in CSV order; those it cannot have are left out."""
+    if scene.dimensions == 1:
+        cols = ["K_cm", "K_int", "U_g", "U_spring", "E"]
+    else:
+        cols = ["K_cm", "K_rot", "K_vib"]
+        if spins(scene):
+            cols.append("K_spin")
+        cols.append("U_g")
+        if scene.spring is not None:
+            cols.append("U_spring")
+        cols.append("E")
+    if scene.dissipative:
+        cols.append("E_lost")
+    return cols
+
+
+def partition_1d(
+    mA: float, mB: float, k: float, b: float, g: float,
+    xA: np.ndarray, vA: np.ndarray, xB: np.ndarray, vB: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """1D partition from masses (kg), stiffness (N/m), rest length (m), gravity (m/s^2) and
+    positions/velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J."""
+    M = mA + mB
+    X = (mA * xA + mB * xB) / M
+    V = (mA * vA + mB * vB) / M
+    K_cm = 0.5 * M * V**2
+    K_int = 0.5 * mA * (vA - V) ** 2 + 0.5 * mB * (vB - V) ** 2
+    U_g = M * g * X
+    U_spring = 0.5 * k * (xA - xB - b) ** 2
+    return {"K_cm": K_cm, "K_int": K_int, "U_g": U_g, "U_spring": U_spring,
+            "E": K_cm + K_int + U_g + U_spring}
+
+
+def partition_2d(
+    mA: float, mB: float, k: float, b: float, g: float,
+    rA: np.ndarray, vA: np.ndarray, rB: np.ndarray, vB: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """2D partition; positions and velocities are (n, 2) arrays (m, m/s), y vertical.
+    Returns K_cm, K_rot, K_vib, U_g, U_spring, E in J (K_spin is added by :func:`partition`)."""
+    M = mA + mB
+    mu = mA * mB / M
+    V = (mA * vA + mB * vB) / M
+    Ry = (mA * rA[:, 1] + mB * rB[:, 1]) / M
+    d = rA - rB
+    L = np.hypot(d[:, 0], d[:, 1])
+    w = vA - vB
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = d / L[:, None]
+    # A zero-length axis has no direction: all relative motion then counts as vibration.
+    degenerate = ~(L > 0)
+    along = np.where(degenerate, np.hypot(w[:, 0], w[:, 1]), w[:, 0] * u[:, 0] + w[:, 1] * u[:, 1])
+    across = np.where(degenerate, 0.0, w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0])
+    K_cm = 0.5 * M * (V[:, 0] ** 2 + V[:, 1] ** 2)
+    K_vib = 0.5 * mu * along**2
+    K_rot = 0.5 * mu * across**2
+    U_g = M * g * Ry
+    U_spring = 0.5 * k * (L - b) ** 2
+    return {"K_cm": K_cm, "K_rot": K_rot, "K_vib": K_vib, "U_g": U_g, "U_spring": U_spring,
+            "E": K_cm + K_rot + K_vib + U_g + U_spring}
+
+
+def disc_inertia(mass: float, radius: float) -> float:
+    """Moment of inertia of a uniform disc about its centre, 1/2 m r^2 (kg m^2)."""
+    return 0.5 * mass * radius**2
+
+
+def partition(traj: Trajectory) -> dict[str, np.ndarray]:
+    """All energy columns of ``traj`` (J), in :func:`energy_columns` order."""
+    scene = traj.scene
+    k = scene.spring.stiffness if scene.spring else 0.0
+    b = scene.spring.rest_length if scene.spring else 0.0
+    if scene.dimensions == 1:
+        parts = partition_1d(scene.A.mass, scene.B.mass, k, b, scene.g,
+                             traj["xA"], traj["vA"], traj["xB"], traj["vB"])
+    else:
+        rA = np.column_stack([traj["xA"], traj["yA"]])
+        rB = np.column_stack([traj["xB"], traj["yB"]])
+        vA = np.column_stack([traj["vxA"], traj["vyA"]])
+        vB = np.column_stack([traj["vxB"], traj["vyB"]])
+        parts = partition_2d(scene.A.mass, scene.B.mass, k, b, scene.g, rA, vA, rB, vB)
+        if spins(scene):
+            parts["K_spin"] = sum(
+                0.5 * disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"] ** 2
+                for p in (scene.A, scene.B)
+            )
+            parts["E"] = parts["E"] + parts["K_spin"]
+    if scene.dissipative:
+        parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
+    return {name: parts[name] for name in energy_columns(scene)}
+
+
+def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
+    """The scale (J) that relative energy errors are taken against: |E(0)|, or where that is
+    near zero (zero gravity, say) the largest single term at the start, or 1 J if all vanish."""
+    scale = abs(E0)
+    if terms_at_start:
+        largest = max(abs(v) for v in terms_at_start.values())
+        if scale < 1e-3 * largest:
+            scale = largest
+    return scale if scale > 0 else 1.0
+
+
+def relative_energy_error(traj: Trajectory) -> np.ndarray:
+    """|E(t) - E(0)| / scale for every sample (dimensionless), scale from :func:`energy_scale`."""
+    E = traj["E"]
+    if len(E) == 0:
+        return E
+    terms = {name: float(v[0]) for name, v in traj.energy.items() if name not in ("E", "E_lost")}
+    return np.abs(E - E[0]) / energy_scale(float(E[0]), terms)

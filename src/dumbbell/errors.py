@@ -1,0 +1,19 @@
+"""Errors that the command line turns into one clear line and exit status 2."""
+
+from __future__ import annotations
+
+
+class DumbbellError(Exception):
+    """Base class of the errors that are the user's to fix (exit status 2)."""
+
+
+class SceneError(DumbbellError, ValueError):
+    """A scene file or value is not valid.
+
+    The message names the file, the dotted key and what is allowed, e.g.
+    ``scenes/a.toml: spring.stiffness = -1: must be a finite number >= 0 (N/m)``.
+    """
+
+
+class UsageError(DumbbellError, ValueError):
+    """A command-line flag or API argument is not valid."""

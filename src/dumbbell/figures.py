@@ -1,0 +1,156 @@
+"""The textbook's figures of section 13.5.1 as PNG, drawn from a :class:`Trajectory`.
+
+- ``positions`` (Fig. 13.13): heights of A, B and the centre of mass;
+- ``kinetic`` (Fig. 13.14): positions, then K_cm, K_int and E;
+- ``potential`` (Fig. 13.15): positions, then the external (U_g) and internal (U_spring)
+  potential energies.
+
+All show the textbook's window, 0 to 2 s, and mark the first impact. Matplotlib is imported
+only here, and only when a figure is drawn.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .files import atomic_output
+from .trajectory import Trajectory
+
+#: The textbook's time window (s).
+WINDOW = 2.0
+
+COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",
+           "K_rot": "#2ca02c", "K_vib": "#d62728", "K_spin": "#9467bd", "U_g": "#8c564b",
+           "U_spring": "#e6a700", "E": "black", "E_lost": "#7f7f7f"}
+
+LABELS = {"K_cm": "K_cm, centre of mass", "K_int": "K_int, relative to the centre of mass",
+          "K_rot": "K_rot, rotation", "K_vib": "K_vib, vibration", "K_spin": "K_spin, own spin",
+          "U_g": "U_g = M g X, external", "U_spring": "U_spring, internal", "E": "E, total",
+          "E_lost": "E_lost"}
+
+
+def _pyplot() -> Any:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _window(traj: Trajectory, window: float) -> np.ndarray:
+    return traj.t <= window + 1e-12
+
+
+def heights(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertical positions of A, B and the centre of mass (m), in 1D or 2D."""
+    scene = traj.scene
+    key = "x" if scene.dimensions == 1 else "y"
+    a, b = traj[f"{key}A"], traj[f"{key}B"]
+    return a, b, (scene.A.mass * a + scene.B.mass * b) / scene.M
+
+
+def _positions_panel(ax: Any, traj: Trajectory, window: float) -> None:
+    m = _window(traj, window)
+    t = traj.t[m]
+    a, b, cm = (h[m] for h in heights(traj))
+    name = "x" if traj.scene.dimensions == 1 else "y"
+    ax.plot(t, a, color=COLOURS["A"], lw=1.3, label=f"{name}_A, top particle")
+    ax.plot(t, b, color=COLOURS["B"], lw=1.3, label=f"{name}_B, bottom particle")
+    ax.plot(t, cm, color=COLOURS["cm"], lw=1.6, ls=":", label="centre of mass")
+    if traj.scene.floor is not None:
+        ax.axhspan(min(0.0, float(np.nanmin([a.min(), b.min()]))) - 1.0, 0.0, color="0.88",
+                   zorder=0)
+        ax.axhline(0.0, color="0.4", lw=1.0)
+    ax.set_ylabel(f"{name} [m]")
+    top = float(np.nanmax(a)) if len(a) else 1.0
+    ax.set_ylim(min(-0.05, float(np.nanmin(b)) - 0.05) if len(b) else -0.05, top * 1.08 + 0.02)
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+
+
+def _mark_first_impact(axes: list[Any], traj: Trajectory, window: float, text: bool) -> None:
+    first = traj.first_impact()
+    if first is None or first.t > window:
+        return
+    for ax in axes:
+        ax.axvline(first.t, color="0.5", lw=0.8, ls="--", zorder=1)
+    if text:
+        axes[0].annotate(f"first impact, t = {first.t:.4f} s", xy=(first.t, 1.0),
+                         xycoords=("data", "axes fraction"), xytext=(4, -12),
+                         textcoords="offset points", fontsize=8, color="0.3")
+
+
+def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) -> None:
+    m = _window(traj, window)
+    for name in names:
+        style = {"ls": ":", "lw": 1.8} if name == "E" else {"lw": 1.2}
+        ax.plot(traj.t[m], traj[name][m], color=COLOURS.get(name), label=LABELS.get(name, name),
+                **style)
+    ax.set_ylabel("E [J]")
+    values = np.concatenate([traj[name][m] for name in names])
+    lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
+    span = hi - min(lo, 0.0)
+    # Head room above the curves keeps the legend off the total-energy line.
+    ax.set_ylim(min(lo, 0.0) - 0.04 * span, hi + 0.3 * span)
+    ax.legend(loc="upper center", fontsize=8, framealpha=0.9, ncol=len(names))
+
+
+def _finish(fig: Any, axes: list[Any], traj: Trajectory, window: float, path: Path,
+            subtitle: str) -> Path:
+    axes[-1].set_xlabel("t [s]")
+    for ax in axes:
+        ax.set_xlim(0, window)
+        ax.grid(True, color="0.9", lw=0.6)
+    _mark_first_impact(axes, traj, window, text=True)
+    dt = f", dt = {traj.dt:g} s" if traj.dt and traj.solver != "exact" else ""
+    fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=110)
+    _pyplot().close(fig)
+    return path
+
+
+def positions_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
+    """Fig. 13.13: heights of A, B and the centre of mass over [0, window] s."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    _positions_panel(ax, traj, window)
+    return _finish(fig, [ax], traj, window, Path(path),
+                   "the centre of mass falls on parabolas; the particles oscillate about it")
+
+
+def _two_panel(traj: Trajectory, path: str | Path, names: list[str], window: float,
+               subtitle: str) -> Path:
+    plt = _pyplot()
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6.4), sharex=True)
+    _positions_panel(top, traj, window)
+    _energy_panel(bottom, traj, names, window)
+    return _finish(fig, [top, bottom], traj, window, Path(path), subtitle)
+
+
+def kinetic_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
+    """Fig. 13.14: positions, then the kinetic energy split into K_cm and K_int, and E (J)."""
+    names = ["K_cm", "K_int", "E"] if traj.scene.dimensions == 1 else [
+        n for n in ("K_cm", "K_rot", "K_vib", "K_spin", "E") if n in traj.columns]
+    return _two_panel(traj, path, names, window,
+                      "kinetic energy: centre of mass against internal motion")
+
+
+def potential_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
+    """Fig. 13.15: positions, then the external (U_g) and internal (U_spring) potential (J)."""
+    names = [n for n in ("U_g", "U_spring") if n in traj.columns]
+    return _two_panel(traj, path, names, window,
+                      "potential energy: external (gravity) against internal (spring)")
+
+
+#: Figure name (as in a scene's ``[outputs] figures``) -> drawing function.
+FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
+    "positions": positions_figure,
+    "kinetic": kinetic_figure,
+    "potential": potential_figure,
+}

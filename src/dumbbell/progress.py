@@ -1,0 +1,44 @@
+"""Progress bars that show on a terminal and stay quiet in CI, in pipes or with --quiet."""
+
+from __future__ import annotations
+
+import os
+import sys
+from typing import Any
+
+
+def progress_wanted(quiet: bool = False) -> bool:
+    """True when a progress bar should be drawn: stderr is a terminal, not CI, not quiet."""
+    if quiet or os.environ.get("CI"):
+        return False
+    return sys.stderr.isatty()
+
+
+class _NoBar:
+    """Stands in for a tqdm bar when none is wanted, so callers need no branches."""
+
+    n = 0
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+
+    def set_postfix_str(self, text: str) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self) -> _NoBar:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        pass
+
+
+def bar(total: float | None, desc: str, unit: str = "it", quiet: bool = False, **kw: Any) -> Any:
+    """A tqdm bar on a terminal, or a silent stand-in. Use as a context manager."""
+    if not progress_wanted(quiet):
+        return _NoBar()
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit=unit, leave=False, dynamic_ncols=True, **kw)

@@ -1,0 +1,522 @@
+"""Scenes: plain, validated data read from TOML files.
+
+A scene says only what it needs; a table it leaves out is not built (no ``[floor]``: no impact
+handling; no ``[gravity]``: no gravity; no ``[spring]``: the particles do not interact).
+
+>>> scene = load_scene("scenes/textbook-1d.toml")      # doctest: +SKIP
+>>> scene.spring.stiffness, scene.run.dt
+(200.0, 1e-05)
+
+Every failure raises one :class:`SceneError` naming the file, the dotted key and what is
+allowed. :meth:`Scene.with_values` re-validates after changing keys by their dotted names, which
+is how sweeps vary a scene.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SceneError
+
+#: Solver names a scene may ask for; the registry in :mod:`dumbbell.solvers` must agree.
+SOLVER_NAMES = ("euler-cromer", "exact", "pymunk", "verlet", "reference", "euler-cromer-2d")
+#: Figure names ``[outputs] figures`` may list.
+FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation")
+#: Radius given to particles that do not state one (m); only pymunk and drawings use it.
+DEFAULT_RADIUS = 0.02
+#: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
+DEFAULT_UNSTABLE_ENERGY = 10.0
+
+
+@dataclass(frozen=True)
+class Particle:
+    """One particle. Positions in m, velocities in m/s, spin in rad/s, mass in kg."""
+
+    name: str
+    mass: float
+    x: float
+    height: float
+    vx: float
+    vy: float
+    radius: float
+    spin: float
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A Hooke spring between A and B: stiffness in N/m, rest length in m."""
+
+    stiffness: float
+    rest_length: float
+
+
+@dataclass(frozen=True)
+class Rigid:
+    """A massless rigid rod between A and B (2D only): length in m."""
+
+    length: float
+
+
+@dataclass(frozen=True)
+class Floor:
+    """The floor at height 0 for the particle centres. ``elasticity`` is the restitution
+    coefficient (1: elastic), ``friction`` the Coulomb coefficient (2D only)."""
+
+    elasticity: float
+    friction: float
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """Default run options: ``t_end`` and ``dt`` in s, ``every`` in steps (keep every N-th),
+    ``unstable_energy`` the relative energy error that makes a run ``unstable``."""
+
+    t_end: float
+    dt: float
+    solver: str
+    every: int
+    unstable_energy: float
+
+
+@dataclass(frozen=True)
+class PymunkSettings:
+    """Engine settings in SI units; ``None`` means the solver's documented default."""
+
+    collision_slop: float | None
+    collision_bias: float | None
+    iterations: int | None
+    spin: bool | None
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What ``dumbbell run`` makes for the scene."""
+
+    figures: tuple[str, ...]
+    csv: bool
+    gif: dict[str, Any] | None
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. Build it with :func:`load_scene` or :func:`scene_from_dict`."""
+
+    title: str
+    dimensions: int
+    A: Particle
+    B: Particle
+    spring: Spring | None
+    rigid: Rigid | None
+    floor: Floor | None
+    g: float
+    run: RunSettings
+    outputs: Outputs
+    pymunk: PymunkSettings
+    source: str = "<scene>"
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def M(self) -> float:
+        """Total mass (kg)."""
+        return self.A.mass + self.B.mass
+
+    @property
+    def mu(self) -> float:
+        """Reduced mass mA*mB/M (kg)."""
+        return self.A.mass * self.B.mass / (self.A.mass + self.B.mass)
+
+    @property
+    def omega(self) -> float:
+        """Angular frequency of the spring's vibration sqrt(k/mu) (rad/s); 0 without spring."""
+        return math.sqrt(self.spring.stiffness / self.mu) if self.spring else 0.0
+
+    @property
+    def name(self) -> str:
+        """The scene file's stem, used to name outputs."""
+        return Path(self.source).stem if self.source != "<scene>" else "scene"
+
+    @property
+    def dissipative(self) -> bool:
+        """True when energy can leave the system (elasticity below 1, or friction in 2D)."""
+        if self.floor is None:
+            return False
+        return self.floor.elasticity < 1.0 or (self.dimensions == 2 and self.floor.friction > 0)
+
+    def with_values(self, values: dict[str, Any]) -> Scene:
+        """A new scene with keys replaced by dotted name, validated like a file.
+
+        >>> scene.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})   # doctest: +SKIP
+        """
+        raw = copy.deepcopy(self.raw)
+        for dotted, value in values.items():
+            parts = dotted.split(".")
+            table = raw
+            for part in parts[:-1]:
+                nxt = table.setdefault(part, {})
+                if not isinstance(nxt, dict):
+                    raise SceneError(f"{self.source}: {dotted}: '{part}' is not a table")
+                table = nxt
+            table[parts[-1]] = value
+        return scene_from_dict(raw, source=self.source)
+
+
+# --- validation -----------------------------------------------------------------------------
+
+
+class _Checker:
+    """Reads one TOML table, remembering which keys were used, and raises SceneError."""
+
+    def __init__(self, source: str, table: Any, path: str):
+        self.source = source
+        self.path = path
+        if not isinstance(table, dict):
+            self.fail(path, table, "must be a table")
+        self.table = table
+        self.used: set[str] = set()
+
+    def key(self, name: str) -> str:
+        return f"{self.path}.{name}" if self.path else name
+
+    def fail(self, dotted: str, value: Any, allowed: str) -> None:
+        raise SceneError(f"{self.source}: {dotted} = {_show(value)}: {allowed}")
+
+    def has(self, name: str) -> bool:
+        return name in self.table
+
+    def number(
+        self,
+        name: str,
+        default: float | None = None,
+        *,
+        lo: float | None = None,
+        hi: float | None = None,
+        lo_open: bool = False,
+        unit: str = "",
+    ) -> float:
+        self.used.add(name)
+        allowed = _range_text(lo, hi, lo_open, unit)
+        if name not in self.table:
+            if default is None:
+                raise SceneError(f"{self.source}: {self.key(name)} is missing: {allowed}")
+            return default
+        value = self.table[name]
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.fail(self.key(name), value, allowed)
+        value = float(value)
+        if not math.isfinite(value):
+            self.fail(self.key(name), value, allowed)
+        if lo is not None and (value < lo or (lo_open and value == lo)):
+            self.fail(self.key(name), value, allowed)
+        if hi is not None and value > hi:
+            self.fail(self.key(name), value, allowed)
+        return value
+
+    def integer(self, name: str, default: int, *, lo: int, hi: int | None = None) -> int:
+        self.used.add(name)
+        if name not in self.table:
+            return default
+        value = self.table[name]
+        allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
+        if isinstance(value, bool) or not isinstance(value, int):
+            self.fail(self.key(name), value, allowed)
+        if value < lo or (hi is not None and value > hi):
+            self.fail(self.key(name), value, allowed)
+        return int(value)
+
+    def boolean(self, name: str, default: bool | None) -> bool | None:
+        self.used.add(name)
+        if name not in self.table:
+            return default
+        value = self.table[name]
+        if not isinstance(value, bool):
+            self.fail(self.key(name), value, "must be true or false")
+        return value
+
+    def string(self, name: str, default: str | None, choices: tuple[str, ...] | None = None) -> str:
+        self.used.add(name)
+        if name not in self.table:
+            if default is None:
+                raise SceneError(f"{self.source}: {self.key(name)} is missing: must be a string")
+            return default
+        value = self.table[name]
+        if choices is not None:
+            if value not in choices:
+                self.fail(self.key(name), value, "must be one of " + ", ".join(choices))
+        elif not isinstance(value, str):
+            self.fail(self.key(name), value, "must be a string")
+        return value
+
+    def sub(self, name: str) -> _Checker | None:
+        self.used.add(name)
+        if name not in self.table:
+            return None
+        return _Checker(self.source, self.table[name], self.key(name))
+
+    def done(self) -> None:
+        unknown = sorted(set(self.table) - self.used, key=str)
+        if unknown:
+            allowed = ", ".join(sorted(self.used)) or "nothing"
+            where = f"in [{self.path}]" if self.path else "at the top level"
+            raise SceneError(
+                f"{self.source}: unknown key '{self.key(str(unknown[0]))}' {where}; "
+                f"allowed: {allowed}"
+            )
+
+
+def _show(value: Any) -> str:
+    text = repr(value) if isinstance(value, str) else str(value)
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _range_text(lo: float | None, hi: float | None, lo_open: bool, unit: str) -> str:
+    parts = []
+    if lo is not None:
+        parts.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        parts.append(f"<= {hi:g}")
+    text = "must be a finite number" + (" " + " and ".join(parts) if parts else "")
+    return text + (f" ({unit})" if unit else "")
+
+
+def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
+    c.used.add("velocity")
+    if "velocity" not in c.table:
+        return 0.0, 0.0
+    value = c.table["velocity"]
+    dotted = c.key("velocity")
+    if dims == 1:
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            c.fail(dotted, value, "must be a finite number (m/s, upward) in a 1D scene")
+        return 0.0, float(value)
+    ok = (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(not isinstance(v, bool) and isinstance(v, int | float) for v in value)
+        and all(math.isfinite(v) for v in value)
+    )
+    if not ok:
+        c.fail(dotted, value, "must be a list of two finite numbers [vx, vy] (m/s) in a 2D scene")
+    return float(value[0]), float(value[1])
+
+
+def _particle(c: _Checker, name: str, dims: int, placed: bool) -> Particle:
+    mass = c.number("mass", lo=0.0, lo_open=True, unit="kg")
+    radius = c.number("radius", DEFAULT_RADIUS, lo=0.0, unit="m")
+    if placed:
+        # A placed from B by the tilt: its own position would contradict it.
+        for key in ("height", "x"):
+            if c.has(key):
+                c.fail(c.key(key), c.table[key], "must be left out when 'tilt' places A")
+        height = x = 0.0
+    else:
+        height = c.number("height", unit="m, initial height of the centre")
+        x = c.number("x", 0.0, unit="m") if dims == 2 else 0.0
+    vx, vy = _velocity(c, dims)
+    spin = c.number("spin", 0.0, unit="rad/s") if dims == 2 else 0.0
+    c.done()
+    return Particle(name, mass, x, height, vx, vy, radius, spin)
+
+
+def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
+    """Validate a parsed TOML document and build a :class:`Scene` (raises SceneError)."""
+    top = _Checker(source, data, "")
+    title = top.string("title", Path(source).stem)
+    if not isinstance(title, str):
+        top.fail("title", title, "must be a string")
+    dims = top.integer("dimensions", 1, lo=1, hi=2)
+
+    tilt = None
+    if dims == 2 and top.has("tilt"):
+        tilt = top.number("tilt", lo=-180.0, hi=180.0, unit="degrees of the axis from vertical")
+
+    bodies = top.sub("bodies")
+    if bodies is None:
+        raise SceneError(f"{source}: [bodies] is missing: needs [bodies.A] and [bodies.B]")
+    cA, cB = bodies.sub("A"), bodies.sub("B")
+    if cA is None or cB is None:
+        missing = "bodies.A" if cA is None else "bodies.B"
+        raise SceneError(f"{source}: [{missing}] is missing: a dumbbell has particles A and B")
+    bodies.done()
+
+    spring = rigid = None
+    cs = top.sub("spring")
+    if cs is not None:
+        spring = Spring(
+            cs.number("stiffness", lo=0.0, unit="N/m"),
+            cs.number("rest_length", lo=0.0, unit="m"),
+        )
+        cs.done()
+    cr = top.sub("rigid")
+    if cr is not None:
+        if dims != 2:
+            cr.fail("rigid", "[rigid]", "a rigid rod needs dimensions = 2")
+        if spring is not None:
+            cr.fail("rigid", "[rigid]", "a scene has either [spring] or [rigid], not both")
+        rigid = Rigid(cr.number("length", lo=0.0, lo_open=True, unit="m"))
+        cr.done()
+    if tilt is not None and spring is None and rigid is None:
+        top.fail("tilt", tilt, "needs a [spring] or [rigid] to set the distance from B to A")
+
+    B = _particle(cB, "B", dims, placed=False)
+    A = _particle(cA, "A", dims, placed=tilt is not None)
+    if tilt is not None:
+        length = rigid.length if rigid else spring.rest_length  # type: ignore[union-attr]
+        theta = math.radians(tilt)
+        A = Particle(
+            "A", A.mass, B.x + length * math.sin(theta), B.height + length * math.cos(theta),
+            A.vx, A.vy, A.radius, A.spin,
+        )
+
+    cf = top.sub("floor")
+    floor = None
+    if cf is not None:
+        elasticity = cf.number("elasticity", 1.0, lo=0.0, hi=1.0, unit="restitution")
+        friction = cf.number("friction", 0.0, lo=0.0, unit="Coulomb coefficient")
+        if dims == 1 and friction > 0:
+            cf.fail("floor.friction", friction, "must be 0 in a 1D scene (no sideways motion)")
+        floor = Floor(elasticity, friction)
+        cf.done()
+        for p in (A, B):
+            if p.height < 0:
+                raise SceneError(
+                    f"{source}: bodies.{p.name}.height = {_show(p.height)}: must be >= 0 "
+                    "(the particle would start below the floor)"
+                )
+    if dims == 1 and A.height < B.height:
+        raise SceneError(
+            f"{source}: bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
+            f"{_show(B.height)} (A is the top particle in 1D)"
+        )
+    if rigid is not None:
+        dist = math.hypot(A.x - B.x, A.height - B.height)
+        if abs(dist - rigid.length) > 1e-9 * max(1.0, rigid.length):
+            raise SceneError(
+                f"{source}: rigid.length = {_show(rigid.length)}: must equal the distance "
+                f"from B to A ({dist:.6g} m)"
+            )
+
+    cg = top.sub("gravity")
+    g = 0.0
+    if cg is not None:
+        g = cg.number("g", lo=0.0, unit="m/s^2, downward")
+        cg.done()
+
+    crun = top.sub("run")
+    if crun is None:
+        raise SceneError(f"{source}: [run] is missing: needs t_end and dt (s)")
+    t_end = crun.number("t_end", lo=0.0, lo_open=True, unit="s")
+    dt = crun.number("dt", lo=0.0, lo_open=True, unit="s")
+    if dt > t_end:
+        crun.fail("run.dt", dt, f"must be > 0 and <= run.t_end = {t_end:g} (s)")
+    solver = crun.string("solver", "euler-cromer", SOLVER_NAMES)
+    every = crun.integer("every", 1, lo=1)
+    unstable = crun.number(
+        "unstable_energy", DEFAULT_UNSTABLE_ENERGY, lo=0.0, lo_open=True,
+        unit="relative energy error that makes a run unstable",
+    )
+    crun.done()
+
+    co = top.sub("outputs")
+    figures: tuple[str, ...] = ()
+    csv = False
+    gif = None
+    if co is not None:
+        co.used.add("figures")
+        if co.has("figures"):
+            value = co.table["figures"]
+            if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
+                co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+            figures = tuple(value)
+        csv = bool(co.boolean("csv", False))
+        cgif = co.sub("gif")
+        if cgif is not None:
+            gif = {
+                "fps": cgif.integer("fps", 25, lo=1, hi=50),
+                "size": cgif.string("size", "640x360"),
+                "strip": cgif.boolean("strip", True),
+                "t_end": cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
+            }
+            if _parse_size(gif["size"]) is None:
+                cgif.fail("outputs.gif.size", gif["size"], "must be WIDTHxHEIGHT in pixels, "
+                          "each between 64 and 4096")
+            cgif.done()
+        co.done()
+
+    cp = top.sub("pymunk")
+    pm = PymunkSettings(None, None, None, None)
+    if cp is not None:
+        pm = PymunkSettings(
+            cp.number("collision_slop", lo=0.0, unit="m") if cp.has("collision_slop") else None,
+            cp.number("collision_bias", lo=0.0, hi=1.0) if cp.has("collision_bias") else None,
+            cp.integer("iterations", 10, lo=1, hi=10000) if cp.has("iterations") else None,
+            cp.boolean("spin", None),
+        )
+        cp.done()
+    top.done()
+    return Scene(
+        title=title, dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
+        run=RunSettings(t_end, dt, solver, every, unstable),
+        outputs=Outputs(figures, csv, gif), pymunk=pm, source=source, raw=copy.deepcopy(data),
+    )
+
+
+def _parse_size(text: Any) -> tuple[int, int] | None:
+    """'640x360' -> (640, 360); None when not a valid size."""
+    if not isinstance(text, str):
+        return None
+    parts = text.lower().split("x")
+    if len(parts) != 2 or not all(p.isdigit() for p in parts):
+        return None
+    w, h = int(parts[0]), int(parts[1])
+    return (w, h) if 64 <= w <= 4096 and 64 <= h <= 4096 else None
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """Parse 'WIDTHxHEIGHT' (pixels); raises ValueError with the allowed form."""
+    size = _parse_size(text)
+    if size is None:
+        raise ValueError(f"{text!r}: must be WIDTHxHEIGHT in pixels, each between 64 and 4096")
+    return size
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file (TOML). Raises :class:`SceneError` on any problem."""
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise SceneError(f"{source}: no such scene file") from None
+    except IsADirectoryError:
+        raise SceneError(f"{source}: is a directory, not a scene file") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
+    except OSError as exc:
+        raise SceneError(f"{source}: cannot read: {exc.strerror}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{source}: not valid TOML: {exc}") from None
+    return scene_from_dict(data, source=source)
+
+
+def packaged_scene(name: str = "textbook-1d") -> Path:
+    """Path of a scene shipped with the package (wheel) or found in the source checkout."""
+    here = Path(__file__).resolve().parent
+    for folder in (here / "scenes", here.parent.parent / "scenes"):
+        candidate = folder / f"{name}.toml"
+        if candidate.is_file():
+            return candidate
+    raise SceneError(f"{name}.toml: packaged scene not found (looked in the package and scenes/)")
+
+
+def scenes_dir() -> Path:
+    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout)."""
+    return packaged_scene("textbook-1d").parent

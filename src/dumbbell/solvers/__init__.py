@@ -1,0 +1,117 @@
+"""Solvers: each takes a Scene plus run options and returns a :class:`Trajectory`.
+
+>>> traj = simulate(load_scene("scenes/textbook-1d.toml"), "exact", every=100)  # doctest: +SKIP
+
+A solver module provides ``NAME``, ``supports(scene) -> str | None`` (None when it can run
+the scene, else the reason it cannot) and ``solve(scene, options) -> Trajectory``. Modules
+are imported only when their solver is used, so pymunk is loaded only for ``pymunk``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass
+from types import ModuleType
+
+import numpy as np
+
+from ..errors import UsageError
+from ..scene import SOLVER_NAMES, Scene
+from ..trajectory import Trajectory
+
+#: Solver name -> module that implements it.
+REGISTRY: dict[str, str] = {
+    "euler-cromer": "dumbbell.solvers.euler_cromer",
+    "exact": "dumbbell.solvers.exact",
+}
+assert set(REGISTRY) <= set(SOLVER_NAMES)
+
+#: Largest number of steps one run may take, so that no run can hang.
+MAX_STEPS = 10**10
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Options of one run: ``dt`` and ``t_end`` in s, keep every ``every``-th step,
+    ``quiet`` silences the progress bar."""
+
+    dt: float
+    t_end: float
+    every: int = 1
+    quiet: bool = True
+
+    @property
+    def n_steps(self) -> int:
+        """Steps taken: round(t_end / dt)."""
+        return int(round(self.t_end / self.dt))
+
+    @property
+    def n_samples(self) -> int:
+        """Samples kept: steps 0, every, 2*every, ... up to n_steps."""
+        return self.n_steps // self.every + 1
+
+    def sample_times(self, count: int | None = None) -> np.ndarray:
+        """Times of the first ``count`` samples (s; all by default): j * every * dt."""
+        return np.arange(self.n_samples if count is None else count) * (self.every * self.dt)
+
+
+def solver_module(name: str) -> ModuleType:
+    """The module of solver ``name``; UsageError naming the choices when there is none."""
+    if name not in REGISTRY:
+        raise UsageError(f"solver {name!r}: must be one of {', '.join(available())}")
+    return importlib.import_module(REGISTRY[name])
+
+
+def available() -> list[str]:
+    """Names of all solvers this installation has."""
+    return list(REGISTRY)
+
+
+def supported(scene: Scene) -> list[str]:
+    """Names of the solvers that can run ``scene``."""
+    return [n for n in REGISTRY if solver_module(n).supports(scene) is None]
+
+
+def make_options(
+    scene: Scene, dt: float | None = None, t_end: float | None = None, every: int | None = None,
+    quiet: bool = True,
+) -> RunOptions:
+    """Fill run options from the scene's ``[run]`` table and check them (UsageError)."""
+    dt = scene.run.dt if dt is None else dt
+    t_end = scene.run.t_end if t_end is None else t_end
+    every = scene.run.every if every is None else every
+    for name, value, unit in (("dt", dt, "s"), ("t_end", t_end, "s")):
+        if isinstance(value, bool) or not isinstance(value, int | float) or not (
+            math.isfinite(value) and value > 0
+        ):
+            raise UsageError(f"{name} = {value!r}: must be a finite number > 0 ({unit})")
+    if dt > t_end:
+        raise UsageError(f"dt = {dt:g}: must be <= t_end = {t_end:g} (s)")
+    if isinstance(every, bool) or not isinstance(every, int) or every < 1:
+        raise UsageError(f"every = {every!r}: must be a whole number >= 1 (steps)")
+    options = RunOptions(float(dt), float(t_end), int(every), quiet)
+    if options.n_steps > MAX_STEPS:
+        raise UsageError(
+            f"t_end / dt = {options.n_steps:.3g} steps: must be at most {MAX_STEPS:.0e}"
+        )
+    return options
+
+
+def simulate(
+    scene: Scene,
+    solver: str | None = None,
+    dt: float | None = None,
+    t_end: float | None = None,
+    every: int | None = None,
+    quiet: bool = True,
+) -> Trajectory:
+    """Run ``scene`` with ``solver`` (default: the scene's). ``dt`` and ``t_end`` in s override
+    the scene's ``[run]``; ``every`` keeps every N-th step. Returns a :class:`Trajectory`
+    whose ``verdict`` says whether the run ended well."""
+    name = scene.run.solver if solver is None else solver
+    module = solver_module(name)
+    reason = module.supports(scene)
+    if reason is not None:
+        raise UsageError(f"solver {name!r} cannot run {scene.source}: {reason}")
+    return module.solve(scene, make_options(scene, dt, t_end, every, quiet))

@@ -1,0 +1,227 @@
+"""``exact``: the piecewise-analytic 1D solution.
+
+Between impacts the centre of mass falls freely, ``X(t) = X0 + V0 t - g t^2/2``, and the
+stretch ``s = xA - xB - b`` is a harmonic oscillator with ``w = sqrt(k/mu)``. Impacts are the
+first roots of a particle's height, found by a search that cannot miss one: on an interval of
+length h the height dips at most ``C h^2/8`` below its chord, with
+``C = g + (m_other/M) w^2 S`` bounding its curvature (S the oscillation's amplitude), so an
+interval is either cleared, split, or known to hold one crossing that ``brentq`` refines to
+about 1e-14 s. Grazing impacts are found by the splitting. Positions and velocities are then
+evaluated in closed form at the sample times.
+
+A particle that comes to rest on an inelastic floor would bounce infinitely often in finite
+time; the run stops there with the verdict ``failed`` and says so.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..scene import Scene
+from ..trajectory import Impact, Trajectory, Verdict
+from . import RunOptions
+from .verdicts import energy_verdict
+
+NAME = "exact"
+
+#: Root tolerance for impact times (s).
+ROOT_XTOL = 1e-14
+#: Intervals shorter than this (s) are not split further: a dip below the floor inside one
+#: would be shallower than C * MIN_SPLIT^2 / 8, about 1e-25 m.
+MIN_SPLIT = 1e-13
+#: An impact slower than this (m/s) means the particle has come to rest on the floor.
+REST_SPEED = 1e-9
+#: Impacts allowed in one run, so that no run can hang.
+MAX_IMPACTS = 2_000_000
+
+
+@dataclass(frozen=True)
+class Segment:
+    """Free motion from time ``t0`` (s): centre of mass X0 (m), V0 (m/s); stretch s0 (m) and
+    its rate sd0 (m/s)."""
+
+    t0: float
+    X0: float
+    V0: float
+    s0: float
+    sd0: float
+
+
+class _Motion:
+    """Closed-form motion of one segment; ``tau`` is the time since the segment began (s)."""
+
+    def __init__(self, scene: Scene):
+        self.g = scene.g
+        self.M = scene.M
+        self.cA = scene.B.mass / scene.M  # xA = X + cA (b + s)
+        self.cB = scene.A.mass / scene.M  # xB = X - cB (b + s)
+        self.b = scene.spring.rest_length if scene.spring else 0.0
+        self.w = scene.omega
+
+    def stretch(self, seg: Segment, tau):
+        if self.w > 0:
+            cos, sin = np.cos(self.w * tau), np.sin(self.w * tau)
+            return (seg.s0 * cos + (seg.sd0 / self.w) * sin,
+                    -seg.s0 * self.w * sin + seg.sd0 * cos)
+        return seg.s0 + seg.sd0 * tau, seg.sd0 + 0.0 * tau
+
+    def state(self, seg: Segment, tau):
+        """xA, vA, xB, vB at ``tau`` (scalars or arrays)."""
+        X = seg.X0 + seg.V0 * tau - 0.5 * self.g * tau * tau
+        V = seg.V0 - self.g * tau
+        s, sd = self.stretch(seg, tau)
+        return (X + self.cA * (self.b + s), V + self.cA * sd,
+                X - self.cB * (self.b + s), V - self.cB * sd)
+
+    def height(self, seg: Segment, body: str, tau):
+        """Height of ``body`` (m) and its rate (m/s) at ``tau``."""
+        xA, vA, xB, vB = self.state(seg, tau)
+        return (xA, vA) if body == "A" else (xB, vB)
+
+    def amplitude(self, seg: Segment) -> float:
+        """Largest |s| the segment reaches (m); inf without a spring."""
+        return math.hypot(seg.s0, seg.sd0 / self.w) if self.w > 0 else math.inf
+
+    def segment_at(self, t0: float, xA: float, vA: float, xB: float, vB: float) -> Segment:
+        mA_M, mB_M = self.cB, self.cA
+        return Segment(t0, mA_M * xA + mB_M * xB, mA_M * vA + mB_M * vB,
+                       xA - xB - self.b, vA - vB)
+
+
+def _earliest_possible(motion: _Motion, seg: Segment, body: str) -> float:
+    """No impact of ``body`` can happen before this time (s): its height stays within
+    c*S of the centre-of-mass curve, so the centre of mass must first fall to that level."""
+    S = motion.amplitude(seg)
+    if not math.isfinite(S):
+        return 0.0
+    level = motion.cB * (motion.b + S) if body == "B" else motion.cA * (S - motion.b)
+    gap = seg.X0 - level
+    if gap <= 0:
+        return 0.0
+    g, V0 = motion.g, seg.V0
+    if g > 0:
+        return (V0 + math.sqrt(V0 * V0 + 2.0 * g * gap)) / g
+    return gap / -V0 if V0 < 0 else math.inf
+
+
+def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: float) -> float:
+    """First time in (start, stop] at which ``body`` crosses the floor going down, or inf."""
+    S = motion.amplitude(seg)
+    c = motion.cB if body == "B" else motion.cA
+    C = motion.g + (c * motion.w**2 * S if motion.w > 0 else 0.0)
+    period = 2 * math.pi / motion.w if motion.w > 0 else math.inf
+    h = min(period / 16.0, 0.05)
+    a = max(start, _earliest_possible(motion, seg, body))
+    block = 64
+
+    def f(tau):
+        return motion.height(seg, body, tau)
+
+    def search(lo: float, flo: float, dlo: float, hi: float, fhi: float, dhi: float) -> float:
+        # Curvature bound: below the chord by at most C h^2 / 8; the slope changes by <= C h.
+        width = hi - lo
+        if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
+            return math.inf
+        if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
+            # Strictly decreasing on the interval: exactly one crossing.
+            return brentq(lambda x: f(x)[0], lo, hi, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
+        if width < MIN_SPLIT:
+            return hi if fhi <= 0 else math.inf
+        mid = 0.5 * (lo + hi)
+        fm, dm = f(mid)
+        left = search(lo, flo, dlo, mid, fm, dm)
+        if left < math.inf:
+            return left
+        return search(mid, fm, dm, hi, fhi, dhi)
+
+    while a < stop:
+        taus = np.minimum(a + h * np.arange(block + 1), stop)
+        fs, ds = f(taus)
+        width = np.diff(taus)
+        lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
+        suspect = np.flatnonzero((lower <= 0) & (width > 0))
+        for j in suspect:
+            root = search(taus[j], fs[j], ds[j], taus[j + 1], fs[j + 1], ds[j + 1])
+            if root < math.inf:
+                return root
+        a = taus[-1]
+    return math.inf
+
+
+def supports(scene: Scene) -> str | None:
+    """None if this solver can run ``scene``, else why not."""
+    if scene.dimensions != 1:
+        return "the exact solution is 1D; use the 2D reference solver"
+    return None
+
+
+def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], Verdict]:
+    """The free-flight segments up to ``t_end`` (s), the impacts between them, and a verdict."""
+    motion = _Motion(scene)
+    A, B = scene.A, scene.B
+    seg = motion.segment_at(0.0, A.height, A.vy, B.height, B.vy)
+    segs, events = [seg], []
+    if scene.floor is None:
+        return segs, events, Verdict()
+    e = scene.floor.elasticity
+    # After an impact the particle is on the floor moving up: no new root before this time.
+    start = {"A": 0.0, "B": 0.0}
+    while len(events) < MAX_IMPACTS:
+        horizon = t_end - seg.t0
+        roots = {body: _first_root(motion, seg, body, start[body], horizon) for body in "AB"}
+        tau = min(roots.values())
+        if not tau <= horizon:
+            return segs, events, Verdict()
+        xA, vA, xB, vB = (float(v) for v in motion.state(seg, tau))
+        t_hit = seg.t0 + tau
+        velocities = {"A": vA, "B": vB}
+        hit = [body for body in "AB" if roots[body] - tau <= ROOT_XTOL * 10]
+        for body in hit:
+            v = velocities[body]
+            if abs(v) < REST_SPEED:
+                return segs, events, Verdict(
+                    "failed", t_hit,
+                    f"{body} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
+                    "inelastic floor has infinitely many impacts in finite time here",
+                )
+            velocities[body] = -e * v
+            events.append(Impact(t_hit, body, v, velocities[body]))
+        seg = motion.segment_at(t_hit, xA, velocities["A"], xB, velocities["B"])
+        segs.append(seg)
+        C = motion.g + max(motion.cA, motion.cB) * motion.w**2 * motion.amplitude(seg)
+        for body in "AB":
+            v_up = velocities[body]
+            start[body] = (v_up / C if body in hit and C > 0 else 0.0)
+            if body in hit and C == 0:
+                start[body] = horizon  # straight line up, never to return
+    return segs, events, Verdict("failed", seg.t0, f"more than {MAX_IMPACTS} impacts")
+
+
+def solve(scene: Scene, options: RunOptions) -> Trajectory:
+    """Evaluate the exact solution at the sample times ``i * every * dt`` (s)."""
+    t0 = time.perf_counter()
+    segs, events, verdict = segments(scene, options.t_end)
+    motion = _Motion(scene)
+    t = options.sample_times()
+    if not verdict.ok:
+        t = t[t <= verdict.t]
+    # Sample times are sorted, so each segment owns one contiguous slice of them.
+    bounds = np.searchsorted(t, [s.t0 for s in segs[1:]], side="left")
+    cols = {name: np.empty_like(t) for name in ("xA", "vA", "xB", "vB")}
+    for seg, lo, hi in zip(segs, [0, *bounds], [*bounds, len(t)], strict=True):
+        if hi > lo:
+            for name, value in zip(cols, motion.state(seg, t[lo:hi] - seg.t0), strict=True):
+                cols[name][lo:hi] = value
+    wall = time.perf_counter() - t0
+    traj = Trajectory(
+        scene=scene, solver=NAME, t=t, state=cols, events=events, dt=options.dt,
+        every=options.every, wall_time=wall,
+        info={"segments": len(segs), "root_xtol": ROOT_XTOL},
+    )
+    traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
+    return traj

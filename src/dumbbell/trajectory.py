@@ -1,0 +1,131 @@
+"""The one result type every solver returns.
+
+>>> traj = simulate(scene, "exact", every=100)              # doctest: +SKIP
+>>> traj.t[:3], traj["xB"][:3], traj["E"][0]                # doctest: +SKIP
+>>> traj.verdict.status, len(traj.events)                   # doctest: +SKIP
+('ok', 22)
+
+State columns (positions in m, velocities in m/s) come from the solver; energy columns (J)
+are computed on first use by :mod:`dumbbell.energy`, the one place that knows the formulas.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .scene import Scene
+
+#: Verdict statuses, from good to bad.
+VERDICTS = ("ok", "unstable", "tunnelled", "failed")
+
+
+@dataclass(frozen=True)
+class Impact:
+    """One impact with the floor: time (s), body ('A' or 'B'), the body's vertical velocity
+    just before and just after (m/s)."""
+
+    t: float
+    body: str
+    v_before: float
+    v_after: float
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """How a run ended. ``status`` is one of ok, unstable, tunnelled, failed; ``t`` is the
+    time of failure (s, None when ok); ``reason`` says why in words."""
+
+    status: str = "ok"
+    t: float | None = None
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def __str__(self) -> str:
+        if self.ok:
+            return "ok"
+        return f"{self.status} at t = {self.t:.6g} s: {self.reason}"
+
+
+@dataclass
+class Trajectory:
+    """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
+
+    ``dt`` is the step used (s; None for the exact solution), ``every`` how many steps lie
+    between samples, ``wall_time`` the solver's run time (s), ``info`` solver-specific notes
+    (for example settings used, or an estimated error).
+    """
+
+    scene: Scene
+    solver: str
+    t: np.ndarray
+    state: dict[str, np.ndarray]
+    events: list[Impact] = field(default_factory=list)
+    verdict: Verdict = field(default_factory=Verdict)
+    dt: float | None = None
+    every: int = 1
+    wall_time: float = 0.0
+    info: dict[str, Any] = field(default_factory=dict)
+    _energy: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    @property
+    def columns(self) -> list[str]:
+        """The CSV columns, in order: t, the state, then the energy terms the scene has."""
+        from .energy import energy_columns, state_columns
+
+        return ["t", *state_columns(self.scene), *energy_columns(self.scene)]
+
+    @property
+    def energy(self) -> dict[str, np.ndarray]:
+        """Energy terms (J) by column name, computed once."""
+        if self._energy is None:
+            from .energy import partition
+
+            self._energy = partition(self)
+        return self._energy
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name == "t":
+            return self.t
+        if name in self.state:
+            return self.state[name]
+        energy = self.energy
+        if name in energy:
+            return energy[name]
+        raise KeyError(f"{name!r}: no such column; columns are {', '.join(self.columns)}")
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def table(self) -> np.ndarray:
+        """All CSV columns as one (samples, columns) float array."""
+        return np.column_stack([self[c] for c in self.columns])
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the columns with a header row; written to a temporary name, then renamed."""
+        from .files import atomic_output
+
+        with atomic_output(path) as tmp:
+            np.savetxt(tmp, self.table(), delimiter=",", header=",".join(self.columns),
+                       comments="", fmt="%.17g")
+        return Path(path)
+
+    def events_to_csv(self, path: str | Path) -> Path:
+        """Write the impacts as ``t,body,v_before,v_after`` (s, -, m/s, m/s)."""
+        from .files import atomic_output
+
+        with atomic_output(path) as tmp, open(tmp, "w") as fh:
+            fh.write("t,body,v_before,v_after\n")
+            for ev in self.events:
+                fh.write(f"{ev.t!r},{ev.body},{ev.v_before!r},{ev.v_after!r}\n")
+        return Path(path)
+
+    def first_impact(self, body: str | None = None) -> Impact | None:
+        """The first impact (of ``body`` if given), or None."""
+        return next((e for e in self.events if body in (None, e.body)), None)
