@@ -24,6 +24,7 @@ from ..trajectory import Trajectory
 REGISTRY: dict[str, str] = {
     "euler-cromer": "dumbbell.solvers.euler_cromer",
     "exact": "dumbbell.solvers.exact",
+    "verlet": "dumbbell.solvers.verlet",
 }
 assert set(REGISTRY) <= set(SOLVER_NAMES)
 
@@ -52,8 +53,10 @@ class RunOptions:
         return self.n_steps // self.every + 1
 
     def sample_times(self, count: int | None = None) -> np.ndarray:
-        """Times of the first ``count`` samples (s; all by default): j * every * dt."""
-        return np.arange(self.n_samples if count is None else count) * (self.every * self.dt)
+        """Times of the first ``count`` samples (s; all by default): step * dt, with the step
+        index j * every kept whole so every solver and every ``every`` share the same floats."""
+        steps = np.arange(self.n_samples if count is None else count, dtype=np.int64)
+        return (steps * self.every) * self.dt
 
 
 def solver_module(name: str) -> ModuleType:

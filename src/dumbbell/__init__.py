@@ -1,0 +1,20 @@
+"""dumbbell: how a body's mechanical energy is shared between its centre-of-mass motion and
+its internal motion, from the bouncing dumbbell of textbook section 13.5.1.
+
+>>> import dumbbell
+>>> scene = dumbbell.load_scene("scenes/textbook-1d.toml")            # doctest: +SKIP
+>>> traj = dumbbell.simulate(scene, solver="exact", every=100)        # doctest: +SKIP
+>>> traj.t, traj["K_int"], traj.events[0].t                           # doctest: +SKIP
+"""
+
+from .errors import DumbbellError, SceneError, UsageError
+from .scene import Scene, load_scene
+from .solvers import available as solvers
+from .solvers import simulate
+from .trajectory import Impact, Trajectory, Verdict
+
+__all__ = [
+    "DumbbellError", "Impact", "Scene", "SceneError", "Trajectory", "UsageError", "Verdict",
+    "load_scene", "simulate", "solvers",
+]
+__version__ = "0.1.0"

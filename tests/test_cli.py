@@ -1,0 +1,71 @@
+"""The command line as a user meets it: outputs, column contracts, bad flags."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import pytest
+
+from dumbbell.cli import main
+from tests.conftest import SCENES
+
+TEXTBOOK = str(SCENES / "textbook-1d.toml")
+
+
+def test_simulate_writes_the_contract_columns(tmp_path):
+    out, events = tmp_path / "t.csv", tmp_path / "e.csv"
+    assert main(["simulate", TEXTBOOK, "--t-end", "1", "--every", "1000", "-o", str(out),
+                 "--events", str(events), "-q"]) == 0
+    rows = list(csv.reader(out.open()))
+    assert rows[0] == "t,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E".split(",")
+    assert len(rows) == 1 + 101
+    assert float(rows[1][9]) == pytest.approx(2.156)
+    ev = list(csv.reader(events.open()))
+    assert ev[0] == ["t", "body", "v_before", "v_after"]
+    assert ev[1][1] == "B" and float(ev[1][0]) == pytest.approx(math.sqrt(2 / 9.8), abs=2e-5)
+    assert not list(tmp_path.glob(".*part*"))
+
+
+def test_simulate_exact_solver_flag(tmp_path):
+    out = tmp_path / "x.csv"
+    assert main(["simulate", TEXTBOOK, "--solver", "exact", "--t-end", "0.5", "--dt", "1e-3",
+                 "--every", "1", "-o", str(out)]) == 0
+    rows = list(csv.reader(out.open()))
+    assert len(rows) == 1 + 501
+
+
+def test_run_makes_the_textbook_outputs(tmp_path):
+    assert main(["run", "--out", str(tmp_path), "-q"]) == 0
+    names = {p.name for p in tmp_path.iterdir()}
+    assert {"textbook-1d-positions.png", "textbook-1d-kinetic.png",
+            "textbook-1d-potential.png", "textbook-1d.csv", "textbook-1d-impacts.csv"} <= names
+    for p in tmp_path.glob("*.png"):
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def exit_code(argv: list[str]) -> int:
+    """main's status, whether it returns it or argparse exits with it."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
+
+
+@pytest.mark.parametrize("flags,word", [
+    (["--dt", "0"], "--dt"),
+    (["--dt", "-1e-5"], "--dt"),
+    (["--dt", "abc"], "--dt"),
+    (["--t-end", "nan"], "--t-end"),
+    (["--every", "0"], "--every"),
+    (["--every", "1.5"], "--every"),
+    (["--solver", "rk4"], "rk4"),
+    (["--dt", "20"], "dt"),
+    (["--bogus"], "--bogus"),
+])
+def test_bad_flags_exit_2_with_one_line(tmp_path, capsys, flags, word):
+    out = tmp_path / "o.csv"
+    assert exit_code(["simulate", TEXTBOOK, "-o", str(out), *flags]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err and "Traceback" not in err
+    assert not out.exists()

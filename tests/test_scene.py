@@ -1,0 +1,124 @@
+"""Scene loading: the shipped scenes, every kind of bad input, and dotted overrides."""
+
+from __future__ import annotations
+
+import pytest
+
+from dumbbell import SceneError, load_scene
+from dumbbell.cli import main
+from tests.conftest import SCENES
+
+GOOD = """\
+title = "ok"
+dimensions = 1
+[bodies.A]
+mass = 0.1
+height = 1.2
+[bodies.B]
+mass = 0.1
+height = 1.0
+[spring]
+stiffness = 200.0
+rest_length = 0.2
+[floor]
+elasticity = 1.0
+[gravity]
+g = 9.8
+[run]
+t_end = 0.01
+dt = 1e-5
+"""
+
+#: (what is wrong, replace this, with this, the key the message must name, allowed-text part)
+BAD = [
+    ("unknown key", "[floor]\n", "[floor]\ncolour = 'red'\n", "floor.colour", "allowed"),
+    ("unknown table", "[gravity]\n", "[wind]\nspeed = 1.0\n[gravity]\n", "wind", "allowed"),
+    ("wrong type", "mass = 0.1\nheight = 1.2", "mass = '0.1'\nheight = 1.2", "bodies.A.mass",
+     "finite number"),
+    ("not finite", "stiffness = 200.0", "stiffness = inf", "spring.stiffness", "finite"),
+    ("nan", "g = 9.8", "g = nan", "gravity.g", "finite"),
+    ("mass zero", "mass = 0.1\nheight = 1.0", "mass = 0.0\nheight = 1.0", "bodies.B.mass", "> 0"),
+    ("negative stiffness", "stiffness = 200.0", "stiffness = -1.0", "spring.stiffness", ">= 0"),
+    ("negative rest length", "rest_length = 0.2", "rest_length = -0.2", "spring.rest_length",
+     ">= 0"),
+    ("dt zero", "dt = 1e-5", "dt = 0.0", "run.dt", "> 0"),
+    ("dt above t_end", "dt = 1e-5", "dt = 0.5", "run.dt", "<= run.t_end"),
+    ("below the floor", "height = 1.0", "height = -0.1", "bodies.B.height", ">= 0"),
+    ("A below B", "height = 1.2", "height = 0.9", "bodies.A.height", "bodies.B.height"),
+    ("elasticity above 1", "elasticity = 1.0", "elasticity = 1.5", "floor.elasticity", "<= 1"),
+    ("unknown solver", "dt = 1e-5", "dt = 1e-5\nsolver = 'rk4'", "run.solver", "one of"),
+    ("bad dimensions", 'dimensions = 1', 'dimensions = 3', "dimensions", "<= 2"),
+    ("missing mass", "mass = 0.1\nheight = 1.2", "height = 1.2", "bodies.A.mass", "missing"),
+    ("not TOML", "[run]", "[run", "", "not valid TOML"),
+    ("friction in 1D", "elasticity = 1.0", "elasticity = 1.0\nfriction = 0.3", "floor.friction",
+     "1D"),
+    ("bool as number", "t_end = 0.01", "t_end = true", "run.t_end", "finite number"),
+]
+
+
+def test_shipped_scenes_load():
+    paths = sorted(SCENES.rglob("*.toml"))
+    assert paths, "no scenes shipped"
+    for path in paths:
+        load_scene(path)
+
+
+def test_textbook_scene_holds_the_textbook_values(textbook):
+    s = textbook
+    assert (s.A.mass, s.B.mass, s.spring.stiffness, s.spring.rest_length) == (0.1, 0.1, 200.0, 0.2)
+    assert (s.B.height, s.A.height, s.g, s.run.t_end, s.run.dt) == (1.0, 1.2, 9.8, 10.0, 1e-5)
+    assert s.floor.elasticity == 1.0 and s.run.solver == "euler-cromer"
+
+
+@pytest.mark.parametrize("what,old,new,key,allowed", BAD, ids=[b[0] for b in BAD])
+def test_bad_scene_raises_one_scene_error(tmp_path, what, old, new, key, allowed):
+    assert old in GOOD
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace(old, new, 1))
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    message = str(info.value)
+    assert str(path) in message and key in message and allowed in message
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize("what,old,new,key,allowed", BAD, ids=[b[0] for b in BAD])
+def test_bad_scene_exits_2_with_one_line_and_writes_nothing(tmp_path, capsys, what, old, new,
+                                                            key, allowed):
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace(old, new, 1))
+    out = tmp_path / "out"
+    for argv in (["simulate", str(path), "-o", str(out / "t.csv"), "--events",
+                  str(out / "e.csv")], ["run", str(path), "--out", str(out)]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Traceback" not in err and str(path) in err
+        assert not out.exists()
+
+
+def test_missing_file_is_a_scene_error(tmp_path):
+    with pytest.raises(SceneError, match="no such scene file"):
+        load_scene(tmp_path / "nope.toml")
+
+
+def test_good_scene_loads(tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    scene = load_scene(path)
+    assert scene.floor is not None and scene.spring.stiffness == 200.0
+
+
+def test_left_out_tables_are_not_built(tmp_path):
+    text = GOOD.replace("[floor]\nelasticity = 1.0\n", "").replace("[gravity]\ng = 9.8\n", "")
+    path = tmp_path / "bare.toml"
+    path.write_text(text)
+    scene = load_scene(path)
+    assert scene.floor is None and scene.g == 0.0
+
+
+def test_with_values_revalidates(textbook):
+    stiff = textbook.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})
+    assert stiff.spring.stiffness == 2e4 and stiff.run.dt == 1e-4
+    assert textbook.spring.stiffness == 200.0  # the original is untouched
+    with pytest.raises(SceneError, match="spring.stiffness"):
+        textbook.with_values({"spring.stiffness": -5.0})
