@@ -16,6 +16,7 @@ Where energy can leave the system, ``E_lost = E(0) - E(t)`` so that ``E + E_lost
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -59,16 +60,41 @@ def partition_1d(
     xA: np.ndarray, vA: np.ndarray, xB: np.ndarray, vB: np.ndarray,
 ) -> dict[str, np.ndarray]:
     """1D partition from masses (kg), stiffness (N/m), rest length (m), gravity (m/s^2) and
-    positions/velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J."""
-    M = mA + mB
-    X = (mA * xA + mB * xB) / M
-    V = (mA * vA + mB * vB) / M
-    K_cm = 0.5 * M * V**2
-    K_int = 0.5 * mA * (vA - V) ** 2 + 0.5 * mB * (vB - V) ** 2
-    U_g = M * g * X
-    U_spring = 0.5 * k * (xA - xB - b) ** 2
-    return {"K_cm": K_cm, "K_int": K_int, "U_g": U_g, "U_spring": U_spring,
-            "E": K_cm + K_int + U_g + U_spring}
+    positions/velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J.
+
+    >>> partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *np.array([[1.2], [0.0], [1.0], [0.0]]))["E"]
+    array([2.156])
+    """
+    arrays = [np.ascontiguousarray(np.atleast_1d(a), dtype=np.float64) for a in (xA, vA, xB, vB)]
+    out = np.empty((5, arrays[0].size))
+    _loop_1d()(float(mA), float(mB), float(k), float(b), float(g), *arrays, out)
+    return dict(zip(("K_cm", "K_int", "U_g", "U_spring", "E"), out, strict=True))
+
+
+@functools.cache
+def _loop_1d():
+    """The 1D partition as one compiled pass: a million rows cost milliseconds, not the tenths
+    of a second that two dozen numpy temporaries do. Compiled on first use only."""
+    from numba import njit
+
+    @njit(cache=True, nogil=True)
+    def loop(mA, mB, k, b, g, xA, vA, xB, vB, out):  # pragma: no cover
+        M = mA + mB
+        for i in range(xA.size):
+            X = (mA * xA[i] + mB * xB[i]) / M
+            V = (mA * vA[i] + mB * vB[i]) / M
+            K_cm = 0.5 * M * V * V
+            K_int = 0.5 * mA * (vA[i] - V) ** 2 + 0.5 * mB * (vB[i] - V) ** 2
+            U_g = M * g * X
+            stretch = xA[i] - xB[i] - b
+            U_spring = 0.5 * k * stretch * stretch
+            out[0, i] = K_cm
+            out[1, i] = K_int
+            out[2, i] = U_g
+            out[3, i] = U_spring
+            out[4, i] = K_cm + K_int + U_g + U_spring
+
+    return loop
 
 
 def partition_2d(

@@ -8,7 +8,8 @@ centimetres within 10 s.
 
 Collision rule of the textbook: if a particle is below the floor after a step and was not
 before, its velocity is reversed (scaled by the elasticity); it is not moved. A particle below
-the floor that keeps moving down after that is reported as ``tunnelled``.
+the floor that keeps moving down after that is reported as ``tunnelled``, or as ``failed`` when
+it is only resting on the floor, which the flip rule cannot hold.
 
 Only every ``every``-th step is kept, so memory follows the samples, not the steps.
 """
@@ -23,7 +24,7 @@ from numba import njit
 from ..scene import Scene
 from ..trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
-from .verdicts import energy_verdict, nonfinite_reason
+from .verdicts import below_floor_verdict, energy_verdict, nonfinite_reason
 
 NAME = "euler-cromer"
 
@@ -44,6 +45,8 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
     vB = st[3]
     n_ev = 0
     status = _OK
+    # A countdown to the next kept step: an integer modulo every step costs more than the step.
+    until_sample = every - i % every
     while i < i_stop:
         xA_old = xA
         xB_old = xB
@@ -78,12 +81,14 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
                 status = _TUNNEL_A
         if not (abs(xA) < _BIG and abs(vA) < _BIG and abs(xB) < _BIG and abs(vB) < _BIG):
             status = _BLOWUP
-        if i % every == 0:
+        until_sample -= 1
+        if until_sample == 0:
+            until_sample = every
             j = i // every
-            out[j, 0] = xA
-            out[j, 1] = vA
-            out[j, 2] = xB
-            out[j, 3] = vB
+            out[0, j] = xA
+            out[1, j] = vA
+            out[2, j] = xB
+            out[3, j] = vB
         if status != _OK or n_ev >= ev.shape[0] - 2:
             break
     st[0] = xA
@@ -108,12 +113,16 @@ def _kernel_args(scene: Scene) -> tuple[float, float, float, float, float, float
 
 
 def warm_up() -> float:
-    """Compile (or load from numba's cache) the loop; returns the seconds it took."""
+    """Compile (or load from numba's cache) the loop and the 1D energy partition; returns the
+    seconds it took."""
+    from ..energy import partition_1d
+
     t0 = time.perf_counter()
     st = np.array([1.2, 0.0, 1.0, 0.0])
-    out = np.empty((2, 4))
+    out = np.empty((4, 2))
     ev = np.empty((_EVENT_BUFFER, 4))
     _advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, out, ev)
+    partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *out)
     return time.perf_counter() - t0
 
 
@@ -123,9 +132,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 
     mA, mB, k, b, g, e, floor = _kernel_args(scene)
     dt, every, n = options.dt, options.every, options.n_steps
-    out = np.empty((options.n_samples, 4))
+    # One contiguous row per column, so the Trajectory's columns are views, not copies.
+    out = np.empty((4, options.n_samples))
     st = np.array([scene.A.height, scene.A.vy, scene.B.height, scene.B.vy], dtype=np.float64)
-    out[0] = st
+    out[:, 0] = st
     ev = np.empty((_EVENT_BUFFER, 4))
     events: list[Impact] = []
     status, i = _OK, 0
@@ -146,7 +156,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     kept = i // every + 1
     traj = Trajectory(
         scene=scene, solver=NAME, t=options.sample_times(kept),
-        state={name: out[:kept, c] for c, name in enumerate(("xA", "vA", "xB", "vB"))},
+        state={name: out[c, :kept] for c, name in enumerate(("xA", "vA", "xB", "vB"))},
         events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
     )
     if status == _BLOWUP:
@@ -155,11 +165,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         _drop_nonfinite(traj)
     elif status in (_TUNNEL_A, _TUNNEL_B):
         body = "A" if status == _TUNNEL_A else "B"
-        traj.verdict = Verdict(
-            "tunnelled", i * dt,
-            f"{body} is below the floor (x = {st[0 if body == 'A' else 2]:.3g} m) and still "
-            "moving down: the velocity flip came too late to stop it",
-        )
+        c = 0 if body == "A" else 2
+        m = mA if body == "A" else mB
+        accel = g + abs(k * (st[0] - st[2] - b)) / m
+        traj.verdict = below_floor_verdict(traj, i * dt, body, st[c], st[c + 1], accel, dt)
     else:
         traj.verdict = energy_verdict(traj, dt)
     return traj
