@@ -31,7 +31,7 @@ def listing_as_printed(time_end: float = 10.0, dt: float = 0.00001) -> tuple[np.
     b = 0.2
     h0 = 1.0
     g = 9.8
-    n = int(round(time_end / dt))
+    n = round(time_end / dt)
     t = zeros(n, float)
     xA = zeros(n, float)
     vA = zeros(n, float)
@@ -116,8 +116,8 @@ def main() -> None:
 
     ec_min, ec_med, traj = timed(ours, args.repeat)
     sh_min, sh_med, _ = timed(shipped, args.repeat)
-    rows.append(("dumbbell.simulate(textbook scene), 1e6 steps, 1e4 samples (every=100), "
-                 "with energies", f"{sh_min * 1e3:.1f} ms (median {sh_med * 1e3:.1f} ms)"))
+    rows.append((("dumbbell.simulate(textbook scene), 1e6 steps, 1e4 samples (every=100), "
+                 "with energies"), f"{sh_min * 1e3:.1f} ms (median {sh_med * 1e3:.1f} ms)"))
     rows.append(("dumbbell.simulate, 1e6 steps, all 1e6 samples (every=1), with energies",
                  f"{ec_min * 1e3:.1f} ms (median {ec_med * 1e3:.1f} ms)"))
     if not args.skip_listing:

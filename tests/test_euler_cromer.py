@@ -15,7 +15,7 @@ def textbook_listing(t_end: float, dt: float = 1e-5) -> tuple[np.ndarray, ...]:
     """The listing of section 13.5.1 transcribed to plain Python, typos fixed (vA[0], not
     vA[1]), the same operations in the same order."""
     m, k, b, h0, g = 0.1, 200.0, 0.2, 1.0, 9.8
-    n = int(round(t_end / dt)) + 1
+    n = round(t_end / dt) + 1
     xA, vA, xB, vB = [0.0] * n, [0.0] * n, [0.0] * n, [0.0] * n
     xA[0] = h0 + b
     xB[0] = h0
@@ -75,7 +75,7 @@ def test_converges_to_the_exact_solution_over_one_second(textbook):
     exact = simulate(textbook, "exact", t_end=1.0, dt=1e-5, every=100)
     errors = []
     for dt in (1e-3, 1e-4, 1e-5):
-        every = int(round(1e-3 / dt))
+        every = round(1e-3 / dt)
         ec = simulate(textbook, "euler-cromer", t_end=1.0, dt=dt, every=every)
         assert np.allclose(ec.t, exact.t)
         errors.append(max(np.abs(ec[c] - exact[c]).max() for c in ("xA", "xB")))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -45,7 +46,7 @@ def test_centre_of_mass_falls_on_a_parabola_between_impacts(textbook):
     # Between later impacts: a least-squares parabola fits to rounding, with curvature -g/2.
     times = [e.t for e in traj.events]
     checked = 0
-    for t0, t1 in zip(times, times[1:]):
+    for t0, t1 in itertools.pairwise(times):
         m = (traj.t > t0) & (traj.t < t1)
         if m.sum() < 50:
             continue

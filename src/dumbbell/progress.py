@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Any
+from typing import Any, Self
 
 
 def progress_wanted(quiet: bool = False) -> bool:
@@ -28,10 +28,10 @@ class _NoBar:
     def close(self) -> None:
         pass
 
-    def __enter__(self) -> _NoBar:
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         pass
 
 

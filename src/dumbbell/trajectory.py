@@ -122,8 +122,7 @@ class Trajectory:
 
         with atomic_output(path) as tmp, open(tmp, "w") as fh:
             fh.write("t,body,v_before,v_after\n")
-            for ev in self.events:
-                fh.write(f"{ev.t!r},{ev.body},{ev.v_before!r},{ev.v_after!r}\n")
+            fh.writelines(f"{e.t!r},{e.body},{e.v_before!r},{e.v_after!r}\n" for e in self.events)
         return Path(path)
 
     def first_impact(self, body: str | None = None) -> Impact | None:
