@@ -1,0 +1,347 @@
+"""Comparing solvers on one scene against the most accurate solution available.
+
+The truth is the ``exact`` solution in 1D and the ``reference`` (DOP853 at 1e-12) in 2D; a
+scene with friction has neither, so there the truth is pymunk at a ten times smaller step (the
+report says so). Each other run is measured against it:
+
+- impact times side by side, matched in order, with their differences;
+- the largest position error of either particle over a window (default 2 s): the motion is
+  chaotic, so later errors say nothing about the method (PHYSICS.md section 1), and the time
+  at which the error first passes 1 mm;
+- the energy spread over the whole run, ``(max E - min E) / |E(0)|``;
+- the run time.
+
+>>> result = compare(load_scene("scenes/textbook-1d.toml"))       # doctest: +SKIP
+>>> print(result.table())                                          # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import UsageError
+from .scene import Scene
+from .trajectory import Trajectory
+
+#: Default window (s) for position errors.
+WINDOW = 2.0
+#: Position error (m) whose first passing is reported as the divergence time.
+DIVERGED = 1e-3
+
+
+def position_columns(scene: Scene) -> list[str]:
+    """The position columns of a scene (m)."""
+    return ["xA", "xB"] if scene.dimensions == 1 else ["xA", "yA", "xB", "yB"]
+
+
+def position_error(run: Trajectory, truth: Trajectory) -> np.ndarray:
+    """Largest |position difference| of either particle at each common sample (m)."""
+    n = min(len(run.t), len(truth.t))
+    return np.max([np.abs(run[c][:n] - truth[c][:n]) for c in position_columns(run.scene)],
+                  axis=0)
+
+
+def energy_spread(traj: Trajectory) -> float:
+    """(max E - min E) / |E(0)| over the whole run (dimensionless)."""
+    E = traj["E"]
+    if not len(E):
+        return math.nan
+    scale = abs(float(E[0])) or 1.0
+    return float((np.max(E) - np.min(E)) / scale)
+
+
+@dataclass
+class Row:
+    """One compared run: its trajectory and the measures against the truth."""
+
+    label: str
+    traj: Trajectory
+    error: np.ndarray
+    window_error: float
+    diverged_at: float | None
+    spread: float
+
+
+@dataclass
+class Comparison:
+    """The truth, the compared runs and the window (s) of the position errors."""
+
+    scene: Scene
+    truth: Trajectory
+    truth_note: str
+    rows: list[Row]
+    window: float
+    notes: list[str] = field(default_factory=list)
+
+    def table(self) -> str:
+        """The summary as a fixed-width text table."""
+        head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'steps/s':>10}"
+                f"{'max |dx| [m]':>14}{'|dx|>1mm at':>13}{'E spread':>11}{'impacts':>9}"
+                "  verdict")
+        lines = [f"{self.scene.title}  ({self.scene.source})",
+                 f"truth: {self.truth_note}",
+                 f"position error: largest of either particle over [0, {self.window:g}] s "
+                 "(chaotic motion: later errors do not measure the method)",
+                 "", head, "-" * len(head)]
+        for row in [None, *self.rows]:
+            r = self.truth if row is None else row.traj
+            steps = r.info.get("steps")
+            rate = f"{steps / r.wall_time:.3g}" if steps and r.wall_time > 0 else "-"
+            dt = f"{r.dt:g}" if r.dt and r.solver not in ("exact", "reference") else "-"
+            err = "(truth)" if row is None else f"{row.window_error:.3g}"
+            div = "-" if row is None or row.diverged_at is None else f"{row.diverged_at:.3g} s"
+            spread = energy_spread(r)
+            lines.append(
+                f"{(r.solver if row is None else row.label):<26}{dt:>9}{r.wall_time:>14.3g}"
+                f"{rate:>10}{err:>14}{div:>13}{spread:>11.2e}{len(r.events):>9}  {r.verdict}")
+        lines += ["", *self.impact_lines(), *self.notes]
+        return "\n".join(lines)
+
+    def impacts(self) -> list[dict[str, object]]:
+        """Impacts matched in order: truth time and body, then each run's time and its
+        difference from the truth (s)."""
+        out = []
+        for i, ev in enumerate(self.truth.events):
+            rec: dict[str, object] = {"n": i + 1, "body": ev.body, "truth_t": ev.t}
+            for row in self.rows:
+                other = row.traj.events[i] if i < len(row.traj.events) else None
+                same = other is not None and other.body == ev.body
+                rec[f"{row.label}_t"] = other.t if other else math.nan
+                rec[f"{row.label}_diff"] = other.t - ev.t if same else math.nan
+            out.append(rec)
+        return out
+
+    def impact_lines(self) -> list[str]:
+        """The impacts inside the window as text (differences in ms; '?' where the bodies
+        no longer match: the runs have parted)."""
+        head = f"{'impact':>6} {'body':>4} {'truth t [s]':>12}" + "".join(
+            f"{row.label[:22]:>24}" for row in self.rows)
+        lines = [f"impacts in [0, {self.window:g}] s: time, and difference from the truth",
+                 head]
+        for rec in self.impacts():
+            if rec["truth_t"] > self.window:  # type: ignore[operator]
+                break
+            cells = ""
+            for row in self.rows:
+                t, d = rec[f"{row.label}_t"], rec[f"{row.label}_diff"]
+                text = ("-" if math.isnan(t) else (f"{t:.5f} ({d * 1e3:+.3f} ms)"  # type: ignore
+                        if not math.isnan(d) else f"{t:.5f} (?)"))  # type: ignore[arg-type]
+                cells += f"{text:>24}"
+            lines.append(f"{rec['n']:>6} {rec['body']:>4} {rec['truth_t']:>12.6f}{cells}")
+        return lines
+
+
+def truth_solver(scene: Scene) -> str | None:
+    """The most accurate solver for ``scene``: exact (1D), reference (2D frictionless), or
+    None when there is none (friction)."""
+    from .solvers import solver_module
+
+    name = "exact" if scene.dimensions == 1 else "reference"
+    return name if solver_module(name).supports(scene) is None else None
+
+
+def default_solvers(scene: Scene) -> list[str]:
+    """The engine, and the hand-written method that shares its step order or the textbook's."""
+    from .solvers import solver_module
+
+    names = ["pymunk", "euler-cromer" if scene.dimensions == 1 else "euler-cromer-2d"]
+    return [n for n in names if solver_module(n).supports(scene) is None]
+
+
+def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | None = None,
+            window: float = WINDOW, t_end: float | None = None, quiet: bool = True
+            ) -> Comparison:
+    """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
+    the scene's) and the truth, sampled at the same times, and measure them. Raises
+    UsageError before running anything if a solver cannot run the scene."""
+    from .solvers import make_options, simulate, solver_module
+
+    solvers = solvers or default_solvers(scene)
+    dts = dts or [scene.run.dt]
+    t_end = scene.run.t_end if t_end is None else t_end
+    for name in solvers:
+        reason = solver_module(name).supports(scene)
+        if reason is not None:
+            raise UsageError(f"--solvers: {name!r} cannot run {scene.source}: {reason}")
+    if not (window > 0 and math.isfinite(window)):
+        raise UsageError(f"--window = {window!r}: must be a finite number > 0 (s)")
+    # One sample spacing for every run, so that they compare point by point.
+    spacing = max(max(dts), scene.run.dt * scene.run.every)
+    for dt in dts:
+        make_options(scene, dt, t_end)  # validates dt against t_end
+        ratio = spacing / dt
+        if abs(ratio - round(ratio)) > 1e-6 * ratio:
+            raise UsageError(f"--dt {dt:g}: must divide the sample spacing {spacing:g} s "
+                             "(the largest dt, or the scene's dt * every) a whole number of times")
+    truth_name = truth_solver(scene)
+    notes = []
+    if truth_name is None:
+        truth_dt = min(dts) / 10
+        truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
+                         every=int(round(spacing / truth_dt)), quiet=quiet)
+        truth_note = (f"pymunk at dt = {truth_dt:g} s (friction: no exact or reference "
+                      "solution exists, so errors are against a ten times smaller step)")
+    else:
+        truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
+        truth_note = truth_name
+        est = truth.info.get("estimated_error")
+        if est:
+            truth_note += (f" (DOP853, rtol 1e-12; its own estimated error: "
+                           f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
+                           f"energy {est['energy_relative']:.1e})")
+        elif truth_name == "exact":
+            truth_note += " (piecewise analytic; impacts located to 1e-14 s)"
+    rows = []
+    for name in solvers:
+        for dt in dts:
+            run = simulate(scene, name, dt=dt, t_end=t_end, every=int(round(spacing / dt)),
+                           quiet=quiet)
+            err = position_error(run, truth)
+            inside = run.t[: len(err)] <= window + 1e-12
+            over = np.flatnonzero(err > DIVERGED)
+            label = name if len(dts) == 1 else f"{name} dt={dt:g}"
+            rows.append(Row(label, run, err, float(err[inside].max()) if inside.any()
+                            else math.nan, float(run.t[over[0]]) if over.size else None,
+                            energy_spread(run)))
+    if t_end < window:
+        notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
+    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
+
+
+def write(result: Comparison, out: Path) -> list[Path]:
+    """Write the summary CSV, the impacts CSV, the error series CSV and three PNG figures
+    into ``out``; returns the paths."""
+    from .files import atomic_output
+
+    stem = result.scene.name
+    paths = []
+    summary = out / f"{stem}-compare.csv"
+    with atomic_output(summary) as tmp, open(tmp, "w") as fh:
+        fh.write("solver,dt,run_time_s,steps,max_position_error_m,window_s,"
+                 "error_passes_1mm_at_s,energy_spread,impacts,verdict\n")
+        for row in [None, *result.rows]:
+            r = result.truth if row is None else row.traj
+            fh.write(",".join(str(v) for v in (
+                r.solver if row is None else row.label, r.dt if r.dt else "",
+                f"{r.wall_time:.6g}", r.info.get("steps", ""),
+                "" if row is None else repr(row.window_error), result.window,
+                "" if row is None or row.diverged_at is None else repr(row.diverged_at),
+                repr(energy_spread(r)), len(r.events), r.verdict.status)) + "\n")
+    paths.append(summary)
+    impacts = out / f"{stem}-compare-impacts.csv"
+    recs = result.impacts()
+    keys = ["n", "body", "truth_t"] + [k for row in result.rows
+                                       for k in (f"{row.label}_t", f"{row.label}_diff")]
+    with atomic_output(impacts) as tmp, open(tmp, "w") as fh:
+        fh.write(",".join(keys) + "\n")
+        for rec in recs:
+            fh.write(",".join(repr(rec[k]) if isinstance(rec[k], float) else str(rec[k])
+                              for k in keys) + "\n")
+    paths.append(impacts)
+    errors = out / f"{stem}-compare-errors.csv"
+    n = min(len(row.error) for row in result.rows) if result.rows else 0
+    table = np.column_stack([result.truth.t[:n], *[row.error[:n] for row in result.rows]])
+    with atomic_output(errors) as tmp:
+        np.savetxt(tmp, table, delimiter=",", comments="", fmt="%.17g",
+                   header=",".join(["t"] + [f"{row.label}_position_error_m"
+                                            for row in result.rows]))
+    paths.append(errors)
+    paths += figures(result, out)
+    return paths
+
+
+_STYLES = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"]
+#: Line styles by row: runs that agree to rounding (pymunk and euler-cromer-2d) stay visible.
+_DASHES = ["-", (0, (4, 3)), (0, (1, 2)), "-.", "-", (0, (4, 3)), (0, (1, 2))]
+
+
+def figures(result: Comparison, out: Path) -> list[Path]:
+    """Positions overlaid, position error against time (log), and E(t) per solver (PNG)."""
+    from .figures import _pyplot
+    from .files import atomic_output
+
+    plt = _pyplot()
+    scene = result.scene
+    stem = scene.name
+    key = "x" if scene.dimensions == 1 else "y"
+    truth = result.truth
+    shown = min(float(truth.t[-1]), 2.0 * result.window)
+    paths = []
+
+    def save(fig, name: str) -> Path:
+        fig.tight_layout()
+        path = out / f"{stem}-compare-{name}.png"
+        with atomic_output(path) as tmp:
+            fig.savefig(tmp, dpi=110)
+        plt.close(fig)
+        return path
+
+    fig, axes = plt.subplots(2, 1, figsize=(10, 6.4), sharex=True)
+    for ax, body in zip(axes, "AB", strict=True):
+        m = truth.t <= shown + 1e-12
+        ax.plot(truth.t[m], truth[f"{key}{body}"][m], color="black", lw=2.4, alpha=0.35,
+                label=f"{truth.solver} (truth)")
+        for colour, row in zip(_STYLES, result.rows, strict=False):
+            r = row.traj
+            mm = r.t <= shown + 1e-12
+            ax.plot(r.t[mm], r[f"{key}{body}"][mm], color=colour, lw=1.1, label=row.label,
+                    ls=_DASHES[result.rows.index(row) % len(_DASHES)])
+        ax.axvspan(result.window, max(shown, result.window), color="0.93", zorder=0)
+        ax.set_ylabel(f"{key}_{body} [m]")
+        ax.set_title(f"particle {body} ({'top' if body == 'A' else 'bottom'})", fontsize=9)
+        ax.grid(True, color="0.9", lw=0.6)
+        ax.legend(loc="upper right", fontsize=8)
+    axes[0].text(result.window, 1.0, "  after the window: the runs part (chaos)",
+                 transform=axes[0].get_xaxis_transform(), va="top", fontsize=8, color="0.4")
+    axes[-1].set_xlabel("t [s]")
+    axes[-1].set_xlim(0, shown)
+    fig.suptitle(f"{scene.title}: heights, each solver over the truth", fontsize=10)
+    paths.append(save(fig, "positions"))
+
+    fig, ax = plt.subplots(figsize=(10, 4.6))
+    for colour, row in zip(_STYLES, result.rows, strict=False):
+        t = row.traj.t[: len(row.error)]
+        ax.semilogy(t, np.maximum(row.error, 1e-17), color=colour, lw=1.1,
+                    ls=_DASHES[result.rows.index(row) % len(_DASHES)],
+                    label=f"{row.label}: {row.window_error:.2g} m max in [0, {result.window:g}] s")
+    ax.axvline(result.window, color="0.4", ls="--", lw=0.8)
+    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8)
+    ax.text(0.002, DIVERGED, " 1 mm", va="bottom", fontsize=8, color="0.4",
+            transform=ax.get_yaxis_transform())
+    for ev in truth.events:
+        ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0)
+    positive = np.concatenate([row.error[row.error > 0] for row in result.rows] or [[1.0]])
+    if positive.size:
+        ax.set_ylim(bottom=max(1e-16, float(np.percentile(positive, 1)) / 10))
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("largest |position error| [m]")
+    ax.set_xlim(0, float(truth.t[-1]))
+    ax.grid(True, which="major", color="0.9", lw=0.6)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"{scene.title}: position error against {truth.solver} (grey lines: its "
+                 f"impacts; dashed: the {result.window:g} s window)", fontsize=9)
+    paths.append(save(fig, "error"))
+
+    fig, ax = plt.subplots(figsize=(10, 4.6))
+    E0 = float(truth["E"][0]) or 1.0
+    for colour, row in zip(_STYLES, result.rows, strict=False):
+        r = row.traj
+        ax.plot(r.t, r["E"] / E0 - 1.0, color=colour, lw=1.0,
+                ls=_DASHES[result.rows.index(row) % len(_DASHES)],
+                label=f"{row.label}: spread {row.spread:.2e}")
+    ax.plot(truth.t, truth["E"] / E0 - 1.0, color="black", lw=1.2,
+            label=f"{truth.solver}: spread {energy_spread(truth):.1e}")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("E(t) / E(0) - 1")
+    ax.set_xlim(0, float(truth.t[-1]))
+    ax.grid(True, color="0.9", lw=0.6)
+    ax.legend(loc="lower left", fontsize=8)
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+    ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
+                 fontsize=9)
+    paths.append(save(fig, "energy"))
+    return paths

@@ -1,0 +1,313 @@
+"""``pymunk``: the scene in the pymunk physics engine (Munk2D, a Chipmunk2D fork).
+
+What gets built is only what the scene declares:
+
+- one dynamic body per particle, carrying a ``Circle`` of the particle's radius; a rigid
+  dumbbell (``[rigid]``) is instead ONE body carrying both circles, its centre of gravity at the
+  centre of mass and its moment ``mu L^2`` (plus the circles' own ``1/2 m r^2`` when spin is on);
+- ``[spring]``: a ``DampedSpring`` between the centres, damping 0, ``collide_bodies = False``;
+- ``[floor]``: a static box whose top is at ``y = -r``, so that a circle of radius r touches it
+  exactly when its centre is at height 0, where the point particle of the other solvers meets
+  the floor (circles of different radii get one box each, filtered to their own circle). A box,
+  not a ``Segment``: a circle-segment contact normal is computed from the closest point on the
+  segment, which a long segment (needed: the dumbbell may travel far) rounds to about
+  ``length * 1e-16``, so every bounce gave a spurious sideways kick (measured: 6e-13 m/s with a
+  2e6 m segment). The box's top edge gives the normal (0, 1) exactly;
+- ``[gravity]``: ``space.gravity = (0, -g)``.
+
+1D scenes run on the vertical line x = 0 and return the 1D columns (xA, vA, xB, vB: vertical).
+
+Settings (each overridable in a scene's ``[pymunk]`` table), chosen for SI units:
+
+- ``collision_bias = 1.0``: no position correction. pymunk's default (0.0018, tuned for pixel
+  units) pushes an overlapping circle out with an extra velocity, which adds energy each impact;
+  with the correction off an elastic impact only reverses the normal velocity, as the
+  textbook's flip does, and the circle leaves the floor on its own.
+- ``collision_slop = 1e-4`` m: the overlap tolerated before the correction acts (only matters
+  when ``collision_bias`` < 1). pymunk's default 0.1 is 10 cm, five radii of a particle.
+- ``iterations = 10`` (pymunk's default): contact impulses converge in one pass for one contact
+  per body; the spring is an explicit impulse that iterations do not touch.
+- ``spin = false``: the circles get an infinite moment, so they are the point particles of the
+  textbook (no K_spin). With ``spin = true`` each circle (or the rigid body) gets its disc
+  moment and friction can make it spin; the state then holds ``omegaA``/``omegaB`` (rad/s).
+
+Elasticity 1.0 is set on the circles and the scene's elasticity on the floor (pymunk multiplies
+them); friction 1.0 on the circles and the scene's friction on the floor (also multiplied).
+
+Only every ``every``-th step is read back from the engine (reading costs about as much as a
+step); impacts come from collision callbacks, so the inner loop is a bare ``Space.step`` loop.
+Verdicts: a non-finite or blown-up state is ``unstable``; a particle whose centre is more than
+its radius below the floor and still moving down (pymunk finds contacts only once shapes
+overlap, so a step that carries a circle deep into the floor box lets it through) is
+``tunnelled``: the run stops there, keeping the samples up to it. Otherwise the energy verdict.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..energy import disc_inertia, spins, state_columns
+from ..scene import Scene
+from ..trajectory import Impact, Trajectory, Verdict
+from . import RunOptions
+from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
+
+NAME = "pymunk"
+
+#: Defaults of the ``[pymunk]`` table (SI units): see the module docstring for the reasons.
+DEFAULT_SLOP = 1e-4
+DEFAULT_BIAS = 1.0
+DEFAULT_ITERATIONS = 10
+DEFAULT_SPIN = False
+#: A position or velocity beyond this (m, m/s) counts as blown up.
+_BIG = 1e12
+#: Steps between progress-bar updates.
+_CHUNK = 200_000
+#: Half-width and thickness of the floor box (m): wider than anything a scene can reach.
+_FLOOR_HALF_WIDTH = 1e6
+_FLOOR_THICKNESS = 1.0
+_FLOOR_TYPE = 1
+_PARTICLE_TYPE = {"A": 2, "B": 3}
+
+
+def settings(scene: Scene) -> dict[str, Any]:
+    """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else defaults."""
+    pm = scene.pymunk
+    return {
+        "collision_slop": DEFAULT_SLOP if pm.collision_slop is None else pm.collision_slop,
+        "collision_bias": DEFAULT_BIAS if pm.collision_bias is None else pm.collision_bias,
+        "iterations": DEFAULT_ITERATIONS if pm.iterations is None else pm.iterations,
+        "spin": DEFAULT_SPIN if pm.spin is None else pm.spin,
+    }
+
+
+def supports(scene: Scene) -> str | None:
+    """None: pymunk runs every scene (1D on the line x = 0, 2D, rigid, friction, spin)."""
+    return None
+
+
+@dataclass
+class World:
+    """A built pymunk space and handles to what the solver reads back.
+
+    ``points`` maps particle name to (body, shape, offset of the circle from the body's centre
+    of gravity in body coordinates, m)."""
+
+    space: Any
+    points: dict[str, tuple[Any, Any, tuple[float, float]]]
+    spring: Any = None
+    floors: list[Any] = field(default_factory=list)
+    rigid_body: Any = None
+
+
+def build(scene: Scene) -> World:
+    """Build the pymunk space of ``scene`` (see the module docstring)."""
+    import pymunk
+
+    cfg = settings(scene)
+    space = pymunk.Space()
+    space.gravity = (0.0, -scene.g)
+    space.collision_slop = cfg["collision_slop"]
+    space.collision_bias = cfg["collision_bias"]
+    space.iterations = cfg["iterations"]
+    A, B = scene.A, scene.B
+    points: dict[str, tuple[Any, Any, tuple[float, float]]] = {}
+    world = World(space, points)
+
+    def circle(body: Any, p: Any, offset: tuple[float, float]) -> Any:
+        shape = pymunk.Circle(body, p.radius, offset)
+        shape.elasticity = 1.0
+        shape.friction = 1.0
+        shape.collision_type = _PARTICLE_TYPE[p.name]
+        points[p.name] = (body, shape, offset)
+        return shape
+
+    if scene.rigid is not None:
+        M = scene.M
+        R = ((A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M)
+        moment = scene.mu * scene.rigid.length**2
+        if cfg["spin"]:
+            moment += disc_inertia(A.mass, A.radius) + disc_inertia(B.mass, B.radius)
+        body = pymunk.Body(M, moment)
+        body.position = R
+        # One body: its velocity and spin follow from the particles' (consistent) velocities.
+        V = ((A.mass * A.vx + B.mass * B.vx) / M, (A.mass * A.vy + B.mass * B.vy) / M)
+        d = (A.x - B.x, A.height - B.height)
+        w = (A.vx - B.vx, A.vy - B.vy)
+        body.velocity = V
+        body.angular_velocity = (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)
+        shapes = [circle(body, p, (p.x - R[0], p.height - R[1])) for p in (A, B)]
+        space.add(body, *shapes)
+        world.rigid_body = body
+    else:
+        for p in (A, B):
+            moment = disc_inertia(p.mass, p.radius) if cfg["spin"] else math.inf
+            body = pymunk.Body(p.mass, moment)
+            body.position = (p.x, p.height)
+            body.velocity = (p.vx, p.vy)
+            if cfg["spin"]:
+                body.angular_velocity = p.spin
+            space.add(body, circle(body, p, (0.0, 0.0)))
+        if scene.spring is not None:
+            bA, bB = points["A"][0], points["B"][0]
+            spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0),
+                                         scene.spring.rest_length, scene.spring.stiffness, 0.0)
+            spring.collide_bodies = False
+            space.add(spring)
+            world.spring = spring
+
+    if scene.floor is not None:
+        radii = sorted({A.radius, B.radius})
+        for bit, r in enumerate(radii):
+            W, T = _FLOOR_HALF_WIDTH, _FLOOR_THICKNESS
+            box = pymunk.Poly(space.static_body, [(-W, -r - T), (W, -r - T), (W, -r), (-W, -r)])
+            box.elasticity = scene.floor.elasticity
+            box.friction = scene.floor.friction
+            box.collision_type = _FLOOR_TYPE
+            if len(radii) > 1:
+                # Each particle meets only the box placed for its own radius.
+                box.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
+                for p in (A, B):
+                    if p.radius == r:
+                        shape = points[p.name][1]
+                        shape.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
+            space.add(box)
+            world.floors.append(box)
+    return world
+
+
+def _reader(scene: Scene, world: World) -> Any:
+    """A function returning the state row (state_columns order, then spins) of the world."""
+    (bA, sA, _), (bB, sB, _) = world.points["A"], world.points["B"]
+    spin = spins(scene)
+    if world.rigid_body is not None:
+        body = world.rigid_body
+        offA, offB = world.points["A"][2], world.points["B"][2]
+
+        def read2() -> tuple[float, ...]:
+            pA = body.local_to_world(offA)
+            pB = body.local_to_world(offB)
+            vA = body.velocity_at_world_point(pA)
+            vB = body.velocity_at_world_point(pB)
+            w = body.angular_velocity
+            return (pA[0], pA[1], vA[0], vA[1], pB[0], pB[1], vB[0], vB[1], w)
+        return read2
+    if scene.dimensions == 1:
+        def read1() -> tuple[float, ...]:
+            return (bA.position[1], bA.velocity[1], bB.position[1], bB.velocity[1])
+        return read1
+    if spin:
+        def read_spin() -> tuple[float, ...]:
+            pA, vA, pB, vB = bA.position, bA.velocity, bB.position, bB.velocity
+            return (pA[0], pA[1], vA[0], vA[1], pB[0], pB[1], vB[0], vB[1],
+                    bA.angular_velocity, bB.angular_velocity)
+        return read_spin
+
+    def read() -> tuple[float, ...]:
+        pA, vA, pB, vB = bA.position, bA.velocity, bB.position, bB.velocity
+        return (pA[0], pA[1], vA[0], vA[1], pB[0], pB[1], vB[0], vB[1])
+    return read
+
+
+def _extra_columns(scene: Scene, world: World) -> list[str]:
+    if world.rigid_body is not None:
+        return ["omega"]
+    return ["omegaA", "omegaB"] if spins(scene) else []
+
+
+def _vertical_velocity(body: Any, shape: Any) -> float:
+    return float(body.velocity_at_world_point(body.local_to_world(shape.offset))[1])
+
+
+def solve(scene: Scene, options: RunOptions) -> Trajectory:
+    """Run ``scene`` in pymunk at step ``options.dt`` (s). See the module docstring."""
+    from ..progress import bar
+
+    world = build(scene)
+    space = world.space
+    dt, every, n = options.dt, options.every, options.n_steps
+    read = _reader(scene, world)
+    names = state_columns(scene) + _extra_columns(scene, world)
+    out = np.empty((options.n_samples, len(names)))
+    out[0] = read()
+    if world.rigid_body is not None and spins(scene):
+        names += ["omegaA", "omegaB"]
+
+    events: list[Impact] = []
+    pending: dict[str, list[float]] = {}
+    i = 0  # step index; the callbacks read it (a closure cell), so the loop pays nothing
+
+    def begin(arbiter: Any, _space: Any, _data: Any) -> None:
+        shape = arbiter.shapes[0]
+        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
+        pending[name] = [(i + 1) * dt, _vertical_velocity(shape.body, shape)]
+
+    def post_solve(arbiter: Any, _space: Any, _data: Any) -> None:
+        shape = arbiter.shapes[0]
+        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
+        hit = pending.pop(name, None)
+        if hit is not None:
+            events.append(Impact(hit[0], name, hit[1], _vertical_velocity(shape.body, shape)))
+
+    if world.floors:
+        for name in "AB":
+            space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=begin,
+                               post_solve=post_solve)
+
+    radius = {"A": scene.A.radius, "B": scene.B.radius}
+    y_col = {name: names.index(f"{'x' if scene.dimensions == 1 else 'y'}{name}")
+             for name in "AB"}
+    vy_col = {name: names.index(f"{'v' if scene.dimensions == 1 else 'vy'}{name}")
+              for name in "AB"}
+    step = space.step
+    verdict: Verdict | None = None
+    j = 0
+    samples_per_chunk = max(1, _CHUNK // every)
+    t0 = time.perf_counter()
+    with bar(n, f"{NAME} {scene.name}", "step", quiet=options.quiet or n < 5 * _CHUNK) as pb:
+        while j < options.n_samples - 1 and verdict is None:
+            j_stop = min(options.n_samples - 1, j + samples_per_chunk)
+            while j < j_stop:
+                for i in range(j * every, (j + 1) * every):  # noqa: B007 (read by callbacks)
+                    step(dt)
+                j += 1
+                row = read()
+                out[j] = row
+                if not all(abs(v) < _BIG for v in row):
+                    verdict = Verdict("unstable", j * every * dt, nonfinite_reason(scene, dt))
+                    j -= 1  # keep only finite samples
+                    break
+                if world.floors:
+                    for name in "AB":
+                        if row[y_col[name]] < -radius[name] and row[vy_col[name]] < 0:
+                            verdict = Verdict("tunnelled", j * every * dt, tunnel_reason(
+                                scene, name, row[y_col[name]], row[vy_col[name]], dt,
+                                depth=radius[name] + _FLOOR_THICKNESS / 2))
+                            break
+                    if verdict is not None:
+                        break
+            pb.update(min(j * every, n) - pb.n)
+        if verdict is None:
+            for i in range(j * every, n):  # noqa: B007 (read by callbacks)
+                step(dt)
+    wall = time.perf_counter() - t0
+
+    kept = j + 1
+    state = {name: out[:kept, c].copy() for c, name in enumerate(names[: out.shape[1]])}
+    if world.rigid_body is not None and spins(scene):
+        state["omegaA"] = state["omegaB"] = state["omega"]
+    cfg = settings(scene)
+    traj = Trajectory(
+        scene=scene, solver=NAME, t=options.sample_times(kept), state=state,
+        events=[e for e in events if verdict is None or e.t <= verdict.t], dt=dt, every=every,
+        wall_time=wall, info={"steps": min(n, kept * every) if verdict else n, **cfg},
+    )
+    if world.rigid_body is not None:
+        traj.info["moment"] = world.rigid_body.moment
+    traj.verdict = verdict if verdict is not None else energy_verdict(traj, dt)
+    return traj

@@ -1,0 +1,293 @@
+"""``reference``: a high-accuracy solution for frictionless scenes, 1D, 2D and rigid.
+
+Between impacts the equations of motion are integrated by scipy's DOP853 (an 8th-order
+Runge-Kutta method with error control) at ``rtol = atol = 1e-12``; an impact is a terminal
+event (a particle's height crossing 0 downwards), located by the integrator's root finder to
+about 1e-15 s. There the velocity is changed as the floor's impulse demands, and the
+integration restarts. Samples come from the integrator's dense output at the sample times.
+
+- particles joined by a spring (or free): state rA, vA, rB, vB; a frictionless floor only
+  reverses the impacting particle's vertical velocity (times the elasticity);
+- rigid dumbbell: state R, V, axis angle theta, angular velocity Omega (counter-clockwise);
+  the floor's vertical impulse J at a particle changes both V and Omega:
+  ``J = -(1 + e) v_y / (1/M + r_x^2 / I)`` with r the particle's offset from the centre of
+  mass and ``I = mu L^2`` (plus the circles' own ``1/2 m r^2`` when ``[pymunk] spin = true``,
+  as in the pymunk solver).
+
+The reference states its own error: unless told not to, it runs a second time at a ten times
+tighter tolerance and puts the largest position difference (over the first 2 s and over the
+whole run), the impact-time difference and its energy error into ``traj.info["estimated_error"]``.
+Over a long run of a chaotic scene the position difference grows like any other; over the
+window it is the honest error bar.
+
+Friction is not handled (a sliding, sticking contact is not a single impulse).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..energy import disc_inertia, relative_energy_error, spins, state_columns
+from ..scene import Scene
+from ..trajectory import Impact, Trajectory, Verdict
+from . import RunOptions
+from .verdicts import energy_verdict
+
+NAME = "reference"
+
+RTOL = 1e-12
+ATOL = 1e-12
+#: The window (s) over which the error estimate is stated separately (chaos: see PHYSICS.md).
+ERROR_WINDOW = 2.0
+#: An impact slower than this (m/s) means the particle has come to rest on the floor.
+REST_SPEED = 1e-9
+MAX_IMPACTS = 100_000
+
+
+def supports(scene: Scene) -> str | None:
+    """None if this solver can run ``scene``, else why not."""
+    if scene.floor is not None and scene.floor.friction > 0:
+        return ("the reference handles frictionless floors only (friction makes a contact "
+                "slide and stick, not a single impulse); compare pymunk at smaller dt instead")
+    return None
+
+
+@dataclass
+class _Model:
+    """The ODE of one scene: initial state, right-hand side, impact event per body, the jump
+    at an impact, and the conversion of states (n, dim) to the solver's columns."""
+
+    y0: list[float]
+    rhs: Callable[[float, np.ndarray], list[float]]
+    height: dict[str, Callable[[np.ndarray], float]]
+    vertical_velocity: Callable[[np.ndarray, str], float]
+    jump: Callable[[np.ndarray, str, float], np.ndarray]
+    columns: Callable[[np.ndarray], dict[str, np.ndarray]]
+
+
+def _particles_model(scene: Scene) -> _Model:
+    A, B = scene.A, scene.B
+    mA, mB, g = A.mass, B.mass, scene.g
+    k = scene.spring.stiffness if scene.spring else 0.0
+    b = scene.spring.rest_length if scene.spring else 0.0
+
+    if scene.dimensions == 1:
+        # The 1D force law keeps its sign when A passes below B, as in the other 1D solvers.
+        def rhs1(_t: float, y: np.ndarray) -> list[float]:
+            f = k * (y[0] - y[2] - b)
+            return [y[1], -f / mA - g, y[3], f / mB - g]
+
+        def jump1(y: np.ndarray, body: str, e: float) -> np.ndarray:
+            y = y.copy()
+            y[1 if body == "A" else 3] *= -e
+            return y
+
+        def columns1(Y: np.ndarray) -> dict[str, np.ndarray]:
+            return {"xA": Y[:, 0], "vA": Y[:, 1], "xB": Y[:, 2], "vB": Y[:, 3]}
+
+        return _Model([A.height, A.vy, B.height, B.vy], rhs1,
+                      {"A": lambda y: y[0], "B": lambda y: y[2]},
+                      lambda y, body: y[1 if body == "A" else 3], jump1, columns1)
+
+    def rhs2(_t: float, y: np.ndarray) -> list[float]:
+        dx, dy = y[0] - y[4], y[1] - y[5]
+        L = math.hypot(dx, dy)
+        s = -k * (L - b) / L if L > 0 else 0.0  # force on A per unit of d
+        return [y[2], y[3], s * dx / mA, s * dy / mA - g,
+                y[6], y[7], -s * dx / mB, -s * dy / mB - g]
+
+    def jump2(y: np.ndarray, body: str, e: float) -> np.ndarray:
+        y = y.copy()
+        y[3 if body == "A" else 7] *= -e
+        return y
+
+    spin = spins(scene)
+
+    def columns2(Y: np.ndarray) -> dict[str, np.ndarray]:
+        cols = {name: Y[:, c] for c, name in enumerate(state_columns(scene))}
+        if spin:  # frictionless: the circles keep their initial spins
+            cols["omegaA"] = np.full(len(Y), A.spin)
+            cols["omegaB"] = np.full(len(Y), B.spin)
+        return cols
+
+    return _Model([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], rhs2,
+                  {"A": lambda y: y[1], "B": lambda y: y[5]},
+                  lambda y, body: y[3 if body == "A" else 7], jump2, columns2)
+
+
+def rigid_moment(scene: Scene) -> float:
+    """Moment of inertia of the rigid dumbbell about its centre of mass (kg m^2): mu L^2, plus
+    the circles' own moments when they may spin (``[pymunk] spin = true``)."""
+    moment = scene.mu * scene.rigid.length**2  # type: ignore[union-attr]
+    if spins(scene):
+        moment += disc_inertia(scene.A.mass, scene.A.radius)
+        moment += disc_inertia(scene.B.mass, scene.B.radius)
+    return moment
+
+
+def _rigid_model(scene: Scene) -> _Model:
+    A, B = scene.A, scene.B
+    M, g, L = scene.M, scene.g, scene.rigid.length  # type: ignore[union-attr]
+    I = rigid_moment(scene)  # noqa: E741
+    cA, cB = B.mass / M, A.mass / M  # rA = R + cA L u, rB = R - cB L u
+    d = (A.x - B.x, A.height - B.height)
+    w = (A.vx - B.vx, A.vy - B.vy)
+    y0 = [(A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M,
+          (A.mass * A.vx + B.mass * B.vx) / M, (A.mass * A.vy + B.mass * B.vy) / M,
+          math.atan2(d[1], d[0]), (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)]
+    arm = {"A": cA * L, "B": -cB * L}
+
+    def rhs(_t: float, y: np.ndarray) -> list[float]:
+        return [y[2], y[3], 0.0, -g, y[5], 0.0]
+
+    def offset(y: np.ndarray, body: str) -> tuple[float, float]:
+        return arm[body] * math.cos(y[4]), arm[body] * math.sin(y[4])
+
+    def vertical_velocity(y: np.ndarray, body: str) -> float:
+        return y[3] + y[5] * offset(y, body)[0]
+
+    def jump(y: np.ndarray, body: str, e: float) -> np.ndarray:
+        rx = offset(y, body)[0]
+        J = -(1.0 + e) * vertical_velocity(y, body) / (1.0 / M + rx * rx / I)
+        y = y.copy()
+        y[3] += J / M
+        y[5] += rx * J / I
+        return y
+
+    def columns(Y: np.ndarray) -> dict[str, np.ndarray]:
+        X, Yc, VX, VY, th, Om = Y.T
+        cos, sin = np.cos(th), np.sin(th)
+        cols: dict[str, np.ndarray] = {}
+        for body in "AB":
+            ox, oy = arm[body] * cos, arm[body] * sin
+            cols.update({f"x{body}": X + ox, f"y{body}": Yc + oy,
+                         f"vx{body}": VX - Om * oy, f"vy{body}": VY + Om * ox})
+        cols = {name: cols[name] for name in state_columns(scene)}
+        cols["omega"] = Om
+        if spins(scene):
+            cols["omegaA"] = cols["omegaB"] = Om
+        return cols
+
+    return _Model(y0, rhs, {body: (lambda y, body=body: y[1] + offset(y, body)[1])
+                            for body in "AB"},
+                  vertical_velocity, jump, columns)
+
+
+def _model(scene: Scene) -> _Model:
+    return _rigid_model(scene) if scene.rigid is not None else _particles_model(scene)
+
+
+def integrate(scene: Scene, times: np.ndarray, t_end: float, rtol: float = RTOL,
+              atol: float = ATOL, pb: object | None = None
+              ) -> tuple[dict[str, np.ndarray], list[Impact], Verdict, int]:
+    """Integrate ``scene`` to ``t_end`` (s) and sample it at ``times`` (s, sorted).
+
+    Returns the columns at the samples reached, the impacts, a verdict, and the number of
+    right-hand-side evaluations."""
+    from scipy.integrate import solve_ivp
+
+    model = _model(scene)
+    if len(times):
+        t_end = max(t_end, float(times[-1]))  # j * every * dt can round past t_end
+    e = scene.floor.elasticity if scene.floor is not None else 1.0
+    bodies = list(model.height) if scene.floor is not None else []
+    events = []
+    for body in bodies:
+        def event(_t: float, y: np.ndarray, body: str = body) -> float:
+            return model.height[body](y)
+        event.terminal = True  # type: ignore[attr-defined]
+        event.direction = -1  # type: ignore[attr-defined]
+        events.append(event)
+
+    y = np.asarray(model.y0, dtype=float)
+    t = 0.0
+    out = np.empty((len(times), len(y)))
+    k = 0
+    impacts: list[Impact] = []
+    verdict = Verdict()
+    nfev = 0
+    while True:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # tolerances near machine precision
+            sol = solve_ivp(model.rhs, (t, t_end), y, method="DOP853", rtol=rtol, atol=atol,
+                            events=events or None, dense_output=True)
+        nfev += sol.nfev
+        if sol.status < 0:
+            verdict = Verdict("failed", float(sol.t[-1]), f"DOP853 failed: {sol.message}")
+            break
+        t_stop = float(sol.t[-1])
+        hi = int(np.searchsorted(times, t_stop, side="right"))
+        if hi > k:
+            out[k:hi] = sol.sol(times[k:hi]).T
+            k = hi
+        if pb is not None:
+            pb.update(t_stop - t)  # type: ignore[attr-defined]
+        if sol.status != 1:
+            break
+        hits = [(float(te[0]), body) for te, body in zip(sol.t_events, bodies, strict=True)
+                if len(te)]
+        t_hit, body = min(hits)
+        y = np.asarray(sol.y_events[bodies.index(body)][0], dtype=float)
+        v_before = float(model.vertical_velocity(y, body))
+        if abs(v_before) < REST_SPEED:
+            verdict = Verdict("failed", t_hit, f"{body} came to rest on the floor (impact speed "
+                              f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
+            break
+        y = model.jump(y, body, e)
+        impacts.append(Impact(t_hit, body, v_before, float(model.vertical_velocity(y, body))))
+        t = t_hit
+        if len(impacts) >= MAX_IMPACTS:
+            verdict = Verdict("failed", t, f"more than {MAX_IMPACTS} impacts")
+            break
+        if t >= t_end:
+            break
+    return model.columns(out[:k]), impacts, verdict, nfev
+
+
+def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Trajectory:
+    """Integrate ``scene`` and sample at ``i * every * dt`` (s); ``dt`` sets only the sample
+    times. With ``estimate_error`` a second run at 10x tighter tolerance measures the error."""
+    from ..progress import bar
+
+    times = options.sample_times()
+    t0 = time.perf_counter()
+    with bar(options.t_end, f"{NAME} {scene.name}", "s", quiet=options.quiet) as pb:
+        cols, impacts, verdict, nfev = integrate(scene, times, options.t_end, pb=pb)
+    wall = time.perf_counter() - t0
+    n = len(next(iter(cols.values())))
+    traj = Trajectory(scene=scene, solver=NAME, t=times[:n], state=cols, events=impacts,
+                      dt=options.dt, every=options.every, wall_time=wall,
+                      info={"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev})
+    if scene.rigid is not None:
+        traj.info["moment"] = rigid_moment(scene)
+    traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
+    if estimate_error and len(traj.t):
+        traj.info["estimated_error"] = _estimate_error(traj)
+    return traj
+
+
+def _estimate_error(traj: Trajectory) -> dict[str, float]:
+    """Differences from a run at 10x tighter tolerance, and the energy error."""
+    scene = traj.scene
+    cols, impacts, _, _ = integrate(scene, traj.t, float(traj.t[-1]), RTOL / 10, ATOL / 10)
+    n = min(len(traj.t), len(next(iter(cols.values()))))
+    pos = [c for c in state_columns(scene) if not c.startswith("v")]
+    diff = np.max([np.abs(traj.state[c][:n] - cols[c][:n]) for c in pos], axis=0)
+    window = traj.t[:n] <= ERROR_WINDOW + 1e-12
+    est = {
+        "position_m_window": float(diff[window].max()),
+        "window_s": float(min(ERROR_WINDOW, traj.t[n - 1])),
+        "position_m_whole_run": float(diff.max()),
+        "energy_relative": float(relative_energy_error(traj).max()),
+    }
+    early = [(a, b) for a, b in zip(impacts, traj.events, strict=False)
+             if max(a.t, b.t) <= ERROR_WINDOW and a.body == b.body]
+    if early:
+        est["impact_time_s_window"] = float(max(abs(a.t - b.t) for a, b in early))
+    return est
