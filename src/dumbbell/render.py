@@ -1,0 +1,260 @@
+"""GIF animations of a :class:`Trajectory`: frame sampling and the GIF file.
+
+>>> render_gif(traj, "renders/textbook-1d.gif", fps=25, size="640x360")   # doctest: +SKIP
+
+Frames are taken at times k/fps (k = 0, 1, ...; 10 s at 25 fps is 250 frames) from the
+trajectory sample nearest to each frame time: no interpolation, so no energy is made up across
+an impact. ``dumbbell render`` chooses the sampling so that samples fall exactly on frame
+times (see :func:`sample_every`).
+
+GIF facts: delays are stored in 10 ms units. When 100/fps is a whole number (fps 1, 2, 4, 5,
+10, 20, 25, 50) every frame lasts exactly 1000/fps ms. Otherwise delays of the two nearest
+whole units alternate so that frame k still starts at round(k*100/fps) units: the animation
+keeps real time to within 5 ms (30 fps: 30, 40, 30, 30, 40, ... ms). fps above 50 is refused
+(browsers show delays of 10 ms or less as 100 ms). The GIF loops forever.
+
+The file is written by this module, not by Pillow's multi-frame writer: one global palette,
+and each frame after the first holds only the rectangle that changed, with unchanged pixels
+in it marked transparent (disposal 'leave in place'); Pillow's C encoder compresses each
+rectangle (LZW). Drawing and encoding take about the same time per frame.
+"""
+
+from __future__ import annotations
+
+import io
+import itertools
+import math
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import UsageError
+from .files import atomic_output
+from .trajectory import Trajectory
+
+#: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
+MAX_FPS = 50
+#: Samples the strip of the energy time series needs at most over the whole animation.
+STRIP_SAMPLES = 2000
+
+
+def check_fps(fps: Any, where: str = "fps") -> int:
+    """``fps`` as an int in 1..50, else a UsageError naming ``where`` and why."""
+    if isinstance(fps, bool) or not isinstance(fps, int | np.integer) or not 1 <= fps <= MAX_FPS:
+        raise UsageError(
+            f"{where} = {fps}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
+            "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)"
+        )
+    return int(fps)
+
+
+def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, int]:
+    """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
+    from .scene import parse_size
+
+    if isinstance(size, tuple):
+        size = f"{size[0]}x{size[1]}"
+    try:
+        return parse_size(size)
+    except ValueError as exc:
+        raise UsageError(f"{where}: {exc}") from None
+
+
+def frame_count(t_end: float, fps: int) -> int:
+    """Frames of an animation of ``t_end`` s at ``fps``: times 0, 1/fps, ... below t_end."""
+    return max(1, math.ceil(t_end * fps - 1e-9))
+
+
+def delays_cs(n: int, fps: int) -> list[int]:
+    """Delay of each of ``n`` frames in GIF units (10 ms): frame k starts at
+    round(k * 100 / fps) units, so the animation keeps real time."""
+    starts = [math.floor(k * 100 / fps + 0.5) for k in range(n + 1)]
+    return [b - a for a, b in itertools.pairwise(starts)]
+
+
+def sample_every(dt: float, fps: int, t_end: float) -> int:
+    """Steps between kept samples so that samples fall on frame times when 1/fps is a whole
+    number of steps ``dt`` (s), with at most about :data:`STRIP_SAMPLES` samples for the strip."""
+    per_frame = max(1, round(1.0 / (fps * dt)))
+    target = max(1.0, t_end / dt / STRIP_SAMPLES)
+    divisors = [d for d in range(1, math.isqrt(per_frame) + 1) if per_frame % d == 0]
+    divisors += [per_frame // d for d in divisors]
+    fitting = [d for d in divisors if d <= target]
+    return max(fitting) if fitting else 1
+
+
+def _frames(traj: Trajectory, fps: int, t_end: float):
+    """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
+    from .drawing import Frames
+
+    t = traj.t
+    if len(t) == 0:
+        raise UsageError(f"{traj.scene.source}: the trajectory has no samples to render")
+    half = float(t[1] - t[0]) / 2 if len(t) > 1 else 0.0
+    end = min(t_end, float(t[-1]) + half + 1e-12)
+    ft = np.arange(frame_count(end, fps)) / fps
+    ft = ft[ft <= float(t[-1]) + half + 1e-12]
+    i = np.clip(np.searchsorted(t, ft), 1, max(1, len(t) - 1))
+    idx = np.where(np.abs(t[i - 1] - ft) <= np.abs(t[np.minimum(i, len(t) - 1)] - ft), i - 1,
+                   np.minimum(i, len(t) - 1))
+    if traj.scene.dimensions == 1:
+        zero = np.zeros(len(t))
+        A, B = np.column_stack([zero, traj["xA"]]), np.column_stack([zero, traj["xB"]])
+    else:
+        A = np.column_stack([traj["xA"], traj["yA"]])
+        B = np.column_stack([traj["xB"], traj["yB"]])
+    energy = traj.energy
+    # Least and largest value of each term from the previous frame's sample to this one's.
+    starts = np.concatenate([idx[:1], idx[:-1]])
+    lo = {k: _range(v, starts, idx, np.min) for k, v in energy.items()}
+    hi = {k: _range(v, starts, idx, np.max) for k, v in energy.items()}
+    # The animation lasts len(ft)/fps s; the strip shows the samples of that window.
+    window = min(len(ft) / fps, float(t[-1]))
+    keep = t <= window + 1e-12
+    return Frames(
+        t=ft, A=A[idx], B=B[idx], energy={k: v[idx] for k, v in energy.items()}, lo=lo, hi=hi,
+        series_t=t[keep], series={k: v[keep] for k, v in energy.items()},
+        impacts=tuple(e.t for e in traj.events), t_end=max(window, 1e-9),
+    )
+
+
+def _range(values: np.ndarray, starts: np.ndarray, stops: np.ndarray, reduce) -> np.ndarray:
+    """``reduce`` over values[starts[k]:stops[k] + 1] for each k (NaN-safe)."""
+    return np.array([reduce(values[a:b + 1]) for a, b in zip(starts, stops, strict=True)])
+
+
+def render_gif(
+    traj: Trajectory,
+    path: str | Path,
+    *,
+    quiet: bool = False,
+    fps: int = 25,
+    size: str | tuple[int, int] = "640x360",
+    strip: bool = True,
+    t_end: float | None = None,
+    timing: dict[str, float] | None = None,
+) -> Path:
+    """Write an animated GIF of ``traj`` to ``path`` (atomically) and return the path.
+
+    ``fps`` frames per second (1..50), ``size`` 'WxH' in px, ``strip`` adds the energy time
+    series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
+    end). ``timing``, when given, receives the seconds spent drawing and encoding."""
+    from . import progress
+    from .drawing import Painter, palette
+
+    fps = check_fps(fps)
+    width, height = check_size(size)
+    t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
+    if t_end is None or not (math.isfinite(t_end) and t_end > 0):
+        raise UsageError(f"t_end = {t_end}: must be a finite number > 0 (s)")
+    t0 = time.perf_counter()
+    frames = _frames(traj, fps, t_end)
+    painter = Painter(traj.scene, frames, (width, height), strip)
+    pal, clear = palette()
+    delays = delays_cs(len(frames.t), fps)
+    stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
+    path = Path(path)
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh, \
+            progress.bar(len(frames.t), f"render {path.name}", "frame", quiet) as pbar:
+        fh.write(_header(width, height, pal))
+        previous: np.ndarray | None = None
+        for k in range(len(frames.t)):
+            t1 = time.perf_counter()
+            current = np.asarray(painter.frame(k))
+            t2 = time.perf_counter()
+            fh.write(_encode_frame(*_delta(previous, current, clear), delays[k], clear))
+            stats["draw"] += t2 - t1
+            stats["encode"] += time.perf_counter() - t2
+            previous = current
+            pbar.update(1)
+        fh.write(b"\x3b")
+    stats["frames"] = len(frames.t)
+    if timing is not None:
+        timing.update(stats)
+    return path
+
+
+def _header(width: int, height: int, pal: bytes) -> bytes:
+    """GIF89a header, the global palette (256 colours) and 'loop forever'."""
+    lsd = width.to_bytes(2, "little") + height.to_bytes(2, "little") + bytes([0xF7, 0, 0])
+    loop = b"\x21\xff\x0bNETSCAPE2.0\x03\x01" + (0).to_bytes(2, "little") + b"\x00"
+    return b"GIF89a" + lsd + pal + loop
+
+
+def _delta(previous: np.ndarray | None, current: np.ndarray, clear: int
+           ) -> tuple[np.ndarray, int, int, bool]:
+    """The rectangle of ``current`` that differs from ``previous``, unchanged pixels set to
+    ``clear``; with its left and top (px) and whether it uses transparency."""
+    if previous is None:
+        return current, 0, 0, False
+    changed = previous != current
+    rows = np.flatnonzero(changed.any(axis=1))
+    if len(rows) == 0:
+        return np.full((1, 1), clear, dtype=np.uint8), 0, 0, True
+    cols = np.flatnonzero(changed.any(axis=0))
+    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    sub = current[y0:y1, x0:x1].copy()
+    sub[~changed[y0:y1, x0:x1]] = clear
+    return sub, int(x0), int(y0), True
+
+
+def _encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, delay: int,
+                  clear: int) -> bytes:
+    """One frame: graphic control extension (delay in 10 ms units, 'leave in place',
+    transparency) and the image, LZW-compressed by Pillow."""
+    h, w = pixels.shape
+    gce = bytes([0x21, 0xF9, 4, (1 << 2) | int(transparent)]) + delay.to_bytes(2, "little") \
+        + bytes([clear if transparent else 0, 0])
+    desc = b"\x2c" + b"".join(v.to_bytes(2, "little") for v in (left, top, w, h)) + b"\x00"
+    return gce + desc + _lzw(pixels)
+
+
+def _lzw(pixels: np.ndarray) -> bytes:
+    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, taken
+    from a one-frame GIF that Pillow writes (its encoder is C and keeps indices as given)."""
+    from PIL import Image
+
+    im = Image.frombuffer("L", (pixels.shape[1], pixels.shape[0]), np.ascontiguousarray(pixels),
+                          "raw", "L", 0, 1)
+    buf = io.BytesIO()
+    im.save(buf, "GIF", optimize=False, interlace=False)
+    return _image_data(buf.getvalue())
+
+
+def _image_data(gif: bytes) -> bytes:
+    """The first image's LZW data block of a GIF file, terminator included."""
+    pos = 13
+    if gif[10] & 0x80:
+        pos += 3 << ((gif[10] & 7) + 1)
+    while True:
+        marker = gif[pos]
+        if marker == 0x21:  # extension: label, then sub-blocks
+            pos += 2
+            pos = _skip_blocks(gif, pos)
+        elif marker == 0x2C:
+            flags = gif[pos + 9]
+            pos += 10
+            if flags & 0x80:
+                pos += 3 << ((flags & 7) + 1)
+            start = pos
+            return gif[start:_skip_blocks(gif, pos + 1)]
+        else:
+            raise ValueError(f"unexpected GIF block 0x{marker:02x}")
+
+
+def _skip_blocks(data: bytes, pos: int) -> int:
+    while data[pos]:
+        pos += data[pos] + 1
+    return pos + 1
+
+
+def iter_frames(path: str | Path) -> Iterator[Any]:
+    """The frames of a GIF as RGB images (for tests and checks)."""
+    from PIL import Image, ImageSequence
+
+    with Image.open(path) as im:
+        for frame in ImageSequence.Iterator(im):
+            yield frame.convert("RGB")

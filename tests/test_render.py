@@ -1,0 +1,202 @@
+"""GIF animations: timing read back from the file, pixels that follow the trajectory, bars
+proportional to the energies, reproducible bytes, atomic writes and refused frame rates."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from PIL import Image, ImageSequence
+
+from dumbbell.cli import main
+from dumbbell.drawing import TERM_RGB, Painter
+from dumbbell.render import delays_cs, render_gif, sample_every
+from dumbbell.scene import scene_from_dict
+from dumbbell.solvers import simulate
+from dumbbell.trajectory import Trajectory
+from tests.conftest import SCENES, TEXTBOOK
+
+SCENE = str(SCENES / "textbook-1d.toml")
+
+
+@pytest.fixture(scope="module")
+def short(textbook):
+    """The textbook run to 1 s, sampled on the frame times of 25 fps."""
+    return simulate(textbook, t_end=1.0, every=sample_every(textbook.run.dt, 25, 1.0))
+
+
+@pytest.fixture(scope="module")
+def frames(short, tmp_path_factory):
+    """The textbook's first second as a 640x360 GIF, read back as RGB arrays."""
+    path = tmp_path_factory.mktemp("gif") / "t.gif"
+    render_gif(short, path, quiet=True, fps=25, size="640x360", t_end=1.0)
+    with Image.open(path) as im:
+        info = [(f.info.get("duration"), im.info.get("loop")) for f in ImageSequence.Iterator(im)]
+        im.seek(0)
+        arrays = [np.asarray(f.convert("RGB")) for f in ImageSequence.Iterator(im)]
+    return path, info, arrays
+
+
+def _mask(frame: np.ndarray, rgb: tuple[int, int, int]) -> np.ndarray:
+    return np.all(frame == np.array(rgb, dtype=np.uint8), axis=2)
+
+
+def test_frame_count_duration_and_loop_read_back(frames):
+    _, info, arrays = frames
+    assert len(arrays) == 25                      # 1 s at 25 fps: t = 0, 0.04, ..., 0.96
+    assert all(d == 40 for d, _ in info)          # 1000/25 ms, exactly
+    assert info[0][1] == 0                        # loop forever
+    assert arrays[0].shape == (360, 640, 3)
+
+
+def test_delays_keep_real_time_when_fps_does_not_divide_100():
+    assert delays_cs(5, 25) == [4] * 5
+    d = delays_cs(30, 30)
+    assert set(d) == {3, 4}
+    starts = np.cumsum([0, *d])
+    assert np.all(np.abs(starts * 10 - np.arange(31) * 1000 / 30) <= 5)   # within 5 ms
+
+
+def test_particle_height_follows_the_trajectory(frames, short):
+    """B's drawn centre moves linearly with its height, and height 0 is the floor line."""
+    _, _, arrays = frames
+    t = np.arange(len(arrays)) / 25
+    xB = np.interp(t, short.t, short["xB"])
+    left = arrays[0].shape[1] * 3 // 10            # the scene panel (the red K_int bar is right)
+    ys = []
+    for frame in arrays:
+        rows, _ = np.nonzero(_mask(frame[:, :left], TERM_RGB["B"]))
+        ys.append(rows.mean())
+    slope, intercept = np.polyfit(xB, ys, 1)
+    assert slope < -100                             # up in metres is up on screen
+    assert np.max(np.abs(np.polyval([slope, intercept], xB) - ys)) < 1.0   # px
+    # The floor line (dark grey across the scene panel, clear of the dumbbell) is at height 0.
+    darkness = 255.0 - arrays[0][:, left - 50:left - 10, 0].mean(axis=1)
+    line = darkness > 60
+    floor_y = (np.flatnonzero(line) * darkness[line]).sum() / darkness[line].sum()
+    assert abs(floor_y - intercept) < 1.0
+    # Falling then bouncing: lowest drawn position right at the first impact (t = 0.4518 s).
+    assert abs(t[int(np.argmax(ys))] - math.sqrt(2 / 9.8)) <= 0.04
+
+
+def _bar_lengths(frame: np.ndarray, left: int, bottom: int) -> dict[str, int]:
+    """Longest horizontal run (px) of each energy colour in the energy panel."""
+    out = {}
+    for name in ("K_cm", "K_int", "U_g", "U_spring"):
+        m = _mask(frame[:bottom, left:], TERM_RGB[name])
+        best = 0
+        for row in m:
+            if row.any():
+                # longest run of consecutive True
+                edges = np.diff(np.r_[0, row.view(np.int8), 0])
+                starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+                best = max(best, int((stops - starts).max()))
+        out[name] = best
+    return out
+
+
+def test_energy_bars_are_proportional_to_the_energies(frames, short):
+    _, _, arrays = frames
+    left = arrays[0].shape[1] * 3 // 10 + 20       # right of the scene panel and separator
+    bottom = arrays[0].shape[0] // 2                # above the strip
+    idx = np.searchsorted(short.t, np.arange(len(arrays)) / 25 - 1e-9)
+    ratios = []
+    for k in (0, 5, 11, 12, 14, 20):
+        lengths = _bar_lengths(arrays[k], left, bottom)
+        for name, px in lengths.items():
+            value = float(short[name][idx[k]])
+            if value > 0.3:                         # J; long enough to measure to 1 px
+                ratios.append(px / value)
+    assert len(ratios) >= 8
+    # One fixed scale (px per J) for every bar in every frame, to the pixel.
+    assert max(ratios) / min(ratios) < 1 + 3 / (0.3 * min(ratios))
+
+
+def test_first_impact_moves_energy_from_k_cm_to_internal(frames, short):
+    """Frame 11 (t = 0.44 s) is just before the first impact, frame 12 (0.48 s) just after:
+    the K_cm bar collapses and the pale range of K_int since the last frame reaches ~E."""
+    _, _, arrays = frames
+    left, bottom = arrays[0].shape[1] * 3 // 10 + 20, arrays[0].shape[0] // 2
+    before, after = _bar_lengths(arrays[11], left, bottom), _bar_lengths(arrays[12], left, bottom)
+    assert before["K_cm"] > 100 and after["K_cm"] < 10
+    pale = tuple(round(255 + (v - 255) * 5 / 15) for v in TERM_RGB["K_int"])
+    before_pale = _mask(arrays[11][:bottom, left:], pale).sum()
+    after_pale = _mask(arrays[12][:bottom, left:], pale).sum()
+    assert before_pale == 0 and after_pale > 1000
+
+
+def test_identical_inputs_give_identical_bytes(short, tmp_path):
+    a, b = tmp_path / "a.gif", tmp_path / "b.gif"
+    for path in (a, b):
+        render_gif(short, path, quiet=True, fps=10, size="200x120", t_end=0.5)
+    assert a.read_bytes() == b.read_bytes()
+
+
+def test_failed_render_leaves_no_file(short, tmp_path, monkeypatch):
+    calls = {"n": 0}
+    original = Painter.frame
+
+    def failing(self, k):
+        calls["n"] += 1
+        if calls["n"] > 3:
+            raise RuntimeError("disk on fire")
+        return original(self, k)
+
+    monkeypatch.setattr(Painter, "frame", failing)
+    with pytest.raises(RuntimeError):
+        render_gif(short, tmp_path / "x.gif", quiet=True, fps=25, size="200x120", t_end=1.0)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_refused_fps_exits_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "r.gif"
+    assert main(["render", SCENE, "-o", str(out), "--fps", "60", "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--fps" in err[0] and "50" in err[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_render_command_end_to_end(tmp_path):
+    out = tmp_path / "r.gif"
+    assert main(["render", SCENE, "-o", str(out), "--t-end", "0.2", "--size", "160x90",
+                 "--fps", "20", "--no-strip", "-q"]) == 0
+    with Image.open(out) as im:
+        assert im.size == (160, 90) and im.n_frames == 4
+        assert im.info["duration"] == 50
+
+
+def _synthetic_2d() -> Trajectory:
+    """A 2D dumbbell turning at 2 rad/s about a centre of mass at (0.3, 0.5) m, no floor."""
+    raw = {**TEXTBOOK, "dimensions": 2}
+    raw["bodies"] = {"A": {"mass": 0.1, "height": 0.6, "x": 0.3},
+                     "B": {"mass": 0.1, "height": 0.4, "x": 0.3}}
+    raw.pop("floor")
+    scene = scene_from_dict(raw, source="synthetic-2d.toml")
+    t = np.linspace(0.0, 2.0, 201)
+    phi = 2.0 * t
+    ux, uy = np.sin(phi), np.cos(phi)
+    w = 0.1 * 2.0
+    state = {"xA": 0.3 + 0.1 * ux, "yA": 0.5 + 0.1 * uy, "vxA": w * uy, "vyA": -w * ux,
+             "xB": 0.3 - 0.1 * ux, "yB": 0.5 - 0.1 * uy, "vxB": -w * uy, "vyB": w * ux}
+    return Trajectory(scene, "synthetic", t, state)
+
+
+def test_2d_drawing_keeps_the_aspect_ratio_and_follows_both_coordinates(tmp_path):
+    traj = _synthetic_2d()
+    assert traj["K_rot"][0] == pytest.approx(0.5 * 0.05 * 0.2**2 * 2.0**2)
+    path = tmp_path / "s.gif"
+    render_gif(traj, path, quiet=True, fps=10, size="640x360", t_end=2.0)
+    with Image.open(path) as im:
+        arrays = [np.asarray(f.convert("RGB")) for f in ImageSequence.Iterator(im)]
+    assert len(arrays) == 20
+    k = np.arange(20) * 10                           # samples every 0.01 s, frames every 0.1 s
+    px, py = [], []
+    for frame in arrays:
+        rows, cols = np.nonzero(_mask(frame[:, :350], TERM_RGB["A"]))
+        px.append(cols.mean())
+        py.append(rows.mean())
+    sx, _ = np.polyfit(traj["xA"][k], px, 1)
+    sy, _ = np.polyfit(traj["yA"][k], py, 1)
+    assert sx > 50 and sy < 0
+    assert abs(sx + sy) / sx < 0.03                  # 1 m is as long in x as in y
