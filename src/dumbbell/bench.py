@@ -1,0 +1,757 @@
+"""Work-precision benchmarks: error against run time, one line per solver, a point per step.
+
+The convention of DiffEqDevTools and REBOUND (PHYSICS.md section 4):
+
+- every solver runs the scene over its whole ``t_end`` at each step size ``dt``, keeping a
+  sample every ``every = max(1, round(spacing / dt))`` steps (spacing: SAMPLE_SPACING s unless
+  told otherwise);
+- the truth is evaluated at the same sample times: the ``exact`` solver in 1D, the ``reference``
+  solver in 2D (whose own error estimate is reported with it);
+- ``error`` is the largest position error of either particle over the window [0, T] (m): the
+  motion is chaotic, so a trajectory error means something only before the divergence;
+  ``energy_error`` the largest relative energy error over the whole run (for a dissipative
+  scene: of E against the truth's E); ``impact_time_error`` the largest |t_i - t_i(truth)| over
+  the truth's impacts before T, paired in order (inf if the solver's sequence differs there);
+- ``seconds`` is the minimum, ``seconds_median`` the median of ``repeat`` runs after a warm-up
+  run (the warm-up run gives the diagnostics; the runs are deterministic). The time is the
+  solver's own clock, ``Trajectory.wall_time``, which covers the integration and the impact
+  list but not the array set-up, the verdict or the energy partition; ``seconds_call``, the
+  minimum of the whole ``solve`` call including the verdict, is reported beside it.
+  ``compile_seconds`` is the solver's ``warm_up()`` (numba compile, or load from its cache);
+- a run that blows up or tunnels stays in the table with its verdict and an infinite error;
+- a step whose estimated cost (steps times the cost per step measured at the previous,
+  larger step) passes ``budget`` for all its runs is skipped and listed as ``skipped``.
+
+The truth is also a point of its own: its cost for the same samples, and its error against a
+tighter evaluation (1D: the same closed form in 80-bit extended precision with the impact
+times refined by Newton's method there; 2D: the reference's own estimate).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import time
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .energy import energy_scale, relative_energy_error
+from .errors import UsageError
+from .scene import Scene
+from .solvers import RunOptions, make_options, solver_module, supported
+from .trajectory import Trajectory
+
+#: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
+DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
+#: Default window of the position error (s): the textbook figures' 0-2 s.
+DEFAULT_WINDOW = 2.0
+#: Default number of timed runs per point.
+DEFAULT_REPEAT = 5
+#: Default time budget for the runs of one point (s).
+DEFAULT_BUDGET = 60.0
+#: Default target spacing of the compared samples (s).
+SAMPLE_SPACING = 1e-4
+#: Points with a larger error (m) are outside the asymptotic range and left out of order fits.
+FIT_MAX_ERROR = 1e-2
+#: The step of the textbook listing (s): the accuracy the README compares against.
+TEXTBOOK_DT = 1e-5
+#: Solvers whose accuracy does not depend on dt (it only sets their sample times): each is
+#: one point, evaluated at samples every ``spacing`` s.
+STEP_FREE = ("exact", "reference")
+
+CSV_COLUMNS = (
+    "solver", "dt", "seconds", "error", "seconds_median", "seconds_call", "energy_error",
+    "impact_time_error", "impacts_compared", "impacts_truth", "verdict", "verdict_t",
+    "compile_seconds", "steps", "every", "repeat", "window", "t_end", "truth", "reason",
+)
+
+
+@dataclass
+class Point:
+    """One (solver, dt) point. Times in s, ``error`` in m, ``energy_error`` relative."""
+
+    solver: str
+    dt: float | None
+    seconds: float = math.nan
+    error: float = math.nan
+    seconds_median: float = math.nan
+    seconds_call: float = math.nan
+    energy_error: float = math.nan
+    impact_time_error: float = math.nan
+    impacts_compared: int = 0
+    impacts_truth: int = 0
+    verdict: str = "ok"
+    verdict_t: float | None = None
+    compile_seconds: float = math.nan
+    steps: int = 0
+    every: int = 1
+    repeat: int = 0
+    window: float = DEFAULT_WINDOW
+    t_end: float = 0.0
+    truth: str = ""
+    reason: str = ""
+
+    @property
+    def ran(self) -> bool:
+        return self.verdict != "skipped"
+
+    @property
+    def ok(self) -> bool:
+        return self.verdict == "ok"
+
+
+@dataclass
+class Fit:
+    """A fitted convergence order: error ~ C dt^order over the steps ``dts`` (s)."""
+
+    solver: str
+    order: float
+    log10_c: float
+    dts: list[float] = field(default_factory=list)
+
+
+@dataclass
+class BenchResult:
+    """Everything one benchmark measured."""
+
+    scene: str
+    source: str
+    truth: str | None
+    window: float
+    t_end: float
+    repeat: int
+    budget: float
+    points: list[Point]
+    fits: dict[str, Fit]
+    notes: list[str] = field(default_factory=list)
+    spacing: float = SAMPLE_SPACING
+
+    def speedups(self, target: float | None = None) -> dict[str, Any]:
+        """Run time each solver needs for the error ``target`` (m; default: Euler-Cromer's at
+        the textbook's dt), read off its work-precision line by log-log interpolation, and the
+        speed-up against Euler-Cromer (2D: euler-cromer-2d) there."""
+        base_name = self.baseline
+        if target is None:
+            ref = next((p for p in self.points if p.solver == base_name and p.ok
+                        and p.dt is not None and math.isclose(p.dt, TEXTBOOK_DT)), None)
+            if ref is None:
+                return {}
+            target = ref.error
+        times = {}
+        for name in dict.fromkeys(p.solver for p in self.points):
+            line = sorted(((p.seconds, p.error) for p in self.points
+                           if p.solver == name and p.ok and p.dt is not None
+                           and math.isfinite(p.error) and p.error > 0),
+                          key=lambda se: se[0])
+            t = _time_for_error(line, target)
+            if t is not None:
+                times[name] = t
+        base = times.get(base_name)
+        return {"target_error": target, "baseline": base_name,
+                "seconds": times,
+                "speedup": {n: base / t for n, t in times.items()} if base else {}}
+
+    @property
+    def baseline(self) -> str:
+        """The textbook's method for this scene: euler-cromer (1D) or euler-cromer-2d."""
+        names = {p.solver for p in self.points}
+        return "euler-cromer-2d" if "euler-cromer-2d" in names else "euler-cromer"
+
+
+def _time_for_error(line: list[tuple[float, float]], target: float) -> float | None:
+    """The run time (s) at which a (seconds, error) line first reaches ``target`` (m)."""
+    for (t0, e0), (t1, e1) in itertools.pairwise(line):
+        if e0 >= target >= e1 and e0 > e1:
+            f = math.log(e0 / target) / math.log(e0 / e1)
+            return math.exp(math.log(t0) + f * math.log(t1 / t0))
+    reached = [t for t, e in line if e <= target]
+    return min(reached) if reached else None
+
+
+def truth_solver(scene: Scene) -> str | None:
+    """The solver taken as truth: ``exact`` in 1D, ``reference`` in 2D (None if absent)."""
+    from .solvers import REGISTRY
+
+    name = "exact" if scene.dimensions == 1 else "reference"
+    if name not in REGISTRY:
+        return None
+    return name if solver_module(name).supports(scene) is None else None
+
+
+def default_solvers(scene: Scene) -> list[str]:
+    """Every solver that can run ``scene``, except the truth."""
+    truth = truth_solver(scene)
+    return [n for n in supported(scene) if n != truth]
+
+
+def check_request(scene: Scene, solvers: list[str], dts: list[float], window: float,
+                  t_end: float, spacing: float = SAMPLE_SPACING) -> None:
+    """UsageError naming the flag and what is allowed, before anything runs."""
+    for name in solvers:
+        reason = solver_module(name).supports(scene)
+        if reason is not None:
+            raise UsageError(f"--solvers {name}: cannot run {scene.source}: {reason}")
+    if not solvers:
+        raise UsageError(f"--solvers: no solver to benchmark for {scene.source}")
+    for dt in dts:
+        make_options(scene, dt=dt, t_end=t_end)
+    if window > t_end:
+        raise UsageError(f"--window {window:g}: must be <= the run's t_end = {t_end:g} (s)")
+    if not 0 < spacing <= window:
+        raise UsageError(f"--sample-spacing {spacing:g}: must be > 0 and <= the window "
+                         f"{window:g} (s)")
+
+
+def run_bench(
+    scene: Scene,
+    solvers: list[str] | None = None,
+    dts: list[float] | None = None,
+    window: float = DEFAULT_WINDOW,
+    repeat: int = DEFAULT_REPEAT,
+    t_end: float | None = None,
+    budget: float = DEFAULT_BUDGET,
+    spacing: float = SAMPLE_SPACING,
+    quiet: bool = True,
+) -> BenchResult:
+    """Measure error against run time for ``solvers`` (default: all but the truth) at the
+    steps ``dts`` (s; default half-decades 1e-3..1e-6) over the scene's ``t_end`` (s).
+    ``window`` (s) bounds the position error; ``repeat`` timed runs follow a warm-up run;
+    a step whose runs would take more than ``budget`` s in all is skipped. Samples are kept
+    about every ``spacing`` s (the step-free solvers: exactly)."""
+    from .progress import bar
+
+    t_end = scene.run.t_end if t_end is None else t_end
+    solvers = default_solvers(scene) if solvers is None else list(dict.fromkeys(solvers))
+    dts = sorted(DEFAULT_DTS if dts is None else dts, reverse=True)
+    check_request(scene, solvers, dts, window, t_end, spacing)
+    truth = truth_solver(scene)
+    notes: list[str] = []
+    if truth is None:
+        notes.append("no truth solver for this scene (2D needs 'reference'): position and "
+                      "impact-time errors are not computed")
+    truths: dict[tuple[float, int], Trajectory] = {}
+
+    def truth_at(options: RunOptions) -> Trajectory | None:
+        if truth is None:
+            return None
+        key = (options.dt, options.every)
+        if key not in truths:
+            truths[key] = solver_module(truth).solve(scene, replace(options, quiet=True),
+                                                     **_no_estimate(truth))
+        return truths[key]
+
+    points: list[Point] = []
+    steppers = [n for n in solvers if n not in STEP_FREE]
+    single = [n for n in solvers if n in STEP_FREE and n != truth]
+    total = len(steppers) * len(dts) + len(single) + (truth is not None)
+    with bar(total, f"bench {scene.name}", "point", quiet=quiet) as pb:
+        for name in steppers:
+            module = solver_module(name)
+            compile_s = module.warm_up() if hasattr(module, "warm_up") else math.nan
+            cost_per_step = None
+            for dt in dts:
+                pb.set_postfix_str(f"{name} dt={dt:g}")
+                options = make_options(scene, dt=dt, t_end=t_end, every=_every(dt, spacing))
+                base = Point(name, dt, window=window, t_end=t_end, truth=truth or "",
+                             steps=options.n_steps, every=options.every,
+                             compile_seconds=compile_s)
+                estimate = None if cost_per_step is None else cost_per_step * options.n_steps
+                if estimate is not None and estimate * (repeat + 1) > budget:
+                    base.verdict, base.seconds = "skipped", estimate
+                    base.reason = (f"estimated {estimate:.3g} s per run x {repeat + 1} runs > "
+                                   f"budget {budget:g} s")
+                    points.append(base)
+                    pb.update(1)
+                    continue
+                traj, point = _measure(module, scene, options, repeat, base)
+                _score(point, traj, truth_at(options), window)
+                points.append(point)
+                if point.ok and point.steps:
+                    cost_per_step = point.seconds_call / point.steps
+                pb.update(1)
+        for name in single:
+            pb.set_postfix_str(name)
+            points.append(_single_point(scene, name, t_end, window, repeat, truth, truth_at,
+                                        spacing))
+            pb.update(1)
+        if truth is not None:
+            pb.set_postfix_str(f"{truth} (truth)")
+            points.append(_single_point(scene, truth, t_end, window, repeat, truth, None,
+                                        spacing))
+            pb.update(1)
+    fits = {}
+    for name in steppers:
+        fit = fit_order([p for p in points if p.solver == name])
+        if fit is not None:
+            fits[name] = fit
+    return BenchResult(scene.name, scene.source, truth, window, t_end, repeat, budget, points,
+                       fits, notes, spacing)
+
+
+def _every(dt: float, spacing: float) -> int:
+    return max(1, round(spacing / dt))
+
+
+def _no_estimate(name: str) -> dict[str, Any]:
+    """Keyword that spares the reference its second, error-estimating run."""
+    return {"estimate_error": False} if name == "reference" else {}
+
+
+def _measure(module, scene: Scene, options: RunOptions, repeat: int, point: Point,
+             **first: Any) -> tuple[Trajectory, Point]:
+    """Warm-up run (kept for the diagnostics; ``first`` are its extra keywords), then
+    ``repeat`` timed runs."""
+    traj = module.solve(scene, options, **first)
+    own, call = [], []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        again = module.solve(scene, options, **_no_estimate(module.NAME))
+        call.append(time.perf_counter() - t0)
+        own.append(again.wall_time if again.wall_time > 0 else call[-1])
+    point.seconds = min(own)
+    point.seconds_median = float(np.median(own))
+    point.seconds_call = min(call)
+    point.repeat = repeat
+    point.verdict = traj.verdict.status
+    point.verdict_t = traj.verdict.t
+    point.reason = traj.verdict.reason
+    return traj, point
+
+
+def position_error(traj: Trajectory, truth: Trajectory, window: float) -> float:
+    """Largest distance |r - r_truth| of either particle over the samples in [0, window] (m);
+    inf if the run stopped before the window ended. Both must share their sample times."""
+    n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
+    if len(traj.t) < n:
+        return math.inf
+    if not np.array_equal(traj.t[:n], truth.t[:n]):
+        raise ValueError("position_error: the trajectories do not share their sample times")
+    worst = 0.0
+    for body in "AB":
+        cols = [c for c in (f"x{body}", f"y{body}") if c in traj.state]
+        sq = sum((traj.state[c][:n] - truth.state[c][:n]) ** 2 for c in cols)
+        worst = max(worst, float(np.sqrt(np.max(sq))))
+    return worst
+
+
+def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
+                      ) -> tuple[float, int, int]:
+    """(largest |t_i - t_i(truth)| in s, impacts compared, truth's impacts in [0, window]).
+
+    Impacts are paired in order; inf if the solver's sequence misses one or names another
+    body before the window ends."""
+    wanted = [e for e in truth.events if e.t <= window]
+    worst, compared = 0.0, 0
+    for mine, true in zip(traj.events, wanted):
+        if mine.body != true.body:
+            return math.inf, compared, len(wanted)
+        worst = max(worst, abs(mine.t - true.t))
+        compared += 1
+    if compared < len(wanted):
+        return math.inf, compared, len(wanted)
+    return (worst if compared else math.nan), compared, len(wanted)
+
+
+def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
+    """Largest relative energy error over the whole run: drift from E(0), or for a
+    dissipative scene the distance from the truth's E at the same times (dimensionless)."""
+    if len(traj.t) == 0:
+        return math.nan
+    if not traj.scene.dissipative:
+        return float(np.max(relative_energy_error(traj)))
+    if truth is None:
+        return math.nan
+    n = min(len(traj.t), len(truth.t))
+    E, E_true = traj["E"][:n], truth["E"][:n]
+    terms = {k: float(v[0]) for k, v in truth.energy.items() if k not in ("E", "E_lost")}
+    return float(np.max(np.abs(E - E_true)) / energy_scale(float(E_true[0]), terms))
+
+
+def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: float) -> None:
+    point.energy_error = energy_error(traj, truth)
+    if truth is None:
+        return
+    if not point.ok:
+        point.error = math.inf
+    else:
+        point.error = position_error(traj, truth, window)
+    if traj.scene.floor is not None:
+        point.impact_time_error, point.impacts_compared, point.impacts_truth = (
+            impact_time_error(traj, truth, window))
+
+
+def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: int,
+                  truth: str | None, truth_at, spacing: float) -> Point:
+    """A solver without a step (STEP_FREE) as one point: its cost for the bench's samples
+    (every ``spacing`` s over t_end) and its error; for the truth itself, against a tighter
+    evaluation (exact: extended precision) or its own estimate (reference)."""
+    module = solver_module(name)
+    options = make_options(scene, dt=spacing, t_end=t_end, every=1)
+    is_truth = name == truth
+    base = Point(name, None, window=window, t_end=t_end, truth="self" if is_truth else truth
+                 or "", steps=0, every=1,
+                 compile_seconds=module.warm_up() if hasattr(module, "warm_up") else math.nan)
+    first = {} if is_truth or name != "reference" else _no_estimate(name)
+    traj, point = _measure(module, scene, options, repeat, base, **first)
+    if not is_truth:
+        _score(point, traj, truth_at(options) if truth_at else None, window)
+        return point
+    point.energy_error = energy_error(traj, None)
+    if name == "exact":
+        point.error, point.impact_time_error = extended_precision_exact(traj, window)
+        point.reason = "errors against the same closed form in extended precision"
+    else:
+        est = traj.info.get("estimated_error", {})
+        point.error = float(est.get("position_m_window", math.nan))
+        point.impact_time_error = float(est.get("impact_time_s_window", math.nan))
+        point.reason = "its own estimate: against a run at 10x tighter tolerance"
+    point.impacts_compared = point.impacts_truth = sum(e.t <= window for e in traj.events)
+    return point
+
+
+def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, float]:
+    """Largest position error (m) and impact time error (s) over [0, window] of an ``exact``
+    trajectory against the same
+    closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
+    with each impact time refined by Newton's method in that precision. It checks the
+    rounding of the double-precision solution, given its sequence of impacts."""
+    L = np.longdouble
+    scene = traj.scene
+    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
+    M = mA + mB
+    k = L(scene.spring.stiffness) if scene.spring else L(0)
+    b = L(scene.spring.rest_length) if scene.spring else L(0)
+    w = np.sqrt(k * M / (mA * mB))
+    e = L(scene.floor.elasticity) if scene.floor else L(1)
+
+    def state(seg, tau):
+        _t0, X0, V0, s0, sd0 = seg
+        X = X0 + V0 * tau - g * tau * tau / 2
+        V = V0 - g * tau
+        if w > 0:
+            c, s = np.cos(w * tau), np.sin(w * tau)
+            st, sdt = s0 * c + sd0 / w * s, -s0 * w * s + sd0 * c
+        else:
+            st, sdt = s0 + sd0 * tau, sd0 + 0 * tau
+        return (X + mB / M * (b + st), V + mB / M * sdt, X - mA / M * (b + st), V - mA / M * sdt)
+
+    def segment(t0, xA, vA, xB, vB):
+        return (t0, (mA * xA + mB * xB) / M, (mA * vA + mB * vB) / M, xA - xB - b, vA - vB)
+
+    seg = segment(L(0), L(scene.A.height), L(scene.A.vy), L(scene.B.height), L(scene.B.vy))
+    n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
+    t = traj.t[:n].astype(L)
+    worst = worst_t = 0.0
+    starts = [e_.t for e_ in traj.events if e_.t <= window] + [math.inf]
+    events = [e_ for e_ in traj.events if e_.t <= window]
+    lo = 0
+    for j, stop in enumerate(starts):
+        hi = int(np.searchsorted(traj.t[:n], stop, side="left"))
+        if hi > lo:
+            xA, _, xB, _ = state(seg, t[lo:hi] - seg[0])
+            worst = max(worst, float(np.max(np.abs(xA - traj["xA"][lo:hi]))),
+                        float(np.max(np.abs(xB - traj["xB"][lo:hi]))))
+        lo = hi
+        if j == len(events):
+            break
+        hit = events[j]
+        tau = L(hit.t) - seg[0]
+        idx = 0 if hit.body == "A" else 2
+        for _ in range(8):
+            s = state(seg, tau)
+            tau = tau - s[idx] / s[idx + 1]
+        worst_t = max(worst_t, abs(float(seg[0] + tau - L(hit.t))))
+        xA, vA, xB, vB = state(seg, tau)
+        if hit.body == "A":
+            xA, vA = L(0), -e * vA
+        else:
+            xB, vB = L(0), -e * vB
+        seg = segment(seg[0] + tau, xA, vA, xB, vB)
+    return worst, worst_t
+
+
+def fit_order(points: list[Point]) -> Fit | None:
+    """Least-squares slope of log10(error) against log10(dt) over the ok points with an error
+    below FIT_MAX_ERROR (m); None with fewer than 3 such points."""
+    use = [p for p in points if p.ok and p.dt is not None and math.isfinite(p.error)
+           and 0 < p.error < FIT_MAX_ERROR]
+    if len(use) < 3:
+        return None
+    x = np.log10([p.dt for p in use])
+    y = np.log10([p.error for p in use])
+    slope, icpt = np.polyfit(x, y, 1)
+    return Fit(use[0].solver, float(slope), float(icpt), sorted(p.dt for p in use))
+
+
+# ----------------------------------------------------------------------------- outputs
+
+
+def _fmt(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return "nan" if math.isnan(value) else repr(value)
+    return str(value)
+
+
+def write_csv(result: BenchResult, path: Path) -> Path:
+    """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
+    from .files import atomic_output
+
+    with atomic_output(path) as tmp, open(tmp, "w") as fh:
+        fh.write(",".join(CSV_COLUMNS) + "\n")
+        for p in result.points:
+            row = asdict(p)
+            cells = []
+            for c in CSV_COLUMNS:
+                text = _fmt(row[c])
+                cells.append(f'"{text}"' if "," in text else text)
+            fh.write(",".join(cells) + "\n")
+    return path
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _json_value(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_json_value(v) for v in value]
+    return value
+
+
+def to_json(result: BenchResult) -> dict[str, Any]:
+    """The result as plain JSON data (inf as the string "inf", nan as null)."""
+    data = {
+        "scene": result.scene, "source": result.source, "truth": result.truth,
+        "window_s": result.window, "t_end_s": result.t_end, "repeat": result.repeat,
+        "budget_s": result.budget, "sample_spacing_s": result.spacing,
+        "fit_max_error_m": FIT_MAX_ERROR, "notes": result.notes,
+        "points": [asdict(p) for p in result.points],
+        "orders": {n: asdict(f) for n, f in result.fits.items()},
+        "matched_error": result.speedups(),
+    }
+    return _json_value(data)
+
+
+def write_json(result: BenchResult, path: Path) -> Path:
+    from .files import atomic_output
+
+    with atomic_output(path) as tmp:
+        tmp.write_text(json.dumps(to_json(result), indent=1) + "\n")
+    return path
+
+
+def _sci(x: float | None, digits: int = 2) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    if isinstance(x, float) and math.isinf(x):
+        return "inf"
+    return f"{x:.{digits}e}"
+
+
+def dt_label(dt: float) -> str:
+    """'1e-5', '3.2e-6': a step size as written beside a point (s)."""
+    mantissa, exponent = f"{dt:.1e}".split("e")
+    mantissa = mantissa.rstrip("0").rstrip(".")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def markdown(result: BenchResult) -> str:
+    """The table, fitted orders and matched-error speed-ups as markdown."""
+    lines = [
+        (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
+        f"truth: `{result.truth}`; position error over [0, {result.window:g}] s; time: min "
+        f"(median) of {result.repeat} runs after a warm-up."),
+        "",
+        ("| solver | dt (s) | steps | run time min (median) | position error (m) "
+        "| energy error (rel.) | impact time error (s) | verdict |"),
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for p in result.points:
+        dt = dt_label(p.dt) if p.dt is not None else f"(samples every {result.spacing:g} s)"
+        if p.ran:
+            time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
+        else:
+            time_s = f"~{_ms(p.seconds)} (estimate)"
+        verdict = p.verdict if p.ok else f"**{p.verdict}**" + (
+            f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
+        imp = _sci(p.impact_time_error)
+        if p.impacts_truth:
+            imp += f" ({p.impacts_compared}/{p.impacts_truth})"
+        steps = f"{p.steps:,}" if p.dt is not None else "-"
+        lines.append(f"| {p.solver} | {dt} | {steps} | {time_s} | {_sci(p.error)} "
+                     f"| {_sci(p.energy_error)} | {imp} | {verdict} |")
+    lines.append("")
+    if result.fits:
+        fit_text = "; ".join(
+            f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
+            f"{len(f.dts)} points)" for n, f in result.fits.items())
+        lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
+                     f"(least squares in log-log over the ok points with error < "
+                     f"{FIT_MAX_ERROR:g} m): {fit_text}.")
+    sp = result.speedups()
+    if sp and sp.get("seconds"):
+        parts = [f"{n} {_ms(t)} ({sp['speedup'].get(n, math.nan):.3g}x)"
+                 for n, t in sp["seconds"].items()]
+        lines.append(f"Run time to reach {sp['baseline']}'s error at dt = 1e-5 s "
+                     f"({sp['target_error']:.2e} m), interpolated along each line "
+                     f"(speed-up against {sp['baseline']}): {'; '.join(parts)}.")
+    compile_parts = {p.solver: p.compile_seconds for p in result.points
+                     if math.isfinite(p.compile_seconds)}
+    if compile_parts:
+        lines.append("JIT compile (or cache load) before the runs, not in the times above: "
+                     + "; ".join(f"{n} {v:.3g} s" for n, v in compile_parts.items()) + ".")
+    lines.extend(result.notes)
+    return "\n".join(lines) + "\n"
+
+
+def _ms(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "-"
+    if seconds >= 1:
+        return f"{seconds:.3g} s"
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds * 1e6:.3g} µs"
+
+
+def write_markdown(result: BenchResult, path: Path) -> Path:
+    from .files import atomic_output
+
+    with atomic_output(path) as tmp:
+        tmp.write_text(markdown(result))
+    return path
+
+
+STYLES = {"euler-cromer": ("#d62728", "o"), "verlet": ("#1f77b4", "s"),
+          "pymunk": ("#2ca02c", "^"), "euler-cromer-2d": ("#ff7f0e", "v"),
+          "exact": ("black", "*"), "reference": ("#9467bd", "P")}
+
+
+def _style(name: str, i: int) -> tuple[str, str]:
+    return STYLES.get(name, (f"C{i % 10}", "D"))
+
+
+def work_precision_figure(result: BenchResult, path: Path) -> Path:
+    """Log-log error (m) against run time (s), one line per solver, dt beside each point,
+    failed runs as crosses on the top edge."""
+    from .figures import _pyplot
+    from .files import atomic_output
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.2, 6.0), dpi=100)
+    finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
+    top = max(finite) * 8 if finite else 1.0
+    names = list(dict.fromkeys(p.solver for p in result.points))
+    for i, name in enumerate(names):
+        colour, marker = _style(name, i)
+        pts = [p for p in result.points if p.solver == name and p.ran]
+        good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
+        bad = [p for p in pts if not math.isfinite(p.error)]
+        single = name in STEP_FREE
+        label = name
+        if name == result.truth:
+            label += (" (truth; error vs extended precision)" if name == "exact"
+                      else " (truth; its own error estimate)")
+        elif single:
+            label += " (error vs truth)"
+        if good:
+            ax.plot([p.seconds for p in good], [p.error for p in good], marker=marker,
+                    color=colour, label=label, ms=11 if single else 6,
+                    lw=0 if single else 1.5)
+        for j, p in enumerate(good):
+            if p.dt is None:
+                ax.annotate(f"samples every {dt_label(result.spacing)} s",
+                            (p.seconds, p.error), textcoords="offset points", xytext=(-9, -3),
+                            ha="right", fontsize=7.5, color=colour)
+                continue
+            # Steep lines take their labels below-right; flat ones alternate above and below.
+            below = name == "verlet" or j % 2 == 1
+            ax.annotate(dt_label(p.dt), (p.seconds, p.error), textcoords="offset points",
+                        xytext=(6, -11) if below else (7, 2), fontsize=7.5, color=colour)
+        if bad:
+            ax.plot([p.seconds for p in bad], [top] * len(bad), ls="none", marker="x",
+                    color=colour, ms=9, mew=2, label=f"{name}: failed ({bad[0].verdict})")
+            for p in bad:
+                ax.annotate(dt_label(p.dt) if p.dt else "", (p.seconds, top),
+                            textcoords="offset points", xytext=(5, -12), fontsize=7.5,
+                            color=colour)
+    sp = result.speedups()
+    if sp:
+        ax.axhline(sp["target_error"], color="grey", ls=":", lw=1,
+                   label=f"textbook's accuracy ({sp['baseline']} at dt = 1e-5 s)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(f"run time (s, fastest of {result.repeat} runs)")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_title(f"Work-precision: {result.scene}, {result.t_end:g} s simulated; "
+                 f"labels: dt (s)", fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+              frameon=False)
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png")
+    plt.close(fig)
+    return path
+
+
+def convergence_figure(result: BenchResult, path: Path) -> Path:
+    """Log-log error (m) against dt (s), one line per solver, with the fitted order."""
+    from .figures import _pyplot
+    from .files import atomic_output
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7.2, 5.0), dpi=100)
+    names = [n for n in dict.fromkeys(p.solver for p in result.points) if n not in STEP_FREE]
+    finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
+    top = max(finite) * 8 if finite else 1.0
+    for i, name in enumerate(names):
+        colour, marker = _style(name, i)
+        pts = [p for p in result.points if p.solver == name and p.ran and p.dt is not None]
+        good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
+        bad = [p for p in pts if not math.isfinite(p.error)]
+        fit = result.fits.get(name)
+        label = name + (f": fitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
+                        f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
+        ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
+                lw=0, label=label)
+        if fit:
+            xs = np.array([min(fit.dts), max(fit.dts)])
+            ax.plot(xs, 10 ** (fit.log10_c + fit.order * np.log10(xs)), color=colour, lw=1.2)
+        if bad:
+            ax.plot([p.dt for p in bad], [top] * len(bad), ls="none", marker="x", color=colour,
+                    ms=9, mew=2, label=f"{name}: failed")
+    ax.axhline(FIT_MAX_ERROR, color="grey", ls=":", lw=1)
+    ax.text(0.01, FIT_MAX_ERROR, f" fits use errors below {FIT_MAX_ERROR:g} m",
+            transform=ax.get_yaxis_transform(), fontsize=7.5, color="grey", va="bottom")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time step dt (s)")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_title(f"Convergence: {result.scene}, error over [0, {result.window:g} s]; "
+                 "lines: least-squares fits", fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format="png")
+    plt.close(fig)
+    return path
+
+
+def write_all(result: BenchResult, out: Path) -> list[Path]:
+    """CSV, JSON, markdown and both figures into ``out``, named bench-SCENE*."""
+    stem = f"bench-{result.scene}"
+    return [
+        write_csv(result, out / f"{stem}.csv"),
+        write_json(result, out / f"{stem}.json"),
+        write_markdown(result, out / f"{stem}.md"),
+        work_precision_figure(result, out / f"{stem}-work-precision.png"),
+        convergence_figure(result, out / f"{stem}-convergence.png"),
+    ]

@@ -1,0 +1,141 @@
+"""``dumbbell bench``: the work-precision numbers against independent computations."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from dumbbell.bench import (
+    CSV_COLUMNS,
+    DEFAULT_DTS,
+    default_solvers,
+    extended_precision_exact,
+    fit_order,
+    markdown,
+    run_bench,
+    write_all,
+)
+from dumbbell.cli import main
+from dumbbell.solvers import simulate
+from tests.conftest import SCENES, make_scene
+
+TEXTBOOK = str(SCENES / "textbook-1d.toml")
+#: The grid of the order fits: [0, 1 s] (two impacts), half-decades 1e-3..1e-5 s.
+FIT_DTS = [1e-3, 3.16e-4, 1e-4, 3.16e-5, 1e-5]
+
+
+@pytest.fixture(scope="module")
+def one_second():
+    """Euler-Cromer and verlet on the fit grid, 1 s simulated, window [0, 1 s]."""
+    scene = make_scene({"run.t_end": 1.0})
+    return run_bench(scene, solvers=["euler-cromer", "verlet"], dts=FIT_DTS, window=1.0,
+                     repeat=1)
+
+
+def test_defaults():
+    assert DEFAULT_DTS == (1e-3, 3.16e-4, 1e-4, 3.16e-5, 1e-5, 3.16e-6, 1e-6)
+    names = default_solvers(make_scene())
+    assert {"euler-cromer", "verlet"} <= set(names) and "exact" not in names
+
+
+def test_fitted_orders(one_second):
+    # Euler-Cromer flips velocities up to a step late: first order. Verlet with located
+    # impacts keeps its second order through the two impacts of the first second.
+    assert 0.7 < one_second.fits["euler-cromer"].order < 1.4
+    assert 1.7 < one_second.fits["verlet"].order < 2.3
+    assert len(one_second.fits["verlet"].dts) == len(FIT_DTS)
+
+
+def test_error_equals_an_independent_computation(one_second):
+    dt = 1e-4
+    ec = simulate(make_scene(), "euler-cromer", dt=dt, t_end=1.0)
+    ex = simulate(make_scene(), "exact", dt=dt, t_end=1.0)
+    expected = max(np.max(np.abs(ec["xA"] - ex["xA"])), np.max(np.abs(ec["xB"] - ex["xB"])))
+    point = next(p for p in one_second.points if p.solver == "euler-cromer" and p.dt == dt)
+    assert point.every == 1
+    assert point.error == pytest.approx(expected, rel=1e-12)
+    # The impact times: Euler-Cromer flips at the end of the step that crossed the floor.
+    late = max(abs(a.t - b.t) for a, b in zip(ec.events, ex.events, strict=False))
+    assert point.impact_time_error == pytest.approx(late, rel=1e-12)
+    assert point.impacts_truth == point.impacts_compared == 2
+    assert 0 < late < dt  # late by up to one step (plus the drift of the motion)
+    energy = np.abs(ec["E"] - ec["E"][0]).max() / abs(ec["E"][0])
+    assert point.energy_error == pytest.approx(energy, rel=1e-12)
+
+
+def test_textbook_accuracy_over_two_seconds():
+    # PHYSICS.md: Euler-Cromer at dt = 1e-5 is about 2e-3 m off the exact solution by 2 s.
+    result = run_bench(make_scene({"run.t_end": 2.0}), solvers=["euler-cromer"], dts=[1e-5],
+                       repeat=1)
+    point = result.points[0]
+    assert point.every == 10 and point.window == 2.0
+    assert 1e-3 < point.error < 4e-3
+    exact = result.points[-1]
+    assert exact.solver == "exact" and exact.dt is None
+    assert exact.error < 1e-12 and exact.impact_time_error < 1e-14
+    assert exact.seconds > 0 and math.isfinite(exact.seconds_median)
+
+
+def test_extended_precision_check_sees_a_wrong_solution():
+    traj = simulate(make_scene(), "exact", dt=1e-3, t_end=1.0)
+    assert extended_precision_exact(traj, 1.0)[0] < 1e-12
+    traj.state["xB"] = traj.state["xB"] + 1e-9 * (traj.t > 0.7)
+    assert extended_precision_exact(traj, 1.0)[0] == pytest.approx(1e-9, rel=1e-3)
+
+
+def test_failed_runs_are_kept_and_slow_steps_skipped(tmp_path):
+    # k = 2e4 N/m: w = 632 rad/s, so dt = 4e-3 s is past w*dt = 2 and blows up.
+    scene = make_scene({"spring.stiffness": 2e4, "run.t_end": 0.5})
+    result = run_bench(scene, solvers=["euler-cromer"], dts=[4e-3, 1e-3, 1e-4], window=0.5,
+                       repeat=1, budget=1e-9)
+    rows = {p.dt: p for p in result.points if p.dt is not None}
+    assert rows[4e-3].verdict == "unstable" and math.isinf(rows[4e-3].error)
+    assert rows[1e-3].verdict == "ok"  # the first point that ran sets the cost per step
+    assert rows[1e-4].verdict == "skipped" and "budget" in rows[1e-4].reason
+    assert fit_order(result.points) is None
+    write_all(result, tmp_path)
+    table = markdown(result)
+    assert "**unstable**" in table and "**skipped**" in table
+    data = json.loads((tmp_path / "bench-test.json").read_text())
+    assert data["points"][0]["error"] == "inf"
+
+
+def test_cli_writes_every_output(tmp_path):
+    out = tmp_path / "b"
+    assert main(["bench", TEXTBOOK, "--out", str(out), "--solvers", "euler-cromer", "verlet",
+                 "--dts", "1e-3", "1e-4", "--t-end", "0.6", "--window", "0.6",
+                 "--repeat", "2", "-q"]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [f"bench-textbook-1d{s}" for s in
+                     ("-convergence.png", "-work-precision.png", ".csv", ".json", ".md")]
+    rows = list(csv.DictReader((out / "bench-textbook-1d.csv").open()))
+    assert tuple(rows[0]) == CSV_COLUMNS
+    assert [r["solver"] for r in rows] == ["euler-cromer"] * 2 + ["verlet"] * 2 + ["exact"]
+    for r in rows:
+        assert float(r["seconds"]) > 0 and float(r["error"]) >= 0
+        assert float(r["seconds"]) <= float(r["seconds_median"]) <= float(r["seconds_call"]) * 5
+        assert r["verdict"] == "ok" and r["repeat"] == "2"
+    for png in out.glob("*.png"):
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--solvers", "nosuch"], "nosuch"),
+    (["--window", "5", "--t-end", "1"], "--window"),
+    (["--dts", "-1"], "--dts"),
+    (["--repeat", "0"], "--repeat"),
+])
+def test_bad_flags_write_nothing(tmp_path, capsys, flags, message):
+    out = tmp_path / "b"
+    try:
+        status = main(["bench", TEXTBOOK, "--out", str(out), *flags, "-q"])
+    except SystemExit as exc:  # argparse's own checks
+        status = exc.code
+    assert status == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
