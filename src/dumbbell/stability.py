@@ -1,0 +1,388 @@
+"""The stability report: extreme scenes run by every solver, each result beside the theory.
+
+>>> rows = run_cases(find_cases(default_cases()), None)       # doctest: +SKIP
+>>> print(markdown(rows))                                       # doctest: +SKIP
+
+Theory (PHYSICS.md sections 3 and 4), which :func:`predict` turns into an expected verdict:
+
+- the explicit spring step of Euler-Cromer, Verlet and pymunk is stable iff w*dt < 2, with
+  w = sqrt(k/mu); the exact and reference solutions take no such step;
+- pymunk finds a contact only once shapes overlap, so a particle that moves more than twice
+  its radius per step at impact can pass through the floor;
+- on an inelastic floor a bouncing point mass comes to rest after
+  sqrt(2 h/g) (1 + e)/(1 - e), after infinitely many impacts: solvers that model impacts as
+  velocity flips (exact, Euler-Cromer, Verlet) must stop there with ``failed``; pymunk and the
+  reference solver hold resting contact.
+
+The stability map runs a grid over (w*dt, mass ratio) for each time-stepping solver with no
+floor and no gravity, so only the spring's limit counts.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import DumbbellError, UsageError
+from .files import atomic_output
+from .scene import Scene, load_scene, scene_from_dict, scenes_dir
+
+#: Solvers whose spring is an explicit step, stable iff w*dt < 2.
+STEPPERS = ("euler-cromer", "verlet", "pymunk", "euler-cromer-2d")
+#: Solvers whose floor is a velocity flip, which cannot hold a particle at rest.
+FLIP_FLOORS = ("exact", "euler-cromer", "verlet", "euler-cromer-2d")
+#: Report columns, in CSV order.
+COLUMNS = ("case", "title", "solver", "dt", "w_dt", "verdict", "t_fail",
+           "max_rel_energy_error", "predicted", "agreement", "reason", "theory", "wall_s")
+#: The stability map: w*dt values, mass ratios mB/mA, and steps per run.
+MAP_WDT = tuple(round(0.05 + 0.1 * i, 2) for i in range(30))
+MAP_RATIOS = tuple(float(10 ** (i / 2)) for i in range(9))
+MAP_STEPS = 2000
+#: Energy error that counts as a blow-up on the map: far above the bounded swing h/(2-h) of
+#: a stable step (19 at w*dt = 1.9), far below what a run past w*dt = 2 reaches.
+MAP_UNSTABLE_ENERGY = 1e3
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The verdict theory expects, and why in words."""
+
+    status: str
+    why: str
+
+
+def default_cases() -> Path:
+    """The shipped catalogue of extreme scenes."""
+    return scenes_dir() / "extreme"
+
+
+def find_cases(folder: str | Path) -> list[Path]:
+    """The scene files in ``folder``, sorted by name (UsageError if there are none)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise UsageError(f"--cases {folder}: no such folder")
+    paths = sorted(folder.glob("*.toml"))
+    if not paths:
+        raise UsageError(f"--cases {folder}: no scene files (*.toml) in it")
+    return paths
+
+
+def default_solvers(scene: Scene) -> list[str]:
+    """Solvers run on a case by default: all that can run it, but not the slow 2D reference
+    on 1D scenes, whose reference is the exact solution."""
+    from .solvers import supported
+
+    names = supported(scene)
+    if scene.dimensions == 1:
+        names = [n for n in names if n != "reference"]
+    return names
+
+
+def _impact_speed(scene: Scene) -> float:
+    """Speed (m/s) at which the lower particle meets the floor, as a point falling from its
+    height with its starting vertical velocity (the spring's vibration is left out)."""
+    low = min((scene.A, scene.B), key=lambda p: p.height)
+    return math.sqrt(low.vy**2 + 2.0 * scene.g * max(low.height, 0.0))
+
+
+def rest_time(scene: Scene) -> float:
+    """When a point mass dropped like the lower particle comes to rest on an inelastic floor:
+    t1 + 2 e v1 / (g (1 - e)) (s); inf on an elastic floor or without gravity."""
+    if scene.floor is None or scene.g <= 0 or scene.floor.elasticity >= 1.0:
+        return math.inf
+    low = min((scene.A, scene.B), key=lambda p: p.height)
+    v1 = _impact_speed(scene)
+    t1 = (low.vy + v1) / scene.g
+    e = scene.floor.elasticity
+    return t1 + 2.0 * e * v1 / (scene.g * (1.0 - e))
+
+
+def pymunk_floor_thickness() -> float:
+    """Thickness (m) of the box pymunk's floor is made of: a circle must cross it and its own
+    diameter in one step to pass through whatever the phase (0 if the solver is missing)."""
+    import importlib
+
+    try:
+        engine = importlib.import_module("dumbbell.solvers.engine")
+    except ImportError:
+        return 0.0
+    return float(getattr(engine, "_FLOOR_THICKNESS", 0.0))
+
+
+def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
+    """The verdict theory expects for ``scene`` run by ``solver`` at step ``dt`` up to
+    ``t_end`` (s); see the module docstring."""
+    w_dt = scene.omega * dt
+    if solver in STEPPERS and scene.spring is not None and w_dt >= 2.0:
+        return Prediction("unstable", f"w*dt = {w_dt:.2f} >= 2")
+    if solver == "pymunk" and scene.floor is not None and scene.g > 0:
+        v = _impact_speed(scene)
+        r = min(scene.A.radius, scene.B.radius)
+        reach = 2.0 * r + pymunk_floor_thickness()
+        if v * dt > reach:
+            return Prediction("tunnelled", f"moves {v * dt:.3g} m per step at impact "
+                                           f"({v:.3g} m/s), more than the floor box and a "
+                                           f"diameter, {reach:.3g} m")
+    t_rest = rest_time(scene)
+    if solver in FLIP_FLOORS and t_rest < t_end:
+        return Prediction("failed", f"a point mass comes to rest at {t_rest:.2f} s "
+                                    f"< t_end = {t_end:g} s")
+    if scene.spring is not None and solver in STEPPERS:
+        return Prediction("ok", f"w*dt = {w_dt:.2g} < 2")
+    return Prediction("ok", "no step limit applies")
+
+
+def run_case(path: str, solver: str) -> dict[str, Any]:
+    """Run one case with one solver and put the result beside the theory (one report row)."""
+    from .sweep import evaluate
+
+    scene = load_scene(path)
+    t0 = time.perf_counter()
+    result = evaluate(scene, {}, solver)
+    wall = time.perf_counter() - t0
+    expected = predict(scene, solver, scene.run.dt, scene.run.t_end)
+    if result["verdict"] == expected.status:
+        agreement = "agrees"
+    else:
+        agreement = f"DISAGREES: theory expects {expected.status}, got {result['verdict']}"
+    return {"case": scene.name, "title": scene.title, "solver": solver,
+            "dt": scene.run.dt, **result, "predicted": expected.status,
+            "agreement": agreement, "theory": expected.why, "wall_s": wall}
+
+
+def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple[str, str]],
+                                                                        list[str]]:
+    """The (case, solver) runs to make, every scene validated first, and the pairs skipped
+    (with why). ``solvers`` None means :func:`default_solvers` per case."""
+    from .solvers import solver_module
+
+    for name in solvers or ():
+        solver_module(name)
+    runs, skipped = [], []
+    for path in paths:
+        scene = load_scene(path)
+        names = default_solvers(scene) if solvers is None else solvers
+        for name in names:
+            reason = solver_module(name).supports(scene)
+            if reason is None:
+                runs.append((str(path), name))
+            else:
+                skipped.append(f"{scene.name} with {name}: {reason}")
+    return runs, skipped
+
+
+def _in_pool(func: Any, jobs: list[tuple[Any, ...]], workers: int, quiet: bool, desc: str
+             ) -> list[Any]:
+    """``func(*job)`` for every job, on ``workers`` processes, results in job order."""
+    from .progress import bar
+
+    results: list[Any] = [None] * len(jobs)
+    with bar(len(jobs), desc, "run", quiet=quiet) as pb:
+        if workers <= 1 or len(jobs) <= 1:
+            for i, job in enumerate(jobs):
+                results[i] = func(*job)
+                pb.update(1)
+            return results
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = {pool.submit(func, *job): i for i, job in enumerate(jobs)}
+            try:
+                for fut in as_completed(futures):
+                    results[futures[fut]] = fut.result()
+                    pb.update(1)
+            except BaseException:
+                for fut in futures:
+                    fut.cancel()
+                raise
+    return results
+
+
+def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bool = True
+              ) -> list[dict[str, Any]]:
+    """Every (case path, solver) run as a report row, in the given order."""
+    workers = workers or os.cpu_count() or 1
+    # The longest runs first keeps the pool busy to the end; results keep the given order.
+    return _in_pool(run_case, runs, workers, quiet, "stability cases")
+
+
+def _fmt(value: Any, kind: str = "") -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if kind == "err":
+        return f"{value:.2g}"
+    if kind == "t":
+        return f"{value:.4g}"
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    return str(value)
+
+
+def markdown(rows: list[dict[str, Any]], skipped: list[str] | None = None) -> str:
+    """The report as a markdown table, then the verdict lines of the runs that did not end ok
+    or disagree with the theory."""
+    out = ["| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | t_fail [s] | "
+           "largest rel. energy error | theory expects | agreement |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    previous = None
+    for r in rows:
+        agree = "agrees" if r["agreement"] == "agrees" else "**DISAGREES**"
+        case, title = (r["case"], r["title"]) if r["case"] != previous else ("", "")
+        previous = r["case"]
+        out.append(f"| {case} | {title} | {r['solver']} | {_fmt(r['dt'])} | "
+                   f"{_fmt(r['w_dt'])} | {r['verdict']} | {_fmt(r['t_fail'], 't')} | "
+                   f"{_fmt(r['max_rel_energy_error'], 'err')} | {r['predicted']} "
+                   f"({r['theory']}) | {agree} |")
+    notes = [r for r in rows if r["verdict"] != "ok" or r["agreement"] != "agrees"]
+    if notes:
+        out += ["", "Runs that did not end ok, or disagree with the theory:", ""]
+        for r in notes:
+            line = f"- {r['case']}, {r['solver']}: {r['verdict']}"
+            if r["t_fail"] is not None:
+                line += f" at t = {r['t_fail']:.4g} s"
+            if r["reason"]:
+                line += f": {r['reason']}"
+            if r["agreement"] != "agrees":
+                line += f". {r['agreement']} ({r['theory']})"
+            out.append(line)
+    if skipped:
+        out += ["", "Not run (the solver cannot run the scene):", ""]
+        out += [f"- {s}" for s in skipped]
+    return "\n".join(out) + "\n"
+
+
+def csv_text(rows: list[dict[str, Any]]) -> str:
+    """The report as CSV with :data:`COLUMNS`."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(COLUMNS)
+    for r in rows:
+        writer.writerow(["" if r[c] is None else repr(r[c]) if isinstance(r[c], float)
+                         else r[c] for c in COLUMNS])
+    return buf.getvalue()
+
+
+# --- the stability map ----------------------------------------------------------------------
+
+
+def map_scene() -> Scene:
+    """The map's base scene: k = 200 N/m, mB = 0.1 kg, the spring 1 cm stretched, no floor,
+    no gravity, so only the spring's step limit counts."""
+    return scene_from_dict({
+        "title": "stability map",
+        "bodies": {"A": {"mass": 0.1, "height": 1.21}, "B": {"mass": 0.1, "height": 1.0}},
+        "spring": {"stiffness": 200.0, "rest_length": 0.2},
+        "run": {"t_end": 1.0, "dt": 1e-3, "unstable_energy": MAP_UNSTABLE_ENERGY},
+    }, source="stability-map.toml")
+
+
+def map_points(scene: Scene) -> list[Any]:
+    """The map's grid points, w*dt outer and mass ratio mB/mA inner: A's mass, dt = (w*dt)/w
+    and t_end = MAP_STEPS * dt."""
+    from .sweep import Point
+
+    points = []
+    for h in MAP_WDT:
+        for ratio in MAP_RATIOS:
+            mA = scene.B.mass / ratio
+            mu = mA * scene.B.mass / (mA + scene.B.mass)
+            dt = h / math.sqrt(scene.spring.stiffness / mu)  # type: ignore[union-attr]
+            points.append(Point(len(points), {"bodies.A.mass": mA, "run.dt": dt,
+                                              "run.t_end": MAP_STEPS * dt}))
+    return points
+
+
+def map_rows(solver: str, workers: int | None = None, quiet: bool = True
+             ) -> list[dict[str, Any]]:
+    """The map's rows for one solver, in grid order."""
+    from .sweep import run_pool, run_serial
+
+    scene = map_scene()
+    points = map_points(scene)
+    workers = workers or os.cpu_count() or 1
+    pairs = (run_serial(scene, points, solver, quiet) if workers <= 1
+             else run_pool(scene, points, solver, workers, quiet))
+    by_index = dict(pairs)
+    return [by_index[p.index] for p in points]
+
+
+def draw_stability_map(path: str | Path, maps: dict[str, list[dict[str, Any]]]) -> Path:
+    """One panel per solver: log10 of the largest relative energy error over
+    (w*dt, mass ratio), blow-ups marked, and the line w*dt = 2."""
+    from .figures import _pyplot
+    from .sweep import Axis, draw_map
+
+    plt = _pyplot()
+    n = len(maps)
+    fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
+    x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
+    y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
+    errs = [r["max_rel_energy_error"] for rows in maps.values() for r in rows
+            if r["verdict"] == "ok" and r["max_rel_energy_error"] > 0]
+    lo = math.floor(math.log10(min(errs))) if errs else -16
+    hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
+    mesh = None
+    for ax, (solver, rows) in zip(axes[0], maps.items(), strict=True):
+        wdt = np.array([[r["w_dt"] for r in rows[i::len(MAP_RATIOS)]]
+                        for i in range(len(MAP_RATIOS))], float)
+        mesh = draw_map(fig, ax, x_axis, y_axis, rows, solver,
+                        x_label="w*dt  (w = sqrt(k/mu))", y_label="mass ratio mB/mA",
+                        wdt=wdt, limits=(lo, hi), colorbar=False)
+    fig.subplots_adjust(left=0.055, right=0.9, bottom=0.25, top=0.86, wspace=0.25)
+    cax = fig.add_axes((0.92, 0.25, 0.013, 0.61))
+    cbar = fig.colorbar(mesh, cax=cax)
+    cbar.set_label("log10 of the largest relative energy error")
+    fig.suptitle(f"Stability of the explicit spring step: {MAP_STEPS} steps per run, no floor, "
+                 f"no gravity; 'unstable' = non-finite or energy error > {MAP_UNSTABLE_ENERGY:g}",
+                 fontsize=10)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=90)
+    plt.close(fig)
+    return Path(path)
+
+
+def map_solvers(solvers: list[str] | None) -> list[str]:
+    """The time-stepping solvers a map is drawn for: those asked for (all by default) that
+    can run the 1D map scene."""
+    from .solvers import available, solver_module
+
+    names = available() if solvers is None else solvers
+    scene = map_scene()
+    return [n for n in names if n in STEPPERS and solver_module(n).supports(scene) is None]
+
+
+def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
+           workers: int | None = None, quiet: bool = True) -> dict[str, Any]:
+    """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
+    Everything is validated before anything runs. Returns rows, paths and skipped runs."""
+    paths = find_cases(cases if cases is not None else default_cases())
+    try:
+        runs, skipped = plan_cases(paths, solvers)
+    except DumbbellError:
+        raise
+    if not runs:
+        raise UsageError("--solvers: none of them can run any of the cases")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out}: exists and is not a folder")
+    rows = run_cases(runs, workers, quiet)
+    written = []
+    with atomic_output(out / "stability.md") as tmp:
+        tmp.write_text(markdown(rows, skipped))
+    written.append(out / "stability.md")
+    with atomic_output(out / "stability.csv") as tmp:
+        tmp.write_text(csv_text(rows))
+    written.append(out / "stability.csv")
+    steppers = map_solvers(solvers)
+    if steppers:
+        maps = {name: map_rows(name, workers, quiet) for name in steppers}
+        written.append(draw_stability_map(out / "stability-map.png", maps))
+    return {"rows": rows, "skipped": skipped, "written": written}
