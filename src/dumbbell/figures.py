@@ -148,9 +148,77 @@ def potential_figure(traj: Trajectory, path: str | Path, window: float = WINDOW)
                       "potential energy: external (gravity) against internal (spring)")
 
 
+def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
+    """The motion in the plane (2D): paths of A and B, and the dumbbell every 0.1 s."""
+    m = _window(traj, window)
+    xA, yA, xB, yB = (traj[c][m] for c in ("xA", "yA", "xB", "yB"))
+    ax.plot(xA, yA, color=COLOURS["A"], lw=0.5, alpha=0.5)
+    ax.plot(xB, yB, color=COLOURS["B"], lw=0.5, alpha=0.5)
+    t = traj.t[m]
+    snaps = np.searchsorted(t, np.arange(0.0, t[-1] + 1e-9, 0.1)) if len(t) else []
+    for j, i in enumerate(snaps):
+        grey = str(round(0.75 - 0.7 * j / max(1, len(snaps) - 1), 3))
+        ax.plot([xA[i], xB[i]], [yA[i], yB[i]], color=grey, lw=1.0, zorder=2)
+        ax.plot([xA[i]], [yA[i]], "o", ms=2.5, color=COLOURS["A"], zorder=3)
+        ax.plot([xB[i]], [yB[i]], "o", ms=2.5, color=COLOURS["B"], zorder=3)
+    lo = min(float(np.nanmin(yB)), float(np.nanmin(yA)), 0.0) - 0.05
+    hi = max(float(np.nanmax(yA)), float(np.nanmax(yB))) + 0.05
+    xs = np.concatenate([xA, xB])
+    mid = 0.5 * (float(np.nanmin(xs)) + float(np.nanmax(xs)))
+    half = max(0.5 * (float(np.nanmax(xs)) - float(np.nanmin(xs))) + 0.05, 0.35 * (hi - lo))
+    if traj.scene.floor is not None:
+        ax.axhline(0.0, color="0.4", lw=1.0)
+        ax.axhspan(lo - 1.0, 0.0, color="0.88", zorder=0)
+    ax.set_xlim(mid - half, mid + half)
+    ax.set_ylim(lo, hi)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"in the plane, 0-{window:g} s\n(axis every 0.1 s, dark = later)", fontsize=8)
+
+
+def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
+    """Positions (and, in 2D, the motion in the plane), then the energy terms the scene has
+    in two panels (J): the centre of mass's (K_cm, U_g) with E and E_lost, and the internal
+    ones (K_int, or K_rot, K_vib, U_spring and K_spin)."""
+    plt = _pyplot()
+    cols = traj.columns
+    outer = [n for n in ("K_cm", "U_g", "E", "E_lost") if n in cols]
+    inner = [n for n in ("K_int", "K_rot", "K_vib", "U_spring", "K_spin") if n in cols]
+    fig = plt.figure(figsize=(10, 8.6))
+    wide = traj.scene.dimensions == 2
+    grid = fig.add_gridspec(3, 3 if wide else 1, height_ratios=[1.1, 1, 1])
+    top = fig.add_subplot(grid[0, :2] if wide else grid[0, 0])
+    _positions_panel(top, traj, window)
+    if wide:
+        _plane_panel(fig.add_subplot(grid[0, 2]), traj, window)
+    middle = fig.add_subplot(grid[1, :], sharex=top)
+    bottom = fig.add_subplot(grid[2, :], sharex=top)
+    _energy_panel(middle, traj, outer, window)
+    middle.set_title("centre of mass: K_cm and U_g trade on each parabola; " + (
+        "the floor takes energy out: E + E_lost stays at E(0)" if "E_lost" in cols
+        else "E stays constant"), fontsize=9)
+    if inner:
+        _energy_panel(bottom, traj, inner, window)
+        bottom.set_title("internal: the impacts feed the motion relative to the centre of mass",
+                         fontsize=9)
+    return _finish(fig, [top, middle, bottom], traj, window, Path(path),
+                   "how the energy is shared")
+
+
+def rotation_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
+    """Rotation preview: K_rot(t) of the spring dumbbell for k = 200, 2e3, 2e4 N/m beside
+    the rigid one (see :mod:`dumbbell.rotation`)."""
+    from .rotation import rotation_figure as draw
+
+    return draw(traj, path, window)
+
+
 #: Figure name (as in a scene's ``[outputs] figures``) -> drawing function.
 FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
     "positions": positions_figure,
     "kinetic": kinetic_figure,
     "potential": potential_figure,
+    "energy": energy_figure,
+    "rotation": rotation_figure,
 }

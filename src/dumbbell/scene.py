@@ -204,12 +204,10 @@ class _Checker:
             if default is None:
                 raise SceneError(f"{self.source}: {self.key(name)} is missing: {allowed}")
             return default
-        value = self.table[name]
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            self.fail(self.key(name), value, allowed)
-        value = float(value)
-        if not math.isfinite(value):
-            self.fail(self.key(name), value, allowed)
+        raw = self.table[name]
+        value = _finite(raw)
+        if value is None:
+            self.fail(self.key(name), raw, allowed)
         if lo is not None and (value < lo or (lo_open and value == lo)):
             self.fail(self.key(name), value, allowed)
         if hi is not None and value > hi:
@@ -268,8 +266,23 @@ class _Checker:
             )
 
 
+def _finite(value: Any) -> float | None:
+    """``value`` as a finite float, or None if it is not a finite number (a bool, a string, an
+    integer too large for a float, nan or inf)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:
+        return None
+    return number if math.isfinite(number) else None
+
+
 def _show(value: Any) -> str:
-    text = repr(value) if isinstance(value, str) else str(value)
+    try:
+        text = repr(value) if isinstance(value, str) else str(value)
+    except ValueError:  # an integer with more digits than Python will print
+        text = "a whole number too large to read"
     if isinstance(value, bool):
         text = "true" if value else "false"
     return text if len(text) <= 60 else text[:57] + "..."
@@ -292,14 +305,13 @@ def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
     value = c.table["velocity"]
     dotted = c.key("velocity")
     if dims == 1:
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        if _finite(value) is None:
             c.fail(dotted, value, "must be a finite number (m/s, upward) in a 1D scene")
         return 0.0, float(value)
     ok = (
         isinstance(value, list)
         and len(value) == 2
-        and all(not isinstance(v, bool) and isinstance(v, int | float) for v in value)
-        and all(math.isfinite(v) for v in value)
+        and all(_finite(v) is not None for v in value)
     )
     if not ok:
         c.fail(dotted, value, "must be a list of two finite numbers [vx, vy] (m/s) in a 2D scene")
@@ -366,6 +378,11 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
 
     B = _particle(cB, "B", dims, placed=False)
     A = _particle(cA, "A", dims, placed=tilt is not None)
+    M = A.mass + B.mass
+    if not (math.isfinite(M) and A.mass * B.mass / M > 0):
+        raise SceneError(f"{source}: bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
+                         f"{_show(B.mass)}: their total and reduced mass must be finite and "
+                         "> 0 (kg)")
     if tilt is not None:
         length = rigid.length if rigid else spring.rest_length  # type: ignore[union-attr]
         theta = math.radians(tilt)
@@ -472,7 +489,8 @@ def _parse_size(text: Any) -> tuple[int, int] | None:
     if not isinstance(text, str):
         return None
     parts = text.lower().split("x")
-    if len(parts) != 2 or not all(p.isdigit() for p in parts):
+    # ASCII digits only, and few: int() rejects other Unicode digits and huge strings.
+    if len(parts) != 2 or not all(p.isascii() and p.isdigit() and len(p) <= 6 for p in parts):
         return None
     w, h = int(parts[0]), int(parts[1])
     return (w, h) if 64 <= w <= 4096 and 64 <= h <= 4096 else None
@@ -502,8 +520,9 @@ def load_scene(path: str | Path) -> Scene:
         raise SceneError(f"{source}: cannot read: {exc.strerror}") from None
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source}: not valid TOML: {exc}") from None
+    except ValueError as exc:  # TOMLDecodeError, or an integer too long to convert
+        message = " ".join(str(exc).split())[:200]
+        raise SceneError(f"{source}: not valid TOML: {message}") from None
     return scene_from_dict(data, source=source)
 
 

@@ -25,6 +25,9 @@ REGISTRY: dict[str, str] = {
     "euler-cromer": "dumbbell.solvers.euler_cromer",
     "exact": "dumbbell.solvers.exact",
     "verlet": "dumbbell.solvers.verlet",
+    "pymunk": "dumbbell.solvers.engine",
+    "reference": "dumbbell.solvers.reference",
+    "euler-cromer-2d": "dumbbell.solvers.euler_cromer_2d",
 }
 assert set(REGISTRY) <= set(SOLVER_NAMES)
 

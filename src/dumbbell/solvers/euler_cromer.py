@@ -166,9 +166,9 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     elif status in (_TUNNEL_A, _TUNNEL_B):
         body = "A" if status == _TUNNEL_A else "B"
         c = 0 if body == "A" else 2
-        m = mA if body == "A" else mB
-        accel = g + abs(k * (st[0] - st[2] - b)) / m
-        traj.verdict = below_floor_verdict(traj, i * dt, body, st[c], st[c + 1], accel, dt)
+        f = k * (st[0] - st[2] - b)
+        push = f / mA if body == "A" else -f / mB  # the spring's downward pull on the body
+        traj.verdict = below_floor_verdict(traj, i * dt, body, st[c], st[c + 1], dt, push)
     else:
         traj.verdict = energy_verdict(traj, dt)
     return traj
