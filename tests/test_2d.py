@@ -121,7 +121,7 @@ def test_friction_loses_energy_and_the_partition_adds_up(friction):
 def test_rigid_k_rot_is_half_i_omega_squared(rigid):
     run = simulate(rigid, "pymunk", dt=1e-5, t_end=1.2, every=20)
     assert run.verdict.ok
-    I = 0.05 * 0.2**2  # noqa: E741  mu L^2
+    I = 0.05 * 0.2**2
     assert run.info["moment"] == pytest.approx(I)
     np.testing.assert_allclose(run["K_rot"], 0.5 * I * run.state["omega"] ** 2,
                                rtol=1e-9, atol=1e-15)
@@ -282,6 +282,13 @@ def test_no_floor_and_spin_columns():
         "run": {"t_end": 0.5, "dt": 1e-4}})
     run = simulate(scene, "pymunk", every=10)
     assert "K_spin" in run.columns and "E_lost" not in run.columns
-    I = 0.5 * 0.1 * 0.02**2  # noqa: E741
+    I = 0.5 * 0.1 * 0.02**2
     np.testing.assert_allclose(run["K_spin"], 0.5 * I * 9.0, rtol=1e-12)
     assert not run.events
+
+
+def test_rotation_figure_needs_a_2d_scene(textbook):
+    from dumbbell.errors import SceneError
+
+    with pytest.raises(SceneError, match="outputs.figures.*2D"):
+        textbook.with_values({"outputs.figures": ["rotation"]})

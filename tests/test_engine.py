@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from tests.conftest import SCENES, make_scene
 from dumbbell.cli import main
 from dumbbell.scene import load_scene
 from dumbbell.solvers import simulate
 from dumbbell.solvers.engine import DEFAULT_BIAS, DEFAULT_SLOP, build
+from tests.conftest import SCENES, make_scene
 
 pymunk = pytest.importorskip("pymunk")
 
@@ -70,7 +70,7 @@ def test_different_radii_each_meet_their_own_floor():
 def test_builds_only_what_the_scene_declares(textbook):
     full = build(textbook).space
     assert len(full.bodies) == 2 and len(full.constraints) == 1
-    spring = list(full.constraints)[0]
+    spring = next(iter(full.constraints))
     assert isinstance(spring, pymunk.DampedSpring)
     assert spring.damping == 0 and not spring.collide_bodies
     assert spring.stiffness == 200.0 and spring.rest_length == 0.2
@@ -93,7 +93,7 @@ def test_builds_only_what_the_scene_declares(textbook):
 
     rigid = build(load_scene(SCENES / "rigid-2d.toml"))
     assert len(rigid.space.bodies) == 1 and len(rigid.space.constraints) == 0
-    body = list(rigid.space.bodies)[0]
+    body = next(iter(rigid.space.bodies))
     assert body.moment == pytest.approx(0.05 * 0.2**2)  # mu L^2
     assert len([s for s in rigid.space.shapes if isinstance(s, pymunk.Circle)]) == 2
 

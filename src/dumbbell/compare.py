@@ -84,8 +84,8 @@ class Comparison:
                 "  verdict")
         lines = [f"{self.scene.title}  ({self.scene.source})",
                  f"truth: {self.truth_note}",
-                 f"position error: largest of either particle over [0, {self.window:g}] s "
-                 "(chaotic motion: later errors do not measure the method)",
+                 (f"position error: largest of either particle over [0, {self.window:g}] s "
+                 "(chaotic motion: later errors do not measure the method)"),
                  "", head, "-" * len(head)]
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
@@ -182,7 +182,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
     if truth_name is None:
         truth_dt = min(dts) / 10
         truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
-                         every=int(round(spacing / truth_dt)), quiet=quiet)
+                         every=round(spacing / truth_dt), quiet=quiet)
         truth_note = (f"pymunk at dt = {truth_dt:g} s (friction: no exact or reference "
                       "solution exists, so errors are against a ten times smaller step)")
     else:
@@ -198,7 +198,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
     rows = []
     for name in solvers:
         for dt in dts:
-            run = simulate(scene, name, dt=dt, t_end=t_end, every=int(round(spacing / dt)),
+            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
                            quiet=quiet)
             err = position_error(run, truth)
             inside = run.t[: len(err)] <= window + 1e-12
@@ -238,9 +238,8 @@ def write(result: Comparison, out: Path) -> list[Path]:
                                        for k in (f"{row.label}_t", f"{row.label}_diff")]
     with atomic_output(impacts) as tmp, open(tmp, "w") as fh:
         fh.write(",".join(keys) + "\n")
-        for rec in recs:
-            fh.write(",".join(repr(rec[k]) if isinstance(rec[k], float) else str(rec[k])
-                              for k in keys) + "\n")
+        fh.writelines(",".join(repr(rec[k]) if isinstance(rec[k], float) else str(rec[k])
+                              for k in keys) + "\n" for rec in recs)
     paths.append(impacts)
     errors = out / f"{stem}-compare-errors.csv"
     n = min(len(row.error) for row in result.rows) if result.rows else 0

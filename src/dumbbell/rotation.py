@@ -20,7 +20,6 @@ import copy
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -82,7 +81,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
     w_max = max(s.omega for s in scenes.values())
     dt = min(dt, 0.05 / w_max) if w_max > 0 else dt
     t_end = min(t_end, scene.run.t_end)
-    every = max(1, int(round(SAMPLE / dt)))
+    every = max(1, round(SAMPLE / dt))
     runs = {}
     for label, s in scenes.items():
         name = solver if solver_module(solver).supports(s) is None else "pymunk"
@@ -103,7 +102,7 @@ def _between_first_impacts(traj: Trajectory, name: str) -> float:
 
 def rotation_figure(traj: Trajectory, path: str | Path, window: float = 2.0) -> Path:
     """Draw the preview for ``traj``'s scene (2D) as PNG; returns the path."""
-    from .figures import COLOURS, _finish, _pyplot  # noqa: F401 (shared style)
+    from .figures import COLOURS, _pyplot
     from .files import atomic_output
 
     solver = traj.solver
@@ -131,7 +130,7 @@ def rotation_figure(traj: Trajectory, path: str | Path, window: float = 2.0) -> 
                     f"mean K_rot after 1st impact {_between_first_impacts(r, 'K_rot'):.2f} J\n"
                     f"(rigid: {_between_first_impacts(rigid, 'K_rot'):.2f} J)")
         else:
-            I = rigid.info.get("moment", r.scene.mu * r.scene.rigid.length**2)  # noqa: E741
+            I = rigid.info.get("moment", r.scene.mu * r.scene.rigid.length**2)
             ax.plot(r.t, r["K_rot"], color="black", lw=1.2,
                     label="K_rot = 1/2 mu |w x u|^2 (partition)")
             half = slice(None, None, max(1, len(r.t) // 120))

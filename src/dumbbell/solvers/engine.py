@@ -183,7 +183,7 @@ def build(scene: Scene) -> World:
 
 def _reader(scene: Scene, world: World) -> Any:
     """A function returning the state row (state_columns order, then spins) of the world."""
-    (bA, sA, _), (bB, sB, _) = world.points["A"], world.points["B"]
+    (bA, _sA, _), (bB, _sB, _) = world.points["A"], world.points["B"]
     spin = spins(scene)
     if world.rigid_body is not None:
         body = world.rigid_body
@@ -273,7 +273,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         while j < options.n_samples - 1 and verdict is None:
             j_stop = min(options.n_samples - 1, j + samples_per_chunk)
             while j < j_stop:
-                for i in range(j * every, (j + 1) * every):  # noqa: B007 (read by callbacks)
+                for i in range(j * every, (j + 1) * every):
                     step(dt)
                 j += 1
                 row = read()
@@ -293,7 +293,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                         break
             pb.update(min(j * every, n) - pb.n)
         if verdict is None:
-            for i in range(j * every, n):  # noqa: B007 (read by callbacks)
+            for i in range(j * every, n):
                 step(dt)
     wall = time.perf_counter() - t0
 

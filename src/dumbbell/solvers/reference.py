@@ -134,7 +134,7 @@ def rigid_moment(scene: Scene) -> float:
 def _rigid_model(scene: Scene) -> _Model:
     A, B = scene.A, scene.B
     M, g, L = scene.M, scene.g, scene.rigid.length  # type: ignore[union-attr]
-    I = rigid_moment(scene)  # noqa: E741
+    I = rigid_moment(scene)
     cA, cB = B.mass / M, A.mass / M  # rA = R + cA L u, rB = R - cB L u
     d = (A.x - B.x, A.height - B.height)
     w = (A.vx - B.vx, A.vy - B.vy)
