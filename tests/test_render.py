@@ -3,6 +3,7 @@ proportional to the energies, reproducible bytes, atomic writes and refused fram
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -200,3 +201,13 @@ def test_2d_drawing_keeps_the_aspect_ratio_and_follows_both_coordinates(tmp_path
     sy, _ = np.polyfit(traj["yA"][k], py, 1)
     assert sx > 50 and sy < 0
     assert abs(sx + sy) / sx < 0.03                  # 1 m is as long in x as in y
+
+
+def test_range_since_previous_frame_matches_brute_force():
+    from dumbbell.render import _since_previous
+
+    v = np.random.default_rng(1).random(50)
+    idx = np.array([0, 0, 3, 7, 7, 8, 20, 49])     # frames may share a sample
+    for ufunc, reduce in ((np.maximum, np.max), (np.minimum, np.min)):
+        expected = [v[0]] + [reduce(v[a:b + 1]) for a, b in itertools.pairwise(idx)]
+        assert np.array_equal(_since_previous(v, idx, ufunc), expected)

@@ -234,7 +234,8 @@ class Painter:
         avail_w = self.scene_w - ruler - round(30 * u)
         self.s = min(avail_h / (y1 - y0), avail_w / max(x1 - x0, 1e-9))  # px per m
         self.ox = ruler + round(8 * u) + avail_w / 2 - (x0 + x1) / 2 * self.s
-        self.oy = top + avail_h / 2 + (y0 + y1) / 2 * self.s
+        # World bottom on the panel's bottom: room left over (a wide world) goes to the sky.
+        self.oy = H - bottom + y0 * self.s
         self.world = (x0, x1, y0, y1)
         self.ruler_x = round(ruler - 4 * u)
         right = self.scene_w + round(10 * u)
@@ -356,11 +357,11 @@ class Painter:
                 d.line([(x, (sy1 - 4 * u) * S), (x, sy1 * S)], fill=GREY, width=S)
         # Each term: its range per pixel column as a pale band (terms that oscillate faster
         # than a column can show become bands), then a line for the terms that do not.
-        cols = np.floor(np.asarray([self.strip_x(t) for t in fr.series_t]) * S).astype(int)
+        cols = np.floor(self.strip_x(fr.series_t) * S).astype(int)
         width = max(1, round(1.3 * u * S))
         lines = []
         for name in [n for n in self.names if n != "E"] + ["E"]:
-            ys = np.asarray([self.strip_y(v) for v in fr.series[name]]) * S
+            ys = self.strip_y(fr.series[name]) * S
             ok = np.isfinite(ys)
             if ok.sum() < 2:
                 continue
@@ -369,23 +370,24 @@ class Painter:
             top = np.minimum.reduceat(y, starts)
             bot = np.maximum.reduceat(y, starts)
             if np.median(bot - top) > 3 * S:
-                band = Image.new("L", img.size, 0)
+                ox, oy = sx0 * S, sy0 * S
+                band = Image.new("L", ((sx1 - sx0) * S, (sy1 - sy0) * S), 0)
                 db = ImageDraw.Draw(band)
                 for x, a, b in zip(c[starts].tolist(), top.tolist(), bot.tolist(), strict=True):
-                    db.line([(x, a), (x, b)], fill=255, width=1)
-                img.paste(_blend(TERM_RGB.get(name, GREY), 0.45), (0, 0), band)
+                    db.line([(x - ox, a - oy), (x - ox, b - oy)], fill=255, width=1)
+                img.paste(_blend(TERM_RGB.get(name, GREY), 0.45), (ox, oy), band)
             else:
                 lines.append((name, list(zip(cols[ok].tolist(), y.tolist(), strict=True))))
         for name, pts in lines:
             d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
 
-    def strip_x(self, t: float) -> float:
-        """Pixel x of time ``t`` (s) in the strip."""
+    def strip_x(self, t):
+        """Pixel x of time ``t`` (s, a float or an array) in the strip."""
         sx0, _, sx1, _ = self.strip_box
         return sx0 + 1 + (sx1 - sx0 - 2) * t / self.frames.t_end
 
-    def strip_y(self, value: float) -> float:
-        """Pixel y of energy ``value`` (J) in the strip."""
+    def strip_y(self, value):
+        """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
         _, sy0, _, sy1 = self.strip_box
         pad = 4 * self.u
         return sy1 - pad - (sy1 - sy0 - 2 * pad) * (value - self.e_lo) / (self.e_hi - self.e_lo)
@@ -432,10 +434,14 @@ class Painter:
         m = max(ra, rb, amp) + (18 if two_d else 8) * u
         impact = k in self.impact_frames and sc.floor is not None
         mx = m + (34 * u if two_d else 0)
-        box = (math.floor(min(pa[0], pb[0]) - mx - (12 * u if impact else 0)),
-               math.floor(min(pa[1], pb[1]) - mx),
-               math.ceil(max(pa[0], pb[0]) + mx + 16 * u),
-               math.ceil(max(pa[1], pb[1]) + m + (20 * u if impact else 0)))
+        x0, x1 = min(pa[0], pb[0]) - mx, max(pa[0], pb[0]) + mx + 16 * u
+        y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + m
+        if impact:  # the mark on the floor and the word under it
+            fy = self.px(0.0, 0.0)[1]
+            low = pa if pa[1] > pb[1] else pb
+            x0, x1 = min(x0, low[0] - 30 * u), max(x1, low[0] + 30 * u)
+            y1 = max(y1, fy + 20 * u)
+        box = (math.floor(x0), math.floor(y0), math.ceil(x1), math.ceil(y1))
         crop, (cx, cy), done = self._patch(img, box, SS)
         d = ImageDraw.Draw(crop)
 

@@ -25,15 +25,17 @@ import io
 import itertools
 import math
 import time
-from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import UsageError
 from .files import atomic_output
 from .trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from .drawing import Frames
 
 #: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
 MAX_FPS = 50
@@ -86,7 +88,7 @@ def sample_every(dt: float, fps: int, t_end: float) -> int:
     return max(fitting) if fitting else 1
 
 
-def _frames(traj: Trajectory, fps: int, t_end: float):
+def _frames(traj: Trajectory, fps: int, t_end: float) -> Frames:
     """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
     from .drawing import Frames
 
@@ -108,9 +110,8 @@ def _frames(traj: Trajectory, fps: int, t_end: float):
         B = np.column_stack([traj["xB"], traj["yB"]])
     energy = traj.energy
     # Least and largest value of each term from the previous frame's sample to this one's.
-    starts = np.concatenate([idx[:1], idx[:-1]])
-    lo = {k: _range(v, starts, idx, np.min) for k, v in energy.items()}
-    hi = {k: _range(v, starts, idx, np.max) for k, v in energy.items()}
+    lo = {k: _since_previous(v, idx, np.minimum) for k, v in energy.items()}
+    hi = {k: _since_previous(v, idx, np.maximum) for k, v in energy.items()}
     # The animation lasts len(ft)/fps s; the strip shows the samples of that window.
     window = min(len(ft) / fps, float(t[-1]))
     keep = t <= window + 1e-12
@@ -121,9 +122,14 @@ def _frames(traj: Trajectory, fps: int, t_end: float):
     )
 
 
-def _range(values: np.ndarray, starts: np.ndarray, stops: np.ndarray, reduce) -> np.ndarray:
-    """``reduce`` over values[starts[k]:stops[k] + 1] for each k (NaN-safe)."""
-    return np.array([reduce(values[a:b + 1]) for a, b in zip(starts, stops, strict=True)])
+def _since_previous(values: np.ndarray, idx: np.ndarray, ufunc: np.ufunc) -> np.ndarray:
+    """For each frame k, ``ufunc`` (np.minimum or np.maximum) over the samples from frame
+    k-1's index to frame k's, both included (frame 0: its own sample); ``idx`` non-decreasing."""
+    v = values[: idx[-1] + 1]
+    segments = ufunc.reduceat(v, idx)   # over idx[j] .. idx[j+1] - 1
+    out = v[idx].copy()
+    out[1:] = ufunc(segments[:-1], v[idx[1:]])
+    return out
 
 
 def render_gif(
@@ -249,12 +255,3 @@ def _skip_blocks(data: bytes, pos: int) -> int:
     while data[pos]:
         pos += data[pos] + 1
     return pos + 1
-
-
-def iter_frames(path: str | Path) -> Iterator[Any]:
-    """The frames of a GIF as RGB images (for tests and checks)."""
-    from PIL import Image, ImageSequence
-
-    with Image.open(path) as im:
-        for frame in ImageSequence.Iterator(im):
-            yield frame.convert("RGB")

@@ -27,8 +27,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="FILE.gif",
                    help="GIF to write (default: renders/<scene>.gif)")
     p.add_argument("--fps", metavar="N", type=_whole,
-                   help="frames per second, 1 to 50; each frame lasts 1000/fps ms, in 10 ms "
-                        "units (default 25)")
+                   help="frames per second, 1 to 50 (default 25). GIF delays are whole "
+                        "10 ms units: at 25 fps every frame lasts 40 ms; when 100/fps is not "
+                        "whole (30 fps) delays alternate (30, 40, 30 ms) to keep real time")
     p.add_argument("--size", metavar="WxH", help="width x height in pixels (default 640x360)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="length of the animation in s (default: the scene's run.t_end)")
