@@ -134,8 +134,9 @@ def _toml_value(value) -> str:
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):
-        return {math.inf: "inf", -math.inf: "-inf"}.get(value, "nan" if value != value
-                                                         else repr(value))
+        if math.isnan(value):
+            return "nan"
+        return {math.inf: "inf", -math.inf: "-inf"}.get(value, repr(value))
     if isinstance(value, str):
         return json.dumps(value)  # JSON strings are TOML basic strings
     if isinstance(value, list):

@@ -319,7 +319,7 @@ class SweepResult:
 
         plt = _pyplot()
         fig, ax = plt.subplots(figsize=(8.2, 6.2) if len(self.axes) == 2 else (8.2, 4.6))
-        title = (f"{self.scene.title}: {self.solver}, t_end = {self.t_end:g} s, "
+        title = (f"Sweep of {self.scene.name}: {self.solver}, t_end = {self.t_end:g} s, "
                  f"{len(self.rows)} runs")
         if len(self.axes) == 2:
             draw_map(fig, ax, self.axes[0], self.axes[1], self.rows, title)

@@ -1,0 +1,184 @@
+"""Verdicts on stiff and extreme scenes, against the theory: explicit spring steps are stable
+iff w*dt < 2 (w = sqrt(k/mu)); pymunk lets a fast particle tunnel through the floor; an
+inelastic floor brings a flip-rule solver to a stop with a verdict, not a hang."""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+import shutil
+
+import numpy as np
+import pytest
+
+from dumbbell.cli import main
+from dumbbell.scene import load_scene
+from dumbbell.solvers import REGISTRY, simulate
+from dumbbell.solvers.verdicts import seconds, stable_swing
+from dumbbell.stability import find_cases, plan_cases, predict, rest_time
+from tests.conftest import SCENES, make_scene
+
+EXTREME = SCENES / "extreme"
+#: Solvers whose spring is an explicit step; each is tested once it is registered.
+STEPPERS = ["euler-cromer", "pymunk", "verlet"]
+
+
+def _need(solver: str) -> None:
+    if solver not in REGISTRY:
+        pytest.skip(f"solver {solver} is not registered yet")
+
+
+def _stiff(ratio: float, w_dt: float):
+    """The stiff no-floor case with mB/mA = ratio and dt set so that w*dt is ``w_dt``."""
+    base = load_scene(EXTREME / "stiff-wdt-1.9.toml")
+    mA = base.B.mass / ratio
+    scene = base.with_values({"bodies.A.mass": mA})
+    return scene.with_values({"run.dt": w_dt / scene.omega, "run.t_end": 400 * w_dt /
+                              scene.omega})
+
+
+@pytest.mark.parametrize("ratio", [1.0, 100.0])
+@pytest.mark.parametrize("solver", STEPPERS)
+def test_verdict_flips_between_wdt_1_9_and_2_1(solver, ratio):
+    _need(solver)
+    stable = simulate(_stiff(ratio, 1.9), solver)
+    assert stable.verdict.status == "ok", stable.verdict
+    assert len(stable.t) == 401 and np.isfinite(stable["E"]).all()
+
+    scene = _stiff(ratio, 2.1)
+    blown = simulate(scene, solver)
+    v = blown.verdict
+    assert v.status == "unstable"
+    # Stopped early, samples kept up to the failure, all of them finite.
+    assert 0 < v.t < scene.run.t_end and len(blown.t) < 401
+    assert blown.t[-1] <= v.t + 1e-12
+    assert all(np.isfinite(col).all() for col in blown.state.values())
+    limit = 2.0 / scene.omega
+    assert "w*dt = 2.10 > 2" in v.reason and f"use dt < {seconds(limit)} s" in v.reason
+    assert re.fullmatch(r"unstable at t = [0-9.e-]+ s: w\*dt = 2\.10 > 2 .*", str(v))
+
+
+def test_the_stable_swing_is_the_theory_bound():
+    """At w*dt = h < 2 Euler-Cromer's energy swings by up to h/(2-h) of the vibration energy,
+    without growing: measured here from the stretched spring at rest."""
+    for h in (1.0, 1.5, 1.9):
+        traj = simulate(_stiff(1.0, h), "euler-cromer")
+        E = traj["E"]
+        swing = float(np.max(np.abs(E - E[0])) / E[0])
+        assert swing == pytest.approx(stable_swing(h), rel=2e-3)
+
+
+def test_default_threshold_names_the_swing_when_it_calls_a_stable_step_unstable():
+    scene = _stiff(1.0, 1.9).with_values({"run.unstable_energy": 10.0})
+    v = simulate(scene, "euler-cromer").verdict
+    assert v.status == "unstable" and "w*dt = 1.90 < 2" in v.reason and "19" in v.reason
+
+
+@pytest.mark.parametrize("solver,status", [("pymunk", "tunnelled"), ("exact", "ok"),
+                                           ("euler-cromer", "ok")])
+def test_high_drop_tunnels_only_in_pymunk(solver, status):
+    _need(solver)
+    scene = load_scene(EXTREME / "high-drop.toml")
+    traj = simulate(scene, solver)
+    assert traj.verdict.status == status, traj.verdict
+    fall = math.sqrt(2 * scene.B.height / scene.g)
+    if status == "tunnelled":
+        # It goes through at the first impact, and the run stops there.
+        assert fall <= traj.verdict.t <= fall + 3 * scene.run.dt
+        assert traj.t[-1] <= traj.verdict.t + 1e-12
+        assert "below the floor" in traj.verdict.reason
+    else:
+        assert traj.first_impact("B").t == pytest.approx(fall, abs=scene.run.dt)
+    assert predict(scene, solver, scene.run.dt, scene.run.t_end).status == status
+
+
+def test_inelastic_floor_ends_with_failed_not_tunnelled():
+    """The textbook's flip rule cannot hold a particle at rest: a clear 'failed', near the
+    time a point mass would come to rest, with the samples before it kept."""
+    scene = make_scene({"floor.elasticity": 0.8, "run.t_end": 6.0, "run.dt": 1e-4})
+    for solver in ("euler-cromer", "exact"):
+        traj = simulate(scene, solver, every=10)
+        v = traj.verdict
+        assert v.status == "failed" and ("came to rest" in v.reason or "stays on the floor" in v.reason)
+        assert 0.6 * rest_time(scene) < v.t < 1.1 * rest_time(scene)
+        assert traj.t[-1] <= v.t + 1e-12
+
+
+def test_long_horizon_drain_is_named():
+    """Over 1000 s at dt = 1e-4 s the textbook's impacts drain the elastic dumbbell's energy
+    until B rests on the floor: a 'failed' verdict that says so, not a false 'tunnelled'."""
+    scene = load_scene(EXTREME / "long-horizon.toml")
+    traj = simulate(scene, "euler-cromer")
+    v = traj.verdict
+    assert v.status == "failed" and "drained the energy" in v.reason
+    assert 500 < v.t < scene.run.t_end
+    E = traj["E"]
+    assert E[-1] < 0.5 * E[0]  # the drain the message reports is real
+    assert predict(scene, "euler-cromer", scene.run.dt, scene.run.t_end).status == "ok"
+
+
+def test_predictions_of_the_catalogue():
+    expect = {"stiff-wdt-1.9": "ok", "stiff-wdt-2.1": "unstable", "high-drop": "tunnelled",
+              "inelastic-floor": "failed"}
+    for name, status in expect.items():
+        scene = load_scene(EXTREME / f"{name}.toml")
+        solver = "pymunk" if name == "high-drop" else "euler-cromer"
+        assert predict(scene, solver, scene.run.dt, scene.run.t_end).status == status
+        assert predict(scene, "exact", scene.run.dt, scene.run.t_end).status == (
+            "failed" if name == "inelastic-floor" else "ok")
+
+
+def test_every_catalogue_scene_loads_and_says_what_it_tests():
+    paths = find_cases(EXTREME)
+    assert len(paths) >= 12
+    for path in paths:
+        scene = load_scene(path)
+        assert path.read_text().startswith("# Tests:"), path.name
+        assert scene.title
+    runs, _ = plan_cases(paths, None)
+    assert {s for _, s in runs} >= {"euler-cromer", "exact"}
+
+
+def test_stability_command_writes_table_csv_and_map(tmp_path, capsys):
+    cases = tmp_path / "cases"
+    cases.mkdir()
+    for name in ("stiff-wdt-1.9", "stiff-wdt-2.1", "inelastic-floor"):
+        shutil.copy(EXTREME / f"{name}.toml", cases)
+    out = tmp_path / "out"
+    assert main(["stability", "--cases", str(cases), "--solvers", "euler-cromer", "exact",
+                 "--out", str(out), "--workers", "1", "-q"]) == 0
+    rows = list(csv.DictReader((out / "stability.csv").open()))
+    assert len(rows) == 6
+    got = {(r["case"], r["solver"]): r for r in rows}
+    assert got[("stiff-wdt-2.1", "euler-cromer")]["verdict"] == "unstable"
+    assert float(got[("stiff-wdt-2.1", "euler-cromer")]["t_fail"]) < 0.05
+    assert got[("stiff-wdt-1.9", "euler-cromer")]["verdict"] == "ok"
+    assert float(got[("stiff-wdt-1.9", "euler-cromer")]["max_rel_energy_error"]) == (
+        pytest.approx(19, rel=0.01))
+    assert float(got[("stiff-wdt-2.1", "exact")]["max_rel_energy_error"]) < 1e-12
+    assert all(r["agreement"] == "agrees" for r in rows)
+    table = (out / "stability.md").read_text()
+    assert table.startswith("| case |") and "w*dt = 2.10 > 2" in table
+    assert (out / "stability-map.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(out.glob(".*part*"))
+
+
+@pytest.mark.parametrize("flags,word", [
+    (["--cases", "/nonexistent/dir"], "--cases"),
+    (["--solvers", "nope"], "nope"),
+    (["--workers", "0"], "--workers"),
+])
+def test_stability_bad_flags(tmp_path, capsys, flags, word):
+    out = tmp_path / "out"
+    assert _exit(["stability", *flags, "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err
+    assert not out.exists()
+
+
+def _exit(argv: list[str]) -> int:
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return int(exc.code)
