@@ -82,14 +82,36 @@ def build_parser() -> Parser:
     return parser
 
 
+#: Output flags every command may have: argparse dest -> (flag, names a folder).
+OUTPUT_FLAGS = {"out": ("--out", True), "output": ("--output", False),
+                "events": ("--events", False)}
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Refuse output paths that cannot be written before any work is done (UsageError)."""
+    from .files import check_writable
+
+    for dest, (flag, folder) in OUTPUT_FLAGS.items():
+        value = getattr(args, dest, None)
+        if isinstance(value, str) and value:
+            check_writable(value, flag, folder)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        _check_outputs(args)
         return int(args.func(args) or 0)
     except DumbbellError as exc:
         sys.stderr.write(f"dumbbell {args.command}: error: {exc}\n")
+        return EXIT_USAGE
+    except OSError as exc:
+        # Backstop: an output that still cannot be written is one line, not a traceback.
+        where = exc.filename or "an output file"
+        sys.stderr.write(f"dumbbell {args.command}: error: cannot write {where}: "
+                         f"{exc.strerror or exc}\n")
         return EXIT_USAGE
     except KeyboardInterrupt:
         sys.stderr.write(f"dumbbell {args.command}: interrupted; no partial output was kept\n")

@@ -35,3 +35,23 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def check_writable(path: str | Path, flag: str, folder: bool = False) -> None:
+    """Raise UsageError naming ``flag`` unless ``path`` (a folder if ``folder``, else a file)
+    could be created or replaced: called before any work, so nothing is half written."""
+    from .errors import UsageError
+
+    path = Path(path)
+    if folder and path.exists() and not path.is_dir():
+        raise UsageError(f"{flag} {path}: exists and is not a folder")
+    if not folder and path.is_dir():
+        raise UsageError(f"{flag} {path}: is a folder; give a file name")
+    here = path if folder else path.parent
+    here = here if str(here) else Path(".")
+    while not here.exists() and here != here.parent:
+        here = here.parent
+    if not here.is_dir():
+        raise UsageError(f"{flag} {path}: {here} is a file, not a folder")
+    if not os.access(here, os.W_OK | os.X_OK):
+        raise UsageError(f"{flag} {path}: cannot write in {here} (permission denied)")

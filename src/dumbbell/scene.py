@@ -450,6 +450,8 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
             value = co.table["figures"]
             if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
                 co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+            if "rotation" in value and dims != 2:
+                co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
             figures = tuple(value)
         csv = bool(co.boolean("csv", False))
         cgif = co.sub("gif")

@@ -93,18 +93,24 @@ def below_floor_verdict(
     moving down at ``speed`` (m/s) although the floor should have turned it back. ``push`` is
     the spring's downward acceleration on it (m/s^2), ``depth`` as in :func:`tunnel_reason`.
 
-    Moving down no faster than a few steps of gravity, it has come to rest on the floor, which
-    a velocity-flip rule cannot hold: ``failed``, saying how much energy was left. Otherwise it
-    went through: ``tunnelled``."""
+    Moving down no faster than a few steps of gravity plus the spring's push give, it is held
+    on the floor (at rest, or pressed by the other particle), which a velocity-flip rule
+    cannot do: ``failed``, saying how much energy was left. Otherwise it went through:
+    ``tunnelled``."""
     scene = traj.scene
-    if abs(speed) <= 3.0 * scene.g * dt:
-        reason = (f"{body} came to rest on the floor ({abs(height):.2g} m below it, moving at "
-                  f"{abs(speed):.2g} m/s): a velocity-flip floor cannot hold a particle at rest")
+    pressed = max(push, 0.0)
+    if abs(speed) <= 3.0 * (scene.g + pressed) * dt:
+        how = (f"pressed onto it by the spring at {pressed:.3g} m/s^2" if pressed > scene.g
+               else "at rest on it")
+        reason = (f"{body} stays on the floor, {how} ({abs(height):.2g} m below it, moving at "
+                  f"{abs(speed):.2g} m/s): a velocity-flip floor cannot hold a particle in "
+                  "lasting contact")
         if len(traj.t) and scene.floor is not None and scene.floor.elasticity >= 1.0:
             E = traj["E"]
             left = float(E[-1] / E[0]) if E[0] else math.nan
-            reason += (f"; the floor is elastic, so the step's impact errors drained the "
-                       f"energy to {left:.0%} of its start: use a smaller dt")
+            if left < 0.5:
+                reason += (f"; the floor is elastic, so the step's impact errors drained the "
+                           f"energy to {left:.0%} of its start: use a smaller dt")
         return Verdict("failed", t, reason)
     reason = tunnel_reason(scene, body, height, speed, dt, depth)
     if push > scene.g:
