@@ -211,3 +211,52 @@ def test_range_since_previous_frame_matches_brute_force():
     for ufunc, reduce in ((np.maximum, np.max), (np.minimum, np.min)):
         expected = [v[0]] + [reduce(v[a:b + 1]) for a, b in itertools.pairwise(idx)]
         assert np.array_equal(_since_previous(v, idx, ufunc), expected)
+
+
+def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
+    """Index 255 marks 'unchanged' (transparent) in the GIF: a drawn pixel with it would show
+    the previous frame's colour instead."""
+    from dumbbell.drawing import palette
+    from dumbbell.render import _frames
+
+    frames = _frames(short, 25, 1.0)
+    painter = Painter(short.scene, frames, (320, 180), True)
+    clear = palette()[1]
+    assert all(clear not in np.asarray(painter.frame(k)) for k in range(len(frames.t)))
+
+
+def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook):
+    """Over 2 s the strip shows a window of drawing.WINDOW s: the cursor walks in, then stays
+    put while the curves scroll under it, and in every frame the U_g curve just left of the
+    cursor is drawn at U_g of that column's time (so the window's time axis is right)."""
+    from dumbbell import drawing
+    from dumbbell.render import _frames
+
+    traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
+    frames = _frames(traj, 25, 2.0)
+    painter = Painter(textbook, frames, (640, 360), True)
+    assert painter.window == drawing.WINDOW < 2.0
+    sx0, sy0, sx1, sy1 = painter.strip_box
+    ink, brown = np.array(drawing.INK), np.array(TERM_RGB["U_g"])
+    cursors = []
+    for k in range(0, len(frames.t), 3):
+        rgb = np.asarray(painter.frame(k).convert("RGB"))
+        box = rgb[sy0 + 1:sy1, sx0 + 1:sx1]
+        cols = np.flatnonzero(np.all(box == ink, axis=2).sum(axis=0) > 0.8 * box.shape[0])
+        assert len(cols) > 0
+        cursor = sx0 + 1 + int(cols.min())
+        cursors.append((float(frames.t[k]), cursor))
+        # The column 6 px left of the cursor shows the time 6 px earlier.
+        x = cursor - 6
+        t = float(frames.t[k]) - (cursor - x) / painter.px_per_s
+        if t < 0.05:
+            continue
+        rows = np.flatnonzero(np.all(rgb[sy0 + 1:sy1, x] == brown, axis=1)) + sy0 + 1
+        assert len(rows) > 0
+        expected = painter.strip_y(float(np.interp(t, traj.t, traj["U_g"])))
+        assert abs(rows.mean() + 0.5 - expected) < 2.0, (t, rows, expected)
+    walk = [(t, c) for t, c in cursors if t <= 0.7]
+    still = {c for t, c in cursors if t >= 0.8 and t <= 2.0 - drawing.AHEAD - 0.05}
+    slope = np.polyfit(*zip(*walk), 1)[0]
+    assert abs(slope - painter.px_per_s) < 0.02 * painter.px_per_s   # walks at the strip's scale
+    assert len(still) == 1                                             # then stays put

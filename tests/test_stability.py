@@ -4,6 +4,7 @@ inelastic floor brings a flip-rule solver to a stop with a verdict, not a hang."
 
 from __future__ import annotations
 
+import copy
 import csv
 import math
 import re
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from dumbbell.cli import main
-from dumbbell.scene import load_scene
+from dumbbell.scene import load_scene, scene_from_dict
 from dumbbell.solvers import REGISTRY, simulate
 from dumbbell.solvers.verdicts import seconds, stable_swing
 from dumbbell.stability import find_cases, plan_cases, predict, rest_time
@@ -182,3 +183,28 @@ def _exit(argv: list[str]) -> int:
         return main(argv)
     except SystemExit as exc:
         return int(exc.code)
+
+
+@pytest.mark.parametrize("solver", sorted(REGISTRY))
+def test_every_solver_ends_a_blow_up_with_a_verdict(solver):
+    """Every registered solver, on the stiff case in 1D or 2D (whichever it runs) at
+    w*dt = 2.1: a time-stepper stops early with 'unstable', keeping only finite samples up to
+    the failure; a solver without a step limit stays ok."""
+    from dumbbell.solvers import solver_module
+
+    one_d = _stiff(1.0, 2.1).with_values({"run.t_end": 100 * 2.1e-3})
+    raw = copy.deepcopy(one_d.raw)
+    del raw["bodies"]["A"]["height"]
+    two_d = scene_from_dict({**raw, "dimensions": 2, "tilt": 30.0}, source="stiff-2d.toml")
+    scene = next((s for s in (one_d, two_d) if solver_module(solver).supports(s) is None),
+                 None)
+    if scene is None:
+        pytest.skip(f"{solver} runs neither the 1D nor the 2D stiff case")
+    traj = simulate(scene, solver)
+    v = traj.verdict
+    if solver in ("exact", "reference"):
+        assert v.ok, v
+        return
+    assert v.status == "unstable" and "w*dt = 2.10 > 2" in v.reason, v
+    assert len(traj.t) < 101 and traj.t[-1] <= v.t + 1e-12
+    assert all(np.isfinite(col).all() for col in traj.state.values())

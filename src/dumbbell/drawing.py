@@ -2,16 +2,17 @@
 
 A frame is the scene (floor, height ruler, particles at their true radius, the spring as a
 zig-zag with a constant number of coils or a rigid rod, the centre of mass, the time and, in
-2D, the axis angle from vertical), an energy panel (one bar per energy column, a stacked bar
-for E with a marker at the total, one fixed scale for the whole animation) and optionally a
-strip of the energy time series with a moving cursor.
+2D, the axis angle from vertical), an energy panel (one bar per energy column with a pale bar
+behind it up to the largest value since the previous frame, a stacked bar for E with a marker
+at the total, one fixed scale for the whole animation) and optionally a strip of the energy
+time series with a moving cursor.
 
 Why a fixed palette: quantizing every RGB frame to 256 colours costs more than drawing it.
 Everything static is drawn once (at twice the size, then halved, so edges are smooth) and
 mapped to the palette once. Per frame only the dumbbell and the changing texts are drawn in
 RGB (the dumbbell at twice the size) on small crops of the background and mapped to the palette
-(fast: the palette holds the blends of every ink with white); bars and the cursor are drawn
-straight into the palette image.
+(fast: the palette holds the blends of every ink with white); numbers are pasted from cached
+glyph masks; bars and the cursor are drawn straight into the palette image.
 
 The world-to-pixel mapping is fixed for the whole animation (from the extents of the
 trajectory in the rendered window) and keeps the aspect ratio: 1 m is as long in x as in y.
@@ -38,6 +39,19 @@ SS = 2
 COILS = 9
 #: Smallest drawn particle radius (px); smaller particles are drawn as markers of this size.
 MIN_RADIUS_PX = 3.5
+#: Radius of the centre-of-mass symbol (px at 640x360); the spring's zig-zag is wider.
+CM_RADIUS = 3.0
+#: Least distance (px at 640x360) of the 2D particle labels from the centre of mass: beyond
+#: the angle's arc (radius 20) and vertical line (25) with room for the letter.
+LABEL_CLEAR = 32.0
+#: Seconds of the energy time series the strip shows at once. The textbook spring's energy
+#: terms oscillate at 20 Hz: over 1 s and ~390 px each oscillation is ~20 px wide and reads
+#: as a line (over 2 s they merge into a hatched band; over the whole run, a pale band).
+WINDOW = 1.0
+#: Fraction of the strip's window after the cursor (what comes next).
+AHEAD = 0.25
+#: Width (px) of the pieces the strip's tape is drawn in.
+TAPE_CHUNK = 1024
 
 WHITE = (255, 255, 255)
 BLACK = (0, 0, 0)
@@ -201,6 +215,9 @@ class Painter:
         self.st_note = Stamps(font(max(8, round(11 * u))))
         self._layout()
         self._energy_scale()
+        if strip:
+            self._strip_window()
+            self.tape = self._tape()
         self.bg = self._background()
         self.bg_rgb = self.bg.convert("RGB")
         self.bg_ss = self.bg_rgb.resize((self.W * SS, self.H * SS), Image.Resampling.NEAREST)
@@ -333,58 +350,115 @@ class Painter:
         d.line([(zx, (rows[0][1] - 3) * S), (zx, (rows[-1][2] + 3) * S)], fill=GREY, width=S)
 
     def _strip_static(self, img: Image.Image, d: ImageDraw.ImageDraw, S: int, fs) -> None:
+        """The parts of the strip that do not scroll: the frame (one crisp pixel on each side),
+        the energy ticks and the axis names. The rest is pasted from the tape every frame."""
         u = self.u
         sx0, sy0, sx1, sy1 = self.strip_box
-        fr = self.frames
-        d.rectangle([sx0 * S, sy0 * S, sx1 * S, sy1 * S], outline=LIGHT, width=S)
-        step = _nice_step((self.e_hi - self.e_lo) / 2)
-        for k in range(math.ceil(self.e_lo / step - 1e-9), math.floor(self.e_hi / step + 1e-9) + 1):
-            y = self.strip_y(k * step)
-            d.line([(sx0 * S, y * S), (sx1 * S, y * S)], fill=(238, 238, 238), width=S)
-            d.text(((sx0 - 4 * u) * S, y * S), _fmt_tick(k * step), font=fs, fill=GREY,
-                   anchor="rm")
+        d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
+        for v in self._energy_ticks():
+            y = self.strip_y(v)
+            d.text(((sx0 - 4 * u) * S, y * S), _fmt_tick(v), font=fs, fill=GREY, anchor="rm")
         d.text(((sx0 - 4 * u) * S, (sy0 - 4 * u) * S), "J", font=fs, fill=GREY, anchor="rs")
-        tstep = _nice_step(fr.t_end / 5)
-        for k in range(math.floor(fr.t_end / tstep + 1e-9) + 1):
-            x = self.strip_x(k * tstep)
-            d.line([(x * S, sy1 * S), (x * S, (sy1 + 3 * u) * S)], fill=GREY, width=S)
-            d.text((x * S, (sy1 + 4 * u) * S), _fmt_tick(k * tstep), font=fs, fill=GREY,
-                   anchor="mt")
         d.text(((sx0 - 4 * u) * S, (sy1 + 4 * u) * S), "t (s)", font=fs, fill=GREY, anchor="rt")
-        for ti in fr.impacts:
-            if ti <= fr.t_end:
-                x = self.strip_x(ti) * S
-                d.line([(x, (sy1 - 4 * u) * S), (x, sy1 * S)], fill=GREY, width=S)
-        # Each term: its range per pixel column as a pale band (terms that oscillate faster
-        # than a column can show become bands), then a line for the terms that do not.
-        cols = np.floor(self.strip_x(fr.series_t) * S).astype(int)
-        width = max(1, round(1.3 * u * S))
-        lines = []
-        for name in [n for n in self.names if n != "E"] + ["E"]:
-            ys = self.strip_y(fr.series[name]) * S
+
+    def _energy_ticks(self) -> list[float]:
+        step = _nice_step((self.e_hi - self.e_lo) / 2)
+        lo, hi = math.ceil(self.e_lo / step - 1e-9), math.floor(self.e_hi / step + 1e-9)
+        return [k * step for k in range(lo, hi + 1)]
+
+    def _strip_window(self) -> None:
+        """Time scale of the strip: it shows :data:`WINDOW` s (the whole animation when
+        shorter), :data:`AHEAD` of it after the cursor, and scrolls with the cursor."""
+        sx0, sy0, sx1, sy1 = self.strip_box
+        self.inner_x, self.inner_w = sx0 + 1, sx1 - sx0 - 1    # inside the frame (px)
+        self.tick_len = max(2, round(3 * self.u))
+        self.tape_y, self.tape_h = sy0 + 1, sy1 + self.tick_len - sy0
+        t_end = self.frames.t_end
+        self.window = min(WINDOW, t_end)
+        self.px_per_s = (self.inner_w - 1) / self.window
+        self.tape_w = max(self.inner_w, math.ceil(t_end * self.px_per_s) + 1)
+        self.cursor_px = round((1 - AHEAD) * (self.inner_w - 1)) if self.window < t_end else 0
+        self.t_step = _nice_step(self.window / 5)
+
+    def _tape(self) -> Image.Image:
+        """The energy time series of the whole animation on one long palette image at the
+        strip's time scale (grid, bottom edge, time and impact ticks included); each frame
+        pastes the window it shows. Drawn in pieces so long runs need little memory.
+
+        Drawn without supersampling, unlike the rest: the strip scrolls, so its every line
+        pixel is encoded again in every frame, and smooth edges make those pixels cost ~60 %
+        more bytes (the textbook GIF would exceed 2 MB)."""
+        fr, u, S = self.frames, self.u, 1
+        p, h = self.px_per_s, self.tape_h
+        tape = Image.new("P", (self.tape_w, h))
+        y_of = [(self.strip_y(v) - self.tape_y) * S for v in self._energy_ticks()]
+        edge = (self.strip_box[3] - self.tape_y) * S
+        ticks = [k * self.t_step for k in range(math.floor(fr.t_end / self.t_step + 1e-9) + 1)]
+        impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
+        # Terms whose range per pixel column is mostly wider than 3 px (faster than a column
+        # can show) are drawn as pale bands of that range; the others as lines; E on top.
+        order = [n for n in self.names if n != "E"] + ["E"]
+        t = fr.series_t
+        cols_all = np.floor(t * p * S).astype(np.int64)
+        series, band = {}, {}
+        for name in order:
+            ys = (self.strip_y(fr.series[name]) - self.tape_y) * S
             ok = np.isfinite(ys)
             if ok.sum() < 2:
                 continue
-            c, y = cols[ok], ys[ok]
+            c, y = cols_all[ok], ys[ok]
             starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-            top = np.minimum.reduceat(y, starts)
-            bot = np.maximum.reduceat(y, starts)
-            if np.median(bot - top) > 3 * S:
-                ox, oy = sx0 * S, sy0 * S
-                band = Image.new("L", ((sx1 - sx0) * S, (sy1 - sy0) * S), 0)
-                db = ImageDraw.Draw(band)
-                for x, a, b in zip(c[starts].tolist(), top.tolist(), bot.tolist(), strict=True):
-                    db.line([(x - ox, a - oy), (x - ox, b - oy)], fill=255, width=1)
-                img.paste(_blend(TERM_RGB.get(name, GREY), 0.45), (ox, oy), band)
-            else:
-                lines.append((name, list(zip(cols[ok].tolist(), y.tolist(), strict=True))))
-        for name, pts in lines:
-            d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
+            series[name] = (t[ok], c, y)
+            band[name] = bool(np.median(np.maximum.reduceat(y, starts)
+                                        - np.minimum.reduceat(y, starts)) > 3 * S)
+        width = max(1, round(2 * u))
+        for c0 in range(0, self.tape_w, TAPE_CHUNK):
+            c1 = min(self.tape_w, c0 + TAPE_CHUNK)
+            img = Image.new("RGB", ((c1 - c0) * S, h * S), WHITE)
+            d = ImageDraw.Draw(img)
+            for y in y_of:
+                d.line([(0, y), ((c1 - c0) * S, y)], fill=(238, 238, 238), width=S)
+            d.rectangle([0, edge, (c1 - c0) * S, edge + S - 1], fill=LIGHT)
+            for ti in ticks:
+                x = (ti * p - c0) * S
+                if -S <= x <= (c1 - c0 + 1) * S:
+                    d.line([(x, edge), (x, edge + (self.tick_len + 1) * S)], fill=GREY, width=S)
+            for ti in impacts:
+                x = (ti * p - c0) * S
+                if -S <= x <= (c1 - c0 + 1) * S:
+                    d.line([(x, edge - 4 * u * S), (x, edge)], fill=GREY, width=S)
+            lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
+            lines = []
+            for name, (ts, c, y) in series.items():
+                i0 = max(0, int(np.searchsorted(ts, lo_t)) - 1)
+                i1 = min(len(ts), int(np.searchsorted(ts, hi_t, side="right")) + 1)
+                if i1 - i0 < 2:
+                    continue
+                cc, yy = c[i0:i1] - c0 * S, y[i0:i1]
+                if band[name]:
+                    starts = np.flatnonzero(np.r_[True, cc[1:] != cc[:-1]])
+                    top = np.minimum.reduceat(yy, starts)
+                    bot = np.maximum.reduceat(yy, starts)
+                    mask = Image.new("L", img.size, 0)
+                    dm = ImageDraw.Draw(mask)
+                    for x, a, b in zip(cc[starts].tolist(), top.tolist(), bot.tolist(),
+                                       strict=True):
+                        dm.line([(x, a), (x, b)], fill=255, width=1)
+                    img.paste(_blend(TERM_RGB.get(name, GREY), 0.45), (0, 0), mask)
+                else:
+                    xs = (ts[i0:i1] * p - c0) * S
+                    lines.append((name, list(zip(xs.tolist(), yy.tolist(), strict=True))))
+            for name, pts in lines:
+                d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
+            tape.paste(to_palette(img), (c0, 0))
+        return tape
 
-    def strip_x(self, t):
-        """Pixel x of time ``t`` (s, a float or an array) in the strip."""
-        sx0, _, sx1, _ = self.strip_box
-        return sx0 + 1 + (sx1 - sx0 - 2) * t / self.frames.t_end
+    def strip_offset(self, k: int) -> tuple[int, int]:
+        """For frame ``k``: the tape column at the strip's left edge and the cursor's column
+        in the tape (px). The cursor walks in until it reaches its place, then the tape
+        scrolls under it, and at the end the cursor walks out to the right edge."""
+        x = round(float(self.frames.t[k]) * self.px_per_s)
+        return min(max(0, x - self.cursor_px), self.tape_w - self.inner_w), x
 
     def strip_y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
@@ -401,11 +475,32 @@ class Painter:
         self._time_label(img, k)
         self._bars(img, k)
         if self.strip:
-            x = round(self.strip_x(float(self.frames.t[k])))
-            _, sy0, _, sy1 = self.strip_box
-            ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
-                                     width=max(1, round(1.5 * self.u)))
+            self._strip(img, k)
         return img
+
+    def _strip(self, img: Image.Image, k: int) -> None:
+        """The window of the tape that frame ``k`` shows, its time labels and the cursor."""
+        left, x = self.strip_offset(k)
+        img.paste(self.tape.crop((left, 0, left + self.inner_w, self.tape_h)),
+                  (self.inner_x, self.tape_y))
+        sx0, _, _, sy1 = self.strip_box
+        u, st = self.u, self.st_note
+        y = sy1 + self.tick_len + 1
+        # Labels may reach past the frame's left edge, short of the axis name 't (s)'.
+        x_min = sx0 - round(3 * u)
+        crop, (cx, cy), done = self._patch(img, (x_min, y, self.W, self.H), 1)
+        first = math.ceil(left / self.px_per_s / self.t_step - 1e-9)
+        last = math.floor((left + self.inner_w - 1) / self.px_per_s / self.t_step + 1e-9)
+        for j in range(first, last + 1):
+            xt = self.inner_x + j * self.t_step * self.px_per_s - left
+            text = _fmt_tick(j * self.t_step)
+            half = st.width(text) / 2
+            if xt - half >= x_min and xt + half <= self.W - 2 * u:
+                st.draw(crop, (xt + 0.5 - cx, sy1 + 4 * u - cy), text, GREY, "mt")
+        done()
+        xc = self.inner_x + x - left
+        ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=self.idx["ink"],
+                                 width=max(1, round(1.5 * u)))
 
     def _patch(self, img: Image.Image, box: tuple[int, int, int, int], ss: int):
         """An RGB crop of the background, ``ss`` times the size, its corner (px), and a function
@@ -429,13 +524,13 @@ class Painter:
         ra = max(sc.A.radius * self.s, MIN_RADIUS_PX * u)
         rb = max(sc.B.radius * self.s, MIN_RADIUS_PX * u)
         rest = sc.spring.rest_length if sc.spring else sc.rigid.length if sc.rigid else 0.0
-        amp = max(3.5 * u, min(0.06 * rest * self.s, 8 * u))
+        amp = max((CM_RADIUS + 1.5) * u, min(0.06 * rest * self.s, 8 * u))
         two_d = sc.dimensions == 2
         m = max(ra, rb, amp) + (18 if two_d else 8) * u
         impact = k in self.impact_frames and sc.floor is not None
         mx = m + (34 * u if two_d else 0)
         x0, x1 = min(pa[0], pb[0]) - mx, max(pa[0], pb[0]) + mx + 16 * u
-        y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + m
+        y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + (mx if two_d else m)
         if impact:  # the mark on the floor and the word under it
             fy = self.px(0.0, 0.0)[1]
             low = pa if pa[1] > pb[1] else pb
@@ -465,23 +560,28 @@ class Painter:
                    width=max(2, round(1.5 * u * S)), joint="curve")
         else:
             d.line([P(pa), P(pb)], fill=LIGHT, width=S)
-        # Labels sit beyond each particle along the axis, clear of the spring; in 1D (and
-        # when the particles touch) to the right.
+        # Labels sit beyond each particle along the axis, clear of the spring; in 2D at least
+        # LABEL_CLEAR from the centre of mass (clear of the angle's arc and vertical line when
+        # the spring is compressed) and above the floor; in 1D (and when the particles
+        # touch) to the right.
         dx, dy = pa[0] - pb[0], pa[1] - pb[1]
         dist = math.hypot(dx, dy)
         ex, ey = (dx / dist, dy / dist) if two_d and dist > 0 else (0.0, 0.0)
+        floor_y = self.px(0.0, 0.0)[1] if sc.floor is not None else math.inf
         for p, r, name, sign in ((pa, ra, "A", 1), (pb, rb, "B", -1)):
             x, y = P(p)
             d.ellipse([x - r * S, y - r * S, x + r * S, y + r * S], fill=TERM_RGB[name],
                       outline=INK, width=max(1, round(0.8 * u * S)))
             if ex or ey:
-                off = (r + 7 * u) * S
-                self.st_label.draw(crop, (x + sign * ex * off, y + sign * ey * off), name, INK,
-                                   "mm")
+                reach = max(math.hypot(p[0] - pc[0], p[1] - pc[1]) + r + 7 * u, LABEL_CLEAR * u)
+                lx, ly = pc[0] + sign * ex * reach, min(pc[1] + sign * ey * reach,
+                                                        floor_y - 7 * u)
+                self.st_label.draw(crop, P((lx, ly)), name, INK, "mm")
             else:
                 self.st_label.draw(crop, (x + (r + 4 * u) * S, y), name, INK, "lm")
-        # Centre of mass: the quartered-disc symbol.
-        (x, y), rc = P(pc), 4.5 * u * S
+        # Centre of mass: the quartered-disc symbol, narrower than the spring's zig-zag so
+        # the coils still show beside it when the spring is fully compressed.
+        (x, y), rc = P(pc), CM_RADIUS * u * S
         bb = [x - rc, y - rc, x + rc, y + rc]
         d.ellipse(bb, fill=WHITE, outline=BLACK, width=max(1, round(0.8 * u * S)))
         d.pieslice(bb, 180, 270, fill=BLACK)
@@ -503,7 +603,7 @@ class Painter:
                 P((pc[0] + ex * reach, pc[1] + ey * reach))], fill=LIGHT, width=S)
         rv = 20 * u
         x, y = P(pc)
-        d.line([(x, y), (x, y - rv * 1.35 * S)], fill=GREY, width=S)
+        d.line([(x, y), (x, y - rv * 1.25 * S)], fill=GREY, width=S)
         start, end = sorted((-90.0, -90.0 + theta))
         d.arc([x - rv * S, y - rv * S, x + rv * S, y + rv * S], start, end, fill=GREY,
               width=max(1, round(1.3 * u * S)))

@@ -159,7 +159,8 @@ class Scene:
             for part in parts[:-1]:
                 nxt = table.setdefault(part, {})
                 if not isinstance(nxt, dict):
-                    raise SceneError(f"{self.source}: {dotted}: '{part}' is not a table")
+                    raise SceneError(f"{self.source}: {_printable(dotted)}: "
+                                     f"'{_printable(part)}' is not a table")
                 table = nxt
             table[parts[-1]] = value
         return scene_from_dict(raw, source=self.source)
@@ -261,9 +262,14 @@ class _Checker:
             allowed = ", ".join(sorted(self.used)) or "nothing"
             where = f"in [{self.path}]" if self.path else "at the top level"
             raise SceneError(
-                f"{self.source}: unknown key '{self.key(str(unknown[0]))}' {where}; "
+                f"{self.source}: unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
                 f"allowed: {allowed}"
             )
+
+
+def _printable(text: str) -> str:
+    """``text`` with control characters escaped, so that an error stays on one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def _finite(value: Any) -> float | None:

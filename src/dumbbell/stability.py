@@ -7,8 +7,8 @@ Theory (PHYSICS.md sections 3 and 4), which :func:`predict` turns into an expect
 
 - the explicit spring step of Euler-Cromer, Verlet and pymunk is stable iff w*dt < 2, with
   w = sqrt(k/mu); the exact and reference solutions take no such step;
-- pymunk finds a contact only once shapes overlap, so a particle that moves more than twice
-  its radius per step at impact can pass through the floor;
+- pymunk finds a contact only once shapes overlap, so a particle that moves farther in one
+  step at impact than the floor's box is thick plus its own diameter passes through it;
 - on an inelastic floor a bouncing point mass comes to rest after
   sqrt(2 h/g) (1 + e)/(1 - e), after infinitely many impacts: solvers that model impacts as
   velocity flips (exact, Euler-Cromer, Verlet) must stop there with ``failed``; pymunk and the

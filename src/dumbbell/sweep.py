@@ -27,7 +27,7 @@ import os
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -232,11 +232,12 @@ def _evaluate_batch(scene: Scene, batch: list[Point], solver: str
 
 
 def _warm_up(solver: str) -> None:
-    """Load a solver's compiled code in a worker before the timed work arrives."""
-    if solver == "euler-cromer":
-        from .solvers.euler_cromer import warm_up
+    """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
+    from .solvers import solver_module
 
-        warm_up()
+    warm = getattr(solver_module(solver), "warm_up", None)
+    if callable(warm):
+        warm()
 
 
 def _batches(points: list[Point], workers: int) -> list[list[Point]]:
@@ -258,7 +259,6 @@ class SweepResult:
     rows: list[dict[str, Any]]
     wall_time: float = 0.0
     backend: str = ""
-    info: dict[str, Any] = field(default_factory=dict)
 
     @property
     def columns(self) -> list[str]:
@@ -534,13 +534,13 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[dict[str,
                                  label=f"{name} ({int(mask.sum())} runs)"))
     if x_axis.key == "w_dt":
         ax.axvline(2.0, color="red", lw=2.2, ls="--")
-        handles.append(plt_line("red", "--", "w*dt = 2: stability limit from theory"))
+        handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
     elif np.nanmax(w_dt) > 2.0 > np.nanmin(w_dt):
         # log10(w*dt) is linear in log k and log dt, so its interpolated contour is straight.
         with np.errstate(divide="ignore"):
             ax.contour(xs, ys, np.log10(w_dt), levels=[math.log10(2.0)], colors="red",
                        linewidths=2.2, linestyles="--")
-        handles.append(plt_line("red", "--", "w*dt = 2: stability limit from theory"))
+        handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
     else:
         handles.append(Patch(facecolor="none", edgecolor="none",
                              label=f"w*dt from {np.nanmin(w_dt):.2g} to {np.nanmax(w_dt):.2g}: "
@@ -557,7 +557,7 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[dict[str,
     return mesh
 
 
-def plt_line(colour: str, style: str, label: str) -> Any:
+def _legend_line(colour: str, style: str, label: str) -> Any:
     from matplotlib.lines import Line2D
 
     return Line2D([], [], color=colour, ls=style, lw=2.2, label=label)
@@ -580,8 +580,10 @@ def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> No
     for name, colour in FAIL_COLOURS.items():
         mask = np.array([v == name for v in verdicts])
         if mask.any():
-            ax.plot(xs[mask], np.full(mask.sum(), max(top, 1.0) * 3), "X", color=colour,
-                    mec="0.2", ms=9, ls="none", label=f"{name} ({int(mask.sum())} runs)")
+            # At the error reached before the run stopped; off the top if none was finite.
+            ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
+            ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
+                    label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
     w_dt = np.array([r["w_dt"] for r in rows], float)
     cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
     if cross.size:

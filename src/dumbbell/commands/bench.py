@@ -10,7 +10,14 @@ from ..cli import add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from ..bench import DEFAULT_BUDGET, DEFAULT_REPEAT, DEFAULT_WINDOW, SAMPLE_SPACING
+    from ..bench import (
+        DEFAULT_BUDGET,
+        DEFAULT_REPEAT,
+        DEFAULT_WINDOW,
+        MIN_TIMED,
+        SAMPLE_SPACING,
+        SAMPLES_PER_PERIOD,
+    )
 
     p = sub.add_parser(
         "bench", help="error against run time for every solver (work-precision diagrams)",
@@ -39,16 +46,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="simulated time of each run in s (default: the scene's run.t_end)")
     p.add_argument("--repeat", type=positive_int("runs"), metavar="N", default=DEFAULT_REPEAT,
-                   help=f"timed runs per point after one warm-up run (default {DEFAULT_REPEAT})")
+                   help=f"timed runs per point after one warm-up run (default {DEFAULT_REPEAT}"
+                        f"; runs shorter than {MIN_TIMED:g} s in all are repeated until they "
+                        "are not)")
     p.add_argument("--budget", type=positive_float("s"), metavar="S", default=DEFAULT_BUDGET,
                    help="skip a step when the estimated time of its runs (steps x cost per "
                         "step at the previous step x (N+1)) passes S seconds (default "
                         f"{DEFAULT_BUDGET:g})")
     p.add_argument("--sample-spacing", type=positive_float("s"), metavar="S",
-                   default=SAMPLE_SPACING,
-                   help="compare positions at samples about S seconds apart (every "
-                        "round(S/dt) steps; default %(default)g); the exact and reference "
-                        "solvers are timed for exactly these samples")
+                   help=f"compare positions at samples about S seconds apart (every "
+                        f"round(S/dt) steps; default {SAMPLE_SPACING:g}, the textbook run's "
+                        f"output, or 1/{SAMPLES_PER_PERIOD} of the spring's period if shorter); "
+                        "the exact and reference solvers are timed for exactly these samples")
     add_quiet(p)
     p.set_defaults(func=run)
 

@@ -46,6 +46,13 @@ def seconds(value: float) -> str:
     return f"{mantissa}e{int(exponent)}"
 
 
+def ratio_text(ratio: float) -> str:
+    """w*dt for a message: two decimals, more near the limit so that 1.999 is not '2.00'."""
+    if abs(ratio - STEP_LIMIT) < 0.005:
+        return f"{ratio:.5f}"
+    return f"{ratio:.2f}" if ratio >= 0.1 else f"{ratio:.2g}"
+
+
 def stable_swing(ratio: float) -> float:
     """Largest relative swing of a *stable* explicit oscillator's energy at w*dt = ``ratio``:
     h/(2 - h) of its vibration energy (a 19-fold swing at 1.9); inf at and past the limit."""
@@ -57,10 +64,10 @@ def nonfinite_reason(scene: Scene, dt: float) -> str:
     w = scene.omega
     limit = stability_limit(scene)
     if limit is not None and w * dt >= STEP_LIMIT:
-        return (f"w*dt = {w * dt:.2f} > 2 (w = sqrt(k/mu) = {w:.4g} rad/s); "
+        return (f"w*dt = {ratio_text(w * dt)} > 2 (w = sqrt(k/mu) = {w:.4g} rad/s); "
                 f"use dt < {seconds(limit)} s")
     if limit is not None:
-        return (f"the state grew without bound although w*dt = {w * dt:.2f} < 2 "
+        return (f"the state grew without bound although w*dt = {ratio_text(w * dt)} < 2 "
                 f"(w = {w:.4g} rad/s)")
     return "the state grew without bound"
 
@@ -115,7 +122,7 @@ def below_floor_verdict(
     reason = tunnel_reason(scene, body, height, speed, dt, depth)
     if push > scene.g:
         reason += (f"; the spring pushed it back down (at {push:.3g} m/s^2) before it climbed "
-                   f"out, with w*dt = {step_ratio(scene, dt):.2f}: use a smaller dt")
+                   f"out, with w*dt = {ratio_text(step_ratio(scene, dt))}: use a smaller dt")
     return Verdict("tunnelled", t, reason)
 
 
@@ -153,7 +160,7 @@ def energy_verdict(traj: Trajectory, dt: float | None) -> Verdict:
                   f"{scene.run.unstable_energy:g}")
         if ratio > 1.0:
             # Near the limit a stable explicit step swings the energy a lot without growing.
-            reason += (f"; w*dt = {ratio:.2f} < 2, where even a stable step swings the "
+            reason += (f"; w*dt = {ratio_text(ratio)} < 2, where even a stable step swings the "
                        f"vibration energy by up to {stable_swing(ratio):.3g} times itself: "
                        "raise run.unstable_energy if that swing is expected, or lower dt")
     keep_samples(traj, j + 1)
