@@ -70,6 +70,8 @@ SAMPLE_SPACING = 1e-3
 SAMPLES_PER_PERIOD = 50
 #: Points with a larger error (m) are outside the asymptotic range and left out of order fits.
 FIT_MAX_ERROR = 1e-2
+#: ... and points with a smaller one are at the rounding level, where dt no longer matters.
+FIT_MIN_ERROR = 1e-11
 #: The step of the textbook listing (s): the accuracy the README compares against.
 TEXTBOOK_DT = 1e-5
 #: Solvers whose accuracy does not depend on dt (it only sets their sample times): each is
@@ -500,14 +502,14 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
         else:
             xB, vB = L(0), -e * vB
         seg = segment(seg[0] + tau, xA, vA, xB, vB)
-    return worst, worst_t
+    return worst, (worst_t if events else math.nan)
 
 
 def fit_order(points: list[Point]) -> Fit | None:
     """Least-squares slope of log10(error) against log10(dt) over the ok points with an error
-    below FIT_MAX_ERROR (m); None with fewer than 3 such points."""
+    between FIT_MIN_ERROR and FIT_MAX_ERROR (m); None with fewer than 3 such points."""
     use = [p for p in points if p.ok and p.dt is not None and math.isfinite(p.error)
-           and 0 < p.error < FIT_MAX_ERROR]
+           and FIT_MIN_ERROR < p.error < FIT_MAX_ERROR]
     if len(use) < 3:
         return None
     x = np.log10([p.dt for p in use])
@@ -556,7 +558,8 @@ def to_json(result: BenchResult) -> dict[str, Any]:
         "scene": result.scene, "source": result.source, "truth": result.truth,
         "window_s": result.window, "t_end_s": result.t_end, "repeat": result.repeat,
         "budget_s": result.budget, "sample_spacing_s": result.spacing,
-        "fit_max_error_m": FIT_MAX_ERROR, "notes": result.notes,
+        "fit_max_error_m": FIT_MAX_ERROR, "fit_min_error_m": FIT_MIN_ERROR,
+        "notes": result.notes,
         "points": [asdict(p) for p in result.points],
         "orders": {n: asdict(f) for n, f in result.fits.items()},
         "matched_error": result.speedups(),
@@ -619,8 +622,8 @@ def markdown(result: BenchResult) -> str:
             f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
             f"{len(f.dts)} points)" for n, f in result.fits.items())
         lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
-                     f"(least squares in log-log over the ok points with error < "
-                     f"{FIT_MAX_ERROR:g} m): {fit_text}.")
+                     f"(least squares in log-log over the ok points with error between "
+                     f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")
     sp = result.speedups()
     if sp and sp.get("seconds"):
         parts = [f"{n} {_ms(t)} ({sp['speedup'].get(n, math.nan):.3g}x)"
@@ -637,8 +640,7 @@ def markdown(result: BenchResult) -> str:
                      + " (the first numba solver also pays numba's one-time start-up).")
     for p in result.points:
         if p.ran and p.window != result.window:
-            lines.append(f"The {p.solver} row's errors are over [0, {p.window:g}] s: "
-                         f"{p.reason}.")
+            lines.append(f"The {p.solver} row's errors are {p.reason}.")
     lines.extend(result.notes)
     return "\n".join(lines) + "\n"
 
@@ -681,6 +683,7 @@ def work_precision_figure(result: BenchResult, path: Path) -> Path:
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
     top = max(finite) * 8 if finite else 1.0
     names = list(dict.fromkeys(p.solver for p in result.points))
+    labels: list[tuple[str, float, float, str]] = []
     for i, name in enumerate(names):
         colour, marker = _style(name, i)
         pts = [p for p in result.points if p.solver == name and p.ran]
@@ -690,30 +693,23 @@ def work_precision_figure(result: BenchResult, path: Path) -> Path:
         label = name
         if name == result.truth:
             label += (" (truth; error vs extended precision)" if name == "exact"
-                      else " (truth; its own error estimate)")
+                      else " (truth; its own error estimate"
+                      + (f" over [0, {good[0].window:g} s])" if good else ")"))
         elif single:
             label += " (error vs truth)"
         if good:
             ax.plot([p.seconds for p in good], [p.error for p in good], marker=marker,
                     color=colour, label=label, ms=11 if single else 6,
                     lw=0 if single else 1.5)
-        for j, p in enumerate(good):
-            if p.dt is None:
-                ax.annotate(f"samples every {dt_label(result.spacing)} s",
-                            (p.seconds, p.error), textcoords="offset points", xytext=(-9, -3),
-                            ha="right", fontsize=7.5, color=colour)
-                continue
-            # Steep lines take their labels below-right; flat ones alternate above and below.
-            below = name == "verlet" or j % 2 == 1
-            ax.annotate(dt_label(p.dt), (p.seconds, p.error), textcoords="offset points",
-                        xytext=(6, -11) if below else (7, 2), fontsize=7.5, color=colour)
+        for p in good:
+            text = (dt_label(p.dt) if p.dt is not None
+                    else f"samples every {dt_label(result.spacing)} s")
+            labels.append((text, p.seconds, p.error, colour))
         if bad:
             ax.plot([p.seconds for p in bad], [top] * len(bad), ls="none", marker="x",
                     color=colour, ms=9, mew=2, label=f"{name}: failed ({bad[0].verdict})")
-            for p in bad:
-                ax.annotate(dt_label(p.dt) if p.dt else "", (p.seconds, top),
-                            textcoords="offset points", xytext=(5, -12), fontsize=7.5,
-                            color=colour)
+            labels.extend((dt_label(p.dt) if p.dt else "", p.seconds, top, colour)
+                          for p in bad)
     sp = result.speedups()
     if sp:
         ax.axhline(sp["target_error"], color="grey", ls=":", lw=1,
@@ -729,10 +725,44 @@ def work_precision_figure(result: BenchResult, path: Path) -> Path:
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
               frameon=False)
     fig.tight_layout()
+    _place_labels(ax, labels)
     with atomic_output(path) as tmp:
         fig.savefig(tmp, format="png")
     plt.close(fig)
     return path
+
+
+#: Where a point's label may go, in order of preference: offset (points) and alignment.
+_LABEL_SPOTS = ((7, 2, "left"), (6, -11, "left"), (-7, 2, "right"), (-7, -11, "right"),
+                (7, 9, "left"), (7, -18, "left"), (-7, 9, "right"), (-7, -18, "right"))
+
+
+def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
+                  size: float = 7.5) -> None:
+    """Write each (text, x, y, colour) beside its point, at the first spot whose box stays
+    inside the axes and overlaps neither a marker nor a label already placed (else at the
+    first spot)."""
+    px = ax.figure.dpi / 72.0
+    xy = ax.transData.transform([(x, y) for _, x, y, _ in labels]) if labels else []
+    taken = [(u - 6, v - 6, u + 6, v + 6) for u, v in xy]  # the markers
+    frame = ax.get_window_extent()
+    for (text, x, y, colour), (u, v) in zip(labels, xy, strict=True):
+        w, h = 0.55 * size * px * len(text), 1.15 * size * px
+        chosen = _LABEL_SPOTS[0]
+        for spot in _LABEL_SPOTS:
+            dx, dy, ha = spot
+            left = u + dx * px - (w if ha == "right" else 0.0)
+            box = (left, v + dy * px, left + w, v + dy * px + h)
+            inside = (frame.x0 <= box[0] and box[2] <= frame.x1 and frame.y0 <= box[1]
+                      and box[3] <= frame.y1)
+            if inside and not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3]
+                                  and b[1] < box[3] for b in taken):
+                chosen = spot
+                taken.append(box)
+                break
+        dx, dy, ha = chosen
+        ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), ha=ha,
+                    fontsize=size, color=colour)
 
 
 def convergence_figure(result: BenchResult, path: Path) -> Path:

@@ -79,9 +79,24 @@ class _Motion:
                 X - self.cB * (self.b + s), V - self.cB * sd)
 
     def height(self, seg: Segment, body: str, tau):
-        """Height of ``body`` (m) and its rate (m/s) at ``tau``."""
+        """Height of ``body`` (m) and its rate (m/s) at ``tau`` (an array of times)."""
         xA, vA, xB, vB = self.state(seg, tau)
         return (xA, vA) if body == "A" else (xB, vB)
+
+    def height_at(self, seg: Segment, body: str, tau: float) -> tuple[float, float]:
+        """:meth:`height` at one time, in plain floats: the root search calls it hundreds of
+        times per impact, where numpy's per-call overhead would dominate."""
+        X = seg.X0 + seg.V0 * tau - 0.5 * self.g * tau * tau
+        V = seg.V0 - self.g * tau
+        if self.w > 0:
+            cos, sin = math.cos(self.w * tau), math.sin(self.w * tau)
+            s = seg.s0 * cos + (seg.sd0 / self.w) * sin
+            sd = -seg.s0 * self.w * sin + seg.sd0 * cos
+        else:
+            s, sd = seg.s0 + seg.sd0 * tau, seg.sd0
+        if body == "A":
+            return X + self.cA * (self.b + s), V + self.cA * sd
+        return X - self.cB * (self.b + s), V - self.cB * sd
 
     def amplitude(self, seg: Segment) -> float:
         """Largest |s| the segment reaches (m); inf without a spring."""
@@ -119,8 +134,8 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
     a = max(start, _earliest_possible(motion, seg, body))
     block = 64
 
-    def f(tau):
-        return motion.height(seg, body, tau)
+    def f(tau: float) -> tuple[float, float]:
+        return motion.height_at(seg, body, tau)
 
     def search(lo: float, flo: float, dlo: float, hi: float, fhi: float, dhi: float) -> float:
         # Curvature bound: below the chord by at most C h^2 / 8; the slope changes by <= C h.
@@ -141,12 +156,13 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
 
     while a < stop:
         taus = np.minimum(a + h * np.arange(block + 1), stop)
-        fs, ds = f(taus)
+        fs, ds = motion.height(seg, body, taus)
         width = np.diff(taus)
         lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
         suspect = np.flatnonzero((lower <= 0) & (width > 0))
         for j in suspect:
-            root = search(taus[j], fs[j], ds[j], taus[j + 1], fs[j + 1], ds[j + 1])
+            root = search(*(float(v) for v in (taus[j], fs[j], ds[j],
+                                                taus[j + 1], fs[j + 1], ds[j + 1])))
             if root < math.inf:
                 return root
         a = taus[-1]
