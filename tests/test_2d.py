@@ -134,6 +134,12 @@ def test_rigid_k_rot_is_half_i_omega_squared(rigid):
     k_rot = 0.5 * I * (rx * J / I) ** 2
     after = (run.t > run.events[0].t + 1e-3) & (run.t < run.events[0].t + 0.05)
     np.testing.assert_allclose(run["K_rot"][after], k_rot, rtol=1e-3)
+    # The rotation figure's mean: one impact, then the whole flight to the next one.
+    from dumbbell.rotation import mean_after_first_cluster
+
+    mean, start, end = mean_after_first_cluster(run, "K_rot")
+    assert (start, end) == (run.events[0].t, run.events[1].t)
+    assert mean == pytest.approx(k_rot, rel=1e-3)
     E = run["E"]
     assert np.max(np.abs(E - E[0])) / E[0] < 1e-4
 
@@ -265,12 +271,21 @@ def test_rotation_variants_and_the_stiff_limit(tilted):
     assert [s.spring.stiffness for s in scenes.values() if s.spring] == [200.0, 2e3, 2e4]
     assert scenes["rigid"].rigid.length == 0.2
     assert (scenes["rigid"].A.x, scenes["rigid"].A.height) == (tilted.A.x, tilted.A.height)
-    stiff = simulate(scenes["k = 20000 N/m"], "pymunk", dt=1e-5, t_end=0.47, every=10)
+    stiff = simulate(scenes["k = 20000 N/m"], "pymunk", dt=1e-5, t_end=0.6, every=10)
     v = math.sqrt(2 * G * 1.0)
     expected = 0.5 * 0.05 * (2 * v * 0.5) ** 2
     t1 = stiff.events[0].t
     just_after = np.flatnonzero(stiff.t > t1)[0]
     assert stiff["K_rot"][just_after] == pytest.approx(expected, rel=2e-2)
+    # A lands about 0.07 s after B: the figure's mean starts after that landing, and the two
+    # impacts together leave far less rotation than the rigid body's 1.25 J.
+    from dumbbell.rotation import CLUSTER_GAP, mean_after_first_cluster
+
+    (b_hit, a_hit), bodies = [e.t for e in stiff.events], [e.body for e in stiff.events]
+    assert bodies == ["B", "A"] and 0.05 < a_hit - b_hit < CLUSTER_GAP
+    mean, start, end = mean_after_first_cluster(stiff, "K_rot")
+    assert (start, end) == (a_hit, stiff.t[-1])
+    assert 0 < mean < 0.5 * 1.254
 
 
 def test_no_floor_and_spin_columns():

@@ -5,14 +5,16 @@ zig-zag with a constant number of coils or a rigid rod, the centre of mass, the 
 2D, the axis angle from vertical), an energy panel (one bar per energy column with a pale bar
 behind it up to the largest value since the previous frame, a stacked bar for E with a marker
 at the total, one fixed scale for the whole animation) and optionally a strip of the energy
-time series with a moving cursor.
+time series: a window of :data:`WINDOW` s that scrolls with the cursor (time ticks and labels
+move with it; faint lines mark the impacts), on the same fixed energy scale.
 
 Why a fixed palette: quantizing every RGB frame to 256 colours costs more than drawing it.
 Everything static is drawn once (at twice the size, then halved, so edges are smooth) and
 mapped to the palette once. Per frame only the dumbbell and the changing texts are drawn in
 RGB (the dumbbell at twice the size) on small crops of the background and mapped to the palette
 (fast: the palette holds the blends of every ink with white); numbers are pasted from cached
-glyph masks; bars and the cursor are drawn straight into the palette image.
+glyph masks; bars and the cursor are drawn straight into the palette image. The strip's curves
+for the whole animation are drawn once on a long 'tape'; a frame pastes the window it shows.
 
 The world-to-pixel mapping is fixed for the whole animation (from the extents of the
 trajectory in the rendered window) and keeps the aspect ratio: 1 m is as long in x as in y.
@@ -423,9 +425,10 @@ class Painter:
                 x = (ti * p - c0) * S
                 if -S <= x <= (c1 - c0 + 1) * S:
                     d.line([(x, edge), (x, edge + (self.tick_len + 1) * S)], fill=GREY, width=S)
-            for ti in impacts:
+            for ti in impacts:  # a faint line through the strip, a tick at its foot
                 x = (ti * p - c0) * S
                 if -S <= x <= (c1 - c0 + 1) * S:
+                    d.line([(x, 0), (x, edge)], fill=(216, 216, 216), width=S)
                     d.line([(x, edge - 4 * u * S), (x, edge)], fill=GREY, width=S)
             lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
             lines = []

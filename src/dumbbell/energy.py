@@ -133,8 +133,7 @@ def disc_inertia(mass: float, radius: float) -> float:
 def partition(traj: Trajectory) -> dict[str, np.ndarray]:
     """All energy columns of ``traj`` (J), in :func:`energy_columns` order."""
     scene = traj.scene
-    k = scene.spring.stiffness if scene.spring else 0.0
-    b = scene.spring.rest_length if scene.spring else 0.0
+    k, b = scene.k, scene.b
     if scene.dimensions == 1:
         parts = partition_1d(scene.A.mass, scene.B.mass, k, b, scene.g,
                              traj["xA"], traj["vA"], traj["xB"], traj["vB"])

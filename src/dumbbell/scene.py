@@ -136,6 +136,21 @@ class Scene:
         return math.sqrt(self.spring.stiffness / self.mu) if self.spring else 0.0
 
     @property
+    def k(self) -> float:
+        """Spring stiffness (N/m); 0 without a spring."""
+        return self.spring.stiffness if self.spring else 0.0
+
+    @property
+    def b(self) -> float:
+        """Spring rest length (m); 0 without a spring."""
+        return self.spring.rest_length if self.spring else 0.0
+
+    @property
+    def elasticity(self) -> float:
+        """Floor restitution coefficient; 1 without a floor (it is then never used)."""
+        return self.floor.elasticity if self.floor else 1.0
+
+    @property
     def name(self) -> str:
         """The scene file's stem, used to name outputs."""
         return Path(self.source).stem if self.source != "<scene>" else "scene"

@@ -48,7 +48,7 @@ class RunOptions:
     @property
     def n_steps(self) -> int:
         """Steps taken: round(t_end / dt)."""
-        return int(round(self.t_end / self.dt))
+        return round(self.t_end / self.dt)
 
     @property
     def n_samples(self) -> int:
@@ -60,6 +60,13 @@ class RunOptions:
         index j * every kept whole so every solver and every ``every`` share the same floats."""
         steps = np.arange(self.n_samples if count is None else count, dtype=np.int64)
         return (steps * self.every) * self.dt
+
+
+def kernel_params(scene: Scene) -> tuple[float, float, float, float, float, float, bool]:
+    """The scalars the compiled time-steppers take: mA, mB (kg), k (N/m), b (m), g (m/s^2),
+    the floor's elasticity, and whether there is a floor."""
+    return (scene.A.mass, scene.B.mass, scene.k, scene.b, scene.g, scene.elasticity,
+            scene.floor is not None)
 
 
 def solver_module(name: str) -> ModuleType:

@@ -23,7 +23,7 @@ from numba import njit
 
 from ..scene import Scene
 from ..trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from . import RunOptions, kernel_params
 from .verdicts import below_floor_verdict, energy_verdict, nonfinite_reason
 
 NAME = "euler-cromer"
@@ -105,12 +105,6 @@ def supports(scene: Scene) -> str | None:
     return None
 
 
-def _kernel_args(scene: Scene) -> tuple[float, float, float, float, float, float, bool]:
-    k = scene.spring.stiffness if scene.spring else 0.0
-    b = scene.spring.rest_length if scene.spring else 0.0
-    e = scene.floor.elasticity if scene.floor else 1.0
-    return scene.A.mass, scene.B.mass, k, b, scene.g, e, scene.floor is not None
-
 
 def warm_up() -> float:
     """Compile (or load from numba's cache) the loop and the 1D energy partition; returns the
@@ -130,7 +124,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` with the textbook's Euler-Cromer method. See the module docstring."""
     from ..progress import bar
 
-    mA, mB, k, b, g, e, floor = _kernel_args(scene)
+    mA, mB, k, b, g, e, floor = kernel_params(scene)
     dt, every, n = options.dt, options.every, options.n_steps
     # One contiguous row per column, so the Trajectory's columns are views, not copies.
     out = np.empty((4, options.n_samples))

@@ -28,7 +28,7 @@ from numba import njit
 
 from ..scene import Scene
 from ..trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from . import RunOptions, kernel_params
 from .verdicts import energy_verdict, nonfinite_reason
 
 NAME = "euler-cromer-2d"
@@ -145,10 +145,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     from ..progress import bar
 
     A, B = scene.A, scene.B
-    k = scene.spring.stiffness if scene.spring else 0.0
-    b = scene.spring.rest_length if scene.spring else 0.0
-    e = scene.floor.elasticity if scene.floor else 1.0
-    floor = scene.floor is not None
+    mA, mB, k, b, g, e, floor = kernel_params(scene)
     dt, every, n = options.dt, options.every, options.n_steps
     out = np.empty((options.n_samples, 8))
     st = np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)
@@ -161,8 +158,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     with bar(n, f"{NAME} {scene.name}", "step", quiet=options.quiet or n < 10 * _CHUNK) as pb:
         while i < n and status == _OK:
             i_stop = min(n, i + _CHUNK)
-            i_new, status, n_ev = _advance(st, i, i_stop, dt, A.mass, B.mass, k, b, scene.g, e,
-                                           floor, A.radius, B.radius, every, out, ev)
+            i_new, status, n_ev = _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor,
+                                           A.radius, B.radius, every, out, ev)
             events.extend(Impact(float(r[0]) * dt, "AB"[int(r[1])], float(r[2]), float(r[3]))
                           for r in ev[:n_ev])
             pb.update(i_new - i)

@@ -60,7 +60,7 @@ class _Motion:
         self.M = scene.M
         self.cA = scene.B.mass / scene.M  # xA = X + cA (b + s)
         self.cB = scene.A.mass / scene.M  # xB = X - cB (b + s)
-        self.b = scene.spring.rest_length if scene.spring else 0.0
+        self.b = scene.b
         self.w = scene.omega
 
     def stretch(self, seg: Segment, tau):

@@ -74,8 +74,7 @@ class _Model:
 def _particles_model(scene: Scene) -> _Model:
     A, B = scene.A, scene.B
     mA, mB, g = A.mass, B.mass, scene.g
-    k = scene.spring.stiffness if scene.spring else 0.0
-    b = scene.spring.rest_length if scene.spring else 0.0
+    k, b = scene.k, scene.b
 
     if scene.dimensions == 1:
         # The 1D force law keeps its sign when A passes below B, as in the other 1D solvers.

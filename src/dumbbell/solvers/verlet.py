@@ -31,7 +31,7 @@ from numba import njit
 
 from ..scene import Scene
 from ..trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from . import RunOptions, kernel_params
 from .verdicts import energy_verdict, keep_samples, nonfinite_reason, tunnel_reason
 
 NAME = "verlet"
@@ -291,12 +291,6 @@ def supports(scene: Scene) -> str | None:
     return None
 
 
-def _kernel_args(scene: Scene) -> tuple[float, float, float, float, float, float, bool]:
-    k = scene.spring.stiffness if scene.spring else 0.0
-    b = scene.spring.rest_length if scene.spring else 0.0
-    e = scene.floor.elasticity if scene.floor else 1.0
-    return scene.A.mass, scene.B.mass, k, b, scene.g, e, scene.floor is not None
-
 
 def warm_up() -> float:
     """Compile (or load from numba's cache) the loop; returns the seconds it took."""
@@ -317,7 +311,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     verdict or the energy."""
     from ..progress import bar
 
-    mA, mB, k, b, g, e, floor = _kernel_args(scene)
+    mA, mB, k, b, g, e, floor = kernel_params(scene)
     dt, every, n = options.dt, options.every, options.n_steps
     A, B = scene.A, scene.B
     if scene.dimensions == 1:
