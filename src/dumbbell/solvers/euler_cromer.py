@@ -22,17 +22,13 @@ import numpy as np
 from numba import njit
 
 from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params
+from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, run_kernel, trim_blown_up
 from .verdicts import below_floor_verdict, energy_verdict, nonfinite_reason
 
 NAME = "euler-cromer"
 
-_OK, _BLOWUP, _TUNNEL_A, _TUNNEL_B = 0, 1, 2, 3
-#: A state component beyond this magnitude (m or m/s) counts as blown up.
-_BIG = 1e150
-#: Impacts recorded per kernel call before it hands back to Python.
-_EVENT_BUFFER = 4096
 #: Steps per kernel call: the progress bar moves between calls.
 _CHUNK = 4_000_000
 
@@ -44,7 +40,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
     xB = st[2]
     vB = st[3]
     n_ev = 0
-    status = _OK
+    status = OK
     # A countdown to the next kept step: an integer modulo every step costs more than the step.
     until_sample = every - i % every
     while i < i_stop:
@@ -69,7 +65,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
                 ev[n_ev, 3] = vB
                 n_ev += 1
             elif xB < 0.0 and vB < 0.0:
-                status = _TUNNEL_B
+                status = TUNNEL_B
             if xA < 0.0 and xA_old >= 0.0:
                 ev[n_ev, 0] = i
                 ev[n_ev, 1] = 0.0
@@ -78,9 +74,9 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
                 ev[n_ev, 3] = vA
                 n_ev += 1
             elif xA < 0.0 and vA < 0.0:
-                status = _TUNNEL_A
-        if not (abs(xA) < _BIG and abs(vA) < _BIG and abs(xB) < _BIG and abs(vB) < _BIG):
-            status = _BLOWUP
+                status = TUNNEL_A
+        if not (abs(xA) < BIG and abs(vA) < BIG and abs(xB) < BIG and abs(vB) < BIG):
+            status = BLOWUP
         until_sample -= 1
         if until_sample == 0:
             until_sample = every
@@ -89,7 +85,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
             out[1, j] = vA
             out[2, j] = xB
             out[3, j] = vB
-        if status != _OK or n_ev >= ev.shape[0] - 2:
+        if status != OK or n_ev >= ev.shape[0] - 2:
             break
     st[0] = xA
     st[1] = vA
@@ -114,7 +110,7 @@ def warm_up() -> float:
     t0 = time.perf_counter()
     st = np.array([1.2, 0.0, 1.0, 0.0])
     out = np.empty((4, 2))
-    ev = np.empty((_EVENT_BUFFER, 4))
+    ev = np.empty((EVENT_BUFFER, 4))
     _advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, out, ev)
     partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *out)
     return time.perf_counter() - t0
@@ -122,30 +118,15 @@ def warm_up() -> float:
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` with the textbook's Euler-Cromer method. See the module docstring."""
-    from ..progress import bar
-
     mA, mB, k, b, g, e, floor = kernel_params(scene)
-    dt, every, n = options.dt, options.every, options.n_steps
+    dt, every = options.dt, options.every
     # One contiguous row per column, so the Trajectory's columns are views, not copies.
     out = np.empty((4, options.n_samples))
     st = np.array([scene.A.height, scene.A.vy, scene.B.height, scene.B.vy], dtype=np.float64)
     out[:, 0] = st
-    ev = np.empty((_EVENT_BUFFER, 4))
-    events: list[Impact] = []
-    status, i = _OK, 0
-    t0 = time.perf_counter()
-    with bar(n, f"{NAME} {scene.name}", "step", quiet=options.quiet or n < 10 * _CHUNK) as pb:
-        while i < n and status == _OK:
-            i_stop = min(n, i + _CHUNK)
-            i_new, status, n_ev = _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor,
-                                           every, out, ev)
-            events.extend(
-                Impact(float(r[0]) * dt, "AB"[int(r[1])], float(r[2]), float(r[3]))
-                for r in ev[:n_ev]
-            )
-            pb.update(i_new - i)
-            i = i_new
-    wall = time.perf_counter() - t0
+    run = run_kernel(_advance, (mA, mB, k, b, g, e, floor), st, out, options,
+                     f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
+    i, status, events, wall = run.steps, run.status, run.events, run.wall
 
     kept = i // every + 1
     traj = Trajectory(
@@ -153,12 +134,12 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         state={name: out[c, :kept] for c, name in enumerate(("xA", "vA", "xB", "vB"))},
         events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
     )
-    if status == _BLOWUP:
+    if status == BLOWUP:
         t_fail = i * dt
         traj.verdict = Verdict("unstable", t_fail, nonfinite_reason(scene, dt))
-        _drop_nonfinite(traj)
-    elif status in (_TUNNEL_A, _TUNNEL_B):
-        body = "A" if status == _TUNNEL_A else "B"
+        trim_blown_up(traj)
+    elif status in (TUNNEL_A, TUNNEL_B):
+        body = "A" if status == TUNNEL_A else "B"
         c = 0 if body == "A" else 2
         f = k * (st[0] - st[2] - b)
         push = f / mA if body == "A" else -f / mB  # the spring's downward pull on the body
@@ -167,12 +148,3 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         traj.verdict = energy_verdict(traj, dt)
     return traj
 
-
-def _drop_nonfinite(traj: Trajectory) -> None:
-    """Keep only the samples up to the last one whose state is finite and not blown up."""
-    good = np.ones(len(traj.t), dtype=bool)
-    for col in traj.state.values():
-        good &= np.abs(col) < _BIG
-    keep = int(np.argmin(good)) if not good.all() else len(good)
-    traj.t = traj.t[:keep]
-    traj.state = {name: col[:keep] for name, col in traj.state.items()}

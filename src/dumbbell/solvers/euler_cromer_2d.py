@@ -27,15 +27,13 @@ import numpy as np
 from numba import njit
 
 from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params
+from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, run_kernel, trim_blown_up
 from .verdicts import energy_verdict, nonfinite_reason
 
 NAME = "euler-cromer-2d"
 
-_OK, _BLOWUP, _TUNNEL_A, _TUNNEL_B = 0, 1, 2, 3
-_BIG = 1e150
-_EVENT_BUFFER = 4096
 _CHUNK = 4_000_000
 _COLUMNS = ("xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB")
 
@@ -47,7 +45,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, rA, rB, every, out, e
     invA = 1.0 / mA
     invB = 1.0 / mB
     n_ev = 0
-    status = _OK
+    status = OK
     while i < i_stop:
         # 1. positions
         xA = xA + vxA * dt
@@ -95,12 +93,12 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, rA, rB, every, out, e
             n_ev += 1
         if floor:
             if yA < -rA and vyA < 0.0:
-                status = _TUNNEL_A
+                status = TUNNEL_A
             if yB < -rB and vyB < 0.0:
-                status = _TUNNEL_B
-        if not (abs(xA) < _BIG and abs(yA) < _BIG and abs(vxA) < _BIG and abs(vyA) < _BIG
-                and abs(xB) < _BIG and abs(yB) < _BIG and abs(vxB) < _BIG and abs(vyB) < _BIG):
-            status = _BLOWUP
+                status = TUNNEL_B
+        if not (abs(xA) < BIG and abs(yA) < BIG and abs(vxA) < BIG and abs(vyA) < BIG
+                and abs(xB) < BIG and abs(yB) < BIG and abs(vxB) < BIG and abs(vyB) < BIG):
+            status = BLOWUP
         if i % every == 0:
             jj = i // every
             out[jj, 0] = xA
@@ -111,7 +109,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, rA, rB, every, out, e
             out[jj, 5] = yB
             out[jj, 6] = vxB
             out[jj, 7] = vyB
-        if status != _OK or n_ev >= ev.shape[0] - 2:
+        if status != OK or n_ev >= ev.shape[0] - 2:
             break
     st[0], st[1], st[2], st[3] = xA, yA, vxA, vyA
     st[4], st[5], st[6], st[7] = xB, yB, vxB, vyB
@@ -136,49 +134,32 @@ def warm_up() -> float:
     t0 = time.perf_counter()
     st = np.array([0.1, 1.17, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
     _advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02, 1,
-             np.empty((2, 8)), np.empty((_EVENT_BUFFER, 4)))
+             np.empty((2, 8)), np.empty((EVENT_BUFFER, 4)))
     return time.perf_counter() - t0
 
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` in pymunk's step order at step ``options.dt`` (s)."""
-    from ..progress import bar
-
     A, B = scene.A, scene.B
     mA, mB, k, b, g, e, floor = kernel_params(scene)
-    dt, every, n = options.dt, options.every, options.n_steps
+    dt, every = options.dt, options.every
     out = np.empty((options.n_samples, 8))
     st = np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)
     out[0] = st
-    ev = np.empty((_EVENT_BUFFER, 4))
-    events: list[Impact] = []
-    status, i = _OK, 0
     warm_up()  # compiling is not part of the run time
-    t0 = time.perf_counter()
-    with bar(n, f"{NAME} {scene.name}", "step", quiet=options.quiet or n < 10 * _CHUNK) as pb:
-        while i < n and status == _OK:
-            i_stop = min(n, i + _CHUNK)
-            i_new, status, n_ev = _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor,
-                                           A.radius, B.radius, every, out, ev)
-            events.extend(Impact(float(r[0]) * dt, "AB"[int(r[1])], float(r[2]), float(r[3]))
-                          for r in ev[:n_ev])
-            pb.update(i_new - i)
-            i = i_new
-    wall = time.perf_counter() - t0
+    run = run_kernel(_advance, (mA, mB, k, b, g, e, floor, A.radius, B.radius), st, out,
+                     options, f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
+    i, status, events, wall = run.steps, run.status, run.events, run.wall
 
     kept = i // every + 1
     traj = Trajectory(scene=scene, solver=NAME, t=options.sample_times(kept),
                       state={name: out[:kept, c].copy() for c, name in enumerate(_COLUMNS)},
                       events=events, dt=dt, every=every, wall_time=wall, info={"steps": i})
-    if status == _BLOWUP:
-        keep = kept
-        while keep and not np.all(np.abs(out[keep - 1]) < _BIG):
-            keep -= 1
-        traj.t = traj.t[:keep]
-        traj.state = {name: col[:keep] for name, col in traj.state.items()}
+    if status == BLOWUP:
+        trim_blown_up(traj)
         traj.verdict = Verdict("unstable", i * dt, nonfinite_reason(scene, dt))
-    elif status in (_TUNNEL_A, _TUNNEL_B):
-        body = "A" if status == _TUNNEL_A else "B"
+    elif status in (TUNNEL_A, TUNNEL_B):
+        body = "A" if status == TUNNEL_A else "B"
         y = st[1] if body == "A" else st[5]
         traj.verdict = Verdict("tunnelled", i * dt,
                                f"{body} is {-y:.3g} m below the floor and still moving down: "

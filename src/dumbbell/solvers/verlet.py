@@ -30,17 +30,23 @@ import numpy as np
 from numba import njit
 
 from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params
-from .verdicts import energy_verdict, keep_samples, nonfinite_reason, tunnel_reason
+from .stepping import (
+    BIG,
+    BLOWUP,
+    EVENT_BUFFER,
+    OK,
+    REST,
+    TUNNEL_A,
+    TUNNEL_B,
+    run_kernel,
+    trim_blown_up,
+)
+from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
 
 NAME = "verlet"
 
-_OK, _BLOWUP, _TUNNEL_A, _TUNNEL_B, _REST = 0, 1, 2, 3, 4
-#: A state component beyond this magnitude (m or m/s) counts as blown up.
-_BIG = 1e150
-#: Impacts recorded per kernel call before it hands back to Python.
-_EVENT_BUFFER = 4096
 #: Steps per kernel call: the progress bar moves between calls.
 _CHUNK = 2_000_000
 #: An impact slower than this (m/s), or more impacts than _MAX_HITS in one step, means a
@@ -103,7 +109,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
     aA = (-f - mA * g) / mA
     aB = (f - mB * g) / mB
     n_ev = 0
-    status = _OK
+    status = OK
     while i < i_stop:
         rem = dt
         hits = 0
@@ -152,18 +158,18 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
             aA = (-f - mA * g) / mA
             aB = (f - mB * g) / mB
             if abs(v_in) < REST_SPEED or hits > _MAX_HITS:
-                status = _REST
+                status = REST
                 break
-        if status == _REST:
+        if status == REST:
             break
         i += 1
         if floor:
             if xA < 0.0 and vA < 0.0:
-                status = _TUNNEL_A
+                status = TUNNEL_A
             if xB < 0.0 and vB < 0.0:
-                status = _TUNNEL_B
-        if not (abs(xA) < _BIG and abs(vA) < _BIG and abs(xB) < _BIG and abs(vB) < _BIG):
-            status = _BLOWUP
+                status = TUNNEL_B
+        if not (abs(xA) < BIG and abs(vA) < BIG and abs(xB) < BIG and abs(vB) < BIG):
+            status = BLOWUP
         if i % every == 0:
             j = i // every
             out[j, 0] = xA
@@ -171,7 +177,7 @@ def _advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # p
             out[j, 2] = xB
             out[j, 3] = vB
         # One step records at most _MAX_HITS + 1 impacts: hand back while they still fit.
-        if status != _OK or n_ev >= ev.shape[0] - 2 * _MAX_HITS:
+        if status != OK or n_ev >= ev.shape[0] - 2 * _MAX_HITS:
             break
     st[0] = xA
     st[1] = vA
@@ -201,7 +207,7 @@ def _advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
     xA, yA, vxA, vyA, xB, yB, vxB, vyB = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
     axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g)
     n_ev = 0
-    status = _OK
+    status = OK
     while i < i_stop:
         rem = dt
         hits = 0
@@ -248,20 +254,20 @@ def _advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
                 vyB = v_out
             axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g)
             if abs(v_in) < REST_SPEED or hits > _MAX_HITS:
-                status = _REST
+                status = REST
                 break
-        if status == _REST:
+        if status == REST:
             break
         i += 1
         if floor:
             if yA < 0.0 and vyA < 0.0:
-                status = _TUNNEL_A
+                status = TUNNEL_A
             if yB < 0.0 and vyB < 0.0:
-                status = _TUNNEL_B
-        if not (abs(xA) < _BIG and abs(yA) < _BIG and abs(vxA) < _BIG and abs(vyA) < _BIG
-                and abs(xB) < _BIG and abs(yB) < _BIG and abs(vxB) < _BIG
-                and abs(vyB) < _BIG):
-            status = _BLOWUP
+                status = TUNNEL_B
+        if not (abs(xA) < BIG and abs(yA) < BIG and abs(vxA) < BIG and abs(vyA) < BIG
+                and abs(xB) < BIG and abs(yB) < BIG and abs(vxB) < BIG
+                and abs(vyB) < BIG):
+            status = BLOWUP
         if i % every == 0:
             j = i // every
             out[j, 0] = xA
@@ -272,7 +278,7 @@ def _advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
             out[j, 5] = yB
             out[j, 6] = vxB
             out[j, 7] = vyB
-        if status != _OK or n_ev >= ev.shape[0] - 2 * _MAX_HITS:
+        if status != OK or n_ev >= ev.shape[0] - 2 * _MAX_HITS:
             break
     st[0], st[1], st[2], st[3] = xA, yA, vxA, vyA
     st[4], st[5], st[6], st[7] = xB, yB, vxB, vyB
@@ -297,7 +303,7 @@ def warm_up() -> float:
     t0 = time.perf_counter()
     st = np.array([1.2, 0.0, 1.0, 0.0])
     out = np.empty((2, 4))
-    ev = np.empty((_EVENT_BUFFER, 4))
+    ev = np.empty((EVENT_BUFFER, 4))
     _advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, out, ev)
     st2 = np.array([0.1, 1.17, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
     _advance_2d(st2, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, np.empty((2, 8)), ev)
@@ -309,10 +315,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 
     ``wall_time`` covers the kernel calls and the impact list, not the array set-up, the
     verdict or the energy."""
-    from ..progress import bar
-
     mA, mB, k, b, g, e, floor = kernel_params(scene)
-    dt, every, n = options.dt, options.every, options.n_steps
+    dt, every = options.dt, options.every
     A, B = scene.A, scene.B
     if scene.dimensions == 1:
         kernel, columns = _advance, ("xA", "vA", "xB", "vB")
@@ -325,22 +329,9 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                                                                          "B": (5, 7)}
     out = np.empty((options.n_samples, len(columns)))
     out[0] = st
-    ev = np.empty((_EVENT_BUFFER, 4))
-    events: list[Impact] = []
-    status, i = _OK, 0
-    t0 = time.perf_counter()
-    with bar(n, f"{NAME} {scene.name}", "step", quiet=options.quiet or n < 5 * _CHUNK) as pb:
-        while i < n and status == _OK:
-            i_stop = min(n, i + _CHUNK)
-            i_new, status, n_ev = kernel(st, i, i_stop, dt, mA, mB, k, b, g, e, floor,
-                                         every, out, ev)
-            events.extend(
-                Impact(float(r[0]), "AB"[int(r[1])], float(r[2]), float(r[3]))
-                for r in ev[:n_ev]
-            )
-            pb.update(i_new - i)
-            i = i_new
-    wall = time.perf_counter() - t0
+    run = run_kernel(kernel, (mA, mB, k, b, g, e, floor), st, out, options,
+                     f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=False)
+    i, status, events, wall = run.steps, run.status, run.events, run.wall
 
     kept = i // every + 1
     traj = Trajectory(
@@ -348,18 +339,15 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         state={name: out[:kept, c] for c, name in enumerate(columns)},
         events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
     )
-    if status == _BLOWUP:
+    if status == BLOWUP:
         traj.verdict = Verdict("unstable", i * dt, nonfinite_reason(scene, dt))
-        good = np.ones(len(traj.t), dtype=bool)
-        for col in traj.state.values():
-            good &= np.abs(col) < _BIG
-        keep_samples(traj, int(np.argmin(good)) if not good.all() else len(good))
-    elif status in (_TUNNEL_A, _TUNNEL_B):
-        body = "A" if status == _TUNNEL_A else "B"
+        trim_blown_up(traj)
+    elif status in (TUNNEL_A, TUNNEL_B):
+        body = "A" if status == TUNNEL_A else "B"
         y, vy = vertical[body]
         traj.verdict = Verdict("tunnelled", i * dt,
                                tunnel_reason(scene, body, st[y], st[vy], dt))
-    elif status == _REST:
+    elif status == REST:
         last = events[-1] if events else None
         t_rest = last.t if last else i * dt
         traj.verdict = Verdict(

@@ -1,0 +1,70 @@
+"""The driver the compiled time-steppers share (euler-cromer, euler-cromer-2d, verlet).
+
+Each has a numba kernel ``kernel(st, i, i_stop, dt, *params, every, out, ev)`` that advances the
+state ``st`` in place from step ``i`` towards ``i_stop``, writes every ``every``-th step into
+``out``, records impacts as rows ``(time or step, body 0/1, v_before, v_after)`` of ``ev``, and
+returns ``(step reached, status, impacts recorded)``. It stops early on a bad status or when
+``ev`` is nearly full; :func:`run_kernel` calls it chunk by chunk, which is also what moves the
+progress bar.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..progress import bar
+from ..trajectory import Impact, Trajectory
+from . import RunOptions
+from .verdicts import keep_samples
+
+#: A state component beyond this magnitude (m or m/s) counts as blown up.
+BIG = 1e150
+#: Impacts recorded per kernel call before it hands back to Python.
+EVENT_BUFFER = 4096
+#: Kernel status codes.
+OK, BLOWUP, TUNNEL_A, TUNNEL_B, REST = 0, 1, 2, 3, 4
+
+
+@dataclass
+class KernelRun:
+    """What a chunked run ended with: steps taken, status code, impacts, loop time (s)."""
+
+    steps: int
+    status: int
+    events: list[Impact]
+    wall: float
+
+
+def run_kernel(
+    kernel: Callable, params: tuple, st: np.ndarray, out: np.ndarray, options: RunOptions,
+    desc: str, chunk: int, event_time_in_steps: bool,
+) -> KernelRun:
+    """Run ``kernel`` over ``options.n_steps`` steps in chunks of ``chunk`` steps, with a
+    progress bar on a terminal for long runs. ``event_time_in_steps``: the kernel records the
+    step index of an impact (its time is then index * dt) rather than the time itself."""
+    dt, every, n = options.dt, options.every, options.n_steps
+    ev = np.empty((EVENT_BUFFER, 4))
+    scale = dt if event_time_in_steps else 1.0
+    events: list[Impact] = []
+    status, i = OK, 0
+    t0 = time.perf_counter()
+    with bar(n, desc, "step", quiet=options.quiet or n < 5 * chunk) as pb:
+        while i < n and status == OK:
+            i_new, status, n_ev = kernel(st, i, min(n, i + chunk), dt, *params, every, out, ev)
+            events.extend(Impact(float(r[0]) * scale, "AB"[int(r[1])], float(r[2]), float(r[3]))
+                          for r in ev[:n_ev])
+            pb.update(i_new - i)
+            i = i_new
+    return KernelRun(i, status, events, time.perf_counter() - t0)
+
+
+def trim_blown_up(traj: Trajectory) -> None:
+    """Keep the samples before the first one whose state is non-finite or beyond :data:`BIG`."""
+    good = np.ones(len(traj.t), dtype=bool)
+    for col in traj.state.values():
+        good &= np.abs(col) < BIG
+    keep_samples(traj, int(np.argmin(good)) if not good.all() else len(good))
