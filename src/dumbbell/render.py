@@ -39,10 +39,10 @@ if TYPE_CHECKING:
 
 #: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
 MAX_FPS = 50
-#: Samples per second the strip of the energy time series needs: it shows 1 s on ~390 px,
-#: and the textbook spring's 20 Hz energy oscillations keep their peaks (to 0.2 %) with 50
-#: samples per oscillation.
-STRIP_RATE = 1000.0
+#: Samples per second the strip of the energy time series needs: it shows 1 s on ~390 px
+#: (about one sample per pixel column), and the textbook spring's 20 Hz energy oscillations
+#: keep their peaks to 1 % with 25 samples per oscillation.
+STRIP_RATE = 500.0
 #: Most samples kept for the strip over the whole animation (memory of very long runs).
 STRIP_SAMPLES = 200_000
 
