@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from .errors import DumbbellError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("run", "simulate", "render", "bench", "sweep", "compare", "stability")
+COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep")
 
 EXIT_USAGE = 2
 EXIT_VERDICT = 3

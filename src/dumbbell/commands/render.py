@@ -16,10 +16,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "particles at their true radius, the spring as a zig-zag (a rod when "
                     "rigid), the centre of mass, the time and in 2D the axis angle; bars of "
                     "every energy term on one fixed scale with a marker at the total; and a "
-                    "strip of the energy time series with a moving cursor. Settings come from "
-                    "the flags, else the scene's [outputs.gif] table, else fps 25, 640x360, "
-                    "strip on, the scene's run.t_end. A run that ends badly still writes its "
-                    "GIF up to the failure, prints why and exits 3.",
+                    "strip of the energy time series (a 1 s window scrolling under a "
+                    "cursor). Settings come from the flags, else the scene's [outputs.gif] "
+                    "table, else fps 25, 640x360, strip on, the scene's run.t_end. A run "
+                    "that ends badly still writes its GIF up to the failure, prints why and "
+                    "exits 3.",
     )
     p.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
     p.add_argument("--solver", metavar="NAME",
