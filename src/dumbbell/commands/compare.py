@@ -31,9 +31,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="window [0, T] s for the position error (default: 2)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="end time in s (default: the scene's run.t_end)")
-    p.add_argument("--solvers", metavar="NAMES",
-                   help="comma-separated solvers to compare (default: pymunk and "
-                        "euler-cromer in 1D, pymunk and euler-cromer-2d in 2D)")
+    p.add_argument("--solvers", metavar="NAME", nargs="+",
+                   help="solvers to compare, as in bench and stability (commas also work; "
+                        "default: pymunk and euler-cromer in 1D, pymunk and euler-cromer-2d "
+                        "in 2D)")
     add_quiet(p)
     p.set_defaults(func=run)
 
@@ -47,10 +48,10 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     solvers = None
     if args.solvers:
-        solvers = [s.strip() for s in args.solvers.split(",") if s.strip()]
+        solvers = [s.strip() for item in args.solvers for s in item.split(",") if s.strip()]
         unknown = [s for s in solvers if s not in available()]
         if unknown or not solvers:
-            raise UsageError(f"--solvers {args.solvers!r}: must be a comma-separated list of "
+            raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
                              + ", ".join(available()))
     result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
     paths = write(result, Path(args.out))

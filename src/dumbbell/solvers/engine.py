@@ -55,6 +55,7 @@ from ..energy import disc_inertia, spins, state_columns
 from ..scene import Scene
 from ..trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
+from .stepping import blowup_verdict
 from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
 
 NAME = "pymunk"
@@ -309,5 +310,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     )
     if world.rigid_body is not None:
         traj.info["moment"] = world.rigid_body.moment
+    if verdict is not None and verdict.status == "unstable":
+        verdict = blowup_verdict(traj, verdict.t, dt)
     traj.verdict = verdict if verdict is not None else energy_verdict(traj, dt)
     return traj

@@ -22,10 +22,10 @@ import numpy as np
 from numba import njit
 
 from ..scene import Scene
-from ..trajectory import Trajectory, Verdict
+from ..trajectory import Trajectory
 from . import RunOptions, kernel_params
-from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, run_kernel, trim_blown_up
-from .verdicts import below_floor_verdict, energy_verdict, nonfinite_reason
+from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, blowup_verdict, run_kernel
+from .verdicts import below_floor_verdict, energy_verdict
 
 NAME = "euler-cromer"
 
@@ -135,9 +135,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
     )
     if status == BLOWUP:
-        t_fail = i * dt
-        traj.verdict = Verdict("unstable", t_fail, nonfinite_reason(scene, dt))
-        trim_blown_up(traj)
+        traj.verdict = blowup_verdict(traj, i * dt, dt)
     elif status in (TUNNEL_A, TUNNEL_B):
         body = "A" if status == TUNNEL_A else "B"
         c = 0 if body == "A" else 2

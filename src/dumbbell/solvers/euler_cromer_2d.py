@@ -29,8 +29,8 @@ from numba import njit
 from ..scene import Scene
 from ..trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params
-from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, run_kernel, trim_blown_up
-from .verdicts import energy_verdict, nonfinite_reason
+from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, blowup_verdict, run_kernel
+from .verdicts import energy_verdict
 
 NAME = "euler-cromer-2d"
 
@@ -156,8 +156,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                       state={name: out[:kept, c].copy() for c, name in enumerate(_COLUMNS)},
                       events=events, dt=dt, every=every, wall_time=wall, info={"steps": i})
     if status == BLOWUP:
-        trim_blown_up(traj)
-        traj.verdict = Verdict("unstable", i * dt, nonfinite_reason(scene, dt))
+        traj.verdict = blowup_verdict(traj, i * dt, dt)
     elif status in (TUNNEL_A, TUNNEL_B):
         body = "A" if status == TUNNEL_A else "B"
         y = st[1] if body == "A" else st[5]

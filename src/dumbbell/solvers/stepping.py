@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..progress import bar
-from ..trajectory import Impact, Trajectory
+from ..trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
-from .verdicts import keep_samples
+from .verdicts import energy_verdict, keep_samples, nonfinite_reason
 
 #: A state component beyond this magnitude (m or m/s) counts as blown up.
 BIG = 1e150
@@ -68,3 +68,15 @@ def trim_blown_up(traj: Trajectory) -> None:
     for col in traj.state.values():
         good &= np.abs(col) < BIG
     keep_samples(traj, int(np.argmin(good)) if not good.all() else len(good))
+
+
+def blowup_verdict(traj: Trajectory, t_overflow: float, dt: float) -> Verdict:
+    """The verdict of a run whose state overflowed at ``t_overflow`` (s): ``unstable`` from the
+    first sample whose energy error passed the scene's threshold, with the samples after it
+    dropped (they hold only the explosion, up to 1e300 J, which would swamp every plot and
+    bar scale), else from the overflow itself."""
+    trim_blown_up(traj)
+    verdict = energy_verdict(traj, dt)
+    if verdict.ok:
+        verdict = Verdict("unstable", t_overflow, nonfinite_reason(traj.scene, dt))
+    return verdict

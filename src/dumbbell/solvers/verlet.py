@@ -40,10 +40,10 @@ from .stepping import (
     REST,
     TUNNEL_A,
     TUNNEL_B,
+    blowup_verdict,
     run_kernel,
-    trim_blown_up,
 )
-from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
+from .verdicts import energy_verdict, tunnel_reason
 
 NAME = "verlet"
 
@@ -340,8 +340,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
     )
     if status == BLOWUP:
-        traj.verdict = Verdict("unstable", i * dt, nonfinite_reason(scene, dt))
-        trim_blown_up(traj)
+        traj.verdict = blowup_verdict(traj, i * dt, dt)
     elif status in (TUNNEL_A, TUNNEL_B):
         body = "A" if status == TUNNEL_A else "B"
         y, vy = vertical[body]
