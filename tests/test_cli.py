@@ -69,3 +69,18 @@ def test_bad_flags_exit_2_with_one_line(tmp_path, capsys, flags, word):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and word in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_a_closed_pipe_ends_quietly():
+    # `dumbbell simulate SCENE | head -1`: the reader leaves early; that is not an error.
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "dumbbell.cli", "simulate", TEXTBOOK,
+                             "--t-end", "2", "--every", "1"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    assert proc.stdout.readline().startswith(b"t,xA,vA,xB,vB")
+    proc.stdout.close()
+    err = proc.stderr.read()
+    assert proc.wait(timeout=60) == 0
+    assert err == b""

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import math
+import os
 import sys
 from collections.abc import Sequence
 
@@ -107,6 +108,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except DumbbellError as exc:
         sys.stderr.write(f"dumbbell {args.command}: error: {exc}\n")
         return EXIT_USAGE
+    except BrokenPipeError:
+        # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep
+        # Python from complaining again when it flushes stdout at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except OSError as exc:
         # Backstop: an output that still cannot be written is one line, not a traceback.
         where = exc.filename or "an output file"
