@@ -69,6 +69,18 @@ def kernel_params(scene: Scene) -> tuple[float, float, float, float, float, floa
             scene.floor is not None)
 
 
+def point_particle_limits(scene: Scene, name: str) -> str | None:
+    """Why a hand-written 2D solver of two point particles, a spring and a frictionless floor
+    cannot run ``scene``, or None if it can."""
+    if scene.rigid is not None:
+        return f"{name} handles two particles and a spring, not a rigid body"
+    if scene.floor is not None and scene.floor.friction > 0:
+        return f"{name} has a frictionless floor only; use pymunk for friction"
+    if scene.pymunk.spin:
+        return f"{name} has point particles (no spin); use pymunk for spinning particles"
+    return None
+
+
 def solver_module(name: str) -> ModuleType:
     """The module of solver ``name``; UsageError naming the choices when there is none."""
     if name not in REGISTRY:

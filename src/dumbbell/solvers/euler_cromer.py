@@ -101,7 +101,6 @@ def supports(scene: Scene) -> str | None:
     return None
 
 
-
 def warm_up() -> float:
     """Compile (or load from numba's cache) the loop and the 1D energy partition; returns the
     seconds it took."""

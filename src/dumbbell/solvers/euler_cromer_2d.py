@@ -28,7 +28,7 @@ from numba import njit
 
 from ..scene import Scene
 from ..trajectory import Trajectory, Verdict
-from . import RunOptions, kernel_params
+from . import RunOptions, kernel_params, point_particle_limits
 from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, blowup_verdict, run_kernel
 from .verdicts import energy_verdict
 
@@ -120,13 +120,7 @@ def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
     if scene.dimensions != 2:
         return "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
-    if scene.rigid is not None:
-        return "euler-cromer-2d handles two particles and a spring, not a rigid body"
-    if scene.floor is not None and scene.floor.friction > 0:
-        return "euler-cromer-2d has a frictionless floor only; use pymunk for friction"
-    if scene.pymunk.spin:
-        return "euler-cromer-2d has point particles (no spin); use pymunk for spinning particles"
-    return None
+    return point_particle_limits(scene, NAME)
 
 
 def warm_up() -> float:

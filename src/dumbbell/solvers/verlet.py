@@ -31,7 +31,7 @@ from numba import njit
 
 from ..scene import Scene
 from ..trajectory import Trajectory, Verdict
-from . import RunOptions, kernel_params
+from . import RunOptions, kernel_params, point_particle_limits
 from .stepping import (
     BIG,
     BLOWUP,
@@ -287,15 +287,7 @@ def _advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    if scene.dimensions == 2:
-        if scene.rigid is not None:
-            return "verlet handles two particles and a spring, not a rigid body"
-        if scene.floor is not None and scene.floor.friction > 0:
-            return "verlet has a frictionless floor only; use pymunk for friction"
-        if scene.pymunk.spin:
-            return "verlet has point particles (no spin); use pymunk for spinning particles"
-    return None
-
+    return point_particle_limits(scene, NAME) if scene.dimensions == 2 else None
 
 
 def warm_up() -> float:
