@@ -88,7 +88,7 @@ def main() -> None:
     args = parser.parse_args()
 
     import dumbbell
-    from dumbbell.scene import packaged_scene
+    from dumbbell.model.scene import packaged_scene
     from dumbbell.solvers import euler_cromer
 
     scene = dumbbell.load_scene(packaged_scene())
@@ -143,7 +143,7 @@ def main() -> None:
 
     mem = fresh_process("""
         import time, dumbbell
-        from dumbbell.scene import packaged_scene
+        from dumbbell.model.scene import packaged_scene
         from dumbbell.solvers import euler_cromer
         euler_cromer.warm_up()
         scene = dumbbell.load_scene(packaged_scene())

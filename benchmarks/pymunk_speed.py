@@ -23,8 +23,8 @@ import time
 
 import numpy as np
 
-from dumbbell.compare import energy_spread, position_error
-from dumbbell.scene import load_scene, packaged_scene
+from dumbbell.analysis.compare import energy_spread, position_error
+from dumbbell.model.scene import load_scene, packaged_scene
 from dumbbell.solvers import simulate
 from dumbbell.solvers.engine import build
 

@@ -39,10 +39,10 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle
 
-    from dumbbell.energy import energy_columns
-    from dumbbell.figures import COLOURS
-    from dumbbell.render import _frames, sample_every
-    from dumbbell.scene import load_scene
+    from dumbbell.animation.render import _frames, sample_every
+    from dumbbell.model.energy import energy_columns
+    from dumbbell.model.scene import load_scene
+    from dumbbell.plot.figures import COLOURS
     from dumbbell.solvers import simulate
 
     scene = load_scene(scene_path)
@@ -171,8 +171,8 @@ def main() -> None:
               f"ratio {base[-1] / ours[-1]:.1f}", flush=True)
 
     # The split of dumbbell render's own time, in-process (simulation excluded).
-    from dumbbell.render import render_gif, sample_every
-    from dumbbell.scene import load_scene
+    from dumbbell.animation.render import render_gif, sample_every
+    from dumbbell.model.scene import load_scene
     from dumbbell.solvers import simulate
 
     scene = load_scene(args.scene)

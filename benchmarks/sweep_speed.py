@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _sweep(scene, n: int, workers: int, t_end: float = 1.0):
     """Run the n x n sweep; returns (wall s, CPU s of this process and its children, result)."""
-    from dumbbell.sweep import parse_axis, run_sweep
+    from dumbbell.analysis.sweep import parse_axis, run_sweep
 
     axes = [parse_axis(f"k=log:1e2:1e7:{n}"), parse_axis(f"dt=log:1e-6:1e-2:{n}")]
     c0, t0 = os.times(), time.perf_counter()
@@ -41,7 +41,7 @@ def _sweep(scene, n: int, workers: int, t_end: float = 1.0):
 
 
 def speed(n: int, workers: int, repeat: int) -> None:
-    from dumbbell.scene import load_scene
+    from dumbbell.model.scene import load_scene
     from dumbbell.solvers.euler_cromer import warm_up
 
     scene = load_scene(ROOT / "scenes" / "textbook-1d.toml")
@@ -76,7 +76,7 @@ def speed(n: int, workers: int, repeat: int) -> None:
 
 def grid_boundary(n: int, workers: int) -> None:
     """Where the 50x50 sweeps stop being ok, against 2/w, and why the textbook's fails early."""
-    from dumbbell.scene import load_scene
+    from dumbbell.model.scene import load_scene
 
     for name, label in (("textbook-1d.toml", "textbook scene (floor, gravity, threshold 10)"),
                         ("extreme/stiff-wdt-1.9.toml",
@@ -123,7 +123,7 @@ def critical_ratio(scene, solver: str, lo: float = 1.5, hi: float = 2.5, steps: 
 
 def bisected_boundary() -> None:
     """The blow-up boundary by bisection, per solver, k and mass ratio (no floor)."""
-    from dumbbell.scene import load_scene
+    from dumbbell.model.scene import load_scene
     from dumbbell.solvers import REGISTRY
 
     base = load_scene(ROOT / "scenes" / "extreme" / "stiff-wdt-1.9.toml")

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from dumbbell.scene import Scene, load_scene, scene_from_dict
+from dumbbell.model.scene import Scene, load_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from dumbbell.cli import main
-from dumbbell.energy import partition_2d
-from dumbbell.scene import load_scene, scene_from_dict
+from dumbbell.model.energy import partition_2d
+from dumbbell.model.scene import load_scene, scene_from_dict
 from dumbbell.solvers import simulate, solver_module
 from tests.conftest import SCENES, make_scene
 
@@ -135,7 +135,7 @@ def test_rigid_k_rot_is_half_i_omega_squared(rigid):
     after = (run.t > run.events[0].t + 1e-3) & (run.t < run.events[0].t + 0.05)
     np.testing.assert_allclose(run["K_rot"][after], k_rot, rtol=1e-3)
     # The rotation figure's mean: one impact, then the whole flight to the next one.
-    from dumbbell.rotation import mean_after_first_cluster
+    from dumbbell.analysis.rotation import mean_after_first_cluster
 
     mean, start, end = mean_after_first_cluster(run, "K_rot")
     assert (start, end) == (run.events[0].t, run.events[1].t)
@@ -265,7 +265,7 @@ def test_compare_bad_solver_writes_nothing(tmp_path, capsys):
 def test_rotation_variants_and_the_stiff_limit(tilted):
     """A stiff spring dumbbell does not take the rigid body's share of rotation at an
     impact: B alone is reversed, so K_rot = 1/2 mu (2 v sin 30)^2 for every k."""
-    from dumbbell.rotation import variants
+    from dumbbell.analysis.rotation import variants
 
     scenes = variants(tilted)
     assert [s.spring.stiffness for s in scenes.values() if s.spring] == [200.0, 2e3, 2e4]
@@ -279,7 +279,7 @@ def test_rotation_variants_and_the_stiff_limit(tilted):
     assert stiff["K_rot"][just_after] == pytest.approx(expected, rel=2e-2)
     # A lands about 0.07 s after B: the figure's mean starts after that landing, and the two
     # impacts together leave far less rotation than the rigid body's 1.25 J.
-    from dumbbell.rotation import CLUSTER_GAP, mean_after_first_cluster
+    from dumbbell.analysis.rotation import CLUSTER_GAP, mean_after_first_cluster
 
     (b_hit, a_hit), bodies = [e.t for e in stiff.events], [e.body for e in stiff.events]
     assert bodies == ["B", "A"] and 0.05 < a_hit - b_hit < CLUSTER_GAP

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from dumbbell.bench import (
+from dumbbell.analysis.bench import (
     CSV_COLUMNS,
     DEFAULT_DTS,
     default_solvers,
@@ -21,7 +21,7 @@ from dumbbell.bench import (
     write_all,
 )
 from dumbbell.cli import main
-from dumbbell.scene import load_scene
+from dumbbell.model.scene import load_scene
 from dumbbell.solvers import REGISTRY, simulate
 from tests.conftest import SCENES, make_scene
 
@@ -159,7 +159,7 @@ def test_bad_flags_write_nothing(tmp_path, capsys, flags, message):
 
 
 def test_time_for_an_error_interpolates_in_log_log():
-    from dumbbell.bench import _time_for_error
+    from dumbbell.analysis.bench import _time_for_error
 
     line = [(1.0, 1e-2), (10.0, 1e-4), (100.0, 1e-6)]
     assert _time_for_error(line, 1e-3) == pytest.approx(10**0.5)

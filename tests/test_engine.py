@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from dumbbell.cli import main
-from dumbbell.scene import load_scene
+from dumbbell.model.scene import load_scene
 from dumbbell.solvers import simulate
 from dumbbell.solvers.engine import DEFAULT_BIAS, DEFAULT_SLOP, build
 from tests.conftest import SCENES, make_scene

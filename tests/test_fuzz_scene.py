@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from dumbbell.errors import SceneError
-from dumbbell.scene import Scene, load_scene, scene_from_dict
+from dumbbell.model.scene import Scene, load_scene, scene_from_dict
 from tests.conftest import TEXTBOOK
 
 # The suite's run is derandomized, so CI is reproducible; FUZZ_EXAMPLES=5000 explores afresh.

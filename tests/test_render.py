@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
+from dumbbell.animation.drawing import TERM_RGB, Painter
+from dumbbell.animation.render import delays_cs, render_gif, sample_every
 from dumbbell.cli import main
-from dumbbell.drawing import TERM_RGB, Painter
-from dumbbell.render import delays_cs, render_gif, sample_every
-from dumbbell.scene import scene_from_dict
+from dumbbell.model.scene import scene_from_dict
+from dumbbell.model.trajectory import Trajectory
 from dumbbell.solvers import simulate
-from dumbbell.trajectory import Trajectory
 from tests.conftest import SCENES, TEXTBOOK
 
 SCENE = str(SCENES / "textbook-1d.toml")
@@ -204,7 +204,7 @@ def test_2d_drawing_keeps_the_aspect_ratio_and_follows_both_coordinates(tmp_path
 
 
 def test_range_since_previous_frame_matches_brute_force():
-    from dumbbell.render import _since_previous
+    from dumbbell.animation.render import _since_previous
 
     v = np.random.default_rng(1).random(50)
     idx = np.array([0, 0, 3, 7, 7, 8, 20, 49])     # frames may share a sample
@@ -216,8 +216,8 @@ def test_range_since_previous_frame_matches_brute_force():
 def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     """Index 255 marks 'unchanged' (transparent) in the GIF: a drawn pixel with it would show
     the previous frame's colour instead."""
-    from dumbbell.drawing import palette
-    from dumbbell.render import _frames
+    from dumbbell.animation.drawing import palette
+    from dumbbell.animation.render import _frames
 
     frames = _frames(short, 25, 1.0)
     painter = Painter(short.scene, frames, (320, 180), True)
@@ -229,8 +229,8 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
     """Over 2 s the strip shows a window of drawing.WINDOW s: the cursor walks in, then stays
     put while the curves scroll under it, and in every frame the U_g curve just left of the
     cursor is drawn at U_g of that column's time (so the window's time axis is right)."""
-    from dumbbell import drawing
-    from dumbbell.render import _frames
+    from dumbbell.animation import drawing
+    from dumbbell.animation.render import _frames
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
     frames = _frames(traj, 25, 2.0)

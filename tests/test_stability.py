@@ -13,11 +13,11 @@ import shutil
 import numpy as np
 import pytest
 
+from dumbbell.analysis.stability import find_cases, plan_cases, predict, rest_time
 from dumbbell.cli import main
-from dumbbell.scene import load_scene, scene_from_dict
+from dumbbell.model.scene import load_scene, scene_from_dict
 from dumbbell.solvers import REGISTRY, simulate
 from dumbbell.solvers.verdicts import seconds, stable_swing
-from dumbbell.stability import find_cases, plan_cases, predict, rest_time
 from tests.conftest import SCENES, make_scene
 
 EXTREME = SCENES / "extreme"

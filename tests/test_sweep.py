@@ -8,10 +8,10 @@ import math
 
 import pytest
 
+from dumbbell.analysis.sweep import parse_axis, plan, run_sweep
 from dumbbell.cli import main
 from dumbbell.errors import UsageError
-from dumbbell.scene import load_scene
-from dumbbell.sweep import parse_axis, plan, run_sweep
+from dumbbell.model.scene import load_scene
 from tests.conftest import SCENES
 
 TEXTBOOK = str(SCENES / "textbook-1d.toml")

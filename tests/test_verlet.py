@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from dumbbell.energy import relative_energy_error
-from dumbbell.scene import load_scene
+from dumbbell.model.energy import relative_energy_error
+from dumbbell.model.scene import load_scene
 from dumbbell.solvers import REGISTRY, RunOptions, simulate, solver_module, supported
 from tests.conftest import SCENES, make_scene
 

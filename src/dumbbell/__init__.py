@@ -8,10 +8,10 @@ its internal motion, from the bouncing dumbbell of textbook section 13.5.1.
 """
 
 from .errors import DumbbellError, SceneError, UsageError
-from .scene import Scene, load_scene
+from .model.scene import Scene, load_scene
+from .model.trajectory import Impact, Trajectory, Verdict
 from .solvers import available as solvers
 from .solvers import simulate
-from .trajectory import Impact, Trajectory, Verdict
 
 __all__ = [
     "DumbbellError", "Impact", "Scene", "SceneError", "Trajectory", "UsageError", "Verdict",

@@ -17,8 +17,8 @@ from types import ModuleType
 import numpy as np
 
 from ..errors import UsageError
-from ..scene import SOLVER_NAMES, Scene
-from ..trajectory import Trajectory
+from ..model.scene import SOLVER_NAMES, Scene
+from ..model.trajectory import Trajectory
 
 #: Solver name -> module that implements it.
 REGISTRY: dict[str, str] = {

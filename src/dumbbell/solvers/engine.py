@@ -51,9 +51,9 @@ from typing import Any
 
 import numpy as np
 
-from ..energy import disc_inertia, spins, state_columns
-from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..model.energy import disc_inertia, spins, state_columns
+from ..model.scene import Scene
+from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
 from .stepping import blowup_verdict
 from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason

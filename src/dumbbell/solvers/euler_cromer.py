@@ -21,8 +21,8 @@ import time
 import numpy as np
 from numba import njit
 
-from ..scene import Scene
-from ..trajectory import Trajectory
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory
 from . import RunOptions, kernel_params
 from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, blowup_verdict, run_kernel
 from .verdicts import below_floor_verdict, energy_verdict
@@ -104,7 +104,7 @@ def supports(scene: Scene) -> str | None:
 def warm_up() -> float:
     """Compile (or load from numba's cache) the loop and the 1D energy partition; returns the
     seconds it took."""
-    from ..energy import partition_1d
+    from ..model.energy import partition_1d
 
     t0 = time.perf_counter()
     st = np.array([1.2, 0.0, 1.0, 0.0])

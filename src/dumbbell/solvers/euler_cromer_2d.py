@@ -26,8 +26,8 @@ import time
 import numpy as np
 from numba import njit
 
-from ..scene import Scene
-from ..trajectory import Trajectory, Verdict
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params, point_particle_limits
 from .stepping import BIG, BLOWUP, EVENT_BUFFER, OK, TUNNEL_A, TUNNEL_B, blowup_verdict, run_kernel
 from .verdicts import energy_verdict

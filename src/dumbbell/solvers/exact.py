@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..model.scene import Scene
+from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
 from .verdicts import energy_verdict
 

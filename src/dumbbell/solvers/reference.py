@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..energy import disc_inertia, relative_energy_error, spins, state_columns
-from ..scene import Scene
-from ..trajectory import Impact, Trajectory, Verdict
+from ..model.energy import disc_inertia, relative_energy_error, spins, state_columns
+from ..model.scene import Scene
+from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
 from .verdicts import energy_verdict
 

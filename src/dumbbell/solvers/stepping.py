@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
-from ..trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
 from .verdicts import energy_verdict, keep_samples, nonfinite_reason
 

@@ -18,9 +18,9 @@ import math
 
 import numpy as np
 
-from ..energy import relative_energy_error
-from ..scene import Scene
-from ..trajectory import Trajectory, Verdict
+from ..model.energy import relative_energy_error
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory, Verdict
 
 #: The explicit spring step (Euler-Cromer, Verlet, pymunk) is stable iff w*dt < this.
 STEP_LIMIT = 2.0

@@ -29,8 +29,8 @@ import time
 import numpy as np
 from numba import njit
 
-from ..scene import Scene
-from ..trajectory import Trajectory, Verdict
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory, Verdict
 from . import RunOptions, kernel_params, point_particle_limits
 from .stepping import (
     BIG,

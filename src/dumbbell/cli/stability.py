@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..cli import add_quiet, positive_int
+from .app import add_quiet, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..stability import report
+    from ..analysis.stability import report
 
     result = report(args.cases, args.solvers, args.out, args.workers, args.quiet)
     if not args.quiet:

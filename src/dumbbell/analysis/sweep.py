@@ -33,9 +33,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import DumbbellError, UsageError
-from .files import atomic_output
-from .scene import Scene
+from ..errors import DumbbellError, UsageError
+from ..io.files import atomic_output
+from ..model.scene import Scene
 
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}
@@ -167,7 +167,7 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
     """Every grid point, validated as a scene and as a bounded run before anything runs.
 
     ``t_end`` (s) overrides the scene's ``run.t_end``. Raises UsageError naming the axis."""
-    from .solvers import make_options, solver_module
+    from ..solvers import make_options, solver_module
 
     check_axes(axes)
     module = solver_module(solver)
@@ -204,8 +204,8 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
 def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any]:
     """Run one grid point and summarise it: w_dt, verdict, t_fail (s or None),
     max_rel_energy_error and reason. A solver error becomes the verdict ``failed``."""
-    from .energy import relative_energy_error
-    from .solvers import make_options, simulate
+    from ..model.energy import relative_energy_error
+    from ..solvers import make_options, simulate
 
     point = scene.with_values(values)
     options = make_options(point)
@@ -233,7 +233,7 @@ def _evaluate_batch(scene: Scene, batch: list[Point], solver: str
 
 def _warm_up(solver: str) -> None:
     """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
-    from .solvers import solver_module
+    from ..solvers import solver_module
 
     warm = getattr(solver_module(solver), "warm_up", None)
     if callable(warm):
@@ -315,7 +315,7 @@ class SweepResult:
     def draw_map(self, path: str | Path) -> Path:
         """The map PNG: log10 of the largest relative energy error over the grid, failures
         painted by verdict, and the line w*dt = 2."""
-        from .figures import _pyplot
+        from ..plot.figures import _pyplot
 
         plt = _pyplot()
         fig, ax = plt.subplots(figsize=(8.2, 6.2) if len(self.axes) == 2 else (8.2, 4.6))
@@ -347,7 +347,7 @@ def _cell(value: Any) -> str:
 
 def _collect(futures: Iterable[Any], as_completed: Callable[[Any], Iterable[Any]],
              n_points: int, quiet: bool, desc: str) -> list[tuple[int, dict[str, Any]]]:
-    from .progress import bar
+    from ..progress import bar
 
     done: list[tuple[int, dict[str, Any]]] = []
     with bar(n_points, desc, "run", quiet=quiet) as pb:
@@ -361,7 +361,7 @@ def _collect(futures: Iterable[Any], as_completed: Callable[[Any], Iterable[Any]
 def run_serial(scene: Scene, points: list[Point], solver: str, quiet: bool = True
                ) -> list[tuple[int, dict[str, Any]]]:
     """All points in this process, in order."""
-    from .progress import bar
+    from ..progress import bar
 
     out = []
     with bar(len(points), f"sweep {scene.name}", "run", quiet=quiet) as pb:

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import add_quiet
+from .app import add_quiet
 
 #: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
 SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d")
@@ -31,7 +31,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import UsageError
-    from ..scene import load_scene, packaged_scene
+    from ..model.scene import load_scene, packaged_scene
 
     if args.all and args.scene:
         raise UsageError("give either SCENE or --all, not both")
@@ -47,13 +47,13 @@ def run(args: argparse.Namespace) -> int:
 
 def run_scene(scene, out: Path, quiet: bool = False) -> int:
     """Make every output ``scene`` asks for in ``out``; returns the exit status (0 or 3)."""
-    from ..cli import EXIT_VERDICT
     from ..solvers import simulate
+    from .app import EXIT_VERDICT
 
     traj = simulate(scene, quiet=quiet)
     written: list[Path] = []
     if scene.outputs.figures:
-        from ..figures import FIGURES
+        from ..plot.figures import FIGURES
 
         for name in scene.outputs.figures:
             written.append(FIGURES[name](traj, out / f"{scene.name}-{name}.png"))
@@ -62,7 +62,7 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
         if scene.floor is not None:
             written.append(traj.events_to_csv(out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
-        from ..render import render_gif
+        from ..animation.render import render_gif
 
         written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet,
                                   **scene.outputs.gif))

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .files import atomic_output
-from .trajectory import Trajectory
+from ..io.files import atomic_output
+from ..model.trajectory import Trajectory
 
 #: The textbook's time window (s).
 WINDOW = 2.0
@@ -208,8 +208,8 @@ def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) ->
 
 def rotation_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
     """Rotation preview: K_rot(t) of the spring dumbbell for k = 200, 2e3, 2e4 N/m beside
-    the rigid one (see :mod:`dumbbell.rotation`)."""
-    from .rotation import rotation_figure as draw
+    the rigid one (see :mod:`dumbbell.analysis.rotation`)."""
+    from ..analysis.rotation import rotation_figure as draw
 
     return draw(traj, path, window)
 

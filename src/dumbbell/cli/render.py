@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import EXIT_VERDICT, add_quiet, positive_float
+from .app import EXIT_VERDICT, add_quiet, positive_float
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -48,8 +48,8 @@ def _whole(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..render import check_fps, check_size, render_gif, sample_every
-    from ..scene import load_scene
+    from ..animation.render import check_fps, check_size, render_gif, sample_every
+    from ..model.scene import load_scene
     from ..solvers import make_options, simulate
 
     scene = load_scene(args.scene)

@@ -31,9 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import UsageError
-from .files import atomic_output
-from .scene import Scene, load_scene, scene_from_dict, scenes_dir
+from ..errors import UsageError
+from ..io.files import atomic_output
+from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 
 #: Solvers whose spring is an explicit step, stable iff w*dt < 2.
 STEPPERS = ("euler-cromer", "verlet", "pymunk", "euler-cromer-2d")
@@ -79,7 +79,7 @@ def find_cases(folder: str | Path) -> list[Path]:
 def default_solvers(scene: Scene) -> list[str]:
     """Solvers run on a case by default: all that can run it, but not the slow 2D reference
     on 1D scenes, whose reference is the exact solution."""
-    from .solvers import supported
+    from ..solvers import supported
 
     names = supported(scene)
     if scene.dimensions == 1:
@@ -164,7 +164,7 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
                                                                         list[str]]:
     """The (case, solver) runs to make, every scene validated first, and the pairs skipped
     (with why). ``solvers`` None means :func:`default_solvers` per case."""
-    from .solvers import solver_module
+    from ..solvers import solver_module
 
     for name in solvers or ():
         solver_module(name)
@@ -184,7 +184,7 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
 def _in_pool(func: Any, jobs: list[tuple[Any, ...]], workers: int, quiet: bool, desc: str
              ) -> list[Any]:
     """``func(*job)`` for every job, on ``workers`` processes, results in job order."""
-    from .progress import bar
+    from ..progress import bar
 
     results: list[Any] = [None] * len(jobs)
     with bar(len(jobs), desc, "run", quiet=quiet) as pb:
@@ -336,7 +336,7 @@ def map_rows(solver: str, workers: int | None = None, quiet: bool = True
 def draw_stability_map(path: str | Path, maps: dict[str, list[dict[str, Any]]]) -> Path:
     """One panel per solver: log10 of the largest relative energy error over
     (w*dt, mass ratio), blow-ups marked, and the line w*dt = 2."""
-    from .figures import _pyplot
+    from ..plot.figures import _pyplot
     from .sweep import Axis, draw_map
 
     plt = _pyplot()
@@ -371,7 +371,7 @@ def draw_stability_map(path: str | Path, maps: dict[str, list[dict[str, Any]]]) 
 def map_solvers(solvers: list[str] | None) -> list[str]:
     """The time-stepping solvers a map is drawn for: those asked for (all by default) that
     can run the 1D map scene."""
-    from .solvers import available, solver_module
+    from ..solvers import available, solver_module
 
     names = available() if solvers is None else solvers
     scene = map_scene()

@@ -1,5 +1,5 @@
-"""The ``dumbbell`` command. Each subcommand lives in its own module under
-:mod:`dumbbell.commands` and provides ``register(subparsers)``.
+"""The ``dumbbell`` command. Each subcommand lives in its own module in
+:mod:`dumbbell.cli` and provides ``register(subparsers)``.
 
 Exit status: 0 done; 2 bad input (one line naming the file, key or flag and what is allowed;
 nothing written); 3 a run ended with a verdict other than ``ok``.
@@ -14,7 +14,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from .errors import DumbbellError
+from ..errors import DumbbellError
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep")
@@ -79,7 +79,7 @@ def build_parser() -> Parser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
     for name in COMMANDS:
-        importlib.import_module(f"dumbbell.commands.{name}").register(sub)
+        importlib.import_module(f"dumbbell.cli.{name}").register(sub)
     return parser
 
 
@@ -90,7 +90,7 @@ OUTPUT_FLAGS = {"out": ("--out", True), "output": ("--output", False),
 
 def _check_outputs(args: argparse.Namespace) -> None:
     """Refuse output paths that cannot be written before any work is done (UsageError)."""
-    from .files import check_writable
+    from ..io.files import check_writable
 
     for dest, (flag, folder) in OUTPUT_FLAGS.items():
         value = getattr(args, dest, None)
@@ -122,7 +122,3 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write(f"dumbbell {args.command}: interrupted; no partial output was kept\n")
         return 130
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

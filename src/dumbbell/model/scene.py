@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import SceneError
+from ..errors import SceneError
 
 #: Solver names a scene may ask for; the registry in :mod:`dumbbell.solvers` must agree.
 SOLVER_NAMES = ("euler-cromer", "exact", "pymunk", "verlet", "reference", "euler-cromer-2d")
@@ -551,8 +551,8 @@ def load_scene(path: str | Path) -> Scene:
 
 def packaged_scene(name: str = "textbook-1d") -> Path:
     """Path of a scene shipped with the package (wheel) or found in the source checkout."""
-    here = Path(__file__).resolve().parent
-    for folder in (here / "scenes", here.parent.parent / "scenes"):
+    package = Path(__file__).resolve().parent.parent  # src/dumbbell, or dumbbell in a wheel
+    for folder in (package / "scenes", package.parent.parent / "scenes"):
         candidate = folder / f"{name}.toml"
         if candidate.is_file():
             return candidate

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import EXIT_VERDICT, add_quiet, positive_float, positive_int
+from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -37,7 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..scene import load_scene
+    from ..model.scene import load_scene
     from ..solvers import simulate
 
     scene = load_scene(args.scene)

@@ -31,9 +31,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from .energy import energy_columns
-from .figures import COLOURS
-from .scene import Scene
+from ..model.energy import energy_columns
+from ..model.scene import Scene
+from ..plot.figures import COLOURS
 
 #: Supersampling factor of everything drawn with smooth edges.
 SS = 2

@@ -6,11 +6,11 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import add_quiet, positive_float, positive_int
+from .app import add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from ..bench import (
+    from ..analysis.bench import (
         DEFAULT_BUDGET,
         DEFAULT_REPEAT,
         DEFAULT_WINDOW,
@@ -63,8 +63,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..bench import run_bench, write_all
-    from ..scene import load_scene
+    from ..analysis.bench import run_bench, write_all
+    from ..model.scene import load_scene
 
     scene = load_scene(args.scene)
     result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
                        spacing=args.sample_spacing, quiet=args.quiet)
     written = write_all(result, Path(args.out))
     if not args.quiet:
-        from ..bench import markdown
+        from ..analysis.bench import markdown
 
         sys.stdout.write(markdown(result))
         for path in written:

@@ -47,11 +47,11 @@ from typing import Any
 
 import numpy as np
 
-from .energy import energy_scale, relative_energy_error
-from .errors import UsageError
-from .scene import Scene
-from .solvers import RunOptions, make_options, solver_module, supported
-from .trajectory import Trajectory
+from ..errors import UsageError
+from ..model.energy import energy_scale, relative_energy_error
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory
+from ..solvers import RunOptions, make_options, solver_module, supported
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
@@ -191,7 +191,7 @@ def _time_for_error(line: list[tuple[float, float]], target: float) -> float | N
 
 def truth_solver(scene: Scene) -> str | None:
     """The solver taken as truth: ``exact`` in 1D, ``reference`` in 2D (None if absent)."""
-    from .solvers import REGISTRY
+    from ..solvers import REGISTRY
 
     name = "exact" if scene.dimensions == 1 else "reference"
     if name not in REGISTRY:
@@ -248,7 +248,7 @@ def run_bench(
     a step whose runs would take more than ``budget`` s in all is skipped. Samples are kept
     about every ``spacing`` s (default :func:`default_spacing`; the step-free solvers:
     exactly)."""
-    from .progress import bar
+    from ..progress import bar
 
     t_end = scene.run.t_end if t_end is None else t_end
     spacing = default_spacing(scene) if spacing is None else spacing
@@ -531,7 +531,7 @@ def _fmt(value: Any) -> str:
 
 def write_csv(result: BenchResult, path: Path) -> Path:
     """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
-    from .files import atomic_output
+    from ..io.files import atomic_output
 
     with atomic_output(path) as tmp, open(tmp, "w", newline="") as fh:
         writer = csv.writer(fh, lineterminator="\n")
@@ -568,7 +568,7 @@ def to_json(result: BenchResult) -> dict[str, Any]:
 
 
 def write_json(result: BenchResult, path: Path) -> Path:
-    from .files import atomic_output
+    from ..io.files import atomic_output
 
     with atomic_output(path) as tmp:
         tmp.write_text(json.dumps(to_json(result), indent=1) + "\n")
@@ -656,7 +656,7 @@ def _ms(seconds: float) -> str:
 
 
 def write_markdown(result: BenchResult, path: Path) -> Path:
-    from .files import atomic_output
+    from ..io.files import atomic_output
 
     with atomic_output(path) as tmp:
         tmp.write_text(markdown(result))
@@ -675,8 +675,8 @@ def _style(name: str, i: int) -> tuple[str, str]:
 def work_precision_figure(result: BenchResult, path: Path) -> Path:
     """Log-log error (m) against run time (s), one line per solver, dt beside each point,
     failed runs as crosses on the top edge."""
-    from .figures import _pyplot
-    from .files import atomic_output
+    from ..io.files import atomic_output
+    from ..plot.figures import _pyplot
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.2, 6.0), dpi=100)
@@ -767,8 +767,8 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
 
 def convergence_figure(result: BenchResult, path: Path) -> Path:
     """Log-log error (m) against dt (s), one line per solver, with the fitted order."""
-    from .figures import _pyplot
-    from .files import atomic_output
+    from ..io.files import atomic_output
+    from ..plot.figures import _pyplot
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.2, 5.0), dpi=100)

@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import UsageError
-from .scene import Scene, scene_from_dict
-from .trajectory import Trajectory
+from ..errors import UsageError
+from ..model.scene import Scene, scene_from_dict
+from ..model.trajectory import Trajectory
 
 #: Spring constants of the preview (N/m).
 STIFFNESSES = (200.0, 2e3, 2e4)
@@ -83,7 +83,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
            stiffnesses: tuple[float, ...] = STIFFNESSES) -> Series:
     """Run every variant of ``scene`` with ``solver`` at step ``dt`` (s) up to ``t_end`` (s).
     The step is cut where needed to keep w*dt <= 0.05 for the stiffest spring."""
-    from .solvers import simulate, solver_module
+    from ..solvers import simulate, solver_module
 
     scenes = variants(scene, stiffnesses)
     w_max = max(s.omega for s in scenes.values())
@@ -117,8 +117,8 @@ def mean_after_first_cluster(traj: Trajectory, name: str, gap: float = CLUSTER_G
 
 def rotation_figure(traj: Trajectory, path: str | Path, window: float = 2.0) -> Path:
     """Draw the preview for ``traj``'s scene (2D) as PNG; returns the path."""
-    from .figures import COLOURS, _pyplot
-    from .files import atomic_output
+    from ..io.files import atomic_output
+    from ..plot.figures import COLOURS, _pyplot
 
     solver = traj.solver
     dt = traj.dt if traj.dt else traj.scene.run.dt

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import add_quiet, positive_float, positive_int
+from .app import add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -44,10 +44,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
-    from ..scene import load_scene
+    from ..model.scene import load_scene
     from ..solvers import solver_module
-    from ..sweep import check_axes, parse_axis, plan, run_sweep
 
     scene = load_scene(args.scene)
     axes = [parse_axis(text) for text in args.grid]

@@ -6,7 +6,7 @@
 ('ok', 22)
 
 State columns (positions in m, velocities in m/s) come from the solver; energy columns (J)
-are computed on first use by :mod:`dumbbell.energy`, the one place that knows the formulas.
+are computed on first use by :mod:`dumbbell.model.energy`, the one place that knows the formulas.
 """
 
 from __future__ import annotations
@@ -109,7 +109,7 @@ class Trajectory:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the columns with a header row; written to a temporary name, then renamed."""
-        from .files import atomic_output
+        from ..io.files import atomic_output
 
         with atomic_output(path) as tmp:
             np.savetxt(tmp, self.table(), delimiter=",", header=",".join(self.columns),
@@ -118,7 +118,7 @@ class Trajectory:
 
     def events_to_csv(self, path: str | Path) -> Path:
         """Write the impacts as ``t,body,v_before,v_after`` (s, -, m/s, m/s)."""
-        from .files import atomic_output
+        from ..io.files import atomic_output
 
         with atomic_output(path) as tmp, open(tmp, "w") as fh:
             fh.write("t,body,v_before,v_after\n")

@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .errors import UsageError
-from .files import atomic_output
-from .trajectory import Trajectory
+from ..errors import UsageError
+from ..io.files import atomic_output
+from ..model.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from .drawing import Frames
@@ -59,7 +59,7 @@ def check_fps(fps: Any, where: str = "fps") -> int:
 
 def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, int]:
     """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
-    from .scene import parse_size
+    from ..model.scene import parse_size
 
     if isinstance(size, tuple):
         size = f"{size[0]}x{size[1]}"
@@ -153,7 +153,7 @@ def render_gif(
     ``fps`` frames per second (1..50), ``size`` 'WxH' in px, ``strip`` adds the energy time
     series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
     end). ``timing``, when given, receives the seconds spent drawing and encoding."""
-    from . import progress
+    from .. import progress
     from .drawing import Painter, palette
 
     fps = check_fps(fps)

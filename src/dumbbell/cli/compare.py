@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..cli import add_quiet, positive_float
+from .app import add_quiet, positive_float
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,9 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..compare import compare, write
+    from ..analysis.compare import compare, write
     from ..errors import UsageError
-    from ..scene import load_scene
+    from ..model.scene import load_scene
     from ..solvers import available
 
     scene = load_scene(args.scene)

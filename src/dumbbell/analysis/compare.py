@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import UsageError
-from .scene import Scene
-from .trajectory import Trajectory
+from ..errors import UsageError
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory
 
 #: Default window (s) for position errors.
 WINDOW = 2.0
@@ -138,7 +138,7 @@ class Comparison:
 def truth_solver(scene: Scene) -> str | None:
     """The most accurate solver for ``scene``: exact (1D), reference (2D frictionless), or
     None when there is none (friction)."""
-    from .solvers import solver_module
+    from ..solvers import solver_module
 
     name = "exact" if scene.dimensions == 1 else "reference"
     return name if solver_module(name).supports(scene) is None else None
@@ -146,7 +146,7 @@ def truth_solver(scene: Scene) -> str | None:
 
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
-    from .solvers import solver_module
+    from ..solvers import solver_module
 
     names = ["pymunk", "euler-cromer" if scene.dimensions == 1 else "euler-cromer-2d"]
     return [n for n in names if solver_module(n).supports(scene) is None]
@@ -158,7 +158,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
     """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
-    from .solvers import make_options, simulate, solver_module
+    from ..solvers import make_options, simulate, solver_module
 
     solvers = solvers or default_solvers(scene)
     dts = dts or [scene.run.dt]
@@ -215,7 +215,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
 def write(result: Comparison, out: Path) -> list[Path]:
     """Write the summary CSV, the impacts CSV, the error series CSV and three PNG figures
     into ``out``; returns the paths."""
-    from .files import atomic_output
+    from ..io.files import atomic_output
 
     stem = result.scene.name
     paths = []
@@ -260,8 +260,8 @@ _DASHES = ["-", (0, (4, 3)), (0, (1, 2)), "-.", "-", (0, (4, 3)), (0, (1, 2))]
 
 def figures(result: Comparison, out: Path) -> list[Path]:
     """Positions overlaid, position error against time (log), and E(t) per solver (PNG)."""
-    from .figures import _pyplot
-    from .files import atomic_output
+    from ..io.files import atomic_output
+    from ..plot.figures import _pyplot
 
     plt = _pyplot()
     scene = result.scene

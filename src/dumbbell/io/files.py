@@ -40,7 +40,7 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
 def check_writable(path: str | Path, flag: str, folder: bool = False) -> None:
     """Raise UsageError naming ``flag`` unless ``path`` (a folder if ``folder``, else a file)
     could be created or replaced: called before any work, so nothing is half written."""
-    from .errors import UsageError
+    from ..errors import UsageError
 
     path = Path(path)
     if folder and path.exists() and not path.is_dir():
