@@ -81,7 +81,7 @@ def test_sample_spacing_follows_the_spring():
 
 
 def test_textbook_accuracy_over_two_seconds():
-    # PHYSICS.md: Euler-Cromer at dt = 1e-5 is about 2e-3 m off the exact solution by 2 s.
+    # docs/physics.md: Euler-Cromer at dt = 1e-5 is about 2e-3 m off the exact solution by 2 s.
     result = run_bench(make_scene({"run.t_end": 2.0}), solvers=["euler-cromer"], dts=[1e-5],
                        repeat=1)
     point = result.points[0]

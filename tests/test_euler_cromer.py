@@ -80,7 +80,7 @@ def test_converges_to_the_exact_solution_over_one_second(textbook):
         assert np.allclose(ec.t, exact.t)
         errors.append(max(np.abs(ec[c] - exact[c]).max() for c in ("xA", "xB")))
     assert errors[0] > 3 * errors[1] > 9 * errors[2]
-    assert errors[2] < 2e-4  # PHYSICS.md: about 1e-4 m up to 1 s at dt = 1e-5
+    assert errors[2] < 2e-4  # docs/physics.md: about 1e-4 m up to 1 s at dt = 1e-5
 
 
 def test_energy_error_is_bounded_and_first_order(textbook):

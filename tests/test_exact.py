@@ -27,7 +27,7 @@ def test_energy_is_constant_to_1e_12_over_ten_seconds(textbook):
     E = traj["E"]
     assert E[0] == pytest.approx(2.156, rel=1e-15)
     assert np.abs(E - E[0]).max() / E[0] < 1e-12
-    assert 15 <= len(traj.events) <= 40  # PHYSICS.md: about 22 impacts in 10 s
+    assert 15 <= len(traj.events) <= 40  # docs/physics.md: about 22 impacts in 10 s
 
 
 def test_internal_energy_is_zero_until_the_first_impact(textbook):

@@ -1,6 +1,6 @@
 """Work-precision benchmarks: error against run time, one line per solver, a point per step.
 
-The convention of DiffEqDevTools and REBOUND (PHYSICS.md section 4):
+The convention of DiffEqDevTools and REBOUND (docs/measurements.md):
 
 - every solver runs the scene over its whole ``t_end`` at each step size ``dt``, keeping a
   sample every ``every = max(1, round(spacing / dt))`` steps; the spacing is SAMPLE_SPACING

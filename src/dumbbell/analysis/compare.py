@@ -6,7 +6,7 @@ report says so). Each other run is measured against it:
 
 - impact times side by side, matched in order, with their differences;
 - the largest position error of either particle over a window (default 2 s): the motion is
-  chaotic, so later errors say nothing about the method (PHYSICS.md section 1), and the time
+  chaotic, so later errors say nothing about the method (docs/physics.md, on chaos), and the time
   at which the error first passes 1 mm;
 - the energy spread over the whole run, ``(max E - min E) / |E(0)|``;
 - the run time.

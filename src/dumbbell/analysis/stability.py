@@ -3,7 +3,7 @@
 >>> rows = run_cases(find_cases(default_cases()), None)       # doctest: +SKIP
 >>> print(markdown(rows))                                       # doctest: +SKIP
 
-Theory (PHYSICS.md sections 3 and 4), which :func:`predict` turns into an expected verdict:
+Theory (docs/physics.md: the stability limit, how pymunk collides), which :func:`predict` turns into an expected verdict:
 
 - the explicit spring step of Euler-Cromer, Verlet and pymunk is stable iff w*dt < 2, with
   w = sqrt(k/mu); the exact and reference solutions take no such step;

@@ -43,7 +43,7 @@ NAME = "reference"
 
 RTOL = 1e-12
 ATOL = 1e-12
-#: The window (s) over which the error estimate is stated separately (chaos: see PHYSICS.md).
+#: The window (s) over which the error estimate is stated separately (chaos: see docs/physics.md).
 ERROR_WINDOW = 2.0
 #: An impact slower than this (m/s) means the particle has come to rest on the floor.
 REST_SPEED = 1e-9

@@ -9,7 +9,7 @@ A solver that stops early keeps its samples up to the failure (:func:`keep_sampl
 - ``failed``: anything else, with the reason.
 
 The theory behind the messages (explicit spring steps are stable iff w*dt < 2, with
-w = sqrt(k/mu)) is in PHYSICS.md section 4.
+w = sqrt(k/mu)) is in docs/physics.md.
 """
 
 from __future__ import annotations
