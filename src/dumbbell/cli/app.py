@@ -17,7 +17,8 @@ from collections.abc import Sequence
 from ..errors import DumbbellError
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep")
+COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep",
+            "restitution")
 
 EXIT_USAGE = 2
 EXIT_VERDICT = 3

@@ -130,6 +130,16 @@ def disc_inertia(mass: float, radius: float) -> float:
     return 0.5 * mass * radius**2
 
 
+def rigid_moment(scene: Scene) -> float:
+    """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
+    two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
+    moment = scene.mu * scene.rigid.length**2
+    if spins(scene):
+        moment += disc_inertia(scene.A.mass, scene.A.radius) + disc_inertia(scene.B.mass,
+                                                                           scene.B.radius)
+    return moment
+
+
 def partition(traj: Trajectory) -> dict[str, np.ndarray]:
     """All energy columns of ``traj`` (J), in :func:`energy_columns` order."""
     scene = traj.scene

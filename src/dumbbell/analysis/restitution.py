@@ -1,0 +1,277 @@
+"""Apparent restitution of a tilted dumbbell: the centre of mass's rebound against the tilt.
+
+Drop a rigid dumbbell with its axis tilted theta from vertical on a floor of restitution e. The
+floor's impulse J acts at B, off the line through the centre of mass, so it both reverses the
+contact point's velocity (to -e times itself) and sets the body turning. With q = M a_B^2 / I
+(a_B the distance from the centre of mass to B, I the moment about the centre of mass) the
+impulse law gives the centre of mass's apparent restitution
+
+    e_eff = -V_after / V_before = (e - q sin^2 theta) / (1 + q sin^2 theta),
+
+q = 1 for two equal point masses: e_eff(30 degrees) = 0.6 for e = 1. Past sin^2 theta = e/q the
+centre of mass keeps moving down after the "bounce". A spring dumbbell differs: the floor
+pushes one particle at a time, and the first impact is followed by more (the other particle,
+chatter) before the dumbbell leaves the floor; :func:`bounce` measures the whole cluster.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import UsageError
+from ..model.energy import rigid_moment
+from ..model.scene import Scene, scene_from_dict
+from ..model.trajectory import Trajectory
+
+#: Impacts closer together than this (s) belong to one cluster.
+CLUSTER_GAP = 0.1
+#: Spring constants (N/m) of the spring dumbbells beside the rigid one.
+STIFFNESSES = (200.0, 2e3, 2e4)
+
+
+def e_eff_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -> np.ndarray:
+    """The rigid dumbbell's apparent restitution (dimensionless) at tilt ``theta_deg``
+    (degrees from vertical), floor restitution ``e`` and q = M a_B^2 / I."""
+    s2 = np.sin(np.radians(np.asarray(theta_deg, dtype=float))) ** 2
+    return (e - q * s2) / (1.0 + q * s2)
+
+
+def sign_change_deg(e: float, q: float = 1.0) -> float:
+    """The tilt (degrees) past which e_eff turns negative: sin^2 theta = e/q; nan if never."""
+    return math.degrees(math.asin(math.sqrt(e / q))) if e <= q else math.nan
+
+
+def k_rot_share_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -> np.ndarray:
+    """Share of the kinetic energy before the impact that the rigid dumbbell has as K_rot
+    right after it (dimensionless): (1 + e)^2 q sin^2 theta / (1 + q sin^2 theta)^2."""
+    s2 = np.sin(np.radians(np.asarray(theta_deg, dtype=float))) ** 2
+    return (1.0 + e) ** 2 * q * s2 / (1.0 + q * s2) ** 2
+
+
+def rigid_q(scene: Scene) -> float:
+    """q = M a_B^2 / I of the scene's dumbbell made rigid (dimensionless): a_B = mA L / M."""
+    s = scene if scene.rigid is not None else _variant(scene, "rigid", None)
+    a_B = s.A.mass * s.rigid.length / s.M
+    return s.M * a_B**2 / rigid_moment(s)
+
+
+@dataclass(frozen=True)
+class Bounce:
+    """What one drop did at the floor. ``e_first``: -V_y after / V_y before the first impact;
+    ``e_cluster``: V_y as the dumbbell leaves the floor after the whole first cluster of
+    impacts (at its last impact) over V_y before the first (dimensionless; every velocity is
+    carried along the free fall to its impact's time); ``impacts``: impacts in the
+    cluster; ``share_first`` and ``share_cluster``: K_rot right after the first impact and
+    after the cluster, over the kinetic energy just before the first impact."""
+
+    e_first: float
+    e_cluster: float
+    impacts: int
+    share_first: float
+    share_cluster: float
+
+
+def _cm_vy(traj: Trajectory) -> np.ndarray:
+    s = traj.scene
+    return (s.A.mass * traj["vyA"] + s.B.mass * traj["vyB"]) / s.M
+
+
+def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
+    """Measure the first impact cluster of a tilted drop. Velocities are read at the samples
+    on either side and carried to the impact's time with the free fall's -g, so sampling does
+    not bias them; the run must continue ``gap`` s past the cluster."""
+    s = traj.scene
+    times = [e.t for e in traj.events]
+    if not times:
+        raise UsageError(f"{s.source}: no impact in this run (t_end = {float(traj.t[-1]):g} "
+                         "s); run longer")
+    t0 = times[0]
+    n = 1
+    while n < len(times) and times[n] - times[n - 1] <= gap:
+        n += 1
+    t_last = times[n - 1]
+    if float(traj.t[-1]) < t_last + gap:
+        raise UsageError(f"{s.source}: the run ends before the first impact cluster is over "
+                         f"(last impact at {t_last:g} s); run longer")
+    vy = _cm_vy(traj)
+    g = s.g
+    i_before = int(np.searchsorted(traj.t, t0, side="left")) - 1
+    # The sample before the impact, carried forward to the impact's time.
+    v_before = vy[i_before] - g * (t0 - traj.t[i_before])
+    K_before = float(traj["K_cm"][i_before] + traj["K_rot"][i_before] + traj["K_vib"][i_before])
+    # Gravity does work between that sample and the impact: carry K by the change of K_cm only
+    # (between impacts, gravity acts on the centre of mass alone).
+    K_before += 0.5 * s.M * (v_before**2 - vy[i_before] ** 2)
+
+    spacing = float(traj.t[1] - traj.t[0]) if len(traj.t) > 1 else 0.0
+
+    def after(t_imp: float, t_next: float) -> tuple[int, float]:
+        # A sample two spacings past the impact (a stepping engine may spread a contact over
+        # a step or two), unless the next impact comes first; carried back along the free
+        # fall to the impact's own time, when the dumbbell leaves the floor.
+        i = int(np.searchsorted(traj.t, t_imp + 1.5 * spacing, side="right"))
+        if i >= len(traj.t) or traj.t[i] >= t_next:
+            i = int(np.searchsorted(traj.t, t_imp, side="right"))
+        return i, float(vy[i] + g * (traj.t[i] - t_imp))
+
+    t_next_first = times[1] if n > 1 else math.inf
+    i_f, v_first = after(t0, t_next_first)
+    i_c, v_cluster = after(t_last, times[n] if n < len(times) else math.inf)
+    if v_before >= 0:
+        raise UsageError(f"{s.source}: the centre of mass is not falling at the first impact")
+    K_rot = traj["K_rot"]
+    return Bounce(-v_first / v_before, -v_cluster / v_before, n,
+                  float(K_rot[i_f]) / K_before, float(K_rot[i_c]) / K_before)
+
+
+def _variant(scene: Scene, kind: str, value: float | None, tilt: float | None = None) -> Scene:
+    raw = copy.deepcopy(scene.raw)
+    length = (scene.rigid.length if scene.rigid is not None else
+              scene.spring.rest_length if scene.spring is not None else
+              math.hypot(scene.A.x - scene.B.x, scene.A.height - scene.B.height))
+    raw.pop("spring", None)
+    raw.pop("rigid", None)
+    if kind == "rigid":
+        raw["rigid"] = {"length": length}
+    else:
+        raw["spring"] = {"stiffness": float(value), "rest_length": length}
+    if tilt is not None:
+        raw["tilt"] = float(tilt)
+    return scene_from_dict(raw, scene.source)
+
+
+def tilted(scene: Scene, theta_deg: float, stiffness: float | None = None) -> Scene:
+    """``scene``'s dumbbell tilted ``theta_deg`` (degrees from vertical), rigid when
+    ``stiffness`` is None, else a spring of that stiffness (N/m) at the same length."""
+    if stiffness is None:
+        return _variant(scene, "rigid", None, theta_deg)
+    return _variant(scene, "spring", stiffness, theta_deg)
+
+
+def _check_scene(scene: Scene) -> None:
+    if scene.dimensions != 2 or (scene.spring is None and scene.rigid is None):
+        raise UsageError(f"{scene.source}: restitution needs a 2D dumbbell with a [spring] or "
+                         "[rigid] (dimensions = 2)")
+    if scene.floor is None or scene.g <= 0:
+        raise UsageError(f"{scene.source}: restitution needs a [floor] and gravity (g > 0)")
+    if scene.floor.friction != 0:
+        raise UsageError(f"{scene.source}: restitution needs a frictionless floor "
+                         "(floor.friction = 0): the formula has no friction")
+    if scene.B.height <= 0 or scene.B.vy > 0:
+        raise UsageError(f"{scene.source}: restitution drops the dumbbell: bodies.B.height "
+                         "must be > 0 and B must not move up")
+
+
+def drop_duration(scene: Scene) -> float:
+    """Run time (s) that covers the fall, the first cluster of impacts and the gap after it."""
+    g, h, v = scene.g, scene.B.height, -scene.B.vy
+    t_fall = (-v + math.sqrt(v * v + 2 * g * h)) / g if g > 0 else h / max(v, 1e-9)
+    return t_fall + 0.4
+
+
+def truth_for(scene: Scene) -> str:
+    """The name of the most exact solver that runs ``scene`` (rigid or spring, 2D)."""
+    from ..solvers import solver_module
+
+    for name in ("exact", "reference"):
+        try:
+            if solver_module(name).supports(scene) is None:
+                return name
+        except (KeyError, ValueError, UsageError):
+            continue
+    raise UsageError(f"{scene.source}: no truth solver runs this scene")
+
+
+@dataclass(frozen=True)
+class RestitutionResult:
+    """e_eff against tilt: ``theta`` (degrees), the formula, the rigid dumbbell in the truth
+    and in pymunk (first impact), each spring dumbbell (after the first cluster, with its
+    impacts and K_rot share), for floor restitution ``e`` and q = M a_B^2 / I. The rigid
+    dumbbell's K_rot share is taken right after its first impact, like its e_eff."""
+
+    theta: np.ndarray
+    e: float
+    q: float
+    formula: np.ndarray
+    truth: np.ndarray
+    truth_solver: str
+    pymunk: np.ndarray
+    pymunk_dt: float
+    springs: dict[float, dict[str, np.ndarray]] = field(default_factory=dict)
+    rigid_k_rot_share: np.ndarray | None = None
+    rigid_impacts: np.ndarray | None = None
+
+    @property
+    def sign_change(self) -> float:
+        """Tilt (degrees) past which the rigid e_eff is negative; nan if never."""
+        return sign_change_deg(self.e, self.q)
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The CSV's columns by name, in order."""
+        out = {"theta": self.theta, "formula": self.formula, "truth": self.truth,
+               "pymunk": self.pymunk}
+        if self.rigid_impacts is not None:
+            out["rigid_impacts"] = self.rigid_impacts
+            out["rigid_K_rot_share"] = self.rigid_k_rot_share
+        for k, cols in self.springs.items():
+            for name, col in cols.items():
+                out[f"k{k:g}_{name}"] = col
+        return out
+
+    def table(self) -> str:
+        """A Markdown table of the columns, 6 significant digits."""
+        cols = self.columns()
+        head = "| " + " | ".join(cols) + " |"
+        rule = "|" + "---|" * len(cols)
+        rows = ["| " + " | ".join(f"{cols[c][i]:.6g}" for c in cols) + " |"
+                for i in range(len(self.theta))]
+        return "\n".join([head, rule, *rows])
+
+
+def restitution(scene: Scene, thetas: np.ndarray | list[float],
+                stiffnesses: tuple[float, ...] = STIFFNESSES, dt: float = 1e-5,
+                progress=None) -> RestitutionResult:
+    """Run ``scene``'s dumbbell dropped at each tilt of ``thetas`` (degrees): rigid in the
+    truth and in pymunk at step ``dt`` (s), and as spring dumbbells of ``stiffnesses`` (N/m) in
+    pymunk. ``progress``, if given, is called once per run."""
+    from ..solvers import simulate
+
+    _check_scene(scene)
+    thetas = np.asarray(thetas, dtype=float)
+    t_end = drop_duration(scene)
+    e = scene.floor.elasticity
+    q = rigid_q(scene)
+    truth, pm, shares, impacts = [], [], [], []
+    springs: dict[float, dict[str, list[float]]] = {
+        k: {"e_eff": [], "impacts": [], "K_rot_share": []} for k in stiffnesses}
+    truth_name = truth_for(tilted(scene, float(thetas[0])))
+    for th in thetas:
+        rigid = tilted(scene, float(th))
+        tr = simulate(rigid, truth_name, t_end=t_end, every=1)
+        truth.append(bounce(tr).e_first)
+        b = bounce(simulate(rigid, "pymunk", dt=dt, t_end=t_end, every=1))
+        pm.append(b.e_first)
+        shares.append(b.share_first)
+        impacts.append(b.impacts)
+        if progress:
+            progress()
+        for k in stiffnesses:
+            sp = tilted(scene, float(th), k)
+            # Keep w*dt small: the impact is resolved over the spring's own fast time scale.
+            step = min(dt, 0.02 / sp.omega)
+            bs = bounce(simulate(sp, "pymunk", dt=step, t_end=t_end,
+                                 every=max(1, round(1e-4 / step))))
+            springs[k]["e_eff"].append(bs.e_cluster)
+            springs[k]["impacts"].append(bs.impacts)
+            springs[k]["K_rot_share"].append(bs.share_cluster)
+            if progress:
+                progress()
+    return RestitutionResult(
+        theta=thetas, e=e, q=q, formula=e_eff_rigid(thetas, e, q), truth=np.array(truth),
+        truth_solver=truth_name, pymunk=np.array(pm), pymunk_dt=dt,
+        springs={k: {n: np.array(v) for n, v in cols.items()} for k, cols in springs.items()},
+        rigid_k_rot_share=np.array(shares), rigid_impacts=np.array(impacts, dtype=float))

@@ -1,0 +1,201 @@
+"""The toppling dumbbell: a rigid dumbbell stands on end on a frictionless floor and falls over.
+
+The floor can only push up, so no horizontal force acts: the centre of mass falls straight
+down. With B on the floor, a = mA L / M the distance from B to the centre of mass, I the moment
+about the centre of mass and theta the axis' angle from vertical, the centre of mass sits at
+height a cos(theta) and energy conservation gives the angular velocity in closed form:
+
+    1/2 (M a^2 sin^2(theta) + I) theta'^2 = M g a (cos(theta0) - cos(theta))
+
+At the landing (theta = 90 degrees, started near upright, point masses) the centre of mass
+moves at sqrt(g a) and the top particle at L theta' (sqrt(2 g L) for equal masses). The time to
+fall is one quadrature of d(theta)/theta'. :func:`closed_form` gives all of it for a scene;
+:func:`measure` reads the same quantities off any trajectory, so that pymunk (resting contact
+on the floor) can be held against the closed form.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import UsageError
+from ..model.energy import rigid_moment
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory
+
+
+@dataclass(frozen=True)
+class ToppleClosedForm:
+    """The closed form of the topple for a rigid dumbbell with B resting on a frictionless
+    floor. Masses in kg, lengths in m, angles in rad from vertical, g in m/s^2."""
+
+    mA: float
+    mB: float
+    L: float
+    I: float
+    g: float
+    theta0: float
+
+    @property
+    def M(self) -> float:
+        """Total mass (kg)."""
+        return self.mA + self.mB
+
+    @property
+    def a(self) -> float:
+        """Distance from B (on the floor) to the centre of mass (m)."""
+        return self.mA * self.L / self.M
+
+    def omega(self, theta: np.ndarray | float) -> np.ndarray:
+        """Angular speed |theta'| (rad/s) at angle ``theta`` (rad), from energy conservation."""
+        return self._omega_past(np.asarray(theta, dtype=float) - self.theta0)
+
+    def _omega_past(self, delta: np.ndarray | float) -> np.ndarray:
+        # Angular speed ``delta`` rad past the release. cos(theta0) - cos(theta) is written as
+        # a product of sines of delta so that it keeps its digits right after the release.
+        d = np.maximum(np.asarray(delta, dtype=float), 0.0)
+        th = self.theta0 + d
+        M, a = self.M, self.a
+        drop = 2.0 * np.sin(self.theta0 + 0.5 * d) * np.sin(0.5 * d)
+        return np.sqrt(2.0 * M * self.g * a * drop / (M * a * a * np.sin(th) ** 2 + self.I))
+
+    def alpha(self, theta: np.ndarray | float) -> np.ndarray:
+        """Angular acceleration theta'' (rad/s^2) at ``theta`` (rad): half the derivative of
+        omega^2 with respect to theta."""
+        th = np.asarray(theta, dtype=float)
+        M, a, g = self.M, self.a, self.g
+        s, c = np.sin(th), np.cos(th)
+        den = M * a * a * s * s + self.I
+        num = 2.0 * M * g * a * (math.cos(self.theta0) - c)
+        return 0.5 * (2.0 * M * g * a * s * den - num * 2.0 * M * a * a * s * c) / den**2
+
+    def cm_height(self, theta: np.ndarray | float) -> np.ndarray:
+        """Height of the centre of mass (m) at ``theta`` (rad), B on the floor."""
+        return self.a * np.cos(np.asarray(theta, dtype=float))
+
+    def normal_force(self, theta: np.ndarray | float) -> np.ndarray:
+        """The floor's push on B (N) at ``theta`` (rad): M (g + Y''). It must stay >= 0 for B
+        to keep touching the floor; :meth:`check` says where it does not."""
+        th = np.asarray(theta, dtype=float)
+        w, al = self.omega(th), self.alpha(th)
+        y_dd = -self.a * (np.cos(th) * w * w + np.sin(th) * al)
+        return self.M * (self.g + y_dd)
+
+    def landing_omega(self) -> float:
+        """Angular speed at the landing, theta = 90 degrees (rad/s)."""
+        return float(self.omega(math.pi / 2))
+
+    def landing_speeds(self) -> tuple[float, float]:
+        """(centre of mass, top particle A) speeds at the landing (m/s), both straight down."""
+        w = self.landing_omega()
+        return self.a * w, self.L * w
+
+    def fall_time(self) -> float:
+        """Time from release to the landing (s), by quadrature of d(theta)/theta'.
+
+        theta' vanishes at the release like sqrt(theta - theta0); writing
+        theta = theta0 + (pi/2 - theta0) u^2 turns that into a smooth integrand."""
+        from scipy.integrate import quad
+
+        return quad(self._dt_du, 0.0, 1.0, epsabs=1e-13, epsrel=1e-12, limit=200)[0]
+
+    def _dt_du(self, u: float) -> float:
+        span = math.pi / 2 - self.theta0
+        if u == 0.0:
+            # Limit u -> 0: theta' ~ sqrt(2 M g a sin(theta0) span u^2 / (M a^2 s0^2 + I)).
+            s0 = math.sin(self.theta0)
+            k = 2.0 * self.M * self.g * self.a * s0 * span / (self.M * self.a**2 * s0**2 + self.I)
+            return 2.0 * span / math.sqrt(k)
+        return 2.0 * span * u / float(self._omega_past(span * u * u))
+
+    def angle_curve(self, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
+        """(t in s, theta in rad) from the release to the landing, ``n`` points, each time by
+        its own quadrature from the release."""
+        from scipy.integrate import quad
+
+        u = np.linspace(0.0, 1.0, n)
+        t = np.zeros(n)
+        for i in range(1, n):
+            t[i] = t[i - 1] + quad(self._dt_du, u[i - 1], u[i], epsabs=1e-14, epsrel=1e-12)[0]
+        return t, self.theta0 + (math.pi / 2 - self.theta0) * u * u
+
+    def check(self) -> str | None:
+        """None when B stays on the floor all the way down; else why the closed form does not
+        hold (the floor would have to pull)."""
+        th = np.linspace(self.theta0, math.pi / 2, 2001)
+        n = self.normal_force(th)
+        if float(n.min()) < 0:
+            where = math.degrees(float(th[int(np.argmax(n < 0))]))
+            return (f"B leaves the floor at {where:.1f} degrees (the normal force would turn "
+                    "negative): the closed form assumes B stays on the floor")
+        return None
+
+
+def closed_form(scene: Scene) -> ToppleClosedForm:
+    """The closed form for a topple scene: a rigid dumbbell, B at rest on a frictionless floor
+    at height 0, A above it, tilted by a small nonzero angle. Raises UsageError naming what
+    does not fit."""
+    where = scene.source
+    if scene.dimensions != 2 or scene.rigid is None:
+        raise UsageError(f"{where}: the topple needs a rigid 2D dumbbell ([rigid], dimensions = 2)")
+    if scene.floor is None or scene.floor.friction != 0:
+        raise UsageError(f"{where}: the topple needs a frictionless [floor] (friction = 0)")
+    if scene.g <= 0:
+        raise UsageError(f"{where}: the topple needs gravity ([gravity] g > 0)")
+    B, A = scene.B, scene.A
+    if B.height != 0 or B.vx != 0 or B.vy != 0 or A.vx != 0 or A.vy != 0:
+        raise UsageError(f"{where}: the topple starts with B at rest on the floor (bodies.B."
+                         "height = 0) and no velocities")
+    L = scene.rigid.length
+    theta0 = math.atan2(A.x - B.x, A.height - B.height)
+    if not (0 < abs(theta0) < math.pi / 2):
+        raise UsageError(f"{where}: tilt = {math.degrees(theta0):g}: the topple needs A above "
+                         "B, tilted by an angle strictly between 0 and 90 degrees")
+    cf = ToppleClosedForm(A.mass, B.mass, L, rigid_moment(scene), scene.g, abs(theta0))
+    reason = cf.check()
+    if reason:
+        raise UsageError(f"{where}: {reason}")
+    return cf
+
+
+@dataclass(frozen=True)
+class ToppleMeasure:
+    """The topple as read off a trajectory: landing time (s, A's centre reaches the floor),
+    speeds at the landing (m/s), the largest horizontal drift of the centre of mass (m), and
+    the angle from vertical (rad), the centre of mass's horizontal displacement (m) and the
+    top particle's speed (m/s) against time (s), up to the landing."""
+
+    fall_time: float
+    v_top: float
+    v_cm: float
+    cm_drift: float
+    t: np.ndarray
+    theta: np.ndarray
+    cm_x: np.ndarray
+    v_top_curve: np.ndarray
+
+
+def measure(traj: Trajectory) -> ToppleMeasure:
+    """Measure the topple in ``traj`` (2D, B on the floor): the landing is where A's height
+    first reaches 0, found by linear interpolation between samples; the speeds are taken at
+    the last sample before it (sample finely: ``every`` of 1 ms or less)."""
+    s = traj.scene
+    yA = traj["yA"]
+    hit = np.flatnonzero(yA <= 0.0)
+    if hit.size == 0 or hit[0] == 0:
+        raise UsageError(f"{s.source}: A never reaches the floor in this run "
+                         f"(t_end = {float(traj.t[-1]):g} s); run longer")
+    i = int(hit[0])
+    t0, t1, y0, y1 = traj.t[i - 1], traj.t[i], yA[i - 1], yA[i]
+    t_land = float(t0 + (t1 - t0) * y0 / (y0 - y1))
+    M = s.M
+    xcm = (s.A.mass * traj["xA"] + s.B.mass * traj["xB"]) / M
+    vcm = (s.A.mass * traj["vyA"] + s.B.mass * traj["vyB"]) / M
+    speed = np.hypot(traj["vxA"][:i], traj["vyA"][:i])
+    theta = np.arctan2(np.abs(traj["xA"][:i] - traj["xB"][:i]), traj["yA"][:i] - traj["yB"][:i])
+    drift = xcm[:i] - xcm[0]
+    return ToppleMeasure(t_land, float(speed[-1]), float(abs(vcm[i - 1])),
+                         float(np.max(np.abs(drift))), traj.t[:i].copy(), theta, drift, speed)

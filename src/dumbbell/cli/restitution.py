@@ -1,0 +1,96 @@
+"""``dumbbell restitution``: the apparent restitution of a tilted dumbbell against its tilt."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .app import add_quiet, positive_float
+
+#: Largest number of tilts in one call: each costs several runs.
+MAX_TILTS = 91
+
+
+def tilt_range(text: str) -> list[float]:
+    """An argparse type: START:STOP:N, N tilts in degrees from START to STOP inclusive,
+    0 <= START <= STOP < 90."""
+    parts = text.split(":")
+    try:
+        start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
+        ok = len(parts) == 3
+    except (ValueError, IndexError):
+        ok = False
+    if not ok or not (0 <= start <= stop < 90) or not (1 <= n <= MAX_TILTS) or (
+            n == 1 and start != stop) or (n > 1 and start == stop):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: must be START:STOP:N, degrees with 0 <= START <= STOP < 90 and N a "
+            f"whole number from 1 to {MAX_TILTS} (N = 1 needs START = STOP)")
+    if n == 1:
+        return [start]
+    return [start + (stop - start) * i / (n - 1) for i in range(n)]
+
+
+tilt_range.__name__ = "tilt range"
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "restitution", help="apparent restitution of a tilted dumbbell against its tilt",
+        description="Drop SCENE's dumbbell (2D, frictionless floor) at each tilt and measure "
+                    "e_eff = -V_after/V_before of its centre of mass: rigid in the truth and "
+                    "in pymunk (first impact, against the impulse law's formula), and as "
+                    "spring dumbbells of three stiffnesses in pymunk (after the first cluster "
+                    "of impacts). Writes SCENE-restitution.csv (one row per tilt) and "
+                    "SCENE-restitution.png into DIR and prints the table.",
+    )
+    p.add_argument("scene", metavar="SCENE", help="scene file (TOML), 2D with a spring or rod")
+    p.add_argument("--theta", type=tilt_range, default=tilt_range("0:80:9"),
+                   metavar="START:STOP:N",
+                   help="N tilts in degrees from START to STOP inclusive (default 0:80:9; "
+                        "0:60:3 is 0, 30 and 60)")
+    p.add_argument("--dt", type=positive_float("s"), default=1e-5, metavar="DT",
+                   help="pymunk's time step in s for the rigid dumbbell (default 1e-5; the "
+                        "spring dumbbells use at most 0.02/w)")
+    p.add_argument("--stiffness", type=positive_float("N/m"), nargs="+", metavar="K",
+                   default=[200.0, 2e3, 2e4],
+                   help="spring constants of the spring dumbbells in N/m (default 200 2000 "
+                        "20000)")
+    p.add_argument("--out", metavar="DIR", default="renders",
+                   help="folder for the CSV and PNG (default: renders)")
+    add_quiet(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..analysis.restitution import restitution
+    from ..io.files import atomic_output
+    from ..model.scene import load_scene
+    from ..plot.rotation_chapter import restitution as draw
+    from ..progress import bar
+
+    scene = load_scene(args.scene)
+    runs = len(args.theta) * (1 + len(args.stiffness))
+    with bar(runs, "restitution", unit="run", quiet=args.quiet) as progress:
+        result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
+                             progress=progress.update)
+    out = Path(args.out)
+    cols = result.columns()
+    csv = out / f"{scene.name}-restitution.csv"
+    png = out / f"{scene.name}-restitution.png"
+    with atomic_output(csv) as tmp, open(tmp, "w") as fh:
+        fh.write(",".join(cols) + "\n")
+        fh.writelines(",".join(repr(float(cols[c][i])) for c in cols) + "\n" for i in range(len(result.theta)))
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8.5, 9.0))
+    axes = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
+    draw(result, ax=axes)
+    fig.tight_layout()
+    with atomic_output(png) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    print(result.table())
+    if not args.quiet:
+        for path in (csv, png):
+            sys.stderr.write(f"wrote {path}\n")
+    return 0

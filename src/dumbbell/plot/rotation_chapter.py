@@ -1,0 +1,137 @@
+"""Figures of the rotation chapter's preview: apparent restitution against tilt, and the topple
+against its closed form. Each draws on the axes it is given (or a new figure) and returns them;
+none saves or switches matplotlib's backend."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from ..analysis.restitution import RestitutionResult
+    from ..analysis.topple import ToppleClosedForm, ToppleMeasure
+
+#: Colours of the spring dumbbells, softest to stiffest.
+SPRING_COLOURS = ("#9ecae1", "#4292c6", "#08519c")
+
+
+def _axes(ax: Any, nrows: int = 1, **fig_kw: Any) -> Any:
+    if ax is not None:
+        return ax
+    import matplotlib.pyplot as plt
+
+    _, axes = plt.subplots(nrows, 1, **fig_kw)
+    return axes
+
+
+def restitution(result: RestitutionResult, ax: Any = None) -> Any:
+    """e_eff against tilt (degrees), then the impacts in the first cluster and the share of
+    kinetic energy that went into rotation. ``ax``: three axes, or None for a new figure.
+    Returns the three axes."""
+    from ..analysis.restitution import e_eff_rigid, k_rot_share_rigid
+
+    top, mid, bottom = _axes(ax, 3, figsize=(8.5, 9.0), sharex=True,
+                             gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
+    th = np.linspace(float(result.theta.min()), float(result.theta.max()), 400)
+    top.axhline(0, color="0.5", lw=0.8)
+    top.plot(th, e_eff_rigid(th, result.e, result.q), color="black", lw=1.6,
+             label=f"rigid, formula (e - q sin²θ)/(1 + q sin²θ), q = {result.q:.3g}")
+    top.plot(result.theta, result.truth, "o", ms=9, mfc="none", mec="#d62728", mew=1.6,
+             label=f"rigid, truth ({result.truth_solver}), first impact")
+    top.plot(result.theta, result.pymunk, "x", ms=8, color="#2ca02c", mew=1.8,
+             label=f"rigid, pymunk dt = {result.pymunk_dt:g} s, first impact")
+    for (k, cols), colour in zip(result.springs.items(), SPRING_COLOURS, strict=False):
+        top.plot(result.theta, cols["e_eff"], "s--", ms=5, color=colour, lw=1.1,
+                 label=f"spring k = {k:g} N/m (pymunk), leaving after the first cluster")
+    cross = result.sign_change
+    if math.isfinite(cross) and th[0] <= cross <= th[-1]:
+        top.axvline(cross, color="0.4", ls=":", lw=1.2)
+        note = (f"rigid e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q):\npast it the "
+                "centre of mass keeps moving down after the bounce")
+    elif math.isfinite(cross):
+        note = (f"rigid e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q),\noutside the "
+                "tilts run here")
+    else:
+        note = "rigid e_eff stays positive at every tilt (e > q)"
+    top.text(0.99, 0.6, note, transform=top.transAxes, ha="right", va="center", fontsize=8.5,
+             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    top.set_ylabel("e_eff = -V_after / V_before")
+    top.set_title(f"Apparent restitution of a dumbbell dropped at tilt θ on a floor with "
+                  f"e = {result.e:g}", fontsize=10.5)
+    top.legend(fontsize=7.5, loc="lower left", framealpha=0.92)
+
+    series = [("rigid (pymunk)", result.rigid_impacts, "#2ca02c")]
+    series += [(f"k = {k:g} N/m", cols["impacts"], c) for (k, cols), c in
+               zip(result.springs.items(), SPRING_COLOURS, strict=False)]
+    span = float(np.min(np.diff(result.theta))) if len(result.theta) > 1 else 10.0
+    bar = 0.8 * span / len(series)
+    for j, (label, impacts, colour) in enumerate(series):
+        x = result.theta + (j - (len(series) - 1) / 2) * bar
+        mid.bar(x, impacts, width=bar, color=colour, label=label)
+    mid.set_ylabel("impacts in the\nfirst cluster")
+    mid.set_ylim(0, 1.3 * max(float(np.max(s[1])) for s in series))
+    mid.legend(fontsize=7, loc="upper right", ncol=4)
+
+    bottom.plot(th, k_rot_share_rigid(th, result.e, result.q), color="black", lw=1.6,
+                label="rigid, formula (1+e)² q sin²θ / (1 + q sin²θ)², after the first impact")
+    bottom.plot(result.theta, result.rigid_k_rot_share, "x", ms=8, color="#2ca02c", mew=1.8,
+                label="rigid, pymunk, after the first impact")
+    for (k, cols), colour in zip(result.springs.items(), SPRING_COLOURS, strict=False):
+        bottom.plot(result.theta, cols["K_rot_share"], "s--", ms=5, color=colour, lw=1.1,
+                    label=f"k = {k:g} N/m, after the first cluster")
+    bottom.set_ylabel("K_rot / K before")
+    bottom.set_ylim(0, 1.05)
+    bottom.set_xlabel("tilt θ of the axis from vertical [degrees]")
+    bottom.legend(fontsize=7, loc="upper right")
+    for a in (top, mid, bottom):
+        a.grid(True, color="0.9")
+    return top, mid, bottom
+
+
+def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
+           solver: str = "pymunk") -> Any:
+    """The topple against its closed form: angle, the centre of mass's horizontal position and
+    the top particle's speed, all against time (s). ``ax``: three axes, or None."""
+    a1, a2, a3 = _axes(ax, 3, figsize=(8.5, 8.0), sharex=True)
+    t, theta = cf.angle_curve()
+    step = max(1, len(measured.t) // 60)
+    a1.plot(t, np.degrees(theta), color="black", lw=1.6, label="closed form (quadrature)")
+    a1.plot(measured.t[::step], np.degrees(measured.theta[::step]), "o", ms=4, mfc="none",
+            color="#2ca02c", label=solver)
+    a1.axhline(90, color="0.6", lw=0.8, ls=":")
+    a1.set_ylabel("tilt θ [degrees]")
+    T = cf.fall_time()
+    a1.annotate(f"landing: closed form {T:.5f} s, {solver} {measured.fall_time:.5f} s",
+                (T, 90), xytext=(-250, -30), textcoords="offset points", fontsize=8.5,
+                arrowprops={"arrowstyle": "->", "color": "0.4"})
+    a1.legend(fontsize=8, loc="upper left")
+
+    a2.axhline(0, color="black", lw=1.6, label="closed form: no horizontal force, x_cm stays put")
+    a2.plot(measured.t, measured.cm_x, color="#2ca02c", lw=1, label=solver)
+    a2.set_ylabel("x_cm - x_cm(0) [m]")
+    lim = max(1e-6, 2 * float(np.max(np.abs(measured.cm_x))))
+    a2.set_ylim(-lim, lim)
+    a2.text(0.01, 0.08, f"largest drift: {measured.cm_drift:.2g} m", transform=a2.transAxes,
+            fontsize=8.5)
+    a2.legend(fontsize=8, loc="upper left")
+
+    w = cf.omega(theta)
+    vA = w * np.sqrt((cf.L - cf.a) ** 2 * np.cos(theta) ** 2 + cf.L**2 * np.sin(theta) ** 2)
+    a3.plot(t, vA, color="black", lw=1.6, label="closed form")
+    a3.plot(measured.t[::step], measured.v_top_curve[::step], "o", ms=4, mfc="none",
+            color="#2ca02c", label=solver)
+    v_cf = cf.landing_speeds()[1]
+    a3.axhline(math.sqrt(2 * cf.g * cf.L), color="0.5", ls=":", lw=1,
+               label=f"√(2gL) = {math.sqrt(2 * cf.g * cf.L):.4f} m/s (started upright)")
+    a3.set_ylabel("speed of the top particle [m/s]")
+    a3.set_xlabel("t [s]")
+    a3.text(0.01, 0.55, f"at the landing: closed form {v_cf:.4f} m/s,\n{solver} "
+            f"{measured.v_top:.4f} m/s", transform=a3.transAxes, fontsize=8.5)
+    a3.legend(fontsize=8, loc="upper left")
+    for a in (a1, a2, a3):
+        a.grid(True, color="0.9")
+    a1.set_title(f"Toppling rigid dumbbell: L = {cf.L:g} m, released at "
+                 f"{math.degrees(cf.theta0):g}° on a frictionless floor", fontsize=10.5)
+    return a1, a2, a3

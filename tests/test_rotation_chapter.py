@@ -1,0 +1,143 @@
+"""The rotation chapter's preview against closed forms: apparent restitution of a tilted rigid
+dumbbell (impulse law), the toppling dumbbell (energy conservation and one quadrature)."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from dumbbell.analysis.restitution import (
+    bounce,
+    drop_duration,
+    e_eff_rigid,
+    k_rot_share_rigid,
+    rigid_q,
+    sign_change_deg,
+    tilted,
+    truth_for,
+)
+from dumbbell.analysis.topple import closed_form, measure
+from dumbbell.model.scene import load_scene, scene_from_dict
+from dumbbell.solvers import simulate
+
+from .conftest import ROOT, SCENES
+
+ANGLES = (0.0, 30.0, 45.0, 60.0, 80.0)
+
+
+@pytest.fixture(scope="module")
+def tilted_scene():
+    return load_scene(SCENES / "tilted-2d.toml")
+
+
+@pytest.fixture(scope="module")
+def topple_scene():
+    return load_scene(SCENES / "topple-2d.toml")
+
+
+def drop(scene, theta, e, solver, **kw):
+    s = tilted(scene.with_values({"floor.elasticity": e}), theta)
+    return s, simulate(s, solver, t_end=drop_duration(s), every=1, **kw)
+
+
+def test_formula_by_hand():
+    # Two equal point masses: q = 1; e_eff(30 degrees, e = 1) = (1 - 1/4) / (1 + 1/4) = 0.6.
+    assert e_eff_rigid(30.0, 1.0) == pytest.approx(0.6, abs=1e-15)
+    assert sign_change_deg(0.5) == pytest.approx(45.0, abs=1e-12)
+    assert sign_change_deg(1.0) == pytest.approx(90.0, abs=1e-12)
+    # At the sign change e_eff is zero, and the rotational share is (1+e)^2 e/(1+e)^2 = e.
+    assert e_eff_rigid(sign_change_deg(0.3, 2.0), 0.3, 2.0) == pytest.approx(0.0, abs=1e-15)
+    assert k_rot_share_rigid(45.0, 0.5) == pytest.approx(0.5, abs=1e-15)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_rigid_truth_against_impulse_law(tilted_scene, e):
+    for theta in ANGLES:
+        s, traj = drop(tilted_scene, theta, e, truth_for(tilted(tilted_scene, theta)))
+        b = bounce(traj)
+        assert b.e_first == pytest.approx(float(e_eff_rigid(theta, e, rigid_q(s))), abs=1e-9)
+        assert b.share_first == pytest.approx(float(k_rot_share_rigid(theta, e)), abs=1e-9)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_rigid_pymunk_against_impulse_law(tilted_scene, e):
+    for theta in ANGLES:
+        s, traj = drop(tilted_scene, theta, e, "pymunk", dt=1e-5)
+        assert bounce(traj).e_first == pytest.approx(float(e_eff_rigid(theta, e, rigid_q(s))),
+                                                     abs=1e-3)
+
+
+def test_unequal_masses_use_q(tilted_scene):
+    # mA = 3 mB: a_B = 3L/4 and I = mu L^2 = 3/16 M L^2, so q = M a_B^2 / I = 3.
+    heavy = tilted_scene.with_values({"bodies.A.mass": 0.3})
+    assert rigid_q(heavy) == pytest.approx(3.0, rel=1e-12)
+    _, traj = drop(heavy, 35.0, 0.8, truth_for(tilted(heavy, 35.0)))
+    s2 = math.sin(math.radians(35.0)) ** 2
+    assert bounce(traj).e_first == pytest.approx((0.8 - 3 * s2) / (1 + 3 * s2), abs=1e-9)
+
+
+def test_topple_closed_form_by_quadrature_and_ode(topple_scene):
+    from scipy.integrate import solve_ivp
+
+    cf = closed_form(topple_scene)
+    # Started near upright, the landing speeds approach sqrt(g a) and sqrt(2 g L).
+    assert cf.landing_speeds()[1] == pytest.approx(math.sqrt(2 * 9.8 * 0.2), rel=3e-3)
+    # Independent check of the quadrature: integrate the equation of motion itself.
+    def rhs(t, y):
+        return [y[1], float(cf.alpha(y[0]))]
+
+    land = lambda t, y: y[0] - math.pi / 2
+    land.terminal = True
+    sol = solve_ivp(rhs, (0, 2), [cf.theta0, 0.0], events=land, rtol=1e-12, atol=1e-13)
+    assert sol.t_events[0][0] == pytest.approx(cf.fall_time(), rel=1e-8)
+    assert sol.y_events[0][0][1] == pytest.approx(cf.landing_omega(), rel=1e-8)
+    t, theta = cf.angle_curve(50)
+    assert t[-1] == pytest.approx(cf.fall_time(), rel=1e-10)
+    assert np.all(np.diff(theta) > 0) and np.all(cf.normal_force(theta) > 0)
+
+
+def test_topple_in_pymunk(topple_scene):
+    cf = closed_form(topple_scene)
+    m = measure(simulate(topple_scene, "pymunk"))
+    assert m.v_top == pytest.approx(math.sqrt(2 * cf.g * cf.L), rel=0.01)
+    assert m.v_top == pytest.approx(cf.landing_speeds()[1], rel=0.01)
+    assert m.cm_drift < 1e-6
+    assert m.fall_time == pytest.approx(cf.fall_time(), rel=0.01)
+
+
+def test_topple_refuses_what_it_cannot_describe(topple_scene):
+    from dumbbell.errors import UsageError
+
+    with pytest.raises(UsageError, match="frictionless"):
+        closed_form(topple_scene.with_values({"floor.friction": 0.3}))
+    raw = dict(topple_scene.raw, tilt=0.0)
+    with pytest.raises(UsageError, match="strictly between 0 and 90"):
+        closed_form(scene_from_dict(raw, "upright.toml"))
+
+
+@pytest.mark.parametrize("bad", ["0:100:3", "60:0:3", "0:60:0", "0:60", "a:b:c", "0:60:2.5",
+                                 "-5:60:3", "nan:60:3", "0:60:1"])
+def test_restitution_refuses_bad_ranges(tmp_path, bad):
+    out = tmp_path / "out"
+    proc = subprocess.run(
+        [sys.executable, "-m", "dumbbell.cli", "restitution", str(SCENES / "tilted-2d.toml"),
+         "--theta", bad, "--out", str(out), "-q"],
+        capture_output=True, text=True, cwd=ROOT, check=False)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "--theta" in proc.stderr
+    assert not out.exists()
+
+
+def test_restitution_command_writes_csv(tmp_path):
+    from dumbbell.cli import main
+
+    assert main(["restitution", str(SCENES / "tilted-2d.toml"), "--theta", "0:60:3",
+                 "--stiffness", "2000", "--out", str(tmp_path), "-q"]) == 0
+    rows = np.genfromtxt(tmp_path / "tilted-2d-restitution.csv", delimiter=",", names=True)
+    assert list(rows["theta"]) == [0.0, 30.0, 60.0]
+    assert np.allclose(rows["truth"], rows["formula"], atol=1e-9)
+    assert (tmp_path / "tilted-2d-restitution.png").stat().st_size > 10_000
