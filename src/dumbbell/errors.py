@@ -17,3 +17,8 @@ class SceneError(DumbbellError, ValueError):
 
 class UsageError(DumbbellError, ValueError):
     """A command-line flag or API argument is not valid."""
+
+
+class MissingExtraError(DumbbellError, ImportError):
+    """An optional dependency is not installed; the message names the extra that brings it,
+    e.g. ``to_pandas() needs pandas: pip install 'dumbbell[pandas]'``."""

@@ -33,6 +33,21 @@ def state_columns(scene: Scene) -> list[str]:
     return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
 
 
+def column_unit(name: str) -> str:
+    """The SI unit of a CSV column: s, m, m/s, rad/s or J."""
+    if name == "t":
+        return "s"
+    if name.startswith(("K_", "U_", "E")):
+        return "J"
+    if name.startswith("omega"):
+        return "rad/s"
+    if name.startswith("v"):
+        return "m/s"
+    if name.startswith(("x", "y")):
+        return "m"
+    raise KeyError(f"{name!r}: no such column")
+
+
 def spins(scene: Scene) -> bool:
     """True when the particles may spin about their own centres (2D pymunk with spin on)."""
     return scene.dimensions == 2 and bool(scene.pymunk.spin)

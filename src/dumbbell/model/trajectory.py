@@ -13,11 +13,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .scene import Scene
+
+if TYPE_CHECKING:
+    import pandas
+
+#: How many impacts the notebook table lists.
+FIRST_IMPACTS = 5
 
 #: Verdict statuses, from good to bad.
 VERDICTS = ("ok", "unstable", "tunnelled", "failed")
@@ -102,6 +108,47 @@ class Trajectory:
 
     def __len__(self) -> int:
         return len(self.t)
+
+    def __repr__(self) -> str:
+        """One line: scene, solver, dt, time span, samples, impacts, verdict."""
+        dt = "-" if self.dt is None else f"{self.dt:g} s"
+        span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
+        verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
+        return (f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, t={span}, "
+                f"{len(self.t)} samples, {len(self.events)} impacts, verdict: {verdict}>")
+
+    def _repr_html_(self) -> str:
+        """A small table for notebooks: the one-line summary, the energy terms (J) at the start
+        and the end, the first impacts, and the verdict with its reason."""
+        from html import escape
+
+        from .energy import energy_columns
+
+        rows = [f"<tr><th>{escape(name)} (J)</th><td>{self[name][0]:.6g}</td>"
+                f"<td>{self[name][-1]:.6g}</td></tr>"
+                for name in energy_columns(self.scene)] if len(self.t) else []
+        impacts = "".join(f"<tr><td>{e.t:.6g}</td><td>{escape(e.body)}</td>"
+                          f"<td>{e.v_before:.4g}</td><td>{e.v_after:.4g}</td></tr>"
+                          for e in self.events[:FIRST_IMPACTS])
+        more = len(self.events) - FIRST_IMPACTS
+        if more > 0:
+            impacts += f"<tr><td colspan='4'>... and {more} more</td></tr>"
+        return (
+            f"<div><p><code>{escape(repr(self))}</code></p>"
+            f"<p><b>verdict:</b> {escape(str(self.verdict))}</p>"
+            "<table><tr><th>energy</th><th>start</th><th>end</th></tr>"
+            f"{''.join(rows)}</table>"
+            f"<table><tr><th>impact t (s)</th><th>body</th><th>v before (m/s)</th>"
+            f"<th>v after (m/s)</th></tr>{impacts}</table></div>")
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every
+        column's unit in ``df.attrs["units"]``. Needs the extra: pip install 'dumbbell[pandas]'."""
+        from ..io.frames import data_frame
+        from .energy import column_unit
+
+        return data_frame({name: self[name] for name in self.columns}, index="t",
+                          units={name: column_unit(name) for name in self.columns})
 
     def table(self) -> np.ndarray:
         """All CSV columns as one (samples, columns) float array."""

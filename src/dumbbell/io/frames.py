@@ -1,0 +1,32 @@
+"""Tables for notebooks: pandas DataFrames of results (pandas is imported only here)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+from ..errors import MissingExtraError
+
+if TYPE_CHECKING:
+    import pandas
+
+
+def pandas_module(what: str = "to_pandas()") -> Any:
+    """The pandas module, or a MissingExtraError naming the extra that installs it."""
+    try:
+        import pandas
+    except ImportError:
+        raise MissingExtraError(f"{what} needs pandas: pip install 'dumbbell[pandas]'") from None
+    return pandas
+
+
+def data_frame(columns: Mapping[str, Sequence[Any]], index: str | None = None,
+               units: Mapping[str, str] | None = None) -> pandas.DataFrame:
+    """A DataFrame of ``columns`` in their order, ``index`` (a column name) as its index, and
+    the unit of every column (index included) in ``df.attrs["units"]``."""
+    pd = pandas_module()
+    df = pd.DataFrame({name: columns[name] for name in columns})
+    if index is not None:
+        df = df.set_index(index)
+    df.attrs["units"] = dict(units or {})
+    return df
