@@ -17,7 +17,7 @@ Where energy can leave the system, ``E_lost = E(0) - E(t)`` so that ``E + E_lost
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -131,13 +131,45 @@ def partition_2d(
     degenerate = ~(L > 0)
     along = np.where(degenerate, np.hypot(w[:, 0], w[:, 1]), w[:, 0] * u[:, 0] + w[:, 1] * u[:, 1])
     across = np.where(degenerate, 0.0, w[:, 0] * u[:, 1] - w[:, 1] * u[:, 0])
-    K_cm = 0.5 * M * (V[:, 0] ** 2 + V[:, 1] ** 2)
+    K_cm = translational_ke(M, V[:, 0], V[:, 1])
     K_vib = 0.5 * mu * along**2
     K_rot = 0.5 * mu * across**2
-    U_g = M * g * Ry
-    U_spring = 0.5 * k * (L - b) ** 2
+    U_g = gravity_potential(M, 0.0, -g, 0.0, Ry)
+    U_spring = spring_potential(k, L, b)
     return {"K_cm": K_cm, "K_rot": K_rot, "K_vib": K_vib, "U_g": U_g, "U_spring": U_spring,
             "E": K_cm + K_rot + K_vib + U_g + U_spring}
+
+
+def translational_ke(mass: Any, vx: Any, vy: Any) -> Any:
+    """Kinetic energy of a mass (kg) moving at (vx, vy) (m/s): 1/2 m |v|^2 (J).
+    Works elementwise on numpy arrays."""
+    return 0.5 * mass * (vx**2 + vy**2)
+
+
+def rotational_ke(moment: Any, omega: Any) -> Any:
+    """Kinetic energy of spin: 1/2 I omega^2 (J), moment I in kg m^2, omega in rad/s."""
+    return 0.5 * moment * omega**2
+
+
+def spring_potential(stiffness: Any, extent: Any, rest: Any) -> Any:
+    """Potential of a linear spring, 1/2 k (x - rest)^2 (J): k in N/m with x, rest in m, or a
+    rotary spring with k in N m/rad and x, rest in rad."""
+    return 0.5 * stiffness * (extent - rest) ** 2
+
+
+def gravity_potential(mass: Any, gx: float, gy: float, x: Any, y: Any) -> Any:
+    """Potential of a mass (kg) at (x, y) (m) in uniform gravity (gx, gy) (m/s^2), zero at the
+    origin: -m g.r (J). For a system, pass the total mass and the centre of mass."""
+    return -(mass * gx) * x - (mass * gy) * y
+
+
+def angular_momentum(
+    mass: Any, x: Any, y: Any, vx: Any, vy: Any, ox: float = 0.0, oy: float = 0.0,
+) -> Any:
+    """Angular momentum (kg m^2/s, counter-clockwise positive) of a mass (kg) at (x, y) (m)
+    moving at (vx, vy) (m/s) about the point (ox, oy) (m): m (r - o) x v. A body's own spin
+    adds I omega."""
+    return mass * ((x - ox) * vy - (y - oy) * vx)
 
 
 def disc_inertia(mass: float, radius: float) -> float:
@@ -170,7 +202,7 @@ def partition(traj: Trajectory) -> dict[str, np.ndarray]:
         parts = partition_2d(scene.A.mass, scene.B.mass, k, b, scene.g, rA, vA, rB, vB)
         if spins(scene):
             parts["K_spin"] = sum(
-                0.5 * disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"] ** 2
+                rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
                 for p in (scene.A, scene.B)
             )
             parts["E"] = parts["E"] + parts["K_spin"]

@@ -1,0 +1,369 @@
+"""Energy and momentum of any pymunk space, from the per-body formulas of :mod:`dumbbell.model.energy`.
+
+What counts: the space's DYNAMIC bodies. Each has a translational kinetic energy 1/2 m |v|^2
+(v the velocity of its centre of gravity), a rotational one 1/2 I omega^2, a gravity potential
+-m g.r (r its centre of gravity, zero at y = 0 along ``space.gravity``), a momentum m v and an
+angular momentum. Springs add 1/2 k (d - rest)^2 (``DampedSpring``, d between the anchors in
+world coordinates) and 1/2 k (a_a - a_b - rest)^2 (``DampedRotarySpring``, angles in rad).
+
+What is reported instead of guessed:
+
+- static and kinematic bodies (the user moves them; their energy is not the system's) are
+  listed in ``skipped``; springs fixed to them still count, with the anchor where it is now;
+- a body of infinite moment cannot turn (its spin is the user's to set), so its rotational
+  energy is left out and the body listed in ``skipped`` if it spins;
+- a spring with a custom force (or torque) function, a ``SimpleMotor`` and any constraint class
+  not known here go to ``unknown``: their energy is not in ``E``. Joints that do no work
+  (pivots, pins, slides, grooves, gears, limits, ratchets) hold no energy and are not listed;
+- what takes energy out without a contact (``space.damping`` < 1, spring damping) is named in
+  ``notes``.
+
+The vectorized core (:func:`inventory`, :func:`evaluate`) also serves the dumbbell's ``pymunk``
+solver, which evaluates it over all its samples at once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..model.energy import (
+    angular_momentum,
+    gravity_potential,
+    rotational_ke,
+    spring_potential,
+    translational_ke,
+)
+
+#: Joints that hold no energy and, ideally, do no work.
+_WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
+             "RotaryLimitJoint", "RatchetJoint")
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """Something the accounting left out, and why in words."""
+
+    subject: str
+    reason: str
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A spring the accounting knows: ``kind`` 'DampedSpring' or 'DampedRotarySpring', the
+    indices of its two bodies in :attr:`Inventory.bodies`, anchors in body coordinates relative
+    to each body's centre of gravity (m; unused for rotary springs), stiffness (N/m or N m/rad),
+    rest length (m) or rest angle (rad), and damping (N s/m or N m s/rad)."""
+
+    subject: str
+    kind: str
+    a: int
+    b: int
+    anchor_a: tuple[float, float]
+    anchor_b: tuple[float, float]
+    stiffness: float
+    rest: float
+    damping: float
+    constraint: Any = None
+
+
+@dataclass(frozen=True)
+class Inventory:
+    """What the accounting sees in a space: the bodies it tracks (the dynamic ones first, then
+    static or kinematic ones that springs hang from), their masses (kg) and moments (kg m^2,
+    inf when they cannot turn), the springs, gravity (m/s^2) and what it left out."""
+
+    bodies: tuple[Any, ...]
+    labels: tuple[str, ...]
+    dynamic: int
+    mass: np.ndarray
+    moment: np.ndarray
+    gravity: tuple[float, float]
+    springs: tuple[Spring, ...]
+    skipped: tuple[Skipped, ...]
+    unknown: tuple[Skipped, ...]
+    notes: tuple[str, ...]
+
+
+def body_label(space: Any, body: Any) -> str:
+    """A body's name in reports: 'body N' by its place in ``space.bodies``, or 'static body'."""
+    if body is space.static_body:
+        return "static body"
+    for i, other in enumerate(space.bodies):
+        if other is body:
+            return f"body {i}"
+    return "body (not in the space)"
+
+
+def constraint_label(space: Any, constraint: Any) -> str:
+    """A constraint's name in reports: its class and place in ``space.constraints``."""
+    for i, other in enumerate(space.constraints):
+        if other is constraint:
+            return f"{type(constraint).__name__} {i}"
+    return type(constraint).__name__
+
+
+def inventory(space: Any) -> Inventory:
+    """Take stock of ``space`` (see the module docstring for what is counted and reported)."""
+    import pymunk
+
+    dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
+    tracked = list(dyn)
+    labels = [body_label(space, b) for b in dyn]
+    skipped: list[Skipped] = []
+    unknown: list[Skipped] = []
+    notes: list[str] = []
+    for b in space.bodies:
+        if b.body_type == pymunk.Body.STATIC:
+            skipped.append(Skipped(body_label(space, b), "static: holds no energy"))
+        elif b.body_type == pymunk.Body.KINEMATIC:
+            skipped.append(Skipped(body_label(space, b),
+                                   "kinematic: moved by the user, its energy is not counted"))
+    for b, label in zip(dyn, labels, strict=True):
+        if math.isinf(b.moment) and b.angular_velocity != 0.0:
+            skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
+                                          "rad/s: rotational energy left out"))
+
+    def index(body: Any) -> int:
+        for i, other in enumerate(tracked):
+            if other is body:
+                return i
+        tracked.append(body)
+        labels.append(body_label(space, body))
+        return len(tracked) - 1
+
+    springs: list[Spring] = []
+    for c in space.constraints:
+        name = type(c).__name__
+        label = constraint_label(space, c)
+        if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
+            rotary = isinstance(c, pymunk.DampedRotarySpring)
+            custom = c._torque_func if rotary else c._force_func
+            if custom is not None and custom not in (pymunk.DampedSpring.spring_force,
+                                                     pymunk.DampedRotarySpring.spring_torque):
+                unknown.append(Skipped(label, "custom force function: its energy is unknown"))
+                continue
+            a, b = c.a, c.b
+            ia, ib = index(a), index(b)
+            if rotary:
+                anchors = ((0.0, 0.0), (0.0, 0.0))
+                rest = c.rest_angle
+            else:
+                anchors = tuple((float(p[0] - cg[0]), float(p[1] - cg[1])) for p, cg in
+                                ((c.anchor_a, a.center_of_gravity),
+                                 (c.anchor_b, b.center_of_gravity)))
+                rest = c.rest_length
+            if c.damping != 0.0:
+                notes.append(f"{label} has damping {c.damping:g}: it turns energy into heat "
+                             "that the heat counter does not see")
+            springs.append(Spring(label, "DampedRotarySpring" if rotary else "DampedSpring",
+                                  ia, ib, anchors[0], anchors[1], float(c.stiffness),
+                                  float(rest), float(c.damping), c))
+        elif name in _WORKLESS and type(c).__module__.startswith("pymunk"):
+            continue
+        elif isinstance(c, pymunk.SimpleMotor):
+            unknown.append(Skipped(label, "motor: puts energy in (its work is not counted)"))
+        else:
+            unknown.append(Skipped(label, f"{name}: constraint not known to the accounting"))
+    if space.damping != 1.0:
+        notes.append(f"space.damping = {space.damping:g}: bodies lose energy every step that "
+                     "no term here counts")
+    return Inventory(
+        bodies=tuple(tracked), labels=tuple(labels), dynamic=len(dyn),
+        mass=np.array([b.mass for b in tracked], dtype=float),
+        moment=np.array([b.moment for b in tracked], dtype=float),
+        gravity=(float(space.gravity[0]), float(space.gravity[1])),
+        springs=tuple(springs), skipped=tuple(skipped), unknown=tuple(unknown),
+        notes=tuple(notes),
+    )
+
+
+@dataclass(frozen=True)
+class State:
+    """States of the tracked bodies, each array (samples, bodies): centre of gravity x, y (m),
+    its velocity vx, vy (m/s), angle (rad) and angular velocity omega (rad/s)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    vx: np.ndarray
+    vy: np.ndarray
+    angle: np.ndarray
+    omega: np.ndarray
+
+
+def read_state(inv: Inventory) -> State:
+    """The present state of the tracked bodies, as one sample."""
+    rows = []
+    for b in inv.bodies:
+        cg = b.local_to_world(b.center_of_gravity)
+        v = b.velocity
+        rows.append((cg[0], cg[1], v[0], v[1], b.angle, b.angular_velocity))
+    a = np.array(rows, dtype=float).reshape(len(inv.bodies), 6).T[:, None, :]
+    return State(*a)
+
+
+def _rotate(angle: np.ndarray, p: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    if p == (0.0, 0.0):
+        return 0.0 * angle, 0.0 * angle
+    c, s = np.cos(angle), np.sin(angle)
+    return c * p[0] - s * p[1], s * p[0] + c * p[1]
+
+
+def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
+             ) -> dict[str, np.ndarray]:
+    """All terms over all samples: the system's K_trans, K_rot, K_cm, K_int, U_g, U_spring,
+    E (J), px, py (kg m/s), L_cm, L_about (kg m^2/s), X, Y (centre of mass, m), and per body
+    (arrays (samples, dynamic bodies)) body_K_trans, body_K_rot, body_U_g, body_L_about;
+    per spring (samples, springs) spring_U.
+
+    K_int is summed as each body's motion relative to the centre of mass plus its spin
+    (Koenig's theorem), which equals K_trans + K_rot - K_cm without the cancellation."""
+    n = inv.dynamic
+    m, moment = inv.mass, inv.moment
+    gx, gy = inv.gravity
+    ox, oy = about
+    samples = st.x.shape[0]
+    zero = np.zeros(samples)
+    if n == 0:
+        empty = np.zeros((samples, 0))
+        out = {k: zero.copy() for k in ("K_trans", "K_rot", "K_cm", "K_int", "U_g", "E", "px",
+                                         "py", "L_cm", "L_about", "X", "Y")}
+        out.update(body_K_trans=empty, body_K_rot=empty, body_U_g=empty, body_L_about=empty)
+    else:
+        M = m[0]
+        px, py = m[0] * st.vx[:, 0], m[0] * st.vy[:, 0]
+        mx, my = m[0] * st.x[:, 0], m[0] * st.y[:, 0]
+        for i in range(1, n):
+            M = M + m[i]
+            px, py = px + m[i] * st.vx[:, i], py + m[i] * st.vy[:, i]
+            mx, my = mx + m[i] * st.x[:, i], my + m[i] * st.y[:, i]
+        X, Y, Vx, Vy = mx / M, my / M, px / M, py / M
+        spin = np.isfinite(moment[:n])
+        kt = translational_ke(m[:n], st.vx[:, :n], st.vy[:, :n])
+        kr = np.where(spin, rotational_ke(np.where(spin, moment[:n], 0.0), st.omega[:, :n]), 0.0)
+        own = np.where(spin, np.where(spin, moment[:n], 0.0) * st.omega[:, :n], 0.0)
+        lo = angular_momentum(m[:n], st.x[:, :n], st.y[:, :n], st.vx[:, :n], st.vy[:, :n],
+                              ox, oy) + own
+        K_int = translational_ke(m[0], st.vx[:, 0] - Vx, st.vy[:, 0] - Vy)
+        L_cm = angular_momentum(m[0], st.x[:, 0], st.y[:, 0], st.vx[:, 0], st.vy[:, 0], X, Y)
+        for i in range(1, n):
+            K_int = K_int + translational_ke(m[i], st.vx[:, i] - Vx, st.vy[:, i] - Vy)
+            L_cm = L_cm + angular_momentum(m[i], st.x[:, i], st.y[:, i], st.vx[:, i],
+                                           st.vy[:, i], X, Y)
+        for i in range(n):
+            if spin[i]:
+                K_int = K_int + kr[:, i]
+                L_cm = L_cm + own[:, i]
+        K_cm = translational_ke(M, Vx, Vy)
+        out = {
+            "K_trans": kt.sum(axis=1), "K_rot": kr.sum(axis=1), "K_cm": K_cm, "K_int": K_int,
+            "U_g": gravity_potential(M, gx, gy, X, Y), "px": px, "py": py, "L_cm": L_cm,
+            "L_about": lo.sum(axis=1), "X": X, "Y": Y, "body_K_trans": kt, "body_K_rot": kr,
+            "body_U_g": gravity_potential(m[:n], gx, gy, st.x[:, :n], st.y[:, :n]),
+            "body_L_about": lo,
+        }
+    spring_u = np.zeros((samples, len(inv.springs)))
+    U_spring = zero.copy()
+    for j, s in enumerate(inv.springs):
+        if s.kind == "DampedRotarySpring":
+            extent = st.angle[:, s.a] - st.angle[:, s.b]
+        else:
+            ax, ay = _rotate(st.angle[:, s.a], s.anchor_a)
+            bx, by = _rotate(st.angle[:, s.b], s.anchor_b)
+            extent = np.hypot((st.x[:, s.b] + bx) - (st.x[:, s.a] + ax),
+                              (st.y[:, s.b] + by) - (st.y[:, s.a] + ay))
+        spring_u[:, j] = spring_potential(s.stiffness, extent, s.rest)
+        U_spring = spring_u[:, j] if j == 0 else U_spring + spring_u[:, j]
+    out["U_spring"] = U_spring
+    out["spring_U"] = spring_u
+    out["E"] = out["K_cm"] + out["K_int"] + out["U_g"] + U_spring
+    return out
+
+
+@dataclass(frozen=True)
+class BodyEnergy:
+    """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
+    momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s)."""
+
+    subject: str
+    mass: float
+    moment: float
+    K_trans: float
+    K_rot: float
+    U_g: float
+    momentum: tuple[float, float]
+    L_about: float
+
+
+@dataclass(frozen=True)
+class SpringEnergy:
+    """One spring: its label, kind and potential energy U (J)."""
+
+    subject: str
+    kind: str
+    U: float
+
+
+@dataclass(frozen=True)
+class SpaceEnergy:
+    """Energy and momentum of a space's dynamic bodies (SI units).
+
+    K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
+    K_rot + U_g + U_spring in J; ``momentum`` (px, py) in kg m/s; ``L_cm`` and ``L_about`` in
+    kg m^2/s about the centre of mass ``cm`` (m) and about ``about`` (m). ``bodies`` and
+    ``springs`` hold the parts; ``skipped``, ``unknown`` and ``notes`` what was left out."""
+
+    K_trans: float
+    K_rot: float
+    K_cm: float
+    K_int: float
+    U_g: float
+    U_spring: float
+    E: float
+    momentum: tuple[float, float]
+    L_cm: float
+    L_about: float
+    about: tuple[float, float]
+    cm: tuple[float, float]
+    bodies: tuple[BodyEnergy, ...]
+    springs: tuple[SpringEnergy, ...]
+    skipped: tuple[Skipped, ...]
+    unknown: tuple[Skipped, ...]
+    notes: tuple[str, ...]
+
+    @property
+    def complete(self) -> bool:
+        """True when nothing holding energy was left out (no unknown constraints)."""
+        return not self.unknown
+
+
+def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
+    """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
+    See the module docstring for what is counted."""
+    ox, oy = (float(about[0]), float(about[1]))
+    inv = inventory(space)
+    terms = evaluate(inv, read_state(inv), (ox, oy))
+
+    def f(name: str) -> float:
+        return float(terms[name][0])
+
+    bodies = tuple(
+        BodyEnergy(inv.labels[i], float(inv.mass[i]), float(inv.moment[i]),
+                   float(terms["body_K_trans"][0, i]), float(terms["body_K_rot"][0, i]),
+                   float(terms["body_U_g"][0, i]),
+                   (float(inv.mass[i] * inv.bodies[i].velocity[0]),
+                    float(inv.mass[i] * inv.bodies[i].velocity[1])),
+                   float(terms["body_L_about"][0, i]))
+        for i in range(inv.dynamic)
+    )
+    springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]))
+                    for j, s in enumerate(inv.springs))
+    return SpaceEnergy(
+        K_trans=f("K_trans"), K_rot=f("K_rot"), K_cm=f("K_cm"), K_int=f("K_int"), U_g=f("U_g"),
+        U_spring=f("U_spring"), E=f("E"), momentum=(f("px"), f("py")), L_cm=f("L_cm"),
+        L_about=f("L_about"), about=(ox, oy), cm=(f("X"), f("Y")), bodies=bodies,
+        springs=springs, skipped=inv.skipped, unknown=inv.unknown, notes=inv.notes,
+    )
