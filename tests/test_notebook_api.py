@@ -77,3 +77,32 @@ def test_pandas_is_imported_only_by_to_pandas():
             "t = dumbbell.simulate(s, 'exact', t_end=0.5, every=100); repr(t); t._repr_html_();"
             "assert 'pandas' not in sys.modules; t.to_pandas(); assert 'pandas' in sys.modules")
     subprocess.run([sys.executable, "-c", code, str(SCENES / "textbook-1d.toml")], check=True)
+
+
+def test_render_gif_without_a_path_returns_gif_bytes(textbook, tmp_path):
+    import io
+
+    from PIL import Image
+
+    from dumbbell.animation.render import frame_count
+
+    traj = dumbbell.simulate(textbook, solver="euler-cromer", t_end=1.2, every=100)
+    options = {"fps": 10, "size": "320x180", "t_end": 1.2, "quiet": True}
+    gif = dumbbell.render_gif(traj, **options)
+    assert isinstance(gif, bytes) and gif[:6] == b"GIF89a"
+    with Image.open(io.BytesIO(gif)) as image:
+        assert image.format == "GIF" and image.size == (320, 180)
+        assert image.n_frames == frame_count(1.2, 10) == 12
+    # The same inputs give the same bytes, with or without a file.
+    path = dumbbell.render_gif(traj, tmp_path / "a.gif", **options)
+    assert path.read_bytes() == gif.data == bytes(gif)
+    assert gif.save(tmp_path / "b.gif").read_bytes() == gif
+    # A notebook shows it inline: the animation as HTML, its first frame as PNG.
+    html = gif._repr_html_()
+    assert html.startswith('<img src="data:image/gif;base64,')
+    import base64
+
+    assert base64.b64decode(html.split(",", 1)[1].split('"')[0]) == gif
+    with Image.open(io.BytesIO(gif._repr_png_())) as first:
+        assert first.format == "PNG" and first.size == (320, 180)
+    assert "\n" not in repr(gif) and str(len(gif)) in repr(gif)

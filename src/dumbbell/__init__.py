@@ -7,14 +7,15 @@ its internal motion, from the bouncing dumbbell of textbook section 13.5.1.
 >>> traj.t, traj["K_int"], traj.events[0].t                           # doctest: +SKIP
 """
 
-from .errors import DumbbellError, SceneError, UsageError
+from .animation.render import Gif, render_gif
+from .errors import DumbbellError, MissingExtraError, SceneError, UsageError
 from .model.scene import Scene, load_scene
 from .model.trajectory import Impact, Trajectory, Verdict
 from .solvers import available as solvers
 from .solvers import simulate
 
 __all__ = [
-    "DumbbellError", "Impact", "Scene", "SceneError", "Trajectory", "UsageError", "Verdict",
-    "load_scene", "simulate", "solvers",
+    "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError", "Trajectory",
+    "UsageError", "Verdict", "load_scene", "render_gif", "simulate", "solvers",
 ]
 __version__ = "0.1.0"

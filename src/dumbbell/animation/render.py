@@ -21,12 +21,13 @@ rectangle (LZW). Drawing and encoding take about the same time per frame.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import itertools
 import math
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 
@@ -137,9 +138,48 @@ def _since_previous(values: np.ndarray, idx: np.ndarray, ufunc: np.ufunc) -> np.
     return out
 
 
+class Gif(bytes):
+    """The bytes of a GIF file that shows itself in a notebook: ``_repr_html_`` embeds the
+    animation, ``_repr_png_`` gives its first frame. It is ``bytes`` in every other way."""
+
+    @property
+    def data(self) -> bytes:
+        """The GIF file's bytes as plain ``bytes``."""
+        return bytes(self)
+
+    def __repr__(self) -> str:
+        return f"<Gif: {len(self)} bytes>"
+
+    def _repr_html_(self) -> str:
+        import base64
+
+        return f'<img src="data:image/gif;base64,{base64.b64encode(self).decode()}"/>'
+
+    def _repr_png_(self) -> bytes:
+        from PIL import Image
+
+        with Image.open(io.BytesIO(self)) as image:
+            out = io.BytesIO()
+            image.convert("RGB").save(out, format="PNG")
+        return out.getvalue()
+
+    def save(self, path: str | Path) -> Path:
+        """Write the GIF to ``path`` (atomically) and return the path."""
+        path = Path(path)
+        with atomic_output(path) as tmp:
+            Path(tmp).write_bytes(self)
+        return path
+
+
+@overload
+def render_gif(traj: Trajectory, path: None = None, **options: Any) -> Gif: ...
+@overload
+def render_gif(traj: Trajectory, path: str | Path, **options: Any) -> Path: ...
+
+
 def render_gif(
     traj: Trajectory,
-    path: str | Path,
+    path: str | Path | None = None,
     *,
     quiet: bool = False,
     fps: int = 25,
@@ -147,8 +187,9 @@ def render_gif(
     strip: bool = True,
     t_end: float | None = None,
     timing: dict[str, float] | None = None,
-) -> Path:
-    """Write an animated GIF of ``traj`` to ``path`` (atomically) and return the path.
+) -> Path | Gif:
+    """An animated GIF of ``traj``: written to ``path`` (atomically) and the path returned,
+    or with no path its bytes returned as a :class:`Gif`, which a notebook shows inline.
 
     ``fps`` frames per second (1..50), ``size`` 'WxH' in px, ``strip`` adds the energy time
     series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
@@ -167,9 +208,14 @@ def render_gif(
     pal, clear = palette()
     delays = delays_cs(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
-    path = Path(path)
-    with atomic_output(path) as tmp, open(tmp, "wb") as fh, \
-            progress.bar(len(frames.t), f"render {path.name}", "frame", quiet) as pbar:
+    label = f"render {Path(path).name}" if path is not None else "render GIF"
+    with contextlib.ExitStack() as stack:
+        if path is None:
+            fh = stack.enter_context(io.BytesIO())
+        else:
+            tmp = stack.enter_context(atomic_output(path))
+            fh = stack.enter_context(open(tmp, "wb"))
+        pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
         fh.write(_header(width, height, pal))
         previous: np.ndarray | None = None
         for k in range(len(frames.t)):
@@ -182,10 +228,11 @@ def render_gif(
             previous = current
             pbar.update(1)
         fh.write(b"\x3b")
+        result = Gif(fh.getvalue()) if path is None else Path(path)
     stats["frames"] = len(frames.t)
     if timing is not None:
         timing.update(stats)
-    return path
+    return result
 
 
 def _header(width: int, height: int, pal: bytes) -> bytes:
