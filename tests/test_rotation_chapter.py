@@ -141,3 +141,13 @@ def test_restitution_command_writes_csv(tmp_path):
     assert list(rows["theta"]) == [0.0, 30.0, 60.0]
     assert np.allclose(rows["truth"], rows["formula"], atol=1e-9)
     assert (tmp_path / "tilted-2d-restitution.png").stat().st_size > 10_000
+
+
+def test_truth_solvers_decline_resting_contact(topple_scene):
+    from dumbbell.solvers import solver_module
+
+    assert "resting contact" in solver_module("reference").supports(topple_scene)
+    assert solver_module("pymunk").supports(topple_scene) is None
+    # The same dumbbell a millimetre above the floor is an ordinary drop.
+    assert solver_module("reference").supports(
+        topple_scene.with_values({"bodies.B.height": 1e-3})) is None

@@ -183,8 +183,9 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
         truth_dt = min(dts) / 10
         truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
                          every=round(spacing / truth_dt), quiet=quiet)
-        truth_note = (f"pymunk at dt = {truth_dt:g} s (friction: no exact or reference "
-                      "solution exists, so errors are against a ten times smaller step)")
+        why = solver_module("exact" if scene.dimensions == 1 else "reference").supports(scene)
+        truth_note = (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: {why}; "
+                      "so errors are against a ten times smaller step)")
     else:
         truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
         truth_note = truth_name

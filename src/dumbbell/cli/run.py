@@ -9,7 +9,7 @@ from pathlib import Path
 from .app import add_quiet
 
 #: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
-SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d")
+SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d", "topple-2d")
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -26,7 +26,7 @@ from ..errors import SceneError
 #: Solver names a scene may ask for; the registry in :mod:`dumbbell.solvers` must agree.
 SOLVER_NAMES = ("euler-cromer", "exact", "pymunk", "verlet", "reference", "euler-cromer-2d")
 #: Figure names ``[outputs] figures`` may list.
-FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation")
+FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple")
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
 #: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
@@ -161,6 +161,19 @@ class Scene:
         if self.floor is None:
             return False
         return self.floor.elasticity < 1.0 or (self.dimensions == 2 and self.floor.friction > 0)
+
+    def resting_contact(self) -> str | None:
+        """None, or why a particle starts in resting contact: on the floor (height 0), not
+        moving up, pressed down by gravity. Solvers that model the floor only by impacts
+        cannot run such a scene (it would bounce on the spot forever)."""
+        if self.floor is None or self.g <= 0:
+            return None
+        for p in (self.A, self.B):
+            if p.height == 0 and p.vy <= 0:
+                return (f"bodies.{p.name} starts at rest on the floor (height 0): resting "
+                        "contact needs a contact solver such as pymunk; impacts alone cannot "
+                        "hold it")
+        return None
 
     def with_values(self, values: dict[str, Any]) -> Scene:
         """A new scene with keys replaced by dotted name, validated like a file.
@@ -473,6 +486,8 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
                 co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
             if "rotation" in value and dims != 2:
                 co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
+            if "topple" in value and rigid is None:
+                co.fail("outputs.figures", value, "'topple' needs a rigid 2D dumbbell ([rigid])")
             figures = tuple(value)
         csv = bool(co.boolean("csv", False))
         cgif = co.sub("gif")

@@ -214,6 +214,23 @@ def rotation_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) 
     return draw(traj, path, window)
 
 
+def topple_figure(traj: Trajectory, path: str | Path) -> Path:
+    """The toppling dumbbell in ``traj`` against its closed form: angle, the centre of mass's
+    horizontal position and the top particle's speed (see :mod:`dumbbell.analysis.topple`)."""
+    from ..analysis.topple import closed_form, measure
+    from .rotation_chapter import topple
+
+    plt = _pyplot()
+    fig, axes = plt.subplots(3, 1, figsize=(8.5, 8.0), sharex=True)
+    topple(closed_form(traj.scene), measure(traj), ax=axes, solver=traj.solver)
+    fig.tight_layout()
+    path = Path(path)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
+
+
 #: Figure name (as in a scene's ``[outputs] figures``) -> drawing function.
 FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
     "positions": positions_figure,
@@ -221,4 +238,5 @@ FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
     "potential": potential_figure,
     "energy": energy_figure,
     "rotation": rotation_figure,
+    "topple": topple_figure,
 }

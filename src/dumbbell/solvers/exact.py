@@ -173,7 +173,7 @@ def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
     if scene.dimensions != 1:
         return "the exact solution is 1D; use the 2D reference solver"
-    return None
+    return scene.resting_contact()
 
 
 def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], Verdict]:

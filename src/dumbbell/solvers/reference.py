@@ -52,6 +52,8 @@ MAX_IMPACTS = 100_000
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
+    if scene.resting_contact():
+        return scene.resting_contact()
     if scene.floor is not None and scene.floor.friction > 0:
         return ("the reference handles frictionless floors only (friction makes a contact "
                 "slide and stick, not a single impulse); compare pymunk at smaller dt instead")
