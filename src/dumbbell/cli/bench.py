@@ -22,8 +22,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "bench", help="error against run time for every solver (work-precision diagrams)",
         description="Run SCENE with each solver at each step size and measure the largest "
-                    "position error over [0, T] against the truth (1D: the exact solution; "
-                    "2D: the reference solver), the largest relative energy error over the "
+                    "position error over [0, T] against the truth (the exact solution in 1D "
+                    "and for the rigid 2D dumbbell; the reference solver for a 2D spring), the largest relative energy error over the "
                     "whole run and the error of the impact times, against the run time "
                     "(fastest and median of N runs after a warm-up; JIT compile reported "
                     "apart). Writes bench-SCENE.csv, .json, .md, -work-precision.png and "

@@ -1,5 +1,5 @@
 """``dumbbell compare``: the engine and the hand-written method against the exact solution
-(1D) or the high-accuracy reference (2D)."""
+(1D and the rigid 2D dumbbell) or the high-accuracy reference (2D spring)."""
 
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "compare", help="solvers against the exact solution or the 2D reference",
         description="Run SCENE with pymunk and the hand-written method (or --solvers) and with "
-                    "the most accurate solution there is (exact in 1D, the DOP853 reference in "
-                    "2D), then print and write: impact times side by side, the largest position "
+                    "the most accurate solution there is (exact in 1D and for the rigid 2D "
+                    "dumbbell, the DOP853 reference for a 2D spring), then print and write: impact times side by side, the largest position "
                     "error over a window before the chaotic motion parts the runs, each "
                     "solver's energy spread over the whole run, and run times. Writes "
                     "SCENE-compare.csv, -compare-impacts.csv, -compare-errors.csv and three "

@@ -1,4 +1,5 @@
-"""``exact``: the piecewise-analytic 1D solution.
+"""``exact``: the piecewise-analytic 1D solution (and, in :mod:`.exact_rigid`, the rigid 2D
+dumbbell's closed-form flight).
 
 Between impacts the centre of mass falls freely, ``X(t) = X0 + V0 t - g t^2/2``, and the
 stretch ``s = xA - xB - b`` is a harmonic oscillator with ``w = sqrt(k/mu)``. Impacts are the
@@ -172,7 +173,12 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
     if scene.dimensions != 1:
-        return "the exact solution is 1D; use the 2D reference solver"
+        if scene.rigid is not None:
+            from .exact_rigid import supports as rigid_supports
+
+            return rigid_supports(scene)
+        return ("the exact solution covers 1D scenes and the rigid 2D dumbbell; use the "
+                "reference solver for a 2D spring")
     return scene.resting_contact()
 
 
@@ -220,6 +226,8 @@ def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], V
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Evaluate the exact solution at the sample times ``i * every * dt`` (s)."""
+    if scene.rigid is not None:
+        return _solve_rigid(scene, options)
     t0 = time.perf_counter()
     segs, events, verdict = segments(scene, options.t_end)
     motion = _Motion(scene)
@@ -238,6 +246,28 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         scene=scene, solver=NAME, t=t, state=cols, events=events, dt=options.dt,
         every=options.every, wall_time=wall,
         info={"segments": len(segs), "root_xtol": ROOT_XTOL},
+    )
+    traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
+    return traj
+
+
+def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
+    """The rigid 2D dumbbell in closed form (:mod:`.exact_rigid`) at the sample times (s)."""
+    from ..model.energy import rigid_moment
+    from .exact_rigid import ROOT_XTOL as RIGID_XTOL
+    from .exact_rigid import flight, sample
+
+    t0 = time.perf_counter()
+    segs, events, verdict = flight(scene, options.t_end)
+    t = options.sample_times()
+    if not verdict.ok:
+        t = t[t <= verdict.t]
+    cols = sample(scene, segs, t)
+    wall = time.perf_counter() - t0
+    traj = Trajectory(
+        scene=scene, solver=NAME, t=t, state=cols, events=events, dt=options.dt,
+        every=options.every, wall_time=wall,
+        info={"segments": len(segs), "root_xtol": RIGID_XTOL, "moment": rigid_moment(scene)},
     )
     traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
     return traj

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.energy import disc_inertia, relative_energy_error, spins, state_columns
+from ..model.energy import relative_energy_error, rigid_moment, spins, state_columns
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
@@ -120,16 +120,6 @@ def _particles_model(scene: Scene) -> _Model:
     return _Model([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], rhs2,
                   {"A": lambda y: y[1], "B": lambda y: y[5]},
                   lambda y, body: y[3 if body == "A" else 7], jump2, columns2)
-
-
-def rigid_moment(scene: Scene) -> float:
-    """Moment of inertia of the rigid dumbbell about its centre of mass (kg m^2): mu L^2, plus
-    the circles' own moments when they may spin (``[pymunk] spin = true``)."""
-    moment = scene.mu * scene.rigid.length**2  # type: ignore[union-attr]
-    if spins(scene):
-        moment += disc_inertia(scene.A.mass, scene.A.radius)
-        moment += disc_inertia(scene.B.mass, scene.B.radius)
-    return moment
 
 
 def _rigid_model(scene: Scene) -> _Model:
