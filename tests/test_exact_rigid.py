@@ -82,7 +82,7 @@ def test_first_impact_rotation(rigid_run):
     j = int(np.searchsorted(rigid_run.t, first.t)) + 1  # first sample after the impact
     assert rigid_run.state["omega"][j] == pytest.approx(-35.4175, abs=1e-4)
     assert rigid_run["K_rot"][j] == pytest.approx(1.2544, abs=1e-4)
-    before, after = first_impact_state(30.0, 1.0)
+    _, after = first_impact_state(30.0, 1.0)
     assert after.omega == pytest.approx(-35.4175, abs=1e-4)
     assert 0.5 * 0.1 * 0.1 / 0.2 * 0.2**2 * after.omega**2 == pytest.approx(1.2544, abs=1e-4)
 
