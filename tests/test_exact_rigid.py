@@ -203,3 +203,22 @@ def test_bench_truth_point_checks_rigid_against_extended_precision(rigid_run):
 
     err, t_err = extended_precision_rigid(rigid_run, 2.0)
     assert err < 1e-12 and t_err < 1e-12
+
+
+def test_a_truth_that_misses_an_impact_ends_failed(rigid, textbook):
+    from dumbbell.solvers.verdicts import truth_verdict
+
+    # The DOP853 reference steps over the grazing swing of B at 2.68 s on the rigid scene.
+    ref = simulate(rigid, "reference", every=100)
+    assert ref.verdict.status == "failed" and ref.verdict.t == pytest.approx(2.68, abs=0.01)
+    assert "below the floor" in ref.verdict.reason and "missed an impact" in ref.verdict.reason
+    assert min(ref["yA"][:-1].min(), ref["yB"][:-1].min()) >= -1e-9
+    # Any sample of any truth more than 1e-9 m below the floor ends the run there.
+    for run in (simulate(textbook, "exact", every=100, t_end=2.0),
+                simulate(rigid, "exact", every=100, t_end=2.0)):
+        key = "x" if run.scene.dimensions == 1 else "y"
+        j = len(run.t) // 3
+        assert truth_verdict(run, run.verdict).ok
+        run.state[f"{key}B"][j] = -2e-9
+        verdict = truth_verdict(run, run.verdict)
+        assert verdict.status == "failed" and verdict.t == run.t[j] and len(run.t) == j + 1

@@ -26,7 +26,7 @@ from scipy.optimize import brentq
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
-from .verdicts import energy_verdict
+from .verdicts import truth_verdict
 
 NAME = "exact"
 
@@ -247,7 +247,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         every=options.every, wall_time=wall,
         info={"segments": len(segs), "root_xtol": ROOT_XTOL},
     )
-    traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
+    traj.verdict = truth_verdict(traj, verdict)
     return traj
 
 
@@ -269,5 +269,5 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
         every=options.every, wall_time=wall,
         info={"segments": len(segs), "root_xtol": RIGID_XTOL, "moment": rigid_moment(scene)},
     )
-    traj.verdict = verdict if not verdict.ok else energy_verdict(traj, None)
+    traj.verdict = truth_verdict(traj, verdict)
     return traj

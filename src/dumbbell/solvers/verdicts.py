@@ -134,6 +134,34 @@ def keep_samples(traj: Trajectory, count: int) -> None:
     traj._energy = None
 
 
+#: A truth solver's samples may lie at most this far below the floor (m): more means it
+#: missed an impact, and its run must not end ``ok``.
+FLOOR_TOLERANCE = 1e-9
+
+
+def truth_verdict(traj: Trajectory, verdict: Verdict) -> Verdict:
+    """The verdict of a truth solver (exact, reference) that ended with ``verdict``: if any
+    sample has a particle more than FLOOR_TOLERANCE below the floor, ``failed`` at the first
+    such sample (the trajectory is cut after it: the truth missed an impact); else the
+    solver's own verdict, or when that is ok :func:`energy_verdict`."""
+    scene = traj.scene
+    if scene.floor is not None and len(traj.t):
+        key = "x" if scene.dimensions == 1 else "y"
+        heights = np.vstack([traj.state[f"{key}{body}"] for body in "AB"])
+        bad = np.flatnonzero(np.min(heights, axis=0) < -FLOOR_TOLERANCE)
+        if bad.size:
+            j = int(bad[0])
+            body = "AB"[int(np.argmin(heights[:, j]))]
+            depth = float(-heights[:, j].min())
+            t_fail = float(traj.t[j])
+            keep_samples(traj, j + 1)
+            return Verdict("failed", t_fail,
+                           f"{body} is {depth:.3g} m below the floor (more than "
+                           f"{FLOOR_TOLERANCE:g} m): {traj.solver} missed an impact, so this "
+                           "run is not a truth")
+    return verdict if not verdict.ok else energy_verdict(traj, None)
+
+
 def energy_verdict(traj: Trajectory, dt: float | None) -> Verdict:
     """``unstable`` if the relative energy error passes the scene's ``run.unstable_energy``
     (the trajectory is then cut after the first such sample), else ``ok``. ``dt`` is the step
