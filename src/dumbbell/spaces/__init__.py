@@ -25,6 +25,8 @@ from typing import Any
 _WHERE = {
     "energy": "accounting", "SpaceEnergy": "accounting", "BodyEnergy": "accounting",
     "SpringEnergy": "accounting", "Skipped": "accounting",
+    "check": "guard", "survey": "guard", "suggest_dt": "guard", "substeps": "guard",
+    "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
 }
 
 __all__ = list(_WHERE)
