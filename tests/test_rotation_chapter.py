@@ -120,7 +120,7 @@ def test_topple_refuses_what_it_cannot_describe(topple_scene):
 
 
 @pytest.mark.parametrize("bad", ["0:100:3", "60:0:3", "0:60:0", "0:60", "a:b:c", "0:60:2.5",
-                                 "-5:60:3", "nan:60:3", "0:60:1"])
+                                 "-5:60:3", "nan:60:3", "0:60:1", "30,0", "0,,30", "0,95"])
 def test_restitution_refuses_bad_ranges(tmp_path, bad):
     out = tmp_path / "out"
     proc = subprocess.run(
@@ -139,6 +139,12 @@ def test_restitution_command_writes_csv(tmp_path):
                  "--stiffness", "2000", "--out", str(tmp_path), "-q"]) == 0
     rows = np.genfromtxt(tmp_path / "tilted-2d-restitution.csv", delimiter=",", names=True)
     assert list(rows["theta"]) == [0.0, 30.0, 60.0]
+    assert main(["restitution", str(SCENES / "tilted-2d.toml"), "--theta", "10,50",
+                 "--elasticity", "0.5", "--stiffness", "2000", "--out", str(tmp_path),
+                 "-q"]) == 0
+    rows = np.genfromtxt(tmp_path / "tilted-2d-restitution.csv", delimiter=",", names=True)
+    assert list(rows["theta"]) == [10.0, 50.0]
+    assert np.allclose(rows["formula"], e_eff_rigid(rows["theta"], 0.5), atol=1e-15)
     assert np.allclose(rows["truth"], rows["formula"], atol=1e-9)
     assert (tmp_path / "tilted-2d-restitution.png").stat().st_size > 10_000
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -13,25 +14,45 @@ MAX_TILTS = 91
 
 
 def tilt_range(text: str) -> list[float]:
-    """An argparse type: START:STOP:N, N tilts in degrees from START to STOP inclusive,
-    0 <= START <= STOP < 90."""
-    parts = text.split(":")
+    """An argparse type: START:STOP:N (N tilts in degrees from START to STOP inclusive) or a
+    list A,B,C; every tilt in [0, 90) degrees."""
+    message = (f"{text!r}: must be START:STOP:N or a list A,B,...: degrees in [0, 90), with "
+               f"START <= STOP and N a whole number from 1 to {MAX_TILTS} (N = 1 needs "
+               "START = STOP)")
     try:
-        start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
-        ok = len(parts) == 3
-    except (ValueError, IndexError):
-        ok = False
-    if not ok or not (0 <= start <= stop < 90) or not (1 <= n <= MAX_TILTS) or (
-            n == 1 and start != stop) or (n > 1 and start == stop):
-        raise argparse.ArgumentTypeError(
-            f"{text!r}: must be START:STOP:N, degrees with 0 <= START <= STOP < 90 and N a "
-            f"whole number from 1 to {MAX_TILTS} (N = 1 needs START = STOP)")
-    if n == 1:
-        return [start]
-    return [start + (stop - start) * i / (n - 1) for i in range(n)]
+        if ":" in text:
+            start_s, stop_s, n_s = text.split(":")
+            start, stop, n = float(start_s), float(stop_s), int(n_s)
+            if not (1 <= n <= MAX_TILTS) or (n == 1) != (start == stop) or start > stop:
+                raise ValueError
+            values = [start] if n == 1 else [start + (stop - start) * i / (n - 1)
+                                             for i in range(n)]
+        else:
+            values = [float(v) for v in text.split(",")]
+            if not (1 <= len(values) <= MAX_TILTS) or values != sorted(set(values)):
+                raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(message) from None
+    if not all(0 <= v < 90 for v in values):
+        raise argparse.ArgumentTypeError(message)
+    return values
 
 
 tilt_range.__name__ = "tilt range"
+
+
+def restitution_coefficient(text: str) -> float:
+    """An argparse type: a number from 0 to 1."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be a number from 0 to 1")
+    return value
+
+
+restitution_coefficient.__name__ = "restitution"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -48,7 +69,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--theta", type=tilt_range, default=tilt_range("0:80:9"),
                    metavar="START:STOP:N",
                    help="N tilts in degrees from START to STOP inclusive (default 0:80:9; "
-                        "0:60:3 is 0, 30 and 60)")
+                        "0:60:3 is 0, 30 and 60), or a list such as 0,30,45,60,80")
+    p.add_argument("--elasticity", type=restitution_coefficient, metavar="E",
+                   help="the floor's restitution, 0 to 1 (default: the scene's "
+                        "floor.elasticity)")
     p.add_argument("--dt", type=positive_float("s"), default=1e-5, metavar="DT",
                    help="pymunk's time step in s for the rigid dumbbell (default 1e-5; the "
                         "spring dumbbells use at most 0.02/w)")
@@ -70,6 +94,8 @@ def run(args: argparse.Namespace) -> int:
     from ..progress import bar
 
     scene = load_scene(args.scene)
+    if args.elasticity is not None and scene.floor is not None:
+        scene = scene.with_values({"floor.elasticity": args.elasticity})
     runs = len(args.theta) * (1 + len(args.stiffness))
     with bar(runs, "restitution", unit="run", quiet=args.quiet) as progress:
         result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
