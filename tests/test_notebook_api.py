@@ -106,3 +106,87 @@ def test_render_gif_without_a_path_returns_gif_bytes(textbook, tmp_path):
     with Image.open(io.BytesIO(gif._repr_png_())) as first:
         assert first.format == "PNG" and first.size == (320, 180)
     assert "\n" not in repr(gif) and str(len(gif)) in repr(gif)
+
+
+# --- the analyses from Python: typed, frozen results with to_pandas() -------------------------
+
+
+def _frozen(result, field_name):
+    import dataclasses
+
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        setattr(result, field_name, None)
+
+
+def test_compare_from_python(textbook):
+    from dumbbell.analysis.compare import compare as analysis_compare
+
+    result = dumbbell.compare(SCENES / "textbook-1d.toml", solvers=["euler-cromer", "verlet"],
+                              dts=1e-4, window=1.0, t_end=1.2)
+    _frozen(result, "rows")
+    df = result.to_pandas()
+    assert list(df.index) == ["exact", "euler-cromer", "verlet"]
+    assert df.attrs["units"]["window_error"] == "m" and df.attrs["units"]["dt"] == "s"
+    for row in result.rows:
+        assert df.loc[row.label, "window_error"] == row.window_error
+        assert df.loc[row.label, "impacts"] == len(row.traj.events)
+        assert df.loc[row.label, "dt"] == 1e-4
+    # Verlet is second order through impacts, Euler-Cromer first: far apart at the same dt.
+    assert df.loc["verlet", "window_error"] < df.loc["euler-cromer", "window_error"] / 10
+    assert np.isnan(df.loc["exact", "window_error"]) and np.isnan(df.loc["exact", "dt"])
+    assert df.loc["exact", "verdict"] == "ok"
+    impacts = result.impacts_to_pandas()
+    assert list(impacts["truth_t"]) == [e.t for e in result.truth.events]
+    # The old call signature still works and gives the same table.
+    old = analysis_compare(textbook, ["euler-cromer", "verlet"], [1e-4], 1.0, 1.2)
+    assert old.to_pandas().drop(columns=["wall_time", "steps_per_s"]).equals(
+        df.drop(columns=["wall_time", "steps_per_s"]))
+
+
+def test_bench_from_python(textbook):
+    result = dumbbell.bench(textbook, solvers=["euler-cromer"], dts=[1e-3, 1e-4], repeat=1,
+                            t_end=1.0, window=1.0)
+    _frozen(result, "points")
+    df = result.to_pandas()
+    assert len(df) == len(result.points) == 3          # two steps, then the truth
+    assert list(df["solver"]) == ["euler-cromer", "euler-cromer", "exact"]
+    for i, point in enumerate(result.points):
+        assert df["error"][i] == point.error or np.isnan(point.error)
+        assert df["seconds"][i] == point.seconds
+    errors = df[df.solver == "euler-cromer"].set_index("dt")["error"]
+    assert errors[1e-4] < errors[1e-3] / 3                # it converges
+    assert df.attrs["units"]["error"] == "m" and df.attrs["units"]["seconds"] == "s"
+
+
+def test_sweep_from_python(textbook):
+    grid = {"k": [200.0, 5e4], "dt": "lin:1e-3:2.1e-3:2"}
+    result = dumbbell.sweep(textbook, grid, t_end=0.3)
+    _frozen(result, "rows")
+    df = result.to_pandas()
+    assert list(df.columns) == result.columns and len(df) == 4
+    assert list(df["spring.stiffness"]) == [200.0, 200.0, 5e4, 5e4]
+    # w = sqrt(k/mu) = 1000 rad/s at k = 5e4: dt = 2.1e-3 is past w*dt = 2.
+    w_dt = df["w_dt"].to_numpy()
+    assert np.allclose(w_dt[2:], [1.0, 2.1])
+    assert df["verdict"][3] == "unstable" and df["verdict"][0] == "ok"
+    same = dumbbell.sweep(textbook, ["k=200.0,50000.0", "dt=lin:1e-3:2.1e-3:2"], t_end=0.3)
+    assert same.csv_text() == result.csv_text()
+    with pytest.raises(dumbbell.UsageError, match="grid"):
+        dumbbell.sweep(textbook, "k=1,2")
+
+
+def test_stability_from_python(tmp_path):
+    import shutil
+
+    for name in ("stiff-wdt-1.9.toml", "stiff-wdt-2.1.toml"):
+        shutil.copy(SCENES / "extreme" / name, tmp_path / name)
+    result = dumbbell.stability(tmp_path, solvers=["euler-cromer", "exact"], workers=1)
+    _frozen(result, "rows")
+    df = result.to_pandas()
+    assert len(df) == 4 and set(df["solver"]) == {"euler-cromer", "exact"}
+    verdicts = dict(zip(zip(df["case"], df["solver"]), df["verdict"]))
+    assert verdicts[("stiff-wdt-2.1", "euler-cromer")] == "unstable"
+    assert verdicts[("stiff-wdt-1.9", "euler-cromer")] == "ok"
+    assert verdicts[("stiff-wdt-2.1", "exact")] == "ok"
+    assert result.disagreements == []
+    assert "stiff-wdt-2.1" in result.markdown() and df.attrs["units"]["t_fail"] == "s"

@@ -7,6 +7,7 @@ its internal motion, from the bouncing dumbbell of textbook section 13.5.1.
 >>> traj.t, traj["K_int"], traj.events[0].t                           # doctest: +SKIP
 """
 
+from .analysis.api import bench, compare, stability, sweep
 from .animation.render import Gif, render_gif
 from .errors import DumbbellError, MissingExtraError, SceneError, UsageError
 from .model.scene import Scene, load_scene
@@ -16,6 +17,7 @@ from .solvers import simulate
 
 __all__ = [
     "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError", "Trajectory",
-    "UsageError", "Verdict", "load_scene", "render_gif", "simulate", "solvers",
+    "UsageError", "Verdict", "bench", "compare", "load_scene", "render_gif", "simulate",
+    "solvers", "stability", "sweep",
 ]
 __version__ = "0.1.0"

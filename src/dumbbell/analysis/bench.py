@@ -44,7 +44,7 @@ import math
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,6 +53,9 @@ from ..model.energy import energy_scale, relative_energy_error
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from ..solvers import RunOptions, make_options, solver_module, supported
+
+if TYPE_CHECKING:
+    import pandas
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
@@ -130,7 +133,16 @@ class Fit:
     dts: list[float] = field(default_factory=list)
 
 
-@dataclass
+#: Units of :data:`CSV_COLUMNS` ("1": dimensionless; "" for names and counts).
+CSV_UNITS = {"solver": "", "dt": "s", "seconds": "s", "error": "m", "seconds_median": "s",
+             "seconds_call": "s", "energy_error": "1", "impact_time_error": "s",
+             "impacts_compared": "", "impacts_truth": "", "verdict": "", "verdict_t": "s",
+             "compile_seconds": "s", "steps": "", "every": "", "repeat": "", "window": "s",
+             "t_end": "s", "truth": "", "reason": ""}
+assert set(CSV_UNITS) == set(CSV_COLUMNS)
+
+
+@dataclass(frozen=True)
 class BenchResult:
     """Everything one benchmark measured."""
 
@@ -172,6 +184,14 @@ class BenchResult:
         return {"target_error": target, "baseline": base_name,
                 "seconds": times,
                 "speedup": {n: base / t for n, t in times.items()} if base else {}}
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """One row per point with the CSV's columns (numbered from 0), units in
+        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
+        from ..io.frames import data_frame
+
+        rows = [asdict(p) for p in self.points]
+        return data_frame({c: [r[c] for r in rows] for c in CSV_COLUMNS}, units=CSV_UNITS)
 
     @property
     def baseline(self) -> str:

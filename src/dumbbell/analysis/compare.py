@@ -21,12 +21,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import UsageError
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    import pandas
 
 #: Default window (s) for position errors.
 WINDOW = 2.0
@@ -55,7 +59,13 @@ def energy_spread(traj: Trajectory) -> float:
     return float((np.max(E) - np.min(E)) / scale)
 
 
-@dataclass
+#: Columns of :meth:`Comparison.summary` and their units.
+SUMMARY_UNITS = {"solver": "", "dt": "s", "wall_time": "s", "steps_per_s": "1/s",
+                 "window_error": "m", "diverged_at": "s", "energy_spread": "1", "impacts": "",
+                 "verdict": ""}
+
+
+@dataclass(frozen=True)
 class Row:
     """One compared run: its trajectory and the measures against the truth."""
 
@@ -67,7 +77,7 @@ class Row:
     spread: float
 
 
-@dataclass
+@dataclass(frozen=True)
 class Comparison:
     """The truth, the compared runs and the window (s) of the position errors."""
 
@@ -77,6 +87,26 @@ class Comparison:
     rows: list[Row]
     window: float
     notes: list[str] = field(default_factory=list)
+
+    def summary(self) -> list[dict[str, object]]:
+        """One record per run, the truth first, keyed by label: solver, dt (s; None for the
+        step-free truths), run time (s), steps/s, the largest position error over the window
+        (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy spread,
+        impacts and verdict (see :data:`SUMMARY_UNITS`)."""
+        out = []
+        for row in [None, *self.rows]:
+            r = self.truth if row is None else row.traj
+            steps = r.info.get("steps")
+            out.append({
+                "label": r.solver if row is None else row.label, "solver": r.solver,
+                "dt": r.dt if r.dt and r.solver not in ("exact", "reference") else None,
+                "wall_time": r.wall_time,
+                "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
+                "window_error": math.nan if row is None else row.window_error,
+                "diverged_at": None if row is None else row.diverged_at,
+                "energy_spread": energy_spread(r), "impacts": len(r.events),
+                "verdict": r.verdict})
+        return out
 
     def table(self) -> str:
         """The summary as a fixed-width text table."""
@@ -88,19 +118,37 @@ class Comparison:
                  (f"position error: largest of either particle over [0, {self.window:g}] s "
                  "(chaotic motion: later errors do not measure the method)"),
                  "", head, "-" * len(head)]
-        for row in [None, *self.rows]:
-            r = self.truth if row is None else row.traj
-            steps = r.info.get("steps")
-            rate = f"{steps / r.wall_time:.3g}" if steps and r.wall_time > 0 else "-"
-            dt = f"{r.dt:g}" if r.dt and r.solver not in ("exact", "reference") else "-"
-            err = "(truth)" if row is None else f"{row.window_error:.3g}"
-            div = "-" if row is None or row.diverged_at is None else f"{row.diverged_at:.3g} s"
-            spread = energy_spread(r)
+        for i, rec in enumerate(self.summary()):
+            rate = "-" if rec["steps_per_s"] is None else f"{rec['steps_per_s']:.3g}"
+            dt = "-" if rec["dt"] is None else f"{rec['dt']:g}"
+            err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
+            div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
             lines.append(
-                f"{(r.solver if row is None else row.label):<26}{dt:>9}{r.wall_time:>14.3g}"
-                f"{rate:>10}{err:>14}{div:>13}{spread:>11.2e}{len(r.events):>9}  {r.verdict}")
+                f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}"
+                f"{rate:>10}{err:>14}{div:>13}{rec['energy_spread']:>11.2e}"
+                f"{rec['impacts']:>9}  {rec['verdict']}")
         lines += ["", *self.impact_lines(), *self.notes]
         return "\n".join(lines)
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """:meth:`summary` as a DataFrame indexed by label, the verdict as text, units in
+        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
+        from ..io.frames import data_frame
+
+        records = self.summary()
+        columns = {name: [rec[name] for rec in records] for name in ["label", *SUMMARY_UNITS]}
+        columns["verdict"] = [str(v) for v in columns["verdict"]]
+        columns["dt"] = [math.nan if v is None else v for v in columns["dt"]]
+        return data_frame(columns, index="label", units=SUMMARY_UNITS)
+
+    def impacts_to_pandas(self) -> pandas.DataFrame:
+        """:meth:`impacts` as a DataFrame indexed by impact number (times in s)."""
+        from ..io.frames import data_frame
+
+        records = self.impacts()
+        names = list(records[0]) if records else ["n", "body", "truth_t"]
+        return data_frame({c: [r[c] for r in records] for c in names}, index="n",
+                          units={c: "" if c in ("n", "body") else "s" for c in names})
 
     def impacts(self) -> list[dict[str, object]]:
         """Impacts matched in order: truth time and body, then each run's time and its

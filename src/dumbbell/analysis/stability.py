@@ -27,13 +27,16 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import UsageError
 from ..io.files import atomic_output
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
+
+if TYPE_CHECKING:
+    import pandas
 
 #: Solvers whose spring is an explicit step, stable iff w*dt < 2.
 STEPPERS = ("euler-cromer", "verlet", "pymunk", "euler-cromer-2d")
@@ -50,6 +53,42 @@ MAP_STEPS = 2000
 #: Energy error that counts as a blow-up on the map: far above the bounded swing h/(2-h) of
 #: a stable step (19 at w*dt = 1.9), far below what a run past w*dt = 2 reaches.
 MAP_UNSTABLE_ENERGY = 1e3
+
+
+#: Units of :data:`COLUMNS` ("1": dimensionless; "" for names and text).
+UNITS = {"case": "", "title": "", "solver": "", "dt": "s", "w_dt": "1", "verdict": "",
+         "t_fail": "s", "max_rel_energy_error": "1", "dissipative": "", "predicted": "",
+         "agreement": "", "reason": "", "theory": "", "wall_s": "s"}
+assert set(UNITS) == set(COLUMNS)
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """The catalogue's report: one row per (case, solver) run, keyed by :data:`COLUMNS`, and
+    the pairs not run because the solver cannot run the scene."""
+
+    rows: tuple[dict[str, Any], ...]
+    skipped: tuple[str, ...] = ()
+
+    def markdown(self) -> str:
+        """The report as the markdown ``dumbbell stability`` writes."""
+        return markdown(list(self.rows), list(self.skipped))
+
+    def csv_text(self) -> str:
+        """The report as the CSV ``dumbbell stability`` writes."""
+        return csv_text(list(self.rows))
+
+    @property
+    def disagreements(self) -> list[dict[str, Any]]:
+        """The runs whose verdict is not the one the theory expects."""
+        return [r for r in self.rows if r["agreement"] != "agrees"]
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """One row per run with the CSV's columns, units in ``df.attrs["units"]``. Needs
+        pip install 'dumbbell[pandas]'."""
+        from ..io.frames import data_frame
+
+        return data_frame({c: [r[c] for r in self.rows] for c in COLUMNS}, units=UNITS)
 
 
 @dataclass(frozen=True)
@@ -378,27 +417,43 @@ def map_solvers(solvers: list[str] | None) -> list[str]:
     return [n for n in names if n in STEPPERS and solver_module(n).supports(scene) is None]
 
 
+def run_stability(cases: str | Path | None = None, solvers: list[str] | None = None,
+                  workers: int | None = None, quiet: bool = True) -> StabilityResult:
+    """Run every case in the folder ``cases`` (default: the shipped catalogue) with
+    ``solvers`` (default: every solver that can run each case) and put each verdict beside
+    the theory's. Everything is validated before anything runs; nothing is written."""
+    runs, skipped = _runs(cases, solvers)
+    return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped))
+
+
+def _runs(cases: str | Path | None, solvers: list[str] | None
+          ) -> tuple[list[tuple[str, str]], list[str]]:
+    """:func:`plan_cases` for the folder ``cases`` (default: the catalogue); at least one run."""
+    runs, skipped = plan_cases(find_cases(cases if cases is not None else default_cases()),
+                               solvers)
+    if not runs:
+        raise UsageError("--solvers: none of them can run any of the cases")
+    return runs, skipped
+
+
 def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
            workers: int | None = None, quiet: bool = True) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
     Everything is validated before anything runs. Returns rows, paths and skipped runs."""
-    paths = find_cases(cases if cases is not None else default_cases())
-    runs, skipped = plan_cases(paths, solvers)
-    if not runs:
-        raise UsageError("--solvers: none of them can run any of the cases")
+    runs, skipped = _runs(cases, solvers)
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
-    rows = run_cases(runs, workers, quiet)
+    result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped))
     written = []
     with atomic_output(out / "stability.md") as tmp:
-        tmp.write_text(markdown(rows, skipped))
+        tmp.write_text(result.markdown())
     written.append(out / "stability.md")
     with atomic_output(out / "stability.csv") as tmp:
-        tmp.write_text(csv_text(rows))
+        tmp.write_text(result.csv_text())
     written.append(out / "stability.csv")
     steppers = map_solvers(solvers)
     if steppers:
         maps = {name: map_rows(name, workers, quiet) for name in steppers}
         written.append(draw_stability_map(out / "stability-map.png", maps))
-    return {"rows": rows, "skipped": skipped, "written": written}
+    return {"rows": list(result.rows), "skipped": skipped, "written": written}

@@ -29,13 +29,16 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import DumbbellError, UsageError
 from ..io.files import atomic_output
 from ..model.scene import Scene
+
+if TYPE_CHECKING:
+    import pandas
 
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}
@@ -248,7 +251,12 @@ def _batches(points: list[Point], workers: int) -> list[list[Point]]:
     return [points[i::count] for i in range(count)]
 
 
-@dataclass
+#: Units of :data:`RESULT_COLUMNS` ("1": dimensionless).
+RESULT_UNITS = {"w_dt": "1", "verdict": "", "t_fail": "s", "max_rel_energy_error": "1",
+                "reason": ""}
+
+
+@dataclass(frozen=True)
 class SweepResult:
     """The rows of a sweep in grid order, with the axes, the scene and how long it took."""
 
@@ -277,6 +285,15 @@ class SweepResult:
         with atomic_output(path) as tmp:
             tmp.write_text(self.csv_text())
         return Path(path)
+
+    def to_pandas(self) -> pandas.DataFrame:
+        """One row per grid point in grid order, the CSV's columns, units in
+        ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).
+        Needs pip install 'dumbbell[pandas]'."""
+        from ..io.frames import data_frame
+
+        units = {a.key: "" for a in self.axes} | RESULT_UNITS
+        return data_frame({c: [row[c] for row in self.rows] for c in self.columns}, units=units)
 
     def counts(self) -> dict[str, int]:
         """How many points ended with each verdict."""
