@@ -1,0 +1,127 @@
+"""spaces.HeatCounter: zero on elastic frictionless spaces, the closed form of sliding
+friction on a slope, the energy balance to the method's error, and the user's callbacks."""
+
+from __future__ import annotations
+
+import math
+
+import pymunk
+import pytest
+
+from dumbbell import spaces
+
+
+def _si(space: pymunk.Space) -> pymunk.Space:
+    space.collision_bias = 1.0
+    space.collision_slop = 1e-4
+    return space
+
+
+def _slope(mu: float, angle: float, spin: float = 0.0) -> tuple[pymunk.Space, pymunk.Body]:
+    space = _si(pymunk.Space())
+    space.gravity = (0.0, -9.81)
+    c, s = math.cos(angle), math.sin(angle)
+    ramp = pymunk.Poly(space.static_body, [(0, 0), (30 * c, -30 * s), (30 * c, -30 * s - 1),
+                                           (0, -1)])
+    ramp.friction = mu
+    body = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (0.2, 0.1)))
+    box = pymunk.Poly.create_box(body, (0.2, 0.1))
+    box.friction = 1.0  # pymunk multiplies the two shapes' friction: mu on the slope
+    body.angle = -angle
+    lift = 0.05 + (0.2 if spin else 0.0)
+    body.position = (1.0 * c + lift * s, -1.0 * s + lift * c)
+    body.angular_velocity = spin
+    space.add(ramp, body, box)
+    return space, body
+
+
+def test_zero_on_elastic_frictionless_spaces():
+    # Billiards without gravity in a closed box, and a ball bouncing on a floor with gravity.
+    space = _si(pymunk.Space())
+    for a, b in (((-1, -1), (1, -1)), ((1, -1), (1, 1)), ((1, 1), (-1, 1)), ((-1, 1), (-1, -1))):
+        wall = pymunk.Segment(space.static_body, a, b, 0.05)
+        wall.elasticity, wall.friction = 1.0, 0.0
+        space.add(wall)
+    for i, (x, y, vx, vy) in enumerate([(-0.5, 0.0, 3.0, 0.7), (0.5, 0.1, -2.0, 0.3),
+                                        (0.0, 0.6, 0.4, -2.5), (0.1, -0.5, 1.1, 1.9)]):
+        body = pymunk.Body(1.0 + i, math.inf)
+        body.position, body.velocity = (x, y), (vx, vy)
+        ball = pymunk.Circle(body, 0.1)
+        ball.elasticity, ball.friction = 1.0, 0.0
+        space.add(body, ball)
+    heat = spaces.HeatCounter(space)
+    e0 = spaces.energy(space).E
+    spaces.step(space, 5.0, substeps=5000)
+    assert heat.steps > 50  # it saw the impacts
+    assert abs(heat.total) < 1e-12 * e0
+    assert spaces.energy(space).E == pytest.approx(e0, rel=1e-12)
+
+    space = _si(pymunk.Space())
+    space.gravity = (0.0, -9.81)
+    floor = pymunk.Poly(space.static_body, [(-5, 0), (5, 0), (5, -1), (-5, -1)])
+    floor.elasticity, floor.friction = 1.0, 0.0
+    body = pymunk.Body(1.0, math.inf)
+    body.position = (0.1, 1.0)
+    ball = pymunk.Circle(body, 0.05)
+    ball.elasticity, ball.friction = 1.0, 0.0
+    space.add(floor, body, ball)
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 3.0, substeps=3000)
+    assert heat.steps >= 3 and abs(heat.total) < 1e-12 * spaces.energy(space).E
+
+
+@pytest.mark.parametrize("mu, angle", [(0.3, math.radians(30)), (0.5, math.radians(40))])
+def test_sliding_box_heat_is_mu_n_times_distance(mu, angle):
+    space, body = _slope(mu, angle)
+    start = body.position
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 1.0, substeps=10_000)
+    slid = (body.position - start).length
+    assert abs(body.angular_velocity) < 1e-9  # it slid flat, no tumbling
+    assert heat.total == pytest.approx(mu * 1.0 * 9.81 * math.cos(angle) * slid, rel=1e-3)
+
+
+def test_slope_balance_closes_to_the_method_error():
+    # Sliding and tumbling: E(0) - E(t) - heat is the step's error, first order in dt.
+    residual = {}
+    for n in (1000, 10_000):
+        space, _ = _slope(0.4, math.radians(30), spin=-8.0)
+        heat = spaces.HeatCounter(space)
+        e0 = spaces.energy(space).E
+        spaces.step(space, 2.0, substeps=n)
+        lost = e0 - spaces.energy(space).E
+        assert lost > 5.0 and heat.total > 5.0
+        residual[n] = lost - heat.total
+        assert abs(residual[n]) < 20.0 / n * heat.total
+    assert 5 < residual[1000] / residual[10_000] < 20
+
+
+def test_users_callbacks_still_fire():
+    space = _si(pymunk.Space())
+    space.gravity = (0.0, -9.81)
+    floor = pymunk.Segment(space.static_body, (-5, 0), (5, 0), 0.1)
+    floor.collision_type = 1
+    floor.elasticity, floor.friction = 0.5, 0.5
+    body = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    body.position = (0.0, 1.0)
+    ball = pymunk.Circle(body, 0.1)
+    ball.collision_type = 2
+    ball.elasticity, ball.friction = 1.0, 1.0
+    space.add(floor, body, ball)
+    fired: dict[str, list] = {"begin": [], "post": [], "wild": []}
+    space.on_collision(1, 2, begin=lambda a, s, d: fired["begin"].append(d),
+                       post_solve=lambda a, s, d: fired["post"].append(d), data="mine")
+    space.on_collision(None, None, post_solve=lambda a, s, d: fired["wild"].append(d),
+                       data="wild data")
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 1.0, substeps=1000)
+    assert heat.attached and heat.total > 0
+    assert fired["begin"] and set(fired["begin"]) == {"mine"}
+    assert len(fired["post"]) == len(fired["wild"]) == heat.steps
+    assert set(fired["wild"]) == {"wild data"}
+    heat.detach()
+    counted, calls = heat.total, len(fired["wild"])
+    body.position, body.velocity = (0.0, 1.0), (0.0, 0.0)
+    spaces.step(space, 1.0, substeps=1000)
+    assert heat.total == counted and not heat.attached
+    assert len(fired["wild"]) > calls and len(fired["post"]) == len(fired["wild"])
