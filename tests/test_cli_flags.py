@@ -18,6 +18,8 @@ STIFF = SCENES / "extreme" / "stiff-wdt-2.1.toml"
 #: Bad values for flags whose type argparse cannot check (the command must).
 SEMANTIC = {"--solver": "nope", "--solvers": "nope", "--size": "12x", "--scheduler": "nowhere",
             "--cases": "/nonexistent/cases", "--grid": "k=log:1:2", "--dts": "0"}
+#: Flags for which 0 is a good value (a tilt of 0 degrees, a perfectly inelastic floor).
+ZERO_OK = ("--theta", "--elasticity")
 #: Flags that name an output file or folder.
 OUTPUTS = ("--out", "-o", "--output", "--events")
 #: Small runs, so that a command that would run before it fails stays quick.
@@ -66,7 +68,7 @@ def _cases():
                 continue
             bad = []
             if action.type is not None:
-                bad += ["abc", "-1", "0", "nan"]
+                bad += ["abc", "-1", "nan"] + ([] if flag in ZERO_OK else ["0"])
             if action.choices:
                 bad.append("nope")
             for f in action.option_strings:
