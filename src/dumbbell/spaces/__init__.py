@@ -28,6 +28,7 @@ _WHERE = {
     "check": "guard", "survey": "guard", "suggest_dt": "guard", "substeps": "guard",
     "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
     "HeatCounter": "heat",
+    "Recorder": "recorder", "PaletteDrawOptions": "recorder", "draw_options": "recorder",
 }
 
 __all__ = list(_WHERE)

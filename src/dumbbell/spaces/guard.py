@@ -154,13 +154,15 @@ def _can_hit(s: Any, o: Any, apart: set[tuple[int, int]] = frozenset()) -> bool:
             and not s.filter.rejects_collision(o.filter))
 
 
-def _level(space: Any, down: tuple[float, float]) -> float | None:
-    """The lowest point (largest coordinate along ``down``) of the static shapes, else of all
-    shapes; None when the space has no shapes."""
+def _level(space: Any, down: tuple[float, float], apart: set[tuple[int, int]]) -> float | None:
+    """The lowest point (largest coordinate along ``down``) of the static shapes a moving
+    shape can hit, else of all shapes; None when the space has no shapes."""
     import pymunk
 
     shapes = list(space.shapes)
-    static = [s for s in shapes if s.body.body_type == pymunk.Body.STATIC]
+    moving = [s for s in shapes if s.body.body_type != pymunk.Body.STATIC]
+    static = [s for s in shapes if s.body.body_type == pymunk.Body.STATIC
+              and any(_can_hit(m, s, apart) for m in moving)]
     pool = static or shapes
     if not pool:
         return None
@@ -200,7 +202,7 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
     e = energy(space)
     g = math.hypot(*space.gravity)
     down = (space.gravity[0] / g, space.gravity[1] / g) if g > 0 else (0.0, -1.0)
-    level = _level(space, down) if g > 0 else None
+    level = _level(space, down, apart) if g > 0 else None
     potential = e.U_spring
     dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
     if level is not None:
