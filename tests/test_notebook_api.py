@@ -61,7 +61,7 @@ def test_to_pandas_has_every_column_with_t_as_index(scene_file, solver):
     units = df.attrs["units"]
     assert units["t"] == "s" and units["xB"] == "m" and units["E"] == "J"
     assert set(units) == set(traj.columns)
-    assert {units[c] for c in traj.columns} <= {"s", "m", "m/s", "J"}
+    assert {units[c] for c in traj.columns} <= {"s", "m", "m/s", "J", "kg m^2/s"}
 
 
 def test_to_pandas_without_pandas_names_the_extra(exact_run, monkeypatch):

@@ -193,6 +193,7 @@ class Frames:
     series: dict[str, np.ndarray]
     impacts: tuple[float, ...]
     t_end: float
+    L_cm: np.ndarray | None = None  # angular momentum about the centre of mass (kg m^2/s), 2D
 
 
 class Painter:
@@ -477,6 +478,7 @@ class Painter:
         self._dumbbell(img, k)
         self._time_label(img, k)
         self._bars(img, k)
+        self._momentum_label(img, k)
         if self.strip:
             self._strip(img, k)
         return img
@@ -625,6 +627,24 @@ class Painter:
                 theta = axis_angle(self.px(ax, ay), self.px(bx, by))
                 self.st_note.draw(crop, (6 * u - cx, 24 * u - cy),
                                   f"axis {theta:+.0f}° from vertical", GREY, "lt")
+        done()
+
+    def _momentum_label(self, img: Image.Image, k: int) -> None:
+        """L_cm (kg m^2/s) under the energy bars, right-aligned, where there is room (2D)."""
+        fr, u = self.frames, self.u
+        if fr.L_cm is None or not math.isfinite(float(fr.L_cm[k])):
+            return
+        below = self._bar_rows()[-1][2]
+        limit = self.strip_box[1] - round(6 * u) if self.strip else self.H - round(4 * u)
+        if limit - below < 14 * u:
+            return
+        y = (below + limit) / 2
+        box = (self.bars_box[0], round(y - 8 * u), self.bars_box[2], round(y + 8 * u))
+        text = f"L_cm = {float(fr.L_cm[k]):+.4f} kg m²/s (about the centre of mass)"
+        if self.st_note.width(text) > box[2] - box[0]:
+            text = f"L_cm = {float(fr.L_cm[k]):+.4f} kg m²/s"
+        crop, (cx, cy), done = self._patch(img, box, 1)
+        self.st_note.draw(crop, (box[2] - cx, y - cy), text, INK, "rm")
         done()
 
     def _bars(self, img: Image.Image, k: int) -> None:

@@ -125,6 +125,7 @@ def _frames(traj: Trajectory, fps: int, t_end: float) -> Frames:
         t=ft, A=A[idx], B=B[idx], energy={k: v[idx] for k, v in energy.items()}, lo=lo, hi=hi,
         series_t=t[keep], series={k: v[keep] for k, v in energy.items()},
         impacts=tuple(e.t for e in traj.events), t_end=max(window, 1e-9),
+        L_cm=traj["L_cm"][idx] if traj.scene.dimensions == 2 else None,
     )
 
 

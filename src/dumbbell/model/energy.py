@@ -12,6 +12,11 @@
 - ``U_g = M g R_y``, ``U_spring = 1/2 k (L - b)^2`` (only with a spring)
 
 Where energy can leave the system, ``E_lost = E(0) - E(t)`` so that ``E + E_lost`` stays at E(0).
+
+2D trajectories also carry ``L_cm``, the angular momentum about the centre of mass
+(kg m^2/s, counter-clockwise positive): ``sum m_i (r_i - R) x v_i = mu (d x w)`` for the two
+particles (``I omega`` with ``I = mu L^2`` when they form a rigid body), plus each disc's spin
+``1/2 m r^2 omega_i`` where particles may spin.
 """
 
 from __future__ import annotations
@@ -39,6 +44,8 @@ def column_unit(name: str) -> str:
         return "s"
     if name.startswith(("K_", "U_", "E")):
         return "J"
+    if name == "L_cm":
+        return "kg m^2/s"
     if name.startswith("omega"):
         return "rad/s"
     if name.startswith("v"):
@@ -68,6 +75,12 @@ def energy_columns(scene: Scene) -> list[str]:
     if scene.dissipative:
         cols.append("E_lost")
     return cols
+
+
+def momentum_columns(scene: Scene) -> list[str]:
+    """The angular-momentum columns (kg m^2/s) of a scene, after the energy terms in the CSV:
+    ``L_cm`` in 2D, none in 1D."""
+    return ["L_cm"] if scene.dimensions == 2 else []
 
 
 def partition_1d(
@@ -209,6 +222,24 @@ def partition(traj: Trajectory) -> dict[str, np.ndarray]:
     if scene.dissipative:
         parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
     return {name: parts[name] for name in energy_columns(scene)}
+
+
+def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
+    """Angular momentum about the centre of mass at each sample (kg m^2/s): the particles'
+    ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus the discs'
+    own spin ``1/2 m r^2 omega_i`` where particles may spin."""
+    scene = traj.scene
+    mA, mB = scene.A.mass, scene.B.mass
+    M = mA + mB
+    Rx = (mA * traj["xA"] + mB * traj["xB"]) / M
+    Ry = (mA * traj["yA"] + mB * traj["yB"]) / M
+    total = sum(angular_momentum(p.mass, traj[f"x{p.name}"], traj[f"y{p.name}"],
+                                 traj[f"vx{p.name}"], traj[f"vy{p.name}"], Rx, Ry)
+                for p in (scene.A, scene.B))
+    if spins(scene):
+        total = total + sum(disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"]
+                            for p in (scene.A, scene.B))
+    return np.asarray(total, dtype=float)
 
 
 def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:

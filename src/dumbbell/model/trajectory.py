@@ -79,13 +79,16 @@ class Trajectory:
     wall_time: float = 0.0
     info: dict[str, Any] = field(default_factory=dict)
     _energy: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    _momentum: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def columns(self) -> list[str]:
-        """The CSV columns, in order: t, the state, then the energy terms the scene has."""
-        from .energy import energy_columns, state_columns
+        """The CSV columns, in order: t, the state, the energy terms the scene has, then the
+        angular momentum about the centre of mass (2D)."""
+        from .energy import energy_columns, momentum_columns, state_columns
 
-        return ["t", *state_columns(self.scene), *energy_columns(self.scene)]
+        return ["t", *state_columns(self.scene), *energy_columns(self.scene),
+                *momentum_columns(self.scene)]
 
     @property
     def energy(self) -> dict[str, np.ndarray]:
@@ -101,6 +104,12 @@ class Trajectory:
             return self.t
         if name in self.state:
             return self.state[name]
+        if name == "L_cm" and self.scene.dimensions == 2:
+            if self._momentum is None or len(self._momentum) != len(self.t):
+                from .energy import angular_momentum_cm
+
+                self._momentum = angular_momentum_cm(self)
+            return self._momentum
         energy = self.energy
         if name in energy:
             return energy[name]

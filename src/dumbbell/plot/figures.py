@@ -177,6 +177,27 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.set_title(f"in the plane, 0-{window:g} s\n(axis every 0.1 s, dark = later)", fontsize=8)
 
 
+def _momentum_axis(ax: Any, traj: Trajectory, window: float) -> None:
+    """L_cm (kg m^2/s) on a right-hand axis of ``ax``: flat in flight, a step at each impact."""
+    m = _window(traj, window)
+    right = ax.twinx()
+    L = traj["L_cm"][m]
+    right.plot(traj.t[m], L, color="#17becf", lw=1.0, ls=(0, (5, 2)),
+               label="L_cm, about the centre of mass (right axis)")
+    lo, hi = float(np.nanmin(L)), float(np.nanmax(L))
+    pad = 0.1 * max(hi - lo, abs(hi), abs(lo), 1e-12)
+    right.set_ylim(lo - pad, hi + 3 * pad)
+    right.set_ylabel("L_cm [kg m^2/s]", color="#17becf")
+    right.tick_params(axis="y", colors="#17becf", labelsize=8)
+    # One legend, drawn on the upper axis so that the dashed line does not run through it.
+    handles, labels = ax.get_legend_handles_labels()
+    extra = right.get_legend_handles_labels()
+    if ax.get_legend() is not None:
+        ax.get_legend().remove()
+    right.legend(handles + extra[0], labels + extra[1], loc="upper center", fontsize=8,
+                 framealpha=0.9, ncol=3)
+
+
 def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
     """Positions (and, in 2D, the motion in the plane), then the energy terms the scene has
     in two panels (J): the centre of mass's (K_cm, U_g) with E and E_lost, and the internal
@@ -202,6 +223,8 @@ def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) ->
         _energy_panel(bottom, traj, inner, window)
         bottom.set_title("internal: the impacts feed the motion relative to the centre of mass",
                          fontsize=9)
+        if "L_cm" in cols:
+            _momentum_axis(bottom, traj, window)
     return _finish(fig, [top, middle, bottom], traj, window, Path(path),
                    "how the energy is shared")
 

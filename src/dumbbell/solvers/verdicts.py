@@ -132,6 +132,7 @@ def keep_samples(traj: Trajectory, count: int) -> None:
     traj.t = traj.t[:count]
     traj.state = {name: col[:count] for name, col in traj.state.items()}
     traj._energy = None
+    traj._momentum = None
 
 
 #: A truth solver's samples may lie at most this far below the floor (m): more means it
