@@ -157,3 +157,33 @@ def test_truth_solvers_decline_resting_contact(topple_scene):
     # The same dumbbell a millimetre above the floor is an ordinary drop.
     assert solver_module("reference").supports(
         topple_scene.with_values({"bodies.B.height": 1e-3})) is None
+
+
+@pytest.mark.parametrize("solver,tol", [("exact", 1e-12), ("pymunk", 1e-9)])
+def test_angular_momentum_about_the_contact_point(solver, tol):
+    from dumbbell.analysis.contact import about_contact
+
+    scene = load_scene(SCENES / "rigid-2d.toml")
+    traj = simulate(scene, solver, t_end=0.6, every=1, dt=1e-5 if solver == "pymunk" else 1e-4)
+    c = about_contact(traj)
+    assert abs(c.change) < tol
+    # L_cm jumps from 0 to I*omega with the impulse law's omega (rigid, e = 1, 30 degrees):
+    # omega = J a sin(theta) / I, J = (1 + e) m_eff v, 1/m_eff = 1/M + (a sin theta)^2 / I.
+    M, L, g, h = scene.M, 0.2, scene.g, scene.B.height
+    I, a, s = scene.mu * L**2, L / 2, math.sin(math.radians(30.0))
+    v = math.sqrt(2 * g * h)
+    omega = -(1 + 1.0) * v / (1 / M + (a * s) ** 2 / I) * a * s / I
+    assert c.L_cm_before == pytest.approx(0.0, abs=1e-12)
+    assert c.L_cm_after == pytest.approx(I * omega, rel=1e-9 if solver == "exact" else 1e-4)
+
+
+def test_run_draws_the_contact_figure(tmp_path):
+    from dumbbell.cli import main
+
+    scene = load_scene(SCENES / "rigid-2d.toml")
+    assert "contact" in scene.outputs.figures
+    short = tmp_path / "rigid.toml"
+    text = (SCENES / "rigid-2d.toml").read_text().replace("t_end = 10.0", "t_end = 0.6")
+    short.write_text(text.replace("gif = {", "# gif = {"))
+    assert main(["run", str(short), "--out", str(tmp_path / "out"), "-q"]) == 0
+    assert (tmp_path / "out" / "rigid-contact.png").stat().st_size > 10_000

@@ -26,7 +26,7 @@ from ..errors import SceneError
 #: Solver names a scene may ask for; the registry in :mod:`dumbbell.solvers` must agree.
 SOLVER_NAMES = ("euler-cromer", "exact", "pymunk", "verlet", "reference", "euler-cromer-2d")
 #: Figure names ``[outputs] figures`` may list.
-FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple")
+FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
 #: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
@@ -486,6 +486,8 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
                 co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
             if "rotation" in value and dims != 2:
                 co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
+            if "contact" in value and (dims != 2 or cf is None):
+                co.fail("outputs.figures", value, "'contact' needs a 2D scene with a [floor]")
             if "topple" in value and rigid is None:
                 co.fail("outputs.figures", value, "'topple' needs a rigid 2D dumbbell ([rigid])")
             figures = tuple(value)

@@ -254,6 +254,23 @@ def topple_figure(traj: Trajectory, path: str | Path) -> Path:
     return path
 
 
+def contact_figure(traj: Trajectory, path: str | Path) -> Path:
+    """Angular momentum about the contact point through the first impact of ``traj`` (2D):
+    L_cm and the orbital part jump, their sum does not (see :mod:`dumbbell.analysis.contact`)."""
+    from ..analysis.contact import about_contact
+    from .rotation_chapter import contact_momentum
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8.5, 4.6))
+    contact_momentum(about_contact(traj), ax=ax, solver=traj.solver)
+    fig.tight_layout()
+    path = Path(path)
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
+
+
 #: Figure name (as in a scene's ``[outputs] figures``) -> drawing function.
 FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
     "positions": positions_figure,
@@ -262,4 +279,5 @@ FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
     "energy": energy_figure,
     "rotation": rotation_figure,
     "topple": topple_figure,
+    "contact": contact_figure,
 }

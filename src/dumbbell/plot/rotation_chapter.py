@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from ..analysis.contact import ContactMomentum
     from ..analysis.restitution import RestitutionResult
     from ..analysis.topple import ToppleClosedForm, ToppleMeasure
 
@@ -135,3 +136,26 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     a1.set_title(f"Toppling rigid dumbbell: L = {cf.L:g} m, released at "
                  f"{math.degrees(cf.theta0):g}° on a frictionless floor", fontsize=10.5)
     return a1, a2, a3
+
+
+def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> Any:
+    """Angular momentum about the contact point through one impact: L_cm and the orbital part
+    jump, their sum L_P does not. Time in ms from the impact. Returns the axes."""
+    ax = _axes(ax, 1, figsize=(8.5, 4.6))
+    t = (cm.t - cm.impact.t) * 1e3
+    ax.axvline(0, color="0.6", lw=0.8, ls=":")
+    ax.plot(t, cm.L_cm, color="#2ca02c", lw=1.4, label="L_cm, spin about the centre of mass")
+    ax.plot(t, cm.L_orbit, color="#1f77b4", lw=1.4, ls="--",
+            label="M (R - P) x V, the centre of mass's orbit about P")
+    ax.plot(t, cm.L_P, color="black", lw=2.0, label="L_P, their sum: about the contact point")
+    ax.set_xlabel(f"t - t_impact [ms]   (impact of {cm.impact.body} at {cm.impact.t:.6f} s, "
+                  f"P = ({cm.px:.4f} m, 0))")
+    ax.set_ylabel("angular momentum [kg m²/s]")
+    ax.grid(True, color="0.9")
+    ax.legend(fontsize=8, loc="best")
+    who = f" ({solver})" if solver else ""
+    ax.set_title(f"Through a frictionless impact{who}: L_cm jumps {cm.L_cm_before:+.5f} → "
+                 f"{cm.L_cm_after:+.5f}, L_P stays {cm.before:+.6f} → {cm.after:+.6f} "
+                 "kg m²/s\n(the floor's push acts at P: no torque about it; gravity turns L_P "
+                 "slowly and evenly)", fontsize=9)
+    return ax
