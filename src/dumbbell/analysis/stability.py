@@ -69,10 +69,11 @@ class StabilityResult:
 
     rows: tuple[dict[str, Any], ...]
     skipped: tuple[str, ...] = ()
+    guard: tuple[str, ...] = ()
 
     def markdown(self) -> str:
         """The report as the markdown ``dumbbell stability`` writes."""
-        return markdown(list(self.rows), list(self.skipped))
+        return markdown(list(self.rows), list(self.skipped), list(self.guard))
 
     def csv_text(self) -> str:
         """The report as the CSV ``dumbbell stability`` writes."""
@@ -280,9 +281,35 @@ def _fmt(value: Any, kind: str = "") -> str:
     return str(value)
 
 
-def markdown(rows: list[dict[str, Any]], skipped: list[str] | None = None) -> str:
+def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
+    """What the step-size guard (:func:`dumbbell.spaces.check`) says about each case run by
+    pymunk, on the space the solver builds, at the case's dt: its findings and the sub-steps
+    that clear them, or that it finds nothing."""
+    from ..solvers.engine import build
+    from ..spaces.guard import check, substeps
+
+    lines = []
+    for path in sorted({p for p, solver in runs if solver == "pymunk"}):
+        scene = load_scene(path)
+        space = build(scene).space
+        dt = scene.run.dt
+        found = check(space, dt)
+        if not found:
+            lines.append(f"- {scene.name} (dt = {dt:g} s): nothing to fix")
+            continue
+        what = "; ".join(f"{f.kind} {f.subject} {f.value:.3g} > {f.limit:.3g}" for f in found)
+        n = substeps(space, dt)
+        fix = (f"{n} sub-steps (dt = {dt / n:.3g} s) clear it" if n > 1
+               else "settings, not the step: " + "; ".join(f.fix for f in found))
+        lines.append(f"- {scene.name} (dt = {dt:g} s): {what}; {fix}")
+    return lines
+
+
+def markdown(rows: list[dict[str, Any]], skipped: list[str] | None = None,
+             guard: list[str] | None = None) -> str:
     """The report as a markdown table, then the verdict lines of the runs that did not end ok
-    or disagree with the theory."""
+    or disagree with the theory, the step-size guard on the pymunk runs and the runs not
+    made."""
     out = [("| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | "
             "t_fail [s] | largest rel. energy error | theory expects | agreement |"),
            "|---|---|---|---|---|---|---|---|---|---|"]
@@ -311,6 +338,10 @@ def markdown(rows: list[dict[str, Any]], skipped: list[str] | None = None) -> st
             if r["agreement"] != "agrees":
                 line += f". {r['agreement']} ({r['theory']})"
             out.append(line)
+    if guard:
+        out += ["", ("Step-size guard (`dumbbell.spaces.check` on the space the pymunk solver "
+                     "builds, at the case's dt):"), ""]
+        out += guard
     if skipped:
         out += ["", "Not run (the solver cannot run the scene):", ""]
         out += [f"- {s}" for s in skipped]
@@ -423,7 +454,8 @@ def run_stability(cases: str | Path | None = None, solvers: list[str] | None = N
     ``solvers`` (default: every solver that can run each case) and put each verdict beside
     the theory's. Everything is validated before anything runs; nothing is written."""
     runs, skipped = _runs(cases, solvers)
-    return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped))
+    return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
+                           tuple(guard_lines(runs)))
 
 
 def _runs(cases: str | Path | None, solvers: list[str] | None
@@ -444,7 +476,8 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
-    result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped))
+    result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
+                             tuple(guard_lines(runs)))
     written = []
     with atomic_output(out / "stability.md") as tmp:
         tmp.write_text(result.markdown())

@@ -242,6 +242,40 @@ def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
     return np.asarray(total, dtype=float)
 
 
+def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The dumbbell's energy columns (J, :func:`energy_columns` order) from the general
+    accounting of its bodies over the same samples (``terms``: K_cm, K_int, K_rot (the bodies'
+    own spin), U_g, U_spring, E, as :func:`dumbbell.spaces.accounting.evaluate` gives them).
+
+    K_cm, K_int (1D), U_g, U_spring and E are the accounting's. In 2D the internal motion is
+    split the dumbbell's way, which the general accounting does not know: K_rot and K_vib of
+    the axis from :func:`partition_2d`, and K_spin, the particles' own spin (the bodies' K_rot
+    when each particle is a body; the discs' share of the one body when rigid). Equal to
+    :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces.md)."""
+    scene = traj.scene
+    parts = {name: terms[name] for name in ("K_cm", "U_g", "U_spring", "E")}
+    if scene.dimensions == 1:
+        parts["K_int"] = terms["K_int"]
+    else:
+        rA = np.column_stack([traj["xA"], traj["yA"]])
+        rB = np.column_stack([traj["xB"], traj["yB"]])
+        vA = np.column_stack([traj["vxA"], traj["vyA"]])
+        vB = np.column_stack([traj["vxB"], traj["vyB"]])
+        axis = partition_2d(scene.A.mass, scene.B.mass, scene.k, scene.b, scene.g,
+                            rA, vA, rB, vB)
+        parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
+        if spins(scene):
+            if scene.rigid is None:
+                parts["K_spin"] = terms["K_rot"]
+            else:
+                parts["K_spin"] = sum(
+                    rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
+                    for p in (scene.A, scene.B))
+    if scene.dissipative:
+        parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
+    return {name: parts[name] for name in energy_columns(scene)}
+
+
 def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
     """The scale (J) that relative energy errors are taken against: |E(0)|, or where that is
     near zero (zero gravity, say) the largest single term at the start, or 1 J if all vanish."""

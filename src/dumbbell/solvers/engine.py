@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from ..model.energy import disc_inertia, spins, state_columns
+from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import RunOptions
@@ -225,6 +225,33 @@ def _vertical_velocity(body: Any, shape: Any) -> float:
     return float(body.velocity_at_world_point(body.local_to_world(shape.offset))[1])
 
 
+def _energy(scene: Scene, world: World, traj: Trajectory) -> dict[str, np.ndarray]:
+    """The energy columns (J) from the general accounting of pymunk's own bodies, springs and
+    gravity (:mod:`dumbbell.spaces.accounting`), evaluated over all samples at once."""
+    from ..spaces.accounting import State, evaluate, inventory
+
+    inv = inventory(world.space)
+    n = len(traj.t)
+    zero = np.zeros(n)
+    if world.rigid_body is not None:
+        mA, mB, M = scene.A.mass, scene.B.mass, scene.M
+        cols = [[(mA * traj[f"{c}A"] + mB * traj[f"{c}B"]) / M]
+                for c in ("x", "y", "vx", "vy")]
+        omega = [traj.state["omega"]]
+    else:
+        if scene.dimensions == 1:
+            cols = [[zero, zero], [traj["xA"], traj["xB"]], [zero, zero], [traj["vA"], traj["vB"]]]
+        else:
+            cols = [[traj[f"{c}A"], traj[f"{c}B"]] for c in ("x", "y", "vx", "vy")]
+        omega = ([traj.state["omegaA"], traj.state["omegaB"]] if spins(scene)
+                 else [zero, zero])
+    # Tracked bodies beyond the dynamic ones (a floor's static body) never move.
+    extra = len(inv.bodies) - len(omega)
+    pad = [zero] * extra
+    st = State(*(np.column_stack(c + pad) for c in (*cols, [zero] * len(omega), omega)))
+    return partition_from_terms(traj, evaluate(inv, st))
+
+
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Run ``scene`` in pymunk at step ``options.dt`` (s). See the module docstring."""
     from ..progress import bar
@@ -310,6 +337,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     )
     if world.rigid_body is not None:
         traj.info["moment"] = world.rigid_body.moment
+    traj._energy = _energy(scene, world, traj)
     if verdict is not None and verdict.status == "unstable":
         verdict = blowup_verdict(traj, verdict.t, dt)
     traj.verdict = verdict if verdict is not None else energy_verdict(traj, dt)
