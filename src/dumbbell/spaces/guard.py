@@ -232,7 +232,9 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
                              f"{v:.4g} m/s ({source}) moves {v * dt:.3g} m per step; "
                              f"dt < {dt_max:.4g} s", dt_max), v * dt < limit))
 
-    if shapes:
+    # Slop and bias act only where shapes can touch.
+    contacts = any(_can_hit(a, b, apart) for i, a in enumerate(shapes) for b in shapes[i + 1:])
+    if shapes and contacts:
         smallest = min(sizes)
         if smallest > 0:
             slop_limit = SLOP_FRACTION * smallest

@@ -140,8 +140,14 @@ def _options_class() -> type:
                     pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
                     self.items.append(("spring", pa.x, pa.y, pb.x, pb.y))
                 elif isinstance(c, pymunk.DampedRotarySpring):
-                    body = b if b.body_type == pymunk.Body.DYNAMIC else a
-                    p = body.local_to_world(body.center_of_gravity)
+                    # At the pivot the two bodies share, if any; else at the moving body.
+                    pins = [j for j in space.constraints if isinstance(j, pymunk.PivotJoint)
+                            and {id(j.a), id(j.b)} == {id(a), id(b)}]
+                    if pins:
+                        p = pins[0].a.local_to_world(pins[0].anchor_a)
+                    else:
+                        body = b if b.body_type == pymunk.Body.DYNAMIC else a
+                        p = body.local_to_world(body.center_of_gravity)
                     self.items.append(("rotary", p.x, p.y, a.angle - b.angle - c.rest_angle))
                 elif isinstance(c, pymunk.PinJoint | pymunk.SlideJoint):
                     pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
@@ -474,8 +480,8 @@ class _Painter:
         d = ImageDraw.Draw(img)
         self._draw_items(d, self.rec.options.static or [], S, 0.0, 0.0)
         if self.rec.title:
-            d.text(((W * 0.56 if self.rec.energy else W) * S / 2, 6 * u * S), self.rec.title,
-                   font=font(round(12 * u) * S, True), fill=INK, anchor="mt")
+            d.text(((self.scene_w - 8 * u) * S, 6 * u * S), self.rec.title,
+                   font=font(round(12 * u) * S, True), fill=INK, anchor="rt")
         if self.rec.energy:
             d.line([(self.scene_w * S, 8 * u * S), (self.scene_w * S, (H - 8 * u) * S)],
                    fill=LIGHT, width=S)
