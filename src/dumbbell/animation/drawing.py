@@ -196,7 +196,30 @@ class Frames:
     L_cm: np.ndarray | None = None  # angular momentum about the centre of mass (kg m^2/s), 2D
 
 
-class Painter:
+class Backdrop:
+    """Frames drawn over a background made once: ``bg_rgb`` (RGB, ``W`` x ``H`` px) and
+    ``bg_ss`` (the same at :data:`SS` times the size); what changes is drawn on crops."""
+
+    W: int
+    H: int
+    bg_rgb: Image.Image
+    bg_ss: Image.Image
+
+    def _patch(self, img: Image.Image, box: tuple[int, int, int, int], ss: int):
+        """An RGB crop of the background, ``ss`` times the size, its corner (px), and a function
+        that maps it back into ``img`` through the palette."""
+        x0, y0 = max(0, box[0]), max(0, box[1])
+        x1, y1 = min(self.W, box[2]), min(self.H, box[3])
+        src = self.bg_ss if ss == SS else self.bg_rgb
+        crop = src.crop((x0 * ss, y0 * ss, max(x0, x1) * ss, max(y0, y1) * ss))
+
+        def done() -> None:
+            img.paste(to_palette(crop.reduce(ss) if ss > 1 else crop), (x0, y0))
+
+        return crop, (x0, y0), done
+
+
+class Painter(Backdrop):
     """Draws the frames of one animation of ``scene`` at ``size`` (px) into the palette."""
 
     def __init__(self, scene: Scene, frames: Frames, size: tuple[int, int], strip: bool):
@@ -506,19 +529,6 @@ class Painter:
         xc = self.inner_x + x - left
         ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=self.idx["ink"],
                                  width=max(1, round(1.5 * u)))
-
-    def _patch(self, img: Image.Image, box: tuple[int, int, int, int], ss: int):
-        """An RGB crop of the background, ``ss`` times the size, its corner (px), and a function
-        that maps it back into ``img`` through the palette."""
-        x0, y0 = max(0, box[0]), max(0, box[1])
-        x1, y1 = min(self.W, box[2]), min(self.H, box[3])
-        src = self.bg_ss if ss == SS else self.bg_rgb
-        crop = src.crop((x0 * ss, y0 * ss, max(x0, x1) * ss, max(y0, y1) * ss))
-
-        def done() -> None:
-            img.paste(to_palette(crop.reduce(ss) if ss > 1 else crop), (x0, y0))
-
-        return crop, (x0, y0), done
 
     def _dumbbell(self, img: Image.Image, k: int) -> None:
         fr, sc, u, S = self.frames, self.scene, self.u, SS

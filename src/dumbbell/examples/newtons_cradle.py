@@ -12,10 +12,11 @@ step divided into the guard's sub-steps and at ten times finer.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from typing import Any
+
+from . import arguments, print_guard
 
 #: Ball radius (m), mass (kg), pin length (m), gap between hanging balls (m), start angle.
 RADIUS, MASS, LENGTH, GAP, LIFT = 0.025, 0.5, 0.3, 1e-4, math.radians(30)
@@ -91,17 +92,9 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
 def main(argv: list[str] | None = None) -> int:
     from .. import spaces
 
-    parser = argparse.ArgumentParser(prog="python -m dumbbell.examples.newtons_cradle",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="newtons_cradle.gif", help="GIF or MP4 to write")
-    parser.add_argument("--seconds", type=float, default=10.0, help="simulated time (s)")
-    parser.add_argument("--fps", type=int, default=25)
-    parser.add_argument("--dt", type=float, default=1e-3, help="step (s); also run at dt/10")
-    args = parser.parse_args(argv)
-    frame_dt = 1.0 / args.fps
+    args = arguments("newtons_cradle", __doc__, 10.0, argv)
     space = build()
-    print(spaces.report(space, frame_dt))
-    print(spaces.report(space, args.dt))
+    print_guard(space, args)
     with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle") as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec)

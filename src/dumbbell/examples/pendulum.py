@@ -15,11 +15,12 @@ of E (gravity, the rotary spring, the rod's translation and spin) over the run.
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import math
 import sys
 from typing import Any
+
+from . import arguments, print_guard
 
 #: Rod mass (kg), length (m), width (m), spring stiffness (N m/rad), pivot height (m: the rod
 #: hangs with its centre of gravity at y = 0, where U_g is zero), starting angle (rad).
@@ -89,16 +90,9 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
 def main(argv: list[str] | None = None) -> int:
     from .. import spaces
 
-    parser = argparse.ArgumentParser(prog="python -m dumbbell.examples.pendulum",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="pendulum.gif", help="GIF or MP4 to write")
-    parser.add_argument("--seconds", type=float, default=10.0, help="simulated time (s)")
-    parser.add_argument("--fps", type=int, default=25)
-    parser.add_argument("--dt", type=float, default=1e-3, help="step (s); also run at dt/10")
-    args = parser.parse_args(argv)
+    args = arguments("pendulum", __doc__, 10.0, argv)
     space = build()
-    print(spaces.report(space, 1.0 / args.fps))
-    print(spaces.report(space, args.dt))
+    print_guard(space, args)
     with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring",
                          world=(-0.45, 0.45, -0.55, 0.55)) as rec:
         rec.capture()

@@ -12,10 +12,11 @@ report, then at both steps E(0), E(t), the heat and what is left, relative to th
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from typing import Any
+
+from . import arguments, print_guard
 
 #: Slope angle (rad), friction coefficient, restitution, box size (m), mass (kg), spin (rad/s).
 ANGLE, MU, ELASTICITY, SIZE, MASS, SPIN = math.radians(30), 0.4, 0.2, (0.2, 0.1), 1.0, -12.0
@@ -72,16 +73,9 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
 def main(argv: list[str] | None = None) -> int:
     from .. import spaces
 
-    parser = argparse.ArgumentParser(prog="python -m dumbbell.examples.slope",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="slope.gif", help="GIF or MP4 to write")
-    parser.add_argument("--seconds", type=float, default=2.0, help="simulated time (s)")
-    parser.add_argument("--fps", type=int, default=25)
-    parser.add_argument("--dt", type=float, default=1e-3, help="step (s); also run at dt/10")
-    args = parser.parse_args(argv)
+    args = arguments("slope", __doc__, 2.0, argv)
     space = build()
-    print(spaces.report(space, 1.0 / args.fps))
-    print(spaces.report(space, args.dt))
+    print_guard(space, args)
     heat = spaces.HeatCounter(space)
     c, s = math.cos(ANGLE), math.sin(ANGLE)
     with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope",

@@ -40,6 +40,7 @@ from ..animation.drawing import (
     SS,
     TERM_RGB,
     WHITE,
+    Backdrop,
     Stamps,
     _blend,
     _fmt_tick,
@@ -317,13 +318,15 @@ def _write_mp4(path: Path, painter: _Painter, fps: int) -> None:
                                     pixelformat="yuv420p", macro_block_size=2,
                                     ffmpeg_log_level="error")
         try:
+            # yuv420p needs even sizes: an odd edge gets one more row or column of itself.
+            pad = ((0, painter.H % 2), (0, painter.W % 2), (0, 0))
             for k in range(painter.n):
-                writer.append_data(lut[np.asarray(painter.frame(k))])
+                writer.append_data(np.pad(lut[np.asarray(painter.frame(k))], pad, mode="edge"))
         finally:
             writer.close()
 
 
-class _Painter:
+class _Painter(Backdrop):
     """Draws the recorder's frames into the fixed palette (see the module docstring)."""
 
     def __init__(self, rec: Recorder) -> None:
@@ -542,17 +545,10 @@ class _Painter:
 
     # --- one frame --------------------------------------------------------------------------
 
-    def _patch(self, img: Image.Image, box: tuple[float, float, float, float], ss: int):
-        x0, y0 = max(0, math.floor(box[0])), max(0, math.floor(box[1]))
-        x1, y1 = min(self.W, math.ceil(box[2])), min(self.H, math.ceil(box[3]))
-        x1, y1 = max(x0, x1), max(y0, y1)
-        src = self.bg_ss if ss == SS else self.bg_rgb
-        crop = src.crop((x0 * ss, y0 * ss, x1 * ss, y1 * ss))
-
-        def done() -> None:
-            img.paste(to_palette(crop.reduce(ss) if ss > 1 else crop), (x0, y0))
-
-        return crop, (x0, y0), done
+    def _fpatch(self, img: Image.Image, box: tuple[float, float, float, float], ss: int):
+        """:meth:`Backdrop._patch` of the whole pixels that cover ``box`` (px)."""
+        return self._patch(img, (math.floor(box[0]), math.floor(box[1]), math.ceil(box[2]),
+                                 math.ceil(box[3])), ss)
 
     def frame(self, k: int) -> Image.Image:
         """Frame ``k`` as a palette image."""
@@ -566,11 +562,11 @@ class _Painter:
                 box = (max(px0 - m, 0), max(py0 - m, 0), min(px1 + m, self.scene_w - 1),
                        min(py1 + m, self.H))
                 if box[2] > box[0] and box[3] > box[1]:
-                    crop, (cx, cy), done = self._patch(img, box, SS)
+                    crop, (cx, cy), done = self._fpatch(img, box, SS)
                     self._draw_items(ImageDraw.Draw(crop), items, SS, cx, cy)
                     done()
         u = self.u
-        crop, (cx, cy), done = self._patch(img, (4 * u, 2 * u, 130 * u, 24 * u), 1)
+        crop, (cx, cy), done = self._fpatch(img, (4 * u, 2 * u, 130 * u, 24 * u), 1)
         self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), f"t = {self.t[k]:.2f} s", INK, "lt")
         done()
         if self.rec.energy:
@@ -599,7 +595,7 @@ class _Painter:
                 d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
         bx1 = self.bars_box[2]
         box = (self.bar_right + 2, self.rows[0][1] - 3, bx1, self.rows[-1][2] + 3)
-        crop, (cx, cy), done = self._patch(img, box, 1)
+        crop, (cx, cy), done = self._fpatch(img, box, 1)
         for name, top, bot in self.rows:
             v = values[name]
             text = f"{v:.{self.decimals}f}" if math.isfinite(v) else "n/a"
