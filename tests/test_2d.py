@@ -12,7 +12,7 @@ import pytest
 from dumbbell.cli import main
 from dumbbell.model.energy import partition_2d
 from dumbbell.model.scene import load_scene, scene_from_dict
-from dumbbell.solvers import simulate, solver_module
+from dumbbell.solvers import simulate, solver_class
 from tests.conftest import SCENES, make_scene
 
 G = 9.8
@@ -170,7 +170,7 @@ def test_reference_energy_and_limits(tilted):
     E = ref["E"]
     assert np.max(np.abs(E - E[0])) / E[0] < 1e-9
     assert "estimated_error" in ref.info
-    assert "friction" in solver_module("reference").supports(
+    assert "friction" in solver_class("reference").supports(
         load_scene(SCENES / "friction-2d.toml"))
 
 
@@ -224,7 +224,7 @@ def test_euler_cromer_2d_differs_from_the_textbook_order_by_the_velocity_lag(til
 
 
 def test_euler_cromer_2d_says_what_it_cannot_run(rigid, friction, textbook):
-    module = solver_module("euler-cromer-2d")
+    module = solver_class("euler-cromer-2d")
     assert "rigid" in module.supports(rigid)
     assert "friction" in module.supports(friction)
     assert "1D" in module.supports(textbook)

@@ -10,7 +10,7 @@ import pytest
 from scipy.optimize import brentq
 
 from dumbbell.model.scene import load_scene, scene_from_dict
-from dumbbell.solvers import simulate, solver_module
+from dumbbell.solvers import simulate, solver_class
 from dumbbell.solvers.exact_rigid import first_impact_state
 
 from .conftest import SCENES
@@ -185,7 +185,7 @@ def test_flat_landing_hits_both_ends_at_once():
 
 
 def test_exact_runs_rigid_scenes_only_without_friction(rigid):
-    exact = solver_module("exact")
+    exact = solver_class("exact")
     assert exact.supports(rigid) is None
     assert "friction" in exact.supports(rigid.with_values({"floor.friction": 0.5}))
     spring = load_scene(SCENES / "tilted-2d.toml")

@@ -150,12 +150,12 @@ def test_restitution_command_writes_csv(tmp_path):
 
 
 def test_truth_solvers_decline_resting_contact(topple_scene):
-    from dumbbell.solvers import solver_module
+    from dumbbell.solvers import solver_class
 
-    assert "resting contact" in solver_module("reference").supports(topple_scene)
-    assert solver_module("pymunk").supports(topple_scene) is None
+    assert "resting contact" in solver_class("reference").supports(topple_scene)
+    assert solver_class("pymunk").supports(topple_scene) is None
     # The same dumbbell a millimetre above the floor is an ordinary drop.
-    assert solver_module("reference").supports(
+    assert solver_class("reference").supports(
         topple_scene.with_values({"bodies.B.height": 1e-3})) is None
 
 

@@ -190,13 +190,13 @@ def test_every_solver_ends_a_blow_up_with_a_verdict(solver):
     """Every registered solver, on the stiff case in 1D or 2D (whichever it runs) at
     w*dt = 2.1: a time-stepper stops early with 'unstable', keeping only finite samples up to
     the failure; a solver without a step limit stays ok."""
-    from dumbbell.solvers import solver_module
+    from dumbbell.solvers import solver_class
 
     one_d = _stiff(1.0, 2.1).with_values({"run.t_end": 100 * 2.1e-3})
     raw = copy.deepcopy(one_d.raw)
     del raw["bodies"]["A"]["height"]
     two_d = scene_from_dict({**raw, "dimensions": 2, "tilt": 30.0}, source="stiff-2d.toml")
-    scene = next((s for s in (one_d, two_d) if solver_module(solver).supports(s) is None),
+    scene = next((s for s in (one_d, two_d) if solver_class(solver).supports(s) is None),
                  None)
     if scene is None:
         pytest.skip(f"{solver} runs neither the 1D nor the 2D stiff case")

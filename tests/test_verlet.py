@@ -10,7 +10,7 @@ import pytest
 
 from dumbbell.model.energy import relative_energy_error
 from dumbbell.model.scene import load_scene
-from dumbbell.solvers import REGISTRY, RunOptions, simulate, solver_module, supported
+from dumbbell.solvers import REGISTRY, RunOptions, simulate, solver_class, supported
 from tests.conftest import SCENES, make_scene
 
 #: A heavy A on a soft spring: A reaches the floor too (exact: B, A, B, A, B in [0, 1] s).
@@ -139,7 +139,7 @@ def test_2d_tilted_second_order_against_the_reference():
     errs = {}
     for dt in (1e-3, 1e-4):
         run = simulate(scene, "verlet", dt=dt, t_end=0.8, every=1)
-        truth = solver_module("reference").solve(scene, RunOptions(dt, 0.8),
+        truth = solver_class("reference").solve(scene, RunOptions(dt, 0.8),
                                                  estimate_error=False)
         assert [e.body for e in run.events] == [e.body for e in truth.events] == ["B", "A"]
         errs[dt] = max(np.max(np.hypot(run[f"x{c}"] - truth[f"x{c}"],

@@ -71,7 +71,7 @@ def sweep(scene: Scene | str | Path,
     local processes (None: one per CPU), or a Dask ``scheduler``. ``.to_pandas()`` has one
     row per point: the values, w*dt, the verdict, the time of failure (s) and the largest
     relative energy error."""
-    from ..solvers import solver_module
+    from ..solvers import solver_class
     from .sweep import check_axes, parse_axis, run_sweep
 
     if isinstance(grid, Mapping):
@@ -87,7 +87,7 @@ def sweep(scene: Scene | str | Path,
     check_axes(axes)
     the_scene = _scene(scene)
     solver = solver or the_scene.run.solver
-    solver_module(solver)                      # an unknown name fails before anything runs
+    solver_class(solver)                      # an unknown name fails before anything runs
     return run_sweep(the_scene, axes, solver, t_end, workers, scheduler, quiet)
 
 

@@ -52,7 +52,7 @@ from ..errors import UsageError
 from ..model.energy import energy_scale, relative_energy_error
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from ..solvers import RunOptions, make_options, solver_module, supported
+from ..solvers import RunOptions, Solver, make_options, solver_class, supported, truth_solver
 
 if TYPE_CHECKING:
     import pandas
@@ -78,9 +78,6 @@ FIT_MAX_ERROR = 1e-2
 FIT_MIN_ERROR = 1e-11
 #: The step of the textbook listing (s): the accuracy the README compares against.
 TEXTBOOK_DT = 1e-5
-#: Solvers whose accuracy does not depend on dt (it only sets their sample times): each is
-#: one point, evaluated at samples every ``spacing`` s.
-STEP_FREE = ("exact", "reference")
 
 CSV_COLUMNS = (
     "solver", "dt", "seconds", "error", "seconds_median", "seconds_call", "energy_error",
@@ -210,17 +207,6 @@ def _time_for_error(line: list[tuple[float, float]], target: float) -> float | N
     return min(reached) if reached else None
 
 
-def truth_solver(scene: Scene) -> str | None:
-    """The solver taken as truth: ``exact`` in 1D and for the rigid 2D dumbbell, ``reference``
-    for a 2D spring (None if absent)."""
-    from ..solvers import REGISTRY
-
-    name = "exact" if scene.dimensions == 1 or scene.rigid is not None else "reference"
-    if name not in REGISTRY:
-        return None
-    return name if solver_module(name).supports(scene) is None else None
-
-
 def default_spacing(scene: Scene) -> float:
     """Spacing of the compared samples (s): SAMPLE_SPACING, or 1/SAMPLES_PER_PERIOD of the
     spring's period when that is shorter."""
@@ -239,7 +225,7 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
                   t_end: float, spacing: float = SAMPLE_SPACING) -> None:
     """UsageError naming the flag and what is allowed, before anything runs."""
     for name in solvers:
-        reason = solver_module(name).supports(scene)
+        reason = solver_class(name).supports(scene)
         if reason is not None:
             raise UsageError(f"--solvers {name}: cannot run {scene.source}: {reason}")
     if not solvers:
@@ -289,18 +275,19 @@ def run_bench(
             return None
         key = (options.dt, options.every)
         if key not in truths:
-            truths[key] = solver_module(truth).solve(scene, replace(options, quiet=True),
-                                                     **_no_estimate(truth))
+            truths[key] = solver_class(truth).solve(scene, replace(options, quiet=True),
+                                                    **_no_estimate(solver_class(truth)))
         return truths[key]
 
     points: list[Point] = []
-    steppers = [n for n in solvers if n not in STEP_FREE]
-    single = [n for n in solvers if n in STEP_FREE and n != truth]
+    # A solver without a step is one point: dt only sets its sample times.
+    steppers = [n for n in solvers if solver_class(n).has_step]
+    single = [n for n in solvers if not solver_class(n).has_step and n != truth]
     total = len(steppers) * len(dts) + len(single) + (truth is not None)
     with bar(total, f"bench {scene.name}", "point", quiet=quiet) as pb:
         for name in steppers:
-            module = solver_module(name)
-            compile_s = module.warm_up() if hasattr(module, "warm_up") else math.nan
+            cls = solver_class(name)
+            compile_s = cls.warm_up()
             cost_per_step = None
             for dt in dts:
                 pb.set_postfix_str(f"{name} dt={dt:g}")
@@ -316,7 +303,7 @@ def run_bench(
                     points.append(base)
                     pb.update(1)
                     continue
-                traj, point = _measure(module, scene, options, repeat, base)
+                traj, point = _measure(cls, scene, options, repeat, base)
                 _score(point, traj, truth_at(options), window)
                 points.append(point)
                 if point.ok and point.steps:
@@ -345,22 +332,22 @@ def _every(dt: float, spacing: float) -> int:
     return max(1, round(spacing / dt))
 
 
-def _no_estimate(name: str) -> dict[str, Any]:
-    """Keyword that spares the reference its second, error-estimating run."""
-    return {"estimate_error": False} if name == "reference" else {}
+def _no_estimate(cls: type[Solver]) -> dict[str, Any]:
+    """Keyword that spares a solver that estimates its own error its second run."""
+    return {"estimate_error": False} if cls.estimates_error else {}
 
 
-def _measure(module, scene: Scene, options: RunOptions, repeat: int, point: Point,
+def _measure(cls: type[Solver], scene: Scene, options: RunOptions, repeat: int, point: Point,
              **first: Any) -> tuple[Trajectory, Point]:
     """Warm-up run (kept for the diagnostics; ``first`` are its extra keywords), then
     ``repeat`` timed runs."""
-    traj = module.solve(scene, options, **first)
+    traj = cls.solve(scene, options, **first)
     own, call = [], []
     # Short runs are repeated until MIN_TIMED s are timed (at most MAX_REPEAT runs), so that
     # one busy moment of a shared machine cannot hold all of them.
     while len(own) < repeat or (sum(call) < MIN_TIMED and len(own) < MAX_REPEAT):
         t0 = time.perf_counter()
-        again = module.solve(scene, options, **_no_estimate(module.NAME))
+        again = cls.solve(scene, options, **_no_estimate(cls))
         call.append(time.perf_counter() - t0)
         own.append(again.wall_time if again.wall_time > 0 else call[-1])
     point.seconds = min(own)
@@ -437,22 +424,22 @@ def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: flo
 
 def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: int,
                   truth: str | None, truth_at, spacing: float) -> Point:
-    """A solver without a step (STEP_FREE) as one point: its cost for the bench's samples
+    """A solver without a step as one point: its cost for the bench's samples
     (every ``spacing`` s over t_end) and its error; for the truth itself, against a tighter
     evaluation (exact: extended precision) or its own estimate (reference)."""
-    module = solver_module(name)
+    cls = solver_class(name)
     options = make_options(scene, dt=spacing, t_end=t_end, every=1)
     is_truth = name == truth
     base = Point(name, None, window=window, t_end=t_end, truth="self" if is_truth else truth
                  or "", steps=0, every=1,
-                 compile_seconds=module.warm_up() if hasattr(module, "warm_up") else math.nan)
-    first = {} if is_truth or name != "reference" else _no_estimate(name)
-    traj, point = _measure(module, scene, options, repeat, base, **first)
+                 compile_seconds=cls.warm_up())
+    first = {} if is_truth else _no_estimate(cls)
+    traj, point = _measure(cls, scene, options, repeat, base, **first)
     if not is_truth:
         _score(point, traj, truth_at(options) if truth_at else None, window)
         return point
     point.energy_error = energy_error(traj, None)
-    if name == "exact":
+    if not cls.estimates_error:
         check = extended_precision_rigid if scene.rigid is not None else extended_precision_exact
         point.error, point.impact_time_error = check(traj, window)
         point.reason = "errors against the same closed form in extended precision"
@@ -770,10 +757,11 @@ def work_precision_figure(result: BenchResult, path: Path) -> Path:
         pts = [p for p in result.points if p.solver == name and p.ran]
         good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
         bad = [p for p in pts if not math.isfinite(p.error)]
-        single = name in STEP_FREE
+        single = not solver_class(name).has_step
         label = name
         if name == result.truth:
-            label += (" (truth; error vs extended precision)" if name == "exact"
+            label += (" (truth; error vs extended precision)"
+                      if not solver_class(name).estimates_error
                       else " (truth; its own error estimate"
                       + (f" over [0, {good[0].window:g} s])" if good else ")"))
         elif single:
@@ -853,7 +841,8 @@ def convergence_figure(result: BenchResult, path: Path) -> Path:
 
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7.2, 5.0), dpi=100)
-    names = [n for n in dict.fromkeys(p.solver for p in result.points) if n not in STEP_FREE]
+    names = [n for n in dict.fromkeys(p.solver for p in result.points)
+             if solver_class(n).has_step]
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
     top = max(finite) * 8 if finite else 1.0
     for i, name in enumerate(names):

@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
+from ..solvers import no_truth_reason, solver_class, truth_solver
 
 if TYPE_CHECKING:
     import pandas
@@ -99,7 +100,7 @@ class Comparison:
             steps = r.info.get("steps")
             out.append({
                 "label": r.solver if row is None else row.label, "solver": r.solver,
-                "dt": r.dt if r.dt and r.solver not in ("exact", "reference") else None,
+                "dt": r.dt if r.dt and solver_class(r.solver).has_step else None,
                 "wall_time": r.wall_time,
                 "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
@@ -184,21 +185,10 @@ class Comparison:
         return lines
 
 
-def truth_solver(scene: Scene) -> str | None:
-    """The most accurate solver for ``scene``: exact (1D, and the rigid 2D dumbbell),
-    reference (2D spring, frictionless), or None when there is none (friction)."""
-    from ..solvers import solver_module
-
-    name = "exact" if scene.dimensions == 1 or scene.rigid is not None else "reference"
-    return name if solver_module(name).supports(scene) is None else None
-
-
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
-    from ..solvers import solver_module
-
     names = ["pymunk", "euler-cromer" if scene.dimensions == 1 else "euler-cromer-2d"]
-    return [n for n in names if solver_module(n).supports(scene) is None]
+    return [n for n in names if solver_class(n).supports(scene) is None]
 
 
 def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | None = None,
@@ -207,13 +197,13 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
     """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
-    from ..solvers import make_options, simulate, solver_module
+    from ..solvers import make_options, simulate
 
     solvers = solvers or default_solvers(scene)
     dts = dts or [scene.run.dt]
     t_end = scene.run.t_end if t_end is None else t_end
     for name in solvers:
-        reason = solver_module(name).supports(scene)
+        reason = solver_class(name).supports(scene)
         if reason is not None:
             raise UsageError(f"--solvers: {name!r} cannot run {scene.source}: {reason}")
     if not (window > 0 and math.isfinite(window)):
@@ -232,8 +222,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
         truth_dt = min(dts) / 10
         truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
                          every=round(spacing / truth_dt), quiet=quiet)
-        why = solver_module("exact" if scene.dimensions == 1 or scene.rigid is not None
-                            else "reference").supports(scene)
+        why = no_truth_reason(scene)
         truth_note = (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: {why}; "
                       "so errors are against a ten times smaller step)")
     else:

@@ -175,14 +175,11 @@ def drop_duration(scene: Scene) -> float:
 
 def truth_for(scene: Scene) -> str:
     """The name of the most exact solver that runs ``scene`` (rigid or spring, 2D)."""
-    from ..solvers import solver_module
+    from ..solvers import METHODS
 
-    for name in ("exact", "reference"):
-        try:
-            if solver_module(name).supports(scene) is None:
-                return name
-        except (KeyError, ValueError, UsageError):
-            continue
+    for name, cls in METHODS.items():
+        if cls.is_truth and cls.supports(scene) is None:
+            return name
     raise UsageError(f"{scene.source}: no truth solver runs this scene")
 
 

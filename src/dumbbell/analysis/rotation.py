@@ -83,7 +83,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
            stiffnesses: tuple[float, ...] = STIFFNESSES) -> Series:
     """Run every variant of ``scene`` with ``solver`` at step ``dt`` (s) up to ``t_end`` (s).
     The step is cut where needed to keep w*dt <= 0.05 for the stiffest spring."""
-    from ..solvers import simulate, solver_module
+    from ..solvers import simulate, solver_class
 
     scenes = variants(scene, stiffnesses)
     w_max = max(s.omega for s in scenes.values())
@@ -92,7 +92,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
     every = max(1, round(SAMPLE / dt))
     runs = {}
     for label, s in scenes.items():
-        name = solver if solver_module(solver).supports(s) is None else "pymunk"
+        name = solver if solver_class(solver).supports(s) is None else "pymunk"
         runs[label] = simulate(s, name, dt=dt, t_end=t_end, every=every)
     return Series(runs, solver, dt)
 

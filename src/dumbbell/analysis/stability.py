@@ -11,8 +11,11 @@ Theory (docs/physics.md: the stability limit, how pymunk collides), which :func:
   step at impact than the floor's box is thick plus its own diameter passes through it;
 - on an inelastic floor a bouncing point mass comes to rest after
   sqrt(2 h/g) (1 + e)/(1 - e), after infinitely many impacts: solvers that model impacts as
-  velocity flips (exact, Euler-Cromer, Verlet) must stop there with ``failed``; pymunk and the
-  reference solver hold resting contact.
+  velocity flips (exact, Euler-Cromer, Verlet, the reference) must stop there with
+  ``failed``; pymunk holds resting contact.
+
+Which rule applies to a solver is its own declaration (``explicit_spring``, ``flip_floor``,
+``catch_depth`` on its class in :mod:`dumbbell.solvers`), not a list here.
 
 The stability map runs a grid over (w*dt, mass ratio) for each time-stepping solver with no
 floor and no gravity, so only the spring's limit counts.
@@ -38,10 +41,6 @@ from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 if TYPE_CHECKING:
     import pandas
 
-#: Solvers whose spring is an explicit step, stable iff w*dt < 2.
-STEPPERS = ("euler-cromer", "verlet", "pymunk", "euler-cromer-2d")
-#: Solvers whose floor is a velocity flip, which cannot hold a particle at rest.
-FLIP_FLOORS = ("exact", "euler-cromer", "verlet", "euler-cromer-2d")
 #: Report columns, in CSV order.
 COLUMNS = ("case", "title", "solver", "dt", "w_dt", "verdict", "t_fail",
            "max_rel_energy_error", "dissipative", "predicted", "agreement", "reason", "theory",
@@ -117,14 +116,12 @@ def find_cases(folder: str | Path) -> list[Path]:
 
 
 def default_solvers(scene: Scene) -> list[str]:
-    """Solvers run on a case by default: all that can run it, but not the slow 2D reference
-    on 1D scenes, whose reference is the exact solution."""
-    from ..solvers import supported
+    """Solvers run on a case by default: all that can run it, but of the truth solvers only
+    the scene's own (the exact solution in 1D, not the slow reference)."""
+    from ..solvers import METHODS, supported, truth_solver
 
-    names = supported(scene)
-    if scene.dimensions == 1:
-        names = [n for n in names if n != "reference"]
-    return names
+    truth = truth_solver(scene)
+    return [n for n in supported(scene) if not METHODS[n].is_truth or n == truth]
 
 
 def _impact_speed(scene: Scene) -> float:
@@ -146,37 +143,27 @@ def rest_time(scene: Scene) -> float:
     return t1 + 2.0 * e * v1 / (scene.g * (1.0 - e))
 
 
-def pymunk_floor_thickness() -> float:
-    """Thickness (m) of the box pymunk's floor is made of: a circle must cross it and its own
-    diameter in one step to pass through whatever the phase (0 if the solver is missing)."""
-    import importlib
-
-    try:
-        engine = importlib.import_module("dumbbell.solvers.engine")
-    except ImportError:
-        return 0.0
-    return float(getattr(engine, "_FLOOR_THICKNESS", 0.0))
-
-
 def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     """The verdict theory expects for ``scene`` run by ``solver`` at step ``dt`` up to
     ``t_end`` (s); see the module docstring."""
+    from ..solvers import solver_class
+
+    cls = solver_class(solver)
     w_dt = scene.omega * dt
-    if solver in STEPPERS and scene.spring is not None and w_dt >= 2.0:
+    if cls.explicit_spring and scene.spring is not None and w_dt >= 2.0:
         return Prediction("unstable", f"w*dt = {w_dt:.2f} >= 2")
-    if solver == "pymunk" and scene.floor is not None and scene.g > 0:
+    reach = cls.catch_depth(scene)
+    if reach is not None and scene.floor is not None and scene.g > 0:
         v = _impact_speed(scene)
-        r = min(scene.A.radius, scene.B.radius)
-        reach = 2.0 * r + pymunk_floor_thickness()
         if v * dt > reach:
             return Prediction("tunnelled", f"moves {v * dt:.3g} m per step at impact "
                                            f"({v:.3g} m/s), more than the floor box and a "
                                            f"diameter, {reach:.3g} m")
     t_rest = rest_time(scene)
-    if solver in FLIP_FLOORS and t_rest < t_end:
+    if cls.flip_floor and t_rest < t_end:
         return Prediction("failed", f"a point mass comes to rest at {t_rest:.2f} s "
                                     f"< t_end = {t_end:g} s")
-    if scene.spring is not None and solver in STEPPERS:
+    if scene.spring is not None and cls.explicit_spring:
         return Prediction("ok", f"w*dt = {w_dt:.2g} < 2")
     return Prediction("ok", "no step limit applies")
 
@@ -204,16 +191,16 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
                                                                         list[str]]:
     """The (case, solver) runs to make, every scene validated first, and the pairs skipped
     (with why). ``solvers`` None means :func:`default_solvers` per case."""
-    from ..solvers import solver_module
+    from ..solvers import solver_class
 
     for name in solvers or ():
-        solver_module(name)
+        solver_class(name)
     runs, skipped = [], []
     for path in paths:
         scene = load_scene(path)
         names = default_solvers(scene) if solvers is None else solvers
         for name in names:
-            reason = solver_module(name).supports(scene)
+            reason = solver_class(name).supports(scene)
             if reason is None:
                 runs.append((str(path), name))
             else:
@@ -266,7 +253,9 @@ def _cost(path: str, solver: str) -> float:
     """A rough cost of one run: its steps, weighted by how slow the solver's step is."""
     scene = load_scene(path)
     steps = scene.run.t_end / scene.run.dt
-    return steps * {"pymunk": 30.0, "reference": 100.0, "exact": 0.01}.get(solver, 1.0)
+    from ..solvers import solver_class
+
+    return steps * solver_class(solver).relative_cost
 
 
 def _fmt(value: Any, kind: str = "") -> str:
@@ -441,11 +430,12 @@ def draw_stability_map(path: str | Path, maps: dict[str, list[dict[str, Any]]]) 
 def map_solvers(solvers: list[str] | None) -> list[str]:
     """The time-stepping solvers a map is drawn for: those asked for (all by default) that
     can run the 1D map scene."""
-    from ..solvers import available, solver_module
+    from ..solvers import available, solver_class
 
     names = available() if solvers is None else solvers
     scene = map_scene()
-    return [n for n in names if n in STEPPERS and solver_module(n).supports(scene) is None]
+    return [n for n in names
+            if solver_class(n).explicit_spring and solver_class(n).supports(scene) is None]
 
 
 def run_stability(cases: str | Path | None = None, solvers: list[str] | None = None,

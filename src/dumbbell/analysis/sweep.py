@@ -170,10 +170,10 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
     """Every grid point, validated as a scene and as a bounded run before anything runs.
 
     ``t_end`` (s) overrides the scene's ``run.t_end``. Raises UsageError naming the axis."""
-    from ..solvers import make_options, solver_module
+    from ..solvers import make_options, solver_class
 
     check_axes(axes)
-    module = solver_module(solver)
+    cls = solver_class(solver)
     fixed = {"run.t_end": t_end} if t_end is not None else {}
     points, total = [], 0
     for index, combo in enumerate(itertools.product(*(a.values for a in axes))):
@@ -183,7 +183,7 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
             point_scene = scene.with_values(values)
         except DumbbellError as exc:
             raise UsageError(f"--grid at {where}: {exc}") from None
-        reason = module.supports(point_scene)
+        reason = cls.supports(point_scene)
         if reason is not None:
             raise UsageError(f"--grid at {where}: solver {solver!r} cannot run it: {reason}")
         try:
@@ -236,11 +236,9 @@ def _evaluate_batch(scene: Scene, batch: list[Point], solver: str
 
 def _warm_up(solver: str) -> None:
     """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
-    from ..solvers import solver_module
+    from ..solvers import solver_class
 
-    warm = getattr(solver_module(solver), "warm_up", None)
-    if callable(warm):
-        warm()
+    solver_class(solver).warm_up()
 
 
 def _batches(points: list[Point], workers: int) -> list[list[Point]]:

@@ -47,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
     from ..model.scene import load_scene
-    from ..solvers import solver_module
+    from ..solvers import solver_class
 
     scene = load_scene(args.scene)
     axes = [parse_axis(text) for text in args.grid]
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         if not axis.numeric:
             raise UsageError(f"--grid {axis.text!r}: a map needs numbers; list numbers only")
     solver = args.solver or scene.run.solver
-    solver_module(solver)
+    solver_class(solver)
     if args.scheduler is not None:
         address = args.scheduler.strip()
         if address != "local" and "://" not in address:

@@ -106,7 +106,10 @@ def _finish(fig: Any, axes: list[Any], traj: Trajectory, window: float, path: Pa
         ax.set_xlim(0, window)
         ax.grid(True, color="0.9", lw=0.6)
     _mark_first_impact(axes, traj, window, text=True)
-    dt = f", dt = {traj.dt:g} s" if traj.dt and traj.solver != "exact" else ""
+    from ..solvers import solver_class
+
+    # A solver without a step takes dt only as the sample spacing: not worth a title.
+    dt = f", dt = {traj.dt:g} s" if traj.dt and solver_class(traj.solver).has_step else ""
     fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
     fig.tight_layout()
     with atomic_output(path) as tmp:

@@ -54,7 +54,7 @@ import numpy as np
 from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from .base import RunOptions, Solver
 from .stepping import blowup_verdict
 from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
 
@@ -342,3 +342,24 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         verdict = blowup_verdict(traj, verdict.t, dt)
     traj.verdict = verdict if verdict is not None else energy_verdict(traj, dt)
     return traj
+
+
+class Pymunk(Solver):
+    """The pymunk (Chipmunk) engine (see the module docstring)."""
+
+    name = NAME
+    order = 1
+    has_step = True
+    explicit_spring = True
+    flip_floor = False
+    relative_cost = 30.0
+    is_truth = False
+    estimates_error = False
+    supports = staticmethod(supports)
+    solve = staticmethod(solve)
+
+    @staticmethod
+    def catch_depth(scene: Scene) -> float:
+        """How far (m) a circle may travel in one step and still be caught by the floor: the
+        floor box's thickness plus the smaller circle's diameter."""
+        return 2.0 * min(scene.A.radius, scene.B.radius) + _FLOOR_THICKNESS

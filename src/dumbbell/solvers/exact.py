@@ -21,11 +21,10 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from .base import RunOptions, Solver
 from .verdicts import truth_verdict
 
 NAME = "exact"
@@ -127,6 +126,8 @@ def _earliest_possible(motion: _Motion, seg: Segment, body: str) -> float:
 
 def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: float) -> float:
     """First time in (start, stop] at which ``body`` crosses the floor going down, or inf."""
+    from scipy.optimize import brentq  # scipy loads only when the exact solver runs
+
     S = motion.amplitude(seg)
     c = motion.cB if body == "B" else motion.cA
     C = motion.g + (c * motion.w**2 * S if motion.w > 0 else 0.0)
@@ -271,3 +272,24 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     )
     traj.verdict = truth_verdict(traj, verdict)
     return traj
+
+
+class Exact(Solver):
+    """The closed-form 1D solution with impacts found by root search (see the module
+    docstring)."""
+
+    name = NAME
+    order = None
+    has_step = False
+    explicit_spring = False
+    flip_floor = True
+    relative_cost = 0.01
+    is_truth = True
+    estimates_error = False
+    supports = staticmethod(supports)
+    solve = staticmethod(solve)
+
+    @staticmethod
+    def truth_for(scene: Scene) -> bool:
+        """The truth for 1D scenes and the rigid 2D dumbbell."""
+        return scene.dimensions == 1 or scene.rigid is not None

@@ -48,7 +48,7 @@ import numpy as np
 from ..model.energy import relative_energy_error, rigid_moment, spins, state_columns
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from . import RunOptions
+from .base import RunOptions, Solver
 from .verdicts import truth_verdict
 
 NAME = "reference"
@@ -313,3 +313,23 @@ def _estimate_error(traj: Trajectory) -> dict[str, float]:
     if early:
         est["impact_time_s_window"] = float(max(abs(a.t - b.t) for a, b in early))
     return est
+
+
+class Reference(Solver):
+    """scipy's DOP853 at tight tolerance with impacts as events (see the module docstring)."""
+
+    name = NAME
+    order = None
+    has_step = False
+    explicit_spring = False
+    flip_floor = True
+    relative_cost = 100.0
+    is_truth = True
+    estimates_error = True
+    supports = staticmethod(supports)
+    solve = staticmethod(solve)
+
+    @staticmethod
+    def truth_for(scene: Scene) -> bool:
+        """The truth for the 2D spring dumbbell."""
+        return scene.dimensions == 2 and scene.rigid is None

@@ -1,11 +1,9 @@
 """The driver the compiled time-steppers share (euler-cromer, euler-cromer-2d, verlet).
 
-Each has a numba kernel ``kernel(st, i, i_stop, dt, *params, every, out, ev)`` that advances the
-state ``st`` in place from step ``i`` towards ``i_stop``, writes every ``every``-th step into
-``out``, records impacts as rows ``(time or step, body 0/1, v_before, v_after)`` of ``ev``, and
-returns ``(step reached, status, impacts recorded)``. It stops early on a bad status or when
-``ev`` is nearly full; :func:`run_kernel` calls it chunk by chunk, which is also what moves the
-progress bar.
+Each has a numba kernel (contract in :mod:`dumbbell.solvers.kernels`). It stops early on a bad
+status or when its impact buffer is nearly full; :func:`run_kernel` calls it chunk by chunk,
+which is also what moves the progress bar, and :func:`kernel_verdict` is the one mapping
+from the status it ended with to a verdict.
 """
 
 from __future__ import annotations
@@ -18,15 +16,9 @@ import numpy as np
 
 from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
-from . import RunOptions
+from .base import RunOptions
+from .kernels import BIG, BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B
 from .verdicts import energy_verdict, keep_samples, nonfinite_reason
-
-#: A state component beyond this magnitude (m or m/s) counts as blown up.
-BIG = 1e150
-#: Impacts recorded per kernel call before it hands back to Python.
-EVENT_BUFFER = 4096
-#: Kernel status codes.
-OK, BLOWUP, TUNNEL_A, TUNNEL_B, REST = 0, 1, 2, 3, 4
 
 
 @dataclass
@@ -80,3 +72,20 @@ def blowup_verdict(traj: Trajectory, t_overflow: float, dt: float) -> Verdict:
     if verdict.ok:
         verdict = Verdict("unstable", t_overflow, nonfinite_reason(traj.scene, dt))
     return verdict
+
+
+def kernel_verdict(
+    traj: Trajectory, run: KernelRun, dt: float,
+    below_floor: Callable[[str], Verdict],
+    at_rest: Callable[[], Verdict] | None = None,
+) -> Verdict:
+    """The verdict of a kernel run that ended with ``run.status``: blown up (:func:`blowup_verdict`),
+    a particle below the floor (``below_floor("A" or "B")``, the solver's own diagnosis),
+    at rest on the floor (``at_rest()``), else the energy check. ``dt`` is the step (s)."""
+    if run.status == BLOWUP:
+        return blowup_verdict(traj, run.steps * dt, dt)
+    if run.status in (TUNNEL_A, TUNNEL_B):
+        return below_floor("A" if run.status == TUNNEL_A else "B")
+    if run.status == REST and at_rest is not None:
+        return at_rest()
+    return energy_verdict(traj, dt)
