@@ -42,7 +42,7 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
     from dumbbell.animation.render import _frames, sample_every
     from dumbbell.model.energy import energy_columns
     from dumbbell.model.scene import load_scene
-    from dumbbell.plot.figures import COLOURS
+    from dumbbell.plot.style import COLOURS
     from dumbbell.solvers import simulate
 
     scene = load_scene(scene_path)

@@ -254,8 +254,8 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
 
 
 def write(result: Comparison, out: Path) -> list[Path]:
-    """Write the summary CSV, the impacts CSV, the error series CSV and three PNG figures
-    into ``out``; returns the paths."""
+    """Write the summary CSV, the impacts CSV and the error series CSV into ``out``; returns
+    the paths. (The figures are :mod:`dumbbell.plot`'s; the command saves them.)"""
     from ..io.files import atomic_output
 
     stem = result.scene.name
@@ -290,98 +290,4 @@ def write(result: Comparison, out: Path) -> list[Path]:
                    header=",".join(["t"] + [f"{row.label}_position_error_m"
                                             for row in result.rows]))
     paths.append(errors)
-    paths += figures(result, out)
-    return paths
-
-
-_STYLES = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"]
-#: Line styles by row: runs that agree to rounding (pymunk and euler-cromer-2d) stay visible.
-_DASHES = ["-", (0, (4, 3)), (0, (1, 2)), "-.", "-", (0, (4, 3)), (0, (1, 2))]
-
-
-def figures(result: Comparison, out: Path) -> list[Path]:
-    """Positions overlaid, position error against time (log), and E(t) per solver (PNG)."""
-    from ..io.files import atomic_output
-    from ..plot.figures import _pyplot
-
-    plt = _pyplot()
-    scene = result.scene
-    stem = scene.name
-    key = "x" if scene.dimensions == 1 else "y"
-    truth = result.truth
-    shown = min(float(truth.t[-1]), 2.0 * result.window)
-    paths = []
-
-    def save(fig, name: str) -> Path:
-        fig.tight_layout()
-        path = out / f"{stem}-compare-{name}.png"
-        with atomic_output(path) as tmp:
-            fig.savefig(tmp, dpi=110)
-        plt.close(fig)
-        return path
-
-    fig, axes = plt.subplots(2, 1, figsize=(10, 6.4), sharex=True)
-    for ax, body in zip(axes, "AB", strict=True):
-        m = truth.t <= shown + 1e-12
-        ax.plot(truth.t[m], truth[f"{key}{body}"][m], color="black", lw=2.4, alpha=0.35,
-                label=f"{truth.solver} (truth)")
-        for colour, row in zip(_STYLES, result.rows, strict=False):
-            r = row.traj
-            mm = r.t <= shown + 1e-12
-            ax.plot(r.t[mm], r[f"{key}{body}"][mm], color=colour, lw=1.1, label=row.label,
-                    ls=_DASHES[result.rows.index(row) % len(_DASHES)])
-        ax.axvspan(result.window, max(shown, result.window), color="0.93", zorder=0)
-        ax.set_ylabel(f"{key}_{body} [m]")
-        ax.set_title(f"particle {body} ({'top' if body == 'A' else 'bottom'})", fontsize=9)
-        ax.grid(True, color="0.9", lw=0.6)
-        ax.legend(loc="upper right", fontsize=8)
-    axes[0].text(result.window, 1.0, "  after the window: the runs part (chaos)",
-                 transform=axes[0].get_xaxis_transform(), va="top", fontsize=8, color="0.4")
-    axes[-1].set_xlabel("t [s]")
-    axes[-1].set_xlim(0, shown)
-    fig.suptitle(f"{scene.title}: heights, each solver over the truth", fontsize=10)
-    paths.append(save(fig, "positions"))
-
-    fig, ax = plt.subplots(figsize=(10, 4.6))
-    for colour, row in zip(_STYLES, result.rows, strict=False):
-        t = row.traj.t[: len(row.error)]
-        ax.semilogy(t, np.maximum(row.error, 1e-17), color=colour, lw=1.1,
-                    ls=_DASHES[result.rows.index(row) % len(_DASHES)],
-                    label=f"{row.label}: {row.window_error:.2g} m max in [0, {result.window:g}] s")
-    ax.axvline(result.window, color="0.4", ls="--", lw=0.8)
-    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8)
-    ax.text(0.002, DIVERGED, " 1 mm", va="bottom", fontsize=8, color="0.4",
-            transform=ax.get_yaxis_transform())
-    for ev in truth.events:
-        ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0)
-    positive = np.concatenate([row.error[row.error > 0] for row in result.rows] or [[1.0]])
-    if positive.size:
-        ax.set_ylim(bottom=max(1e-16, float(np.percentile(positive, 1)) / 10))
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("largest |position error| [m]")
-    ax.set_xlim(0, float(truth.t[-1]))
-    ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"{scene.title}: position error against {truth.solver} (grey lines: its "
-                 f"impacts; dashed: the {result.window:g} s window)", fontsize=9)
-    paths.append(save(fig, "error"))
-
-    fig, ax = plt.subplots(figsize=(10, 4.6))
-    E0 = float(truth["E"][0]) or 1.0
-    for colour, row in zip(_STYLES, result.rows, strict=False):
-        r = row.traj
-        ax.plot(r.t, r["E"] / E0 - 1.0, color=colour, lw=1.0,
-                ls=_DASHES[result.rows.index(row) % len(_DASHES)],
-                label=f"{row.label}: spread {row.spread:.2e}")
-    ax.plot(truth.t, truth["E"] / E0 - 1.0, color="black", lw=1.2,
-            label=f"{truth.solver}: spread {energy_spread(truth):.1e}")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("E(t) / E(0) - 1")
-    ax.set_xlim(0, float(truth.t[-1]))
-    ax.grid(True, color="0.9", lw=0.6)
-    ax.legend(loc="lower left", fontsize=8)
-    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
-                 fontsize=9)
-    paths.append(save(fig, "energy"))
     return paths

@@ -2,7 +2,7 @@
 
 :func:`variants` builds, from one 2D scene, the spring dumbbell at each stiffness and the rigid
 dumbbell of the same masses, tilt and length; :func:`series` runs them;
-:func:`rotation_figure` draws K_rot(t) of each.
+:func:`dumbbell.plot.rotation` draws K_rot(t) of each.
 
 What the figure shows (measured, tilted-2d): between impacts the spring dumbbell turns more and
 more like a rigid body as k grows (the ripple of K_rot, caused by the axis stretching, shrinks
@@ -25,7 +25,6 @@ from __future__ import annotations
 import copy
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -70,13 +69,15 @@ def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict
     return out
 
 
-@dataclass
+@dataclass(frozen=True)
 class Series:
-    """The runs of the preview: label -> trajectory, and the solver and step used."""
+    """The runs of the preview: label -> trajectory, the solver and step (s) used, and the
+    scene they were built from."""
 
     runs: dict[str, Trajectory]
     solver: str
     dt: float
+    scene: Scene
 
 
 def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float = 2.0,
@@ -94,7 +95,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
     for label, s in scenes.items():
         name = solver if solver_class(solver).supports(s) is None else "pymunk"
         runs[label] = simulate(s, name, dt=dt, t_end=t_end, every=every)
-    return Series(runs, solver, dt)
+    return Series(runs, solver, dt, scene)
 
 
 def mean_after_first_cluster(traj: Trajectory, name: str, gap: float = CLUSTER_GAP
@@ -115,69 +116,8 @@ def mean_after_first_cluster(traj: Trajectory, name: str, gap: float = CLUSTER_G
     return (float(np.mean(traj[name][m])) if m.any() else math.nan), start, end
 
 
-def rotation_figure(traj: Trajectory, path: str | Path, window: float = 2.0) -> Path:
-    """Draw the preview for ``traj``'s scene (2D) as PNG; returns the path."""
-    from ..io.files import atomic_output
-    from ..plot.figures import COLOURS, _pyplot
-
-    solver = traj.solver
+def preview(traj: Trajectory, window: float = 2.0) -> Series:
+    """The runs of the rotation preview for ``traj``'s scene (2D): its solver, its step (the
+    scene's without one) and ``window`` s."""
     dt = traj.dt if traj.dt else traj.scene.run.dt
-    s = series(traj.scene, solver=solver, dt=dt, t_end=window)
-    plt = _pyplot()
-    labels = list(s.runs)
-    fig, axes = plt.subplots(len(labels), 1, figsize=(10, 2.1 * len(labels) + 1.2),
-                             sharex=True, sharey=True)
-    rigid = s.runs["rigid"]
-    rigid_mean = mean_after_first_cluster(rigid, "K_rot")[0]
-    top = max(float(np.max(r["K_rot"])) for r in s.runs.values())
-    top = max(top, max(float(np.max(r["K_vib"] + r.energy.get("U_spring", 0.0)))
-                       for r in s.runs.values()))
-    for ax, label in zip(axes, labels, strict=True):
-        r = s.runs[label]
-        if label != "rigid":
-            e_vib = r["K_vib"] + r["U_spring"]
-            ax.fill_between(r.t, 0, e_vib, color=COLOURS["K_vib"], alpha=0.15, lw=0,
-                            label="K_vib + U_spring, vibration")
-            ax.plot(rigid.t, rigid["K_rot"], color="black", lw=1.0, ls="--",
-                    label="K_rot of the rigid dumbbell")
-            ax.plot(r.t, r["K_rot"], color=COLOURS["K_rot"], lw=0.9,
-                    label=f"K_rot, spring dumbbell, {label}")
-            mean, a, b = mean_after_first_cluster(r, "K_rot")
-            if math.isfinite(mean):
-                ax.hlines(mean, a, b, colors=COLOURS["K_rot"], linestyles=(0, (1, 1)), lw=2.2,
-                          label="its mean after the first impacts")
-            note = (f"{label}: w = {r.scene.omega:.0f} rad/s\n"
-                    f"mean K_rot after the first impacts ({a:.2f}-{b:.2f} s): {mean:.2f} J\n"
-                    f"(rigid dumbbell after its 1st impact: {rigid_mean:.2f} J)")
-        else:
-            I = rigid.info.get("moment", r.scene.mu * r.scene.rigid.length**2)
-            ax.plot(r.t, r["K_rot"], color="black", lw=1.2,
-                    label="K_rot = 1/2 mu |w x u|^2 (partition)")
-            half = slice(None, None, max(1, len(r.t) // 120))
-            ax.plot(r.t[half], 0.5 * I * r.state["omega"][half] ** 2, "o", ms=3, mfc="none",
-                    color=COLOURS["K_rot"], label="1/2 I w^2, I = mu L^2 (body's spin)")
-            ax.plot(r.t, r["K_cm"], color=COLOURS["K_cm"], lw=0.8, alpha=0.7, label="K_cm")
-            note = (f"rigid dumbbell (one body): I = {I:.3g} kg m^2\n"
-                    f"mean K_rot after its 1st impact: {rigid_mean:.2f} J")
-        ax.text(0.01, 0.95, note, transform=ax.transAxes, va="top", fontsize=8,
-                bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9})
-        ax.set_ylabel("E [J]")
-        ax.set_ylim(0, top * 1.25)
-        ax.grid(True, color="0.9", lw=0.6)
-        ax.legend(loc="upper right", fontsize=7.5, framealpha=0.9)
-    axes[-1].set_xlabel("t [s]")
-    axes[-1].set_xlim(0, float(rigid.t[-1]))
-    fig.suptitle(
-        f"{traj.scene.title}: rotation preview ({s.runs[labels[0]].solver}, dt = {s.dt:g} s)\n"
-        "Between impacts a stiffer spring dumbbell turns more like a rigid body (flatter "
-        "K_rot), but the floor pushes\nONE particle at a time, quicker than any spring: the "
-        "first impacts leave far less rotation than the rigid body gets,\nand stiffer springs "
-        "do not approach it: what the second particle's landing leaves depends on the "
-        "vibration's phase",
-        fontsize=9.5)
-    fig.tight_layout()
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    return path
+    return series(traj.scene, solver=traj.solver, dt=dt, t_end=window)

@@ -32,10 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from ..errors import UsageError
-from ..io.files import atomic_output
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 
 if TYPE_CHECKING:
@@ -392,41 +389,6 @@ def map_rows(solver: str, workers: int | None = None, quiet: bool = True
     return [by_index[p.index] for p in points]
 
 
-def draw_stability_map(path: str | Path, maps: dict[str, list[dict[str, Any]]]) -> Path:
-    """One panel per solver: log10 of the largest relative energy error over
-    (w*dt, mass ratio), blow-ups marked, and the line w*dt = 2."""
-    from ..plot.figures import _pyplot
-    from .sweep import Axis, draw_map
-
-    plt = _pyplot()
-    n = len(maps)
-    fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
-    x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
-    y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
-    errs = [r["max_rel_energy_error"] for rows in maps.values() for r in rows
-            if r["verdict"] == "ok" and r["max_rel_energy_error"] > 0]
-    lo = math.floor(math.log10(min(errs))) if errs else -16
-    hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
-    mesh = None
-    for ax, (solver, rows) in zip(axes[0], maps.items(), strict=True):
-        wdt = np.array([[r["w_dt"] for r in rows[i::len(MAP_RATIOS)]]
-                        for i in range(len(MAP_RATIOS))], float)
-        mesh = draw_map(fig, ax, x_axis, y_axis, rows, solver,
-                        x_label="w*dt  (w = sqrt(k/mu))", y_label="mass ratio mB/mA",
-                        wdt=wdt, limits=(lo, hi), colorbar=False)
-    fig.subplots_adjust(left=0.055, right=0.9, bottom=0.25, top=0.86, wspace=0.25)
-    cax = fig.add_axes((0.92, 0.25, 0.013, 0.61))
-    cbar = fig.colorbar(mesh, cax=cax)
-    cbar.set_label("log10 of the largest relative energy error")
-    fig.suptitle(f"Stability of the explicit spring step: {MAP_STEPS} steps per run, no floor, "
-                 f"no gravity; 'unstable' = non-finite or energy error > {MAP_UNSTABLE_ENERGY:g}",
-                 fontsize=10)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=90)
-    plt.close(fig)
-    return Path(path)
-
-
 def map_solvers(solvers: list[str] | None) -> list[str]:
     """The time-stepping solvers a map is drawn for: those asked for (all by default) that
     can run the 1D map scene."""
@@ -443,12 +405,12 @@ def run_stability(cases: str | Path | None = None, solvers: list[str] | None = N
     """Run every case in the folder ``cases`` (default: the shipped catalogue) with
     ``solvers`` (default: every solver that can run each case) and put each verdict beside
     the theory's. Everything is validated before anything runs; nothing is written."""
-    runs, skipped = _runs(cases, solvers)
+    runs, skipped = plan_runs(cases, solvers)
     return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                            tuple(guard_lines(runs)))
 
 
-def _runs(cases: str | Path | None, solvers: list[str] | None
+def plan_runs(cases: str | Path | None, solvers: list[str] | None
           ) -> tuple[list[tuple[str, str]], list[str]]:
     """:func:`plan_cases` for the folder ``cases`` (default: the catalogue); at least one run."""
     runs, skipped = plan_cases(find_cases(cases if cases is not None else default_cases()),
@@ -456,27 +418,3 @@ def _runs(cases: str | Path | None, solvers: list[str] | None
     if not runs:
         raise UsageError("--solvers: none of them can run any of the cases")
     return runs, skipped
-
-
-def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
-           workers: int | None = None, quiet: bool = True) -> dict[str, Any]:
-    """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
-    Everything is validated before anything runs. Returns rows, paths and skipped runs."""
-    runs, skipped = _runs(cases, solvers)
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a folder")
-    result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
-                             tuple(guard_lines(runs)))
-    written = []
-    with atomic_output(out / "stability.md") as tmp:
-        tmp.write_text(result.markdown())
-    written.append(out / "stability.md")
-    with atomic_output(out / "stability.csv") as tmp:
-        tmp.write_text(result.csv_text())
-    written.append(out / "stability.csv")
-    steppers = map_solvers(solvers)
-    if steppers:
-        maps = {name: map_rows(name, workers, quiet) for name in steppers}
-        written.append(draw_stability_map(out / "stability-map.png", maps))
-    return {"rows": list(result.rows), "skipped": skipped, "written": written}

@@ -2,7 +2,7 @@
 
 >>> axes = [parse_axis("k=log:1e2:1e7:50"), parse_axis("dt=log:1e-6:1e-2:50")]  # doctest: +SKIP
 >>> result = run_sweep(load_scene("scenes/textbook-1d.toml"), axes, "euler-cromer", 1.0)  # doctest: +SKIP
->>> result.write_csv("sweep.csv"); result.draw_map("sweep.png")                 # doctest: +SKIP
+>>> result.write_csv("sweep.csv"); dumbbell.plot.sweep_map(result)                 # doctest: +SKIP
 
 A grid axis is ``NAME=SPEC``: NAME a dotted scene key (``spring.stiffness``, ``bodies.A.mass``,
 ``run.dt``; ``k`` and ``dt`` are short for the first and last), SPEC one of ``log:A:B:N``
@@ -53,7 +53,6 @@ MAX_SAMPLES = 20_000
 #: Largest number of values on one axis.
 MAX_AXIS_VALUES = 10_000
 #: Verdicts other than ok, and how the maps paint them.
-FAIL_COLOURS = {"unstable": "#bdbdbd", "tunnelled": "#f4a582", "failed": "#4d4d4d"}
 #: CSV columns after the axes.
 RESULT_COLUMNS = ("w_dt", "verdict", "t_fail", "max_rel_energy_error", "reason")
 
@@ -327,25 +326,6 @@ class SweepResult:
                         "theory_dt": 2.0 / w if w > 0 else math.inf})
         return out
 
-    def draw_map(self, path: str | Path) -> Path:
-        """The map PNG: log10 of the largest relative energy error over the grid, failures
-        painted by verdict, and the line w*dt = 2."""
-        from ..plot.figures import _pyplot
-
-        plt = _pyplot()
-        fig, ax = plt.subplots(figsize=(8.2, 6.2) if len(self.axes) == 2 else (8.2, 4.6))
-        title = (f"Sweep of {self.scene.name}: {self.solver}, t_end = {self.t_end:g} s, "
-                 f"{len(self.rows)} runs")
-        if len(self.axes) == 2:
-            draw_map(fig, ax, self.axes[0], self.axes[1], self.rows, title)
-        else:
-            draw_line(ax, self.axes[0], self.rows, title)
-        fig.tight_layout()
-        with atomic_output(path) as tmp:
-            fig.savefig(tmp, dpi=100)
-        plt.close(fig)
-        return Path(path)
-
 
 def _cell(value: Any) -> str:
     if value is None:
@@ -470,149 +450,3 @@ def run_sweep(
             for i, combo in enumerate(itertools.product(*(a.values for a in axes)))]
     return SweepResult(scene, list(axes), solver,
                        t_end if t_end is not None else scene.run.t_end, rows, wall, backend)
-
-
-# --- drawing --------------------------------------------------------------------------------
-
-
-def _edges(values: np.ndarray, log: bool) -> np.ndarray:
-    """Cell edges around sorted centre values (midpoints, geometric on a log axis)."""
-    v = np.log10(values) if log else values.astype(float)
-    if len(v) == 1:
-        mid = np.array([v[0] - 0.5, v[0] + 0.5])
-    else:
-        inner = 0.5 * (v[1:] + v[:-1])
-        mid = np.concatenate([[2 * v[0] - inner[0]], inner, [2 * v[-1] - inner[-1]]])
-    return 10**mid if log else mid
-
-
-def _is_log(axis: Axis) -> bool:
-    if axis.spacing == "log":
-        return True
-    vals = np.array(axis.values, dtype=float)
-    return axis.spacing == "list" and bool(np.all(vals > 0)) and vals.max() / vals.min() > 100
-
-
-AXIS_LABELS = {"spring.stiffness": "k, spring constant [N/m]", "run.dt": "dt, time step [s]",
-               "bodies.A.mass": "m_A [kg]", "bodies.B.mass": "m_B [kg]",
-               "spring.rest_length": "b, rest length [m]", "gravity.g": "g [m/s^2]",
-               "floor.elasticity": "floor elasticity", "run.t_end": "t_end [s]"}
-
-
-def axis_label(key: str) -> str:
-    return AXIS_LABELS.get(key, key)
-
-
-def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[dict[str, Any]],
-             title: str, x_label: str | None = None, y_label: str | None = None,
-             wdt: np.ndarray | None = None, limits: tuple[int, int] | None = None,
-             colorbar: bool = True) -> Any:
-    """Paint a 2D grid of sweep rows (x outer, y inner, as in grid order) on ``ax``:
-    colour by log10 of the largest relative energy error (between ``limits``, else fitted),
-    failures by verdict, and the contour w*dt = 2 (from the rows' w_dt, or ``wdt`` given on
-    the same grid). Returns the colour mesh."""
-    from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch
-
-    if not (x_axis.numeric and y_axis.numeric):
-        raise UsageError("--grid: a map needs numeric axes; use a list of numbers")
-    nx, ny = len(x_axis.values), len(y_axis.values)
-    xs, ys = np.array(x_axis.values, float), np.array(y_axis.values, float)
-    grid = np.array(rows, dtype=object).reshape(nx, ny).T  # [iy, ix]
-    xo, yo = np.argsort(xs), np.argsort(ys)
-    grid = grid[np.ix_(yo, xo)]
-    xs, ys = xs[xo], ys[yo]
-    err = np.array([[r["max_rel_energy_error"] for r in line] for line in grid], float)
-    verdict = np.array([[r["verdict"] for r in line] for line in grid])
-    w_dt = (np.array([[r["w_dt"] for r in line] for line in grid], float) if wdt is None
-            else wdt)
-    xlog, ylog = _is_log(x_axis), _is_log(y_axis)
-    xe, ye = _edges(xs, xlog), _edges(ys, ylog)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        level = np.log10(np.maximum(err, 1e-17))
-    level = np.ma.masked_where((verdict != "ok") | ~np.isfinite(level), level)
-    if limits is None:
-        lo = math.floor(float(level.min())) if level.count() else -16
-        limits = (lo, max(lo + 1, math.ceil(float(level.max()))) if level.count() else 2)
-    mesh = ax.pcolormesh(xe, ye, level, cmap="viridis", vmin=limits[0], vmax=limits[1],
-                         shading="flat")
-    if colorbar:
-        cbar = fig.colorbar(mesh, ax=ax, pad=0.02)
-        cbar.set_label("log10 of the largest relative energy error |E - E0| / |E0|")
-    handles = []
-    for code, (name, colour) in enumerate(FAIL_COLOURS.items()):
-        mask = verdict == name
-        if mask.any():
-            ax.pcolormesh(xe, ye, np.ma.masked_where(~mask, np.full(mask.shape, code)),
-                          cmap=ListedColormap([colour]), shading="flat")
-            handles.append(Patch(facecolor=colour, edgecolor="0.3",
-                                 label=f"{name} ({int(mask.sum())} runs)"))
-    if x_axis.key == "w_dt":
-        ax.axvline(2.0, color="red", lw=2.2, ls="--")
-        handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
-    elif np.nanmax(w_dt) > 2.0 > np.nanmin(w_dt):
-        # log10(w*dt) is linear in log k and log dt, so its interpolated contour is straight.
-        with np.errstate(divide="ignore"):
-            ax.contour(xs, ys, np.log10(w_dt), levels=[math.log10(2.0)], colors="red",
-                       linewidths=2.2, linestyles="--")
-        handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
-    else:
-        handles.append(Patch(facecolor="none", edgecolor="none",
-                             label=f"w*dt from {np.nanmin(w_dt):.2g} to {np.nanmax(w_dt):.2g}: "
-                                   "the line w*dt = 2 is off the map"))
-    ax.set_xscale("log" if xlog else "linear")
-    ax.set_yscale("log" if ylog else "linear")
-    ax.set_xlim(xe[0], xe[-1])
-    ax.set_ylim(ye[0], ye[-1])
-    ax.set_xlabel(x_label or axis_label(x_axis.key))
-    ax.set_ylabel(y_label or axis_label(y_axis.key))
-    ax.set_title(title, fontsize=10)
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
-              fontsize=8, frameon=False)
-    return mesh
-
-
-def _legend_line(colour: str, style: str, label: str) -> Any:
-    from matplotlib.lines import Line2D
-
-    return Line2D([], [], color=colour, ls=style, lw=2.2, label=label)
-
-
-def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> None:
-    """A one-axis sweep: log10 of the largest relative energy error against the value, the
-    failures marked by verdict and the value where w*dt = 2."""
-    if not axis.numeric:
-        raise UsageError("--grid: a plot needs a numeric axis; use a list of numbers")
-    xs = np.array(axis.values, float)
-    order = np.argsort(xs)
-    xs = xs[order]
-    rows = [rows[i] for i in order]
-    err = np.array([r["max_rel_energy_error"] for r in rows], float)
-    verdicts = [r["verdict"] for r in rows]
-    ok = np.array([v == "ok" for v in verdicts])
-    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label="ok")
-    top = np.nanmax(err[np.isfinite(err)]) if np.isfinite(err).any() else 1.0
-    for name, colour in FAIL_COLOURS.items():
-        mask = np.array([v == name for v in verdicts])
-        if mask.any():
-            # At the error reached before the run stopped; off the top if none was finite.
-            ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
-            ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
-                    label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
-    w_dt = np.array([r["w_dt"] for r in rows], float)
-    cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
-    if cross.size:
-        j = int(cross[0])
-        # Interpolate log(w*dt) between the two values around 2.
-        f = (math.log(2.0) - math.log(w_dt[j])) / (math.log(w_dt[j + 1]) - math.log(w_dt[j]))
-        x2 = (xs[j] * (xs[j + 1] / xs[j]) ** f if _is_log(axis)
-              else xs[j] + f * (xs[j + 1] - xs[j]))
-        ax.axvline(x2, color="red", ls="--", lw=2, label="w*dt = 2: stability limit")
-    ax.set_yscale("log")
-    if _is_log(axis):
-        ax.set_xscale("log")
-    ax.set_xlabel(axis_label(axis.key))
-    ax.set_ylabel("largest relative energy error")
-    ax.set_title(title, fontsize=10)
-    ax.grid(True, color="0.9")
-    ax.legend(fontsize=8)

@@ -33,7 +33,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from ..model.energy import energy_columns
 from ..model.scene import Scene
-from ..plot.figures import COLOURS
+from ..plot.style import COLOURS
 
 #: Supersampling factor of everything drawn with smooth edges.
 SS = 2

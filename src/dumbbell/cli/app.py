@@ -101,6 +101,8 @@ def _check_outputs(args: argparse.Namespace) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status."""
+    # The command only writes files: matplotlib's file-only backend, unless the user chose one.
+    os.environ.setdefault("MPLBACKEND", "Agg")
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -71,6 +71,15 @@ def run(args: argparse.Namespace) -> int:
                        repeat=args.repeat, t_end=args.t_end, budget=args.budget,
                        spacing=args.sample_spacing, quiet=args.quiet)
     written = write_all(result, Path(args.out))
+    from ..io.figures import save_figure
+    from ..plot.bench import convergence, work_precision
+
+    stem = Path(args.out) / f"bench-{result.scene}"
+    # The figures keep their own resolution ("figure": the dpi they were made with).
+    written += [save_figure(work_precision(result).figure, f"{stem}-work-precision.png",
+                            dpi="figure"),
+                save_figure(convergence(result).figure, f"{stem}-convergence.png",
+                            dpi="figure")]
     if not args.quiet:
         from ..analysis.bench import markdown
 

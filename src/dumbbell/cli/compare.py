@@ -55,6 +55,13 @@ def run(args: argparse.Namespace) -> int:
                              + ", ".join(available()))
     result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
     paths = write(result, Path(args.out))
+    from .. import plot
+    from ..io.figures import save_figure
+
+    stem = Path(args.out) / f"{scene.name}-compare"
+    for name, draw in (("positions", plot.compare_positions), ("error", plot.compare),
+                       ("energy", plot.compare_energy)):
+        paths.append(save_figure(draw(result).figure, f"{stem}-{name}.png"))
     print(result.table())
     if not args.quiet:
         for path in paths:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from .app import add_quiet
 
@@ -53,10 +54,11 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
     traj = simulate(scene, quiet=quiet)
     written: list[Path] = []
     if scene.outputs.figures:
-        from ..plot.figures import FIGURES
+        from ..io.figures import save_figure
 
         for name in scene.outputs.figures:
-            written.append(FIGURES[name](traj, out / f"{scene.name}-{name}.png"))
+            ax = _figure(name, traj)
+            written.append(save_figure(ax.figure, out / f"{scene.name}-{name}.png"))
     if scene.outputs.csv:
         written.append(traj.to_csv(out / f"{scene.name}.csv"))
         if scene.floor is not None:
@@ -73,3 +75,28 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
         sys.stderr.write(f"dumbbell run: {scene.name}: {traj.solver}: {traj.verdict}\n")
         return EXIT_VERDICT
     return 0
+
+
+def _figure(name: str, traj: Any) -> Any:
+    """Draw figure ``name`` of a scene's ``[outputs] figures`` for ``traj``; returns its axes.
+    The rotation preview runs its own variants of the scene first; the topple figure sets the
+    run beside its closed form."""
+    from .. import plot
+
+    if name == "rotation":
+        from ..analysis.rotation import preview
+
+        return plot.rotation(preview(traj))
+    if name == "contact":
+        from ..analysis.contact import about_contact
+
+        ax = plot.contact_momentum(about_contact(traj), solver=traj.solver)
+        ax.figure.tight_layout()
+        return ax
+    if name == "topple":
+        from ..analysis.topple import closed_form, measure
+
+        axes = plot.topple(closed_form(traj.scene), measure(traj), solver=traj.solver)
+        axes[0].figure.tight_layout()
+        return axes[0]
+    return getattr(plot, name)(traj)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
+from typing import Any
 
 from .app import add_quiet, positive_int
 
@@ -31,9 +33,45 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..analysis.stability import report
+def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
+           workers: int | None = None, quiet: bool = True) -> dict[str, Any]:
+    """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
+    Everything is validated before anything runs. Returns rows, paths and skipped runs."""
+    from ..analysis.stability import (
+        StabilityResult,
+        guard_lines,
+        map_rows,
+        map_solvers,
+        plan_runs,
+        run_cases,
+    )
+    from ..errors import UsageError
+    from ..io.figures import save_figure
+    from ..io.files import atomic_output
+    from ..plot.maps import stability_map
 
+    runs, skipped = plan_runs(cases, solvers)
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out}: exists and is not a folder")
+    result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
+                             tuple(guard_lines(runs)))
+    written = []
+    with atomic_output(out / "stability.md") as tmp:
+        tmp.write_text(result.markdown())
+    written.append(out / "stability.md")
+    with atomic_output(out / "stability.csv") as tmp:
+        tmp.write_text(result.csv_text())
+    written.append(out / "stability.csv")
+    steppers = map_solvers(solvers)
+    if steppers:
+        maps = {name: map_rows(name, workers, quiet) for name in steppers}
+        panels = stability_map(maps)
+        written.append(save_figure(panels[0].figure, out / "stability-map.png", dpi=90))
+    return {"rows": list(result.rows), "skipped": skipped, "written": written}
+
+
+def run(args: argparse.Namespace) -> int:
     result = report(args.cases, args.solvers, args.out, args.workers, args.quiet)
     if not args.quiet:
         rows = result["rows"]

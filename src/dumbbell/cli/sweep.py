@@ -78,7 +78,10 @@ def run(args: argparse.Namespace) -> int:
                        scheduler=args.scheduler and args.scheduler.strip(), quiet=args.quiet,
                        points=points)
     csv_path = result.write_csv(out / f"{scene.name}-sweep.csv")
-    png_path = result.draw_map(out / f"{scene.name}-sweep.png")
+    from ..io.figures import save_figure
+    from ..plot.maps import sweep_map
+
+    png_path = save_figure(sweep_map(result).figure, out / f"{scene.name}-sweep.png", dpi=100)
     if not args.quiet:
         counts = ", ".join(f"{n} {v}" for v, n in sorted(result.counts().items()))
         sys.stderr.write(f"{len(result.rows)} runs ({counts}) in {result.wall_time:.2f} s on "

@@ -1,45 +1,27 @@
-"""The textbook's figures of section 13.5.1 as PNG, drawn from a :class:`Trajectory`.
+"""The textbook's figures of section 13.5.1, drawn from a :class:`Trajectory`.
 
-- ``positions`` (Fig. 13.13): heights of A, B and the centre of mass;
-- ``kinetic`` (Fig. 13.14): positions, then K_cm, K_int and E;
-- ``potential`` (Fig. 13.15): positions, then the external (U_g) and internal (U_spring)
-  potential energies.
+- :func:`positions` (Fig. 13.13): heights of A, B and the centre of mass;
+- :func:`kinetic` (Fig. 13.14): positions, then K_cm, K_int and E;
+- :func:`potential` (Fig. 13.15): positions, then the external (U_g) and internal (U_spring)
+  potential energies;
+- :func:`energy`: every energy term the scene has (and in 2D the motion in the plane).
 
-All show the textbook's window, 0 to 2 s, and mark the first impact. Matplotlib is imported
-only here, and only when a figure is drawn.
+All show the textbook's window, 0 to 2 s, and mark the first impact. Each draws on the axes
+it is given, or makes its own figure when given none, and returns the axes; none saves (see
+:func:`dumbbell.io.figures.save_figure`). Matplotlib is imported only when a figure is drawn.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..io.files import atomic_output
 from ..model.trajectory import Trajectory
+from .style import COLOURS, LABELS, MOMENTUM_COLOUR, pyplot
 
 #: The textbook's time window (s).
 WINDOW = 2.0
-
-COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",
-           "K_rot": "#2ca02c", "K_vib": "#d62728", "K_spin": "#9467bd", "U_g": "#8c564b",
-           "U_spring": "#e6a700", "E": "black", "E_lost": "#7f7f7f"}
-
-LABELS = {"K_cm": "K_cm, centre of mass", "K_int": "K_int, relative to the centre of mass",
-          "K_rot": "K_rot, rotation", "K_vib": "K_vib, vibration", "K_spin": "K_spin, own spin",
-          "U_g": "U_g = M g X, external", "U_spring": "U_spring, internal", "E": "E, total",
-          "E_lost": "E_lost"}
-
-
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _window(traj: Trajectory, window: float) -> np.ndarray:
@@ -99,55 +81,68 @@ def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) ->
     ax.legend(loc="upper center", fontsize=8, framealpha=0.9, ncol=len(names))
 
 
-def _finish(fig: Any, axes: list[Any], traj: Trajectory, window: float, path: Path,
-            subtitle: str) -> Path:
+def _frame(axes: list[Any], traj: Trajectory, window: float) -> None:
+    """Time axis, grid and first-impact mark shared by every panel."""
     axes[-1].set_xlabel("t [s]")
     for ax in axes:
         ax.set_xlim(0, window)
         ax.grid(True, color="0.9", lw=0.6)
     _mark_first_impact(axes, traj, window, text=True)
+
+
+def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle: str) -> None:
+    """Finish a figure this module made: shared frame, then the title naming the run."""
+    _frame(axes, traj, window)
     from ..solvers import solver_class
 
     # A solver without a step takes dt only as the sample spacing: not worth a title.
     dt = f", dt = {traj.dt:g} s" if traj.dt and solver_class(traj.solver).has_step else ""
     fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
     fig.tight_layout()
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    _pyplot().close(fig)
-    return path
 
 
-def positions_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
-    """Fig. 13.13: heights of A, B and the centre of mass over [0, window] s."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4.2))
+def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
+    """Fig. 13.13: heights of A, B and the centre of mass (m) over [0, window] s."""
+    if ax is not None:
+        _positions_panel(ax, traj, window)
+        _frame([ax], traj, window)
+        return ax
+    fig, ax = pyplot().subplots(figsize=(8, 4.2))
     _positions_panel(ax, traj, window)
-    return _finish(fig, [ax], traj, window, Path(path),
-                   "the centre of mass falls on parabolas; the particles oscillate about it")
+    _title(fig, [ax], traj, window,
+           "the centre of mass falls on parabolas; the particles oscillate about it")
+    return ax
 
 
-def _two_panel(traj: Trajectory, path: str | Path, names: list[str], window: float,
-               subtitle: str) -> Path:
-    plt = _pyplot()
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6.4), sharex=True)
+def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
+               subtitle: str) -> Any:
+    """The energy terms ``names`` on ``ax``; without one, a figure of the positions above
+    them (the textbook's layout). Returns the energy axes."""
+    if ax is not None:
+        _energy_panel(ax, traj, names, window)
+        _frame([ax], traj, window)
+        return ax
+    fig, (top, bottom) = pyplot().subplots(2, 1, figsize=(8, 6.4), sharex=True)
     _positions_panel(top, traj, window)
     _energy_panel(bottom, traj, names, window)
-    return _finish(fig, [top, bottom], traj, window, Path(path), subtitle)
+    _title(fig, [top, bottom], traj, window, subtitle)
+    return bottom
 
 
-def kinetic_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
-    """Fig. 13.14: positions, then the kinetic energy split into K_cm and K_int, and E (J)."""
+def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
+    """Fig. 13.14: the kinetic energy split into K_cm and K_int (in 2D K_rot, K_vib, K_spin),
+    and E (J); without ``ax``, below the positions."""
     names = ["K_cm", "K_int", "E"] if traj.scene.dimensions == 1 else [
         n for n in ("K_cm", "K_rot", "K_vib", "K_spin", "E") if n in traj.columns]
-    return _two_panel(traj, path, names, window,
+    return _two_panel(traj, ax, names, window,
                       "kinetic energy: centre of mass against internal motion")
 
 
-def potential_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
-    """Fig. 13.15: positions, then the external (U_g) and internal (U_spring) potential (J)."""
+def potential(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
+    """Fig. 13.15: the external (U_g) and internal (U_spring) potential energy (J); without
+    ``ax``, below the positions."""
     names = [n for n in ("U_g", "U_spring") if n in traj.columns]
-    return _two_panel(traj, path, names, window,
+    return _two_panel(traj, ax, names, window,
                       "potential energy: external (gravity) against internal (spring)")
 
 
@@ -185,13 +180,13 @@ def _momentum_axis(ax: Any, traj: Trajectory, window: float) -> None:
     m = _window(traj, window)
     right = ax.twinx()
     L = traj["L_cm"][m]
-    right.plot(traj.t[m], L, color="#17becf", lw=1.0, ls=(0, (5, 2)),
+    right.plot(traj.t[m], L, color=MOMENTUM_COLOUR, lw=1.0, ls=(0, (5, 2)),
                label="L_cm, about the centre of mass (right axis)")
     lo, hi = float(np.nanmin(L)), float(np.nanmax(L))
     pad = 0.1 * max(hi - lo, abs(hi), abs(lo), 1e-12)
     right.set_ylim(lo - pad, hi + 3 * pad)
-    right.set_ylabel("L_cm [kg m^2/s]", color="#17becf")
-    right.tick_params(axis="y", colors="#17becf", labelsize=8)
+    right.set_ylabel("L_cm [kg m^2/s]", color=MOMENTUM_COLOUR)
+    right.tick_params(axis="y", colors=MOMENTUM_COLOUR, labelsize=8)
     # One legend, drawn on the upper axis so that the dashed line does not run through it.
     handles, labels = ax.get_legend_handles_labels()
     extra = right.get_legend_handles_labels()
@@ -201,15 +196,19 @@ def _momentum_axis(ax: Any, traj: Trajectory, window: float) -> None:
                  framealpha=0.9, ncol=3)
 
 
-def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
-    """Positions (and, in 2D, the motion in the plane), then the energy terms the scene has
-    in two panels (J): the centre of mass's (K_cm, U_g) with E and E_lost, and the internal
-    ones (K_int, or K_rot, K_vib, U_spring and K_spin)."""
-    plt = _pyplot()
+def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
+    """How the energy is shared (J). On ``ax``: every energy term the scene has. Without:
+    positions (and, in 2D, the motion in the plane), then two panels, the centre of mass's
+    terms (K_cm, U_g) with E and E_lost, and the internal ones (K_int, or K_rot, K_vib,
+    U_spring and K_spin); returns the centre-of-mass panel."""
     cols = traj.columns
     outer = [n for n in ("K_cm", "U_g", "E", "E_lost") if n in cols]
     inner = [n for n in ("K_int", "K_rot", "K_vib", "U_spring", "K_spin") if n in cols]
-    fig = plt.figure(figsize=(10, 8.6))
+    if ax is not None:
+        _energy_panel(ax, traj, outer + inner, window)
+        _frame([ax], traj, window)
+        return ax
+    fig = pyplot().figure(figsize=(10, 8.6))
     wide = traj.scene.dimensions == 2
     grid = fig.add_gridspec(3, 3 if wide else 1, height_ratios=[1.1, 1, 1])
     top = fig.add_subplot(grid[0, :2] if wide else grid[0, 0])
@@ -228,59 +227,5 @@ def energy_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) ->
                          fontsize=9)
         if "L_cm" in cols:
             _momentum_axis(bottom, traj, window)
-    return _finish(fig, [top, middle, bottom], traj, window, Path(path),
-                   "how the energy is shared")
-
-
-def rotation_figure(traj: Trajectory, path: str | Path, window: float = WINDOW) -> Path:
-    """Rotation preview: K_rot(t) of the spring dumbbell for k = 200, 2e3, 2e4 N/m beside
-    the rigid one (see :mod:`dumbbell.analysis.rotation`)."""
-    from ..analysis.rotation import rotation_figure as draw
-
-    return draw(traj, path, window)
-
-
-def topple_figure(traj: Trajectory, path: str | Path) -> Path:
-    """The toppling dumbbell in ``traj`` against its closed form: angle, the centre of mass's
-    horizontal position and the top particle's speed (see :mod:`dumbbell.analysis.topple`)."""
-    from ..analysis.topple import closed_form, measure
-    from .rotation_chapter import topple
-
-    plt = _pyplot()
-    fig, axes = plt.subplots(3, 1, figsize=(8.5, 8.0), sharex=True)
-    topple(closed_form(traj.scene), measure(traj), ax=axes, solver=traj.solver)
-    fig.tight_layout()
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
-
-
-def contact_figure(traj: Trajectory, path: str | Path) -> Path:
-    """Angular momentum about the contact point through the first impact of ``traj`` (2D):
-    L_cm and the orbital part jump, their sum does not (see :mod:`dumbbell.analysis.contact`)."""
-    from ..analysis.contact import about_contact
-    from .rotation_chapter import contact_momentum
-
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8.5, 4.6))
-    contact_momentum(about_contact(traj), ax=ax, solver=traj.solver)
-    fig.tight_layout()
-    path = Path(path)
-    with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
-
-
-#: Figure name (as in a scene's ``[outputs] figures``) -> drawing function.
-FIGURES: dict[str, Callable[[Trajectory, str | Path], Path]] = {
-    "positions": positions_figure,
-    "kinetic": kinetic_figure,
-    "potential": potential_figure,
-    "energy": energy_figure,
-    "rotation": rotation_figure,
-    "topple": topple_figure,
-    "contact": contact_figure,
-}
+    _title(fig, [top, middle, bottom], traj, window, "how the energy is shared")
+    return middle

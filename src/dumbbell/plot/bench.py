@@ -1,0 +1,145 @@
+"""Figures of a benchmark (:class:`dumbbell.analysis.bench.BenchResult`): work-precision
+(error against run time) and convergence (error against dt, with the fitted orders). Each
+draws on the axes it is given or makes its own figure, and returns the axes; none saves."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
+from ..solvers import solver_class
+from .style import pyplot, solver_style
+
+
+def work_precision(result: BenchResult, ax: Any = None) -> Any:
+    """Log-log error (m) against run time (s), one line per solver, dt beside each point,
+    failed runs as crosses on the top edge."""
+    own = ax is None
+    if own:
+        fig, ax = pyplot().subplots(figsize=(7.2, 6.0), dpi=100)
+    finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
+    top = max(finite) * 8 if finite else 1.0
+    names = list(dict.fromkeys(p.solver for p in result.points))
+    labels: list[tuple[str, float, float, str]] = []
+    for i, name in enumerate(names):
+        colour, marker = solver_style(name, i)
+        pts = [p for p in result.points if p.solver == name and p.ran]
+        good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
+        bad = [p for p in pts if not math.isfinite(p.error)]
+        single = not solver_class(name).has_step
+        label = name
+        if name == result.truth:
+            label += (" (truth; error vs extended precision)"
+                      if not solver_class(name).estimates_error
+                      else " (truth; its own error estimate"
+                      + (f" over [0, {good[0].window:g} s])" if good else ")"))
+        elif single:
+            label += " (error vs truth)"
+        if good:
+            ax.plot([p.seconds for p in good], [p.error for p in good], marker=marker,
+                    color=colour, label=label, ms=11 if single else 6,
+                    lw=0 if single else 1.5)
+        for p in good:
+            text = (dt_label(p.dt) if p.dt is not None
+                    else f"samples every {dt_label(result.spacing)} s")
+            labels.append((text, p.seconds, p.error, colour))
+        if bad:
+            ax.plot([p.seconds for p in bad], [top] * len(bad), ls="none", marker="x",
+                    color=colour, ms=9, mew=2, label=f"{name}: failed ({bad[0].verdict})")
+            labels.extend((dt_label(p.dt) if p.dt else "", p.seconds, top, colour)
+                          for p in bad)
+    sp = result.speedups()
+    if sp:
+        ax.axhline(sp["target_error"], color="grey", ls=":", lw=1,
+                   label=f"textbook's accuracy ({sp['baseline']} at dt = 1e-5 s)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.margins(x=0.07, y=0.06)  # room for the labels of the outermost points
+    ax.set_xlabel(f"run time (s, fastest of at least {result.repeat} runs)")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_title(f"Work-precision: {result.scene}, {result.t_end:g} s simulated; "
+                 f"labels: dt (s)", fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+              frameon=False)
+    if own:
+        fig.tight_layout()
+    _place_labels(ax, labels)
+    return ax
+
+
+#: Where a point's label may go, in order of preference: offset (points) and alignment.
+_LABEL_SPOTS = ((7, 2, "left"), (6, -11, "left"), (-7, 2, "right"), (-7, -11, "right"),
+                (7, 9, "left"), (7, -18, "left"), (-7, 9, "right"), (-7, -18, "right"))
+
+
+def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
+                  size: float = 7.5) -> None:
+    """Write each (text, x, y, colour) beside its point, at the first spot whose box stays
+    inside the axes and overlaps neither a marker nor a label already placed (else at the
+    first spot)."""
+    px = ax.figure.dpi / 72.0
+    xy = ax.transData.transform([(x, y) for _, x, y, _ in labels]) if labels else []
+    taken = [(u - 6, v - 6, u + 6, v + 6) for u, v in xy]  # the markers
+    frame = ax.get_window_extent()
+    for (text, x, y, colour), (u, v) in zip(labels, xy, strict=True):
+        w, h = 0.55 * size * px * len(text), 1.15 * size * px
+        chosen = _LABEL_SPOTS[0]
+        for spot in _LABEL_SPOTS:
+            dx, dy, ha = spot
+            left = u + dx * px - (w if ha == "right" else 0.0)
+            box = (left, v + dy * px, left + w, v + dy * px + h)
+            inside = (frame.x0 <= box[0] and box[2] <= frame.x1 and frame.y0 <= box[1]
+                      and box[3] <= frame.y1)
+            if inside and not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3]
+                                  and b[1] < box[3] for b in taken):
+                chosen = spot
+                taken.append(box)
+                break
+        dx, dy, ha = chosen
+        ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), ha=ha,
+                    fontsize=size, color=colour)
+
+
+def convergence(result: BenchResult, ax: Any = None) -> Any:
+    """Log-log error (m) against dt (s), one line per solver, with the fitted order."""
+    own = ax is None
+    if own:
+        fig, ax = pyplot().subplots(figsize=(7.2, 5.0), dpi=100)
+    names = [n for n in dict.fromkeys(p.solver for p in result.points)
+             if solver_class(n).has_step]
+    finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
+    top = max(finite) * 8 if finite else 1.0
+    for i, name in enumerate(names):
+        colour, marker = solver_style(name, i)
+        pts = [p for p in result.points if p.solver == name and p.ran and p.dt is not None]
+        good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
+        bad = [p for p in pts if not math.isfinite(p.error)]
+        fit = result.fits.get(name)
+        label = name + (f": fitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
+                        f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
+        ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
+                lw=0, label=label)
+        if fit:
+            xs = np.array([min(fit.dts), max(fit.dts)])
+            ax.plot(xs, 10 ** (fit.log10_c + fit.order * np.log10(xs)), color=colour, lw=1.2)
+        if bad:
+            ax.plot([p.dt for p in bad], [top] * len(bad), ls="none", marker="x", color=colour,
+                    ms=9, mew=2, label=f"{name}: failed")
+    ax.axhline(FIT_MAX_ERROR, color="grey", ls=":", lw=1)
+    ax.text(0.01, FIT_MAX_ERROR, f" fits use errors below {FIT_MAX_ERROR:g} m",
+            transform=ax.get_yaxis_transform(), fontsize=7.5, color="grey", va="bottom")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time step dt (s)")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_title(f"Convergence: {result.scene}, error over [0, {result.window:g} s]; "
+                 "lines: least-squares fits", fontsize=10)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    if own:
+        fig.tight_layout()
+    return ax

@@ -1,0 +1,116 @@
+"""Figures of a comparison (:class:`dumbbell.analysis.compare.Comparison`): heights of each
+solver over the truth, position error against time, and E(t) per solver. Each draws on the
+axes it is given or makes its own figure, and returns the axes; none saves."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..analysis.compare import DIVERGED, Comparison, energy_spread
+from .style import ROW_COLOURS, ROW_DASHES, pyplot
+
+
+def _shown(result: Comparison) -> float:
+    """The time shown in the heights figure (s): twice the window, at most the whole run."""
+    return min(float(result.truth.t[-1]), 2.0 * result.window)
+
+
+def _heights_panel(ax: Any, result: Comparison, body: str) -> None:
+    key = "x" if result.scene.dimensions == 1 else "y"
+    truth = result.truth
+    shown = _shown(result)
+    m = truth.t <= shown + 1e-12
+    ax.plot(truth.t[m], truth[f"{key}{body}"][m], color="black", lw=2.4, alpha=0.35,
+            label=f"{truth.solver} (truth)")
+    for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
+        r = row.traj
+        mm = r.t <= shown + 1e-12
+        ax.plot(r.t[mm], r[f"{key}{body}"][mm], color=colour, lw=1.1, label=row.label,
+                ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)])
+    ax.axvspan(result.window, max(shown, result.window), color="0.93", zorder=0)
+    ax.set_ylabel(f"{key}_{body} [m]")
+    ax.set_title(f"particle {body} ({'top' if body == 'A' else 'bottom'})", fontsize=9)
+    ax.grid(True, color="0.9", lw=0.6)
+    ax.legend(loc="upper right", fontsize=8)
+
+
+def compare_positions(result: Comparison, ax: Any = None) -> Any:
+    """Heights (m) of each solver over the truth's, twice the error window long: on ``ax``
+    particle B only; without, A above B. Returns the (last) axes."""
+    if ax is not None:
+        _heights_panel(ax, result, "B")
+        ax.set_xlabel("t [s]")
+        ax.set_xlim(0, _shown(result))
+        return ax
+    fig, axes = pyplot().subplots(2, 1, figsize=(10, 6.4), sharex=True)
+    for panel, body in zip(axes, "AB", strict=True):
+        _heights_panel(panel, result, body)
+    axes[0].text(result.window, 1.0, "  after the window: the runs part (chaos)",
+                 transform=axes[0].get_xaxis_transform(), va="top", fontsize=8, color="0.4")
+    axes[-1].set_xlabel("t [s]")
+    axes[-1].set_xlim(0, _shown(result))
+    fig.suptitle(f"{result.scene.title}: heights, each solver over the truth", fontsize=10)
+    fig.tight_layout()
+    return axes[-1]
+
+
+def compare(result: Comparison, ax: Any = None) -> Any:
+    """Largest position error (m, log scale) of each solver against the truth over time, with
+    the truth's impacts and the error window marked."""
+    own = ax is None
+    if own:
+        fig, ax = pyplot().subplots(figsize=(10, 4.6))
+    scene, truth = result.scene, result.truth
+    for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
+        t = row.traj.t[: len(row.error)]
+        ax.semilogy(t, np.maximum(row.error, 1e-17), color=colour, lw=1.1,
+                    ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
+                    label=f"{row.label}: {row.window_error:.2g} m max in [0, {result.window:g}] s")
+    ax.axvline(result.window, color="0.4", ls="--", lw=0.8)
+    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8)
+    ax.text(0.002, DIVERGED, " 1 mm", va="bottom", fontsize=8, color="0.4",
+            transform=ax.get_yaxis_transform())
+    for ev in truth.events:
+        ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0)
+    positive = np.concatenate([row.error[row.error > 0] for row in result.rows] or [[1.0]])
+    if positive.size:
+        ax.set_ylim(bottom=max(1e-16, float(np.percentile(positive, 1)) / 10))
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("largest |position error| [m]")
+    ax.set_xlim(0, float(truth.t[-1]))
+    ax.grid(True, which="major", color="0.9", lw=0.6)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(f"{scene.title}: position error against {truth.solver} (grey lines: its "
+                 f"impacts; dashed: the {result.window:g} s window)", fontsize=9)
+    if own:
+        fig.tight_layout()
+    return ax
+
+
+def compare_energy(result: Comparison, ax: Any = None) -> Any:
+    """E(t)/E(0) - 1 of each solver and of the truth."""
+    own = ax is None
+    if own:
+        fig, ax = pyplot().subplots(figsize=(10, 4.6))
+    scene, truth = result.scene, result.truth
+    E0 = float(truth["E"][0]) or 1.0
+    for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
+        r = row.traj
+        ax.plot(r.t, r["E"] / E0 - 1.0, color=colour, lw=1.0,
+                ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
+                label=f"{row.label}: spread {row.spread:.2e}")
+    ax.plot(truth.t, truth["E"] / E0 - 1.0, color="black", lw=1.2,
+            label=f"{truth.solver}: spread {energy_spread(truth):.1e}")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("E(t) / E(0) - 1")
+    ax.set_xlim(0, float(truth.t[-1]))
+    ax.grid(True, color="0.9", lw=0.6)
+    ax.legend(loc="lower left", fontsize=8)
+    ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+    ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
+                 fontsize=9)
+    if own:
+        fig.tight_layout()
+    return ax

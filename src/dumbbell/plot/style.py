@@ -1,0 +1,49 @@
+"""The one place colours, labels and line styles are defined, for figures and animations.
+
+Also :func:`pyplot`, the lazy import of matplotlib's pyplot. It never chooses a backend: a
+notebook keeps its own, and the ``dumbbell`` command picks the file-only backend itself.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: Colour of each particle, the centre of mass and each energy term.
+COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",
+           "K_rot": "#2ca02c", "K_vib": "#d62728", "K_spin": "#9467bd", "U_g": "#8c564b",
+           "U_spring": "#e6a700", "E": "black", "E_lost": "#7f7f7f"}
+#: Colour of the angular momentum L_cm (kept out of COLOURS: the GIF's palette is built from
+#: those, and L_cm is text there, drawn in ink).
+MOMENTUM_COLOUR = "#17becf"
+
+#: Legend text of each energy term.
+LABELS = {"K_cm": "K_cm, centre of mass", "K_int": "K_int, relative to the centre of mass",
+          "K_rot": "K_rot, rotation", "K_vib": "K_vib, vibration", "K_spin": "K_spin, own spin",
+          "U_g": "U_g = M g X, external", "U_spring": "U_spring, internal", "E": "E, total",
+          "E_lost": "E_lost"}
+
+#: Colour and marker of each solver in the benchmark figures.
+SOLVER_STYLES = {"euler-cromer": ("#d62728", "o"), "verlet": ("#1f77b4", "s"),
+                 "pymunk": ("#2ca02c", "^"), "euler-cromer-2d": ("#ff7f0e", "v"),
+                 "exact": ("black", "*"), "reference": ("#9467bd", "P")}
+
+#: Colours of the compared runs, in row order.
+ROW_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"]
+#: Line styles by row: runs that agree to rounding (pymunk and euler-cromer-2d) stay visible.
+ROW_DASHES = ["-", (0, (4, 3)), (0, (1, 2)), "-.", "-", (0, (4, 3)), (0, (1, 2))]
+
+#: Colours of the ways a run can fail, in the stability and sweep maps.
+FAIL_COLOURS = {"unstable": "#bdbdbd", "tunnelled": "#f4a582", "failed": "#4d4d4d"}
+
+
+
+def solver_style(name: str, i: int) -> tuple[str, str]:
+    """Colour and marker of solver ``name``; the ``i``-th default for one without a style."""
+    return SOLVER_STYLES.get(name, (f"C{i % 10}", "D"))
+
+
+def pyplot() -> Any:
+    """matplotlib.pyplot, imported on first use (whatever backend is configured)."""
+    import matplotlib.pyplot as plt
+
+    return plt
