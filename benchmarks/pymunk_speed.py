@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from dumbbell.analysis.compare import energy_spread, position_error
+from dumbbell.analysis.metrics import coordinate_error, energy_spread
 from dumbbell.model.scene import load_scene, packaged_scene
 from dumbbell.solvers import simulate
 from dumbbell.solvers.engine import build
@@ -81,7 +81,7 @@ def accuracy(scene, t_end: float, window: float = 2.0) -> None:
         exact = simulate(scene, "exact", dt=dt, t_end=t_end, every=every)
         for name in ("pymunk", "euler-cromer"):
             run = simulate(scene, name, dt=dt, t_end=t_end, every=every)
-            err = position_error(run, exact)
+            err = coordinate_error(run, exact)
             inside = run.t[: len(err)] <= window + 1e-12
             print(f"| {name} | {dt:g} | {float(np.max(err[inside])):.2e} "
                   f"| {energy_spread(run):.2e} | {len(run.events)} ({len(exact.events)}) "

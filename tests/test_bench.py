@@ -14,13 +14,12 @@ from dumbbell.analysis.bench import (
     DEFAULT_DTS,
     default_solvers,
     default_spacing,
-    extended_precision_exact,
     fit_order,
-    markdown,
     run_bench,
-    write_all,
 )
+from dumbbell.analysis.extended import extended_precision_exact
 from dumbbell.cli import main
+from dumbbell.io.bench import markdown, write_all
 from dumbbell.model.scene import load_scene
 from dumbbell.solvers import REGISTRY, simulate
 from tests.conftest import SCENES, make_scene
@@ -159,12 +158,12 @@ def test_bad_flags_write_nothing(tmp_path, capsys, flags, message):
 
 
 def test_time_for_an_error_interpolates_in_log_log():
-    from dumbbell.analysis.bench import _time_for_error
+    from dumbbell.analysis.bench import time_for_error
 
     line = [(1.0, 1e-2), (10.0, 1e-4), (100.0, 1e-6)]
-    assert _time_for_error(line, 1e-3) == pytest.approx(10**0.5)
-    assert _time_for_error(line, 1e-2) == pytest.approx(1.0)
-    assert _time_for_error(line, 1e-7) is None
+    assert time_for_error(line, 1e-3) == pytest.approx(10**0.5)
+    assert time_for_error(line, 1e-2) == pytest.approx(1.0)
+    assert time_for_error(line, 1e-7) is None
 
 
 @pytest.mark.skipif("reference" not in REGISTRY, reason="needs the 2D reference solver")

@@ -199,7 +199,7 @@ def test_inelastic_floor_ends_failed_at_rest(rigid):
 
 
 def test_bench_truth_point_checks_rigid_against_extended_precision(rigid_run):
-    from dumbbell.analysis.bench import extended_precision_rigid
+    from dumbbell.analysis.extended import extended_precision_rigid
 
     err, t_err = extended_precision_rigid(rigid_run, 2.0)
     assert err < 1e-12 and t_err < 1e-12

@@ -16,7 +16,15 @@ class SceneError(DumbbellError, ValueError):
 
 
 class UsageError(DumbbellError, ValueError):
-    """A command-line flag or API argument is not valid."""
+    """An API argument (or the command-line flag that sets it) is not valid.
+
+    Library code names the parameter and starts the message with it, e.g.
+    ``UsageError("window = -1: must be a finite number > 0 (s)", param="window")``; the
+    command line shows the flag instead (``--window = -1: ...``)."""
+
+    def __init__(self, message: str, param: str | None = None):
+        super().__init__(message)
+        self.param = param
 
 
 class MissingExtraError(DumbbellError, ImportError):

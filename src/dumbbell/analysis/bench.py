@@ -37,22 +37,20 @@ times refined by Newton's method there; reference: its own estimate).
 
 from __future__ import annotations
 
-import csv
 import itertools
-import json
 import math
 import time
 from dataclasses import asdict, dataclass, field, replace
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import UsageError
-from ..model.energy import energy_scale, relative_energy_error
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from ..solvers import RunOptions, Solver, make_options, solver_class, supported, truth_solver
+from .extended import extended_precision_exact, extended_precision_rigid
+from .metrics import energy_error, impact_time_error, position_error
 
 if TYPE_CHECKING:
     import pandas
@@ -172,7 +170,7 @@ class BenchResult:
                            if p.solver == name and p.ok and p.dt is not None
                            and math.isfinite(p.error) and p.error > 0),
                           key=lambda se: se[0])
-            t = _time_for_error(line, target)
+            t = time_for_error(line, target)
             if name == base_name and ref is not None and target == ref.error:
                 t = ref.seconds  # the baseline's own point, not a crossing of its line
             if t is not None:
@@ -197,7 +195,7 @@ class BenchResult:
         return "euler-cromer-2d" if "euler-cromer-2d" in names else "euler-cromer"
 
 
-def _time_for_error(line: list[tuple[float, float]], target: float) -> float | None:
+def time_for_error(line: list[tuple[float, float]], target: float) -> float | None:
     """The run time (s) at which a (seconds, error) line first reaches ``target`` (m)."""
     for (t0, e0), (t1, e1) in itertools.pairwise(line):
         if e0 >= target >= e1 and e0 > e1:
@@ -227,16 +225,16 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
     for name in solvers:
         reason = solver_class(name).supports(scene)
         if reason is not None:
-            raise UsageError(f"--solvers {name}: cannot run {scene.source}: {reason}")
+            raise UsageError(f"solvers {name}: cannot run {scene.source}: {reason}", param="solvers")
     if not solvers:
-        raise UsageError(f"--solvers: no solver to benchmark for {scene.source}")
+        raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
     for dt in dts:
         make_options(scene, dt=dt, t_end=t_end)
     if window > t_end:
-        raise UsageError(f"--window {window:g}: must be <= the run's t_end = {t_end:g} (s)")
+        raise UsageError(f"window {window:g}: must be <= the run's t_end = {t_end:g} (s)", param="window")
     if not 0 < spacing <= window:
-        raise UsageError(f"--sample-spacing {spacing:g}: must be > 0 and <= the window "
-                         f"{window:g} (s)")
+        raise UsageError(f"sample_spacing {spacing:g}: must be > 0 and <= the window "
+                         f"{window:g} (s)", param="sample_spacing")
 
 
 def run_bench(
@@ -360,55 +358,6 @@ def _measure(cls: type[Solver], scene: Scene, options: RunOptions, repeat: int, 
     return traj, point
 
 
-def position_error(traj: Trajectory, truth: Trajectory, window: float) -> float:
-    """Largest distance |r - r_truth| of either particle over the samples in [0, window] (m);
-    inf if the run stopped before the window ended. Both must share their sample times."""
-    n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
-    if len(traj.t) < n:
-        return math.inf
-    if not np.array_equal(traj.t[:n], truth.t[:n]):
-        raise ValueError("position_error: the trajectories do not share their sample times")
-    worst = 0.0
-    for body in "AB":
-        cols = [c for c in (f"x{body}", f"y{body}") if c in traj.state]
-        sq = sum((traj.state[c][:n] - truth.state[c][:n]) ** 2 for c in cols)
-        worst = max(worst, float(np.sqrt(np.max(sq))))
-    return worst
-
-
-def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
-                      ) -> tuple[float, int, int]:
-    """(largest |t_i - t_i(truth)| in s, impacts compared, truth's impacts in [0, window]).
-
-    Impacts are paired in order; inf if the solver's sequence misses one or names another
-    body before the window ends."""
-    wanted = [e for e in truth.events if e.t <= window]
-    worst, compared = 0.0, 0
-    for mine, true in zip(traj.events, wanted):
-        if mine.body != true.body:
-            return math.inf, compared, len(wanted)
-        worst = max(worst, abs(mine.t - true.t))
-        compared += 1
-    if compared < len(wanted):
-        return math.inf, compared, len(wanted)
-    return (worst if compared else math.nan), compared, len(wanted)
-
-
-def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
-    """Largest relative energy error over the whole run: drift from E(0), or for a
-    dissipative scene the distance from the truth's E at the same times (dimensionless)."""
-    if len(traj.t) == 0:
-        return math.nan
-    if not traj.scene.dissipative:
-        return float(np.max(relative_energy_error(traj)))
-    if truth is None:
-        return math.nan
-    n = min(len(traj.t), len(truth.t))
-    E, E_true = traj["E"][:n], truth["E"][:n]
-    terms = {k: float(v[0]) for k, v in truth.energy.items() if k not in ("E", "E_lost")}
-    return float(np.max(np.abs(E - E_true)) / energy_scale(float(E_true[0]), terms))
-
-
 def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: float) -> None:
     point.energy_error = energy_error(traj, truth)
     if truth is None:
@@ -454,125 +403,6 @@ def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: 
     return point
 
 
-def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, float]:
-    """Largest position error (m) and impact time error (s) over [0, window] of an ``exact``
-    trajectory against the same
-    closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
-    with each impact time refined by Newton's method in that precision. It checks the
-    rounding of the double-precision solution, given its sequence of impacts."""
-    L = np.longdouble
-    scene = traj.scene
-    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
-    M = mA + mB
-    k = L(scene.spring.stiffness) if scene.spring else L(0)
-    b = L(scene.spring.rest_length) if scene.spring else L(0)
-    w = np.sqrt(k * M / (mA * mB))
-    e = L(scene.floor.elasticity) if scene.floor else L(1)
-
-    def state(seg, tau):
-        _t0, X0, V0, s0, sd0 = seg
-        X = X0 + V0 * tau - g * tau * tau / 2
-        V = V0 - g * tau
-        if w > 0:
-            c, s = np.cos(w * tau), np.sin(w * tau)
-            st, sdt = s0 * c + sd0 / w * s, -s0 * w * s + sd0 * c
-        else:
-            st, sdt = s0 + sd0 * tau, sd0 + 0 * tau
-        return (X + mB / M * (b + st), V + mB / M * sdt, X - mA / M * (b + st), V - mA / M * sdt)
-
-    def segment(t0, xA, vA, xB, vB):
-        return (t0, (mA * xA + mB * xB) / M, (mA * vA + mB * vB) / M, xA - xB - b, vA - vB)
-
-    seg = segment(L(0), L(scene.A.height), L(scene.A.vy), L(scene.B.height), L(scene.B.vy))
-    n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
-    t = traj.t[:n].astype(L)
-    worst = worst_t = 0.0
-    starts = [e_.t for e_ in traj.events if e_.t <= window] + [math.inf]
-    events = [e_ for e_ in traj.events if e_.t <= window]
-    lo = 0
-    for j, stop in enumerate(starts):
-        hi = int(np.searchsorted(traj.t[:n], stop, side="left"))
-        if hi > lo:
-            xA, _, xB, _ = state(seg, t[lo:hi] - seg[0])
-            worst = max(worst, float(np.max(np.abs(xA - traj["xA"][lo:hi]))),
-                        float(np.max(np.abs(xB - traj["xB"][lo:hi]))))
-        lo = hi
-        if j == len(events):
-            break
-        hit = events[j]
-        tau = L(hit.t) - seg[0]
-        idx = 0 if hit.body == "A" else 2
-        for _ in range(8):
-            s = state(seg, tau)
-            tau = tau - s[idx] / s[idx + 1]
-        worst_t = max(worst_t, abs(float(seg[0] + tau - L(hit.t))))
-        xA, vA, xB, vB = state(seg, tau)
-        if hit.body == "A":
-            xA, vA = L(0), -e * vA
-        else:
-            xB, vB = L(0), -e * vB
-        seg = segment(seg[0] + tau, xA, vA, xB, vB)
-    return worst, (worst_t if events else math.nan)
-
-
-def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, float]:
-    """:func:`extended_precision_exact` for the rigid 2D dumbbell: the parabola-and-rotation
-    closed form and the impulse law in numpy's extended precision, each impact time refined
-    by Newton's method there; largest position error (m) and impact time error (s)."""
-    from ..model.energy import rigid_moment
-
-    L = np.longdouble
-    scene = traj.scene
-    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
-    M = mA + mB
-    length = L(scene.rigid.length)  # type: ignore[union-attr]
-    arm = {"A": mB / M * length, "B": -mA / M * length}
-    moment = L(rigid_moment(scene))
-    e = L(scene.floor.elasticity) if scene.floor else L(1)
-    A, B = scene.A, scene.B
-    d = (L(A.x) - L(B.x), L(A.height) - L(B.height))
-    w = (L(A.vx) - L(B.vx), L(A.vy) - L(B.vy))
-    seg = [L(0), (mA * L(A.x) + mB * L(B.x)) / M, (mA * L(A.height) + mB * L(B.height)) / M,
-           (mA * L(A.vx) + mB * L(B.vx)) / M, (mA * L(A.vy) + mB * L(B.vy)) / M,
-           np.arctan2(d[1], d[0]), (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)]
-
-    def at(seg, tau):
-        t0, X, Y, VX, VY, th, om = seg
-        return [t0 + tau, X + VX * tau, Y + VY * tau - g * tau * tau / 2, VX, VY - g * tau,
-                th + om * tau, om]
-
-    n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
-    t = traj.t[:n].astype(L)
-    events = [e_ for e_ in traj.events if e_.t <= window]
-    worst = worst_t = 0.0
-    lo = 0
-    for j, stop in enumerate([e_.t for e_ in events] + [math.inf]):
-        hi = int(np.searchsorted(traj.t[:n], stop, side="left"))
-        if hi > lo:
-            _, X, Y, _, _, th, _ = at(seg, t[lo:hi] - seg[0])
-            for body in "AB":
-                worst = max(worst,
-                            float(np.max(np.abs(X + arm[body] * np.cos(th) - traj[f"x{body}"][lo:hi]))),
-                            float(np.max(np.abs(Y + arm[body] * np.sin(th) - traj[f"y{body}"][lo:hi]))))
-        lo = hi
-        if j == len(events):
-            break
-        hit = events[j]
-        a = arm[hit.body]
-        tau = L(hit.t) - seg[0]
-        if tau != 0:  # ends that hit together share the time: no new root to refine
-            for _ in range(8):
-                _, _, Y, _, VY, th, om = at(seg, tau)
-                tau = tau - (Y + a * np.sin(th)) / (VY + a * om * np.cos(th))
-        worst_t = max(worst_t, abs(float(seg[0] + tau - L(hit.t))))
-        seg = at(seg, tau)
-        rx = a * np.cos(seg[5])
-        J = -(1 + e) * (seg[4] + seg[6] * rx) / (1 / M + rx * rx / moment)
-        seg[4] += J / M
-        seg[6] += rx * J / moment
-    return worst, (worst_t if events else math.nan)
-
-
 def fit_order(points: list[Point]) -> Fit | None:
     """Least-squares slope of log10(error) against log10(dt) over the ok points with an error
     between FIT_MIN_ERROR and FIT_MAX_ERROR (m); None with fewer than 3 such points."""
@@ -589,155 +419,8 @@ def fit_order(points: list[Point]) -> Fit | None:
 # ----------------------------------------------------------------------------- outputs
 
 
-def _fmt(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return "nan" if math.isnan(value) else repr(value)
-    return str(value)
-
-
-def write_csv(result: BenchResult, path: Path) -> Path:
-    """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
-    from ..io.files import atomic_output
-
-    with atomic_output(path) as tmp, open(tmp, "w", newline="") as fh:
-        writer = csv.writer(fh, lineterminator="\n")
-        writer.writerow(CSV_COLUMNS)
-        for p in result.points:
-            row = asdict(p)
-            writer.writerow([_fmt(row[c]) for c in CSV_COLUMNS])
-    return path
-
-
-def _json_value(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
-    if isinstance(value, dict):
-        return {k: _json_value(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [_json_value(v) for v in value]
-    return value
-
-
-def to_json(result: BenchResult) -> dict[str, Any]:
-    """The result as plain JSON data (inf as the string "inf", nan as null)."""
-    data = {
-        "scene": result.scene, "source": result.source, "truth": result.truth,
-        "window_s": result.window, "t_end_s": result.t_end, "repeat": result.repeat,
-        "budget_s": result.budget, "sample_spacing_s": result.spacing,
-        "fit_max_error_m": FIT_MAX_ERROR, "fit_min_error_m": FIT_MIN_ERROR,
-        "notes": result.notes,
-        "points": [asdict(p) for p in result.points],
-        "orders": {n: asdict(f) for n, f in result.fits.items()},
-        "matched_error": result.speedups(),
-    }
-    return _json_value(data)
-
-
-def write_json(result: BenchResult, path: Path) -> Path:
-    from ..io.files import atomic_output
-
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(to_json(result), indent=1) + "\n")
-    return path
-
-
-def _sci(x: float | None, digits: int = 2) -> str:
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "-"
-    if isinstance(x, float) and math.isinf(x):
-        return "inf"
-    return f"{x:.{digits}e}"
-
-
 def dt_label(dt: float) -> str:
     """'1e-5', '3.2e-6': a step size as written beside a point (s)."""
     mantissa, exponent = f"{dt:.1e}".split("e")
     mantissa = mantissa.rstrip("0").rstrip(".")
     return f"{mantissa}e{int(exponent)}"
-
-
-def markdown(result: BenchResult) -> str:
-    """The table, fitted orders and matched-error speed-ups as markdown."""
-    lines = [
-        (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
-        f"truth: `{result.truth}`; position error over [0, {result.window:g}] s; time: min "
-        f"(median) of at least {result.repeat} runs after a warm-up; short runs are "
-        f"repeated until {MIN_TIMED:g} s are timed."),
-        "",
-        ("| solver | dt (s) | steps | run time min (median) | position error (m) "
-        "| energy error (rel.) | impact time error (s) | verdict |"),
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for p in result.points:
-        dt = dt_label(p.dt) if p.dt is not None else f"(samples every {result.spacing:g} s)"
-        if p.ran:
-            time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
-        else:
-            time_s = f"~{_ms(p.seconds)} (estimate)"
-        verdict = p.verdict if p.ok else f"**{p.verdict}**" + (
-            f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
-        imp = _sci(p.impact_time_error)
-        if p.impacts_truth:
-            imp += f" ({p.impacts_compared}/{p.impacts_truth})"
-        steps = f"{p.steps:,}" if p.dt is not None else "-"
-        lines.append(f"| {p.solver} | {dt} | {steps} | {time_s} | {_sci(p.error)} "
-                     f"| {_sci(p.energy_error)} | {imp} | {verdict} |")
-    lines.append("")
-    if result.fits:
-        fit_text = "; ".join(
-            f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
-            f"{len(f.dts)} points)" for n, f in result.fits.items())
-        lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
-                     f"(least squares in log-log over the ok points with error between "
-                     f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")
-    sp = result.speedups()
-    if sp and sp.get("seconds"):
-        parts = [f"{n} {_ms(t)} ({sp['speedup'].get(n, math.nan):.3g}x)"
-                 for n, t in sp["seconds"].items()]
-        lines.append(f"Run time to reach {sp['baseline']}'s error at dt = 1e-5 s "
-                     f"({sp['target_error']:.2e} m), interpolated along each line "
-                     f"(speed-up against {sp['baseline']}): {'; '.join(parts)}.")
-    compile_parts = {p.solver: p.compile_seconds for p in result.points
-                     if math.isfinite(p.compile_seconds)}
-    if compile_parts:
-        lines.append("JIT compile (or load from numba's cache) before the runs, not in the "
-                     "times above: "
-                     + "; ".join(f"{n} {v:.3g} s" for n, v in compile_parts.items())
-                     + " (the first numba solver also pays numba's one-time start-up).")
-    for p in result.points:
-        if p.ran and p.window != result.window:
-            lines.append(f"The {p.solver} row's errors are {p.reason}.")
-    lines.extend(result.notes)
-    return "\n".join(lines) + "\n"
-
-
-def _ms(seconds: float) -> str:
-    if not math.isfinite(seconds):
-        return "-"
-    if seconds >= 1:
-        return f"{seconds:.3g} s"
-    if seconds >= 1e-3:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds * 1e6:.3g} µs"
-
-
-def write_markdown(result: BenchResult, path: Path) -> Path:
-    from ..io.files import atomic_output
-
-    with atomic_output(path) as tmp:
-        tmp.write_text(markdown(result))
-    return path
-
-
-def write_all(result: BenchResult, out: Path) -> list[Path]:
-    """CSV, JSON and markdown into ``out``, named bench-SCENE*. (The figures are
-    :mod:`dumbbell.plot`'s: :func:`~dumbbell.plot.work_precision` and
-    :func:`~dumbbell.plot.convergence`; the command saves them.)"""
-    stem = f"bench-{result.scene}"
-    return [
-        write_csv(result, out / f"{stem}.csv"),
-        write_json(result, out / f"{stem}.json"),
-        write_markdown(result, out / f"{stem}.md"),
-    ]

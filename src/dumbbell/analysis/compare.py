@@ -29,6 +29,7 @@ from ..errors import UsageError
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from ..solvers import no_truth_reason, solver_class, truth_solver
+from .metrics import coordinate_error, energy_spread
 
 if TYPE_CHECKING:
     import pandas
@@ -37,27 +38,6 @@ if TYPE_CHECKING:
 WINDOW = 2.0
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
-
-
-def position_columns(scene: Scene) -> list[str]:
-    """The position columns of a scene (m)."""
-    return ["xA", "xB"] if scene.dimensions == 1 else ["xA", "yA", "xB", "yB"]
-
-
-def position_error(run: Trajectory, truth: Trajectory) -> np.ndarray:
-    """Largest |position difference| of either particle at each common sample (m)."""
-    n = min(len(run.t), len(truth.t))
-    return np.max([np.abs(run[c][:n] - truth[c][:n]) for c in position_columns(run.scene)],
-                  axis=0)
-
-
-def energy_spread(traj: Trajectory) -> float:
-    """(max E - min E) / |E(0)| over the whole run (dimensionless)."""
-    E = traj["E"]
-    if not len(E):
-        return math.nan
-    scale = abs(float(E[0])) or 1.0
-    return float((np.max(E) - np.min(E)) / scale)
 
 
 #: Columns of :meth:`Comparison.summary` and their units.
@@ -205,17 +185,17 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
     for name in solvers:
         reason = solver_class(name).supports(scene)
         if reason is not None:
-            raise UsageError(f"--solvers: {name!r} cannot run {scene.source}: {reason}")
+            raise UsageError(f"solvers: {name!r} cannot run {scene.source}: {reason}", param="solvers")
     if not (window > 0 and math.isfinite(window)):
-        raise UsageError(f"--window = {window!r}: must be a finite number > 0 (s)")
+        raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
     # One sample spacing for every run, so that they compare point by point.
     spacing = max(max(dts), scene.run.dt * scene.run.every)
     for dt in dts:
         make_options(scene, dt, t_end)  # validates dt against t_end
         ratio = spacing / dt
         if abs(ratio - round(ratio)) > 1e-6 * ratio:
-            raise UsageError(f"--dt {dt:g}: must divide the sample spacing {spacing:g} s "
-                             "(the largest dt, or the scene's dt * every) a whole number of times")
+            raise UsageError(f"dt {dt:g}: must divide the sample spacing {spacing:g} s "
+                             "(the largest dt, or the scene's dt * every) a whole number of times", param="dt")
     truth_name = truth_solver(scene)
     notes = []
     if truth_name is None:
@@ -241,7 +221,7 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
         for dt in dts:
             run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
                            quiet=quiet)
-            err = position_error(run, truth)
+            err = coordinate_error(run, truth)
             inside = run.t[: len(err)] <= window + 1e-12
             over = np.flatnonzero(err > DIVERGED)
             label = name if len(dts) == 1 else f"{name} dt={dt:g}"

@@ -105,10 +105,10 @@ def find_cases(folder: str | Path) -> list[Path]:
     """The scene files in ``folder``, sorted by name (UsageError if there are none)."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise UsageError(f"--cases {folder}: no such folder")
+        raise UsageError(f"cases {folder}: no such folder", param="cases")
     paths = sorted(folder.glob("*.toml"))
     if not paths:
-        raise UsageError(f"--cases {folder}: no scene files (*.toml) in it")
+        raise UsageError(f"cases {folder}: no scene files (*.toml) in it", param="cases")
     return paths
 
 
@@ -416,5 +416,5 @@ def plan_runs(cases: str | Path | None, solvers: list[str] | None
     runs, skipped = plan_cases(find_cases(cases if cases is not None else default_cases()),
                                solvers)
     if not runs:
-        raise UsageError("--solvers: none of them can run any of the cases")
+        raise UsageError("solvers: none of them can run any of the cases", param="solvers")
     return runs, skipped

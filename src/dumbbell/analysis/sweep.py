@@ -78,7 +78,7 @@ def _number(text: str, flag: str) -> float:
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise UsageError(f"--grid {flag!r}: {text!r} is not a finite number")
+        raise UsageError(f"grid {flag!r}: {text!r} is not a finite number", param="grid")
     return value
 
 
@@ -99,61 +99,61 @@ def _list_value(text: str) -> Any:
 
 
 def parse_axis(text: str) -> Axis:
-    """Parse one ``--grid`` item, ``NAME=log:A:B:N``, ``NAME=lin:A:B:N`` or ``NAME=v1,v2,...``
+    """Parse one grid axis (the command's ``--grid`` item), ``NAME=log:A:B:N``, ``NAME=lin:A:B:N`` or ``NAME=v1,v2,...``
     (UsageError naming the item and what is allowed)."""
     form = "NAME=log:A:B:N, NAME=lin:A:B:N or NAME=V1,V2,..."
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     if not sep or not name or not spec:
-        raise UsageError(f"--grid {text!r}: must be {form}")
+        raise UsageError(f"grid {text!r}: must be {form}", param="grid")
     key = SHORT_NAMES.get(name, name)
     if not all(part.isidentifier() or part in ("A", "B") for part in key.split(".")):
-        raise UsageError(f"--grid {text!r}: {name!r} is not a dotted scene key such as "
-                         "spring.stiffness, bodies.A.mass or run.dt (k and dt are short names)")
+        raise UsageError(f"grid {text!r}: {name!r} is not a dotted scene key such as "
+                         "spring.stiffness, bodies.A.mass or run.dt (k and dt are short names)", param="grid")
     kind = spec.split(":", 1)[0]
     if kind in ("log", "lin"):
         parts = spec.split(":")
         if len(parts) != 4:
-            raise UsageError(f"--grid {text!r}: must be {name}={kind}:A:B:N")
+            raise UsageError(f"grid {text!r}: must be {name}={kind}:A:B:N", param="grid")
         a, b = _number(parts[1], text), _number(parts[2], text)
         try:
             n = int(parts[3])
         except ValueError:
             n = 0
         if not 2 <= n <= MAX_AXIS_VALUES:
-            raise UsageError(f"--grid {text!r}: N = {parts[3]!r} must be a whole number from 2 "
-                             f"to {MAX_AXIS_VALUES}")
+            raise UsageError(f"grid {text!r}: N = {parts[3]!r} must be a whole number from 2 "
+                             f"to {MAX_AXIS_VALUES}", param="grid")
         if a == b:
-            raise UsageError(f"--grid {text!r}: A and B must differ")
+            raise UsageError(f"grid {text!r}: A and B must differ", param="grid")
         if kind == "log":
             if a <= 0 or b <= 0:
-                raise UsageError(f"--grid {text!r}: log spacing needs A > 0 and B > 0")
+                raise UsageError(f"grid {text!r}: log spacing needs A > 0 and B > 0", param="grid")
             values = tuple(float(v) for v in np.geomspace(a, b, n))
         else:
             values = tuple(float(v) for v in np.linspace(a, b, n))
         return Axis(key, text, values, kind)
     items = [s for s in spec.split(",")]
     if any(not s.strip() for s in items):
-        raise UsageError(f"--grid {text!r}: an empty value in the list; must be {form}")
+        raise UsageError(f"grid {text!r}: an empty value in the list; must be {form}", param="grid")
     if len(items) > MAX_AXIS_VALUES:
-        raise UsageError(f"--grid {text!r}: at most {MAX_AXIS_VALUES} values")
+        raise UsageError(f"grid {text!r}: at most {MAX_AXIS_VALUES} values", param="grid")
     values = tuple(_list_value(s) for s in items)
     if len(set(map(repr, values))) != len(values):
-        raise UsageError(f"--grid {text!r}: a value is listed twice")
+        raise UsageError(f"grid {text!r}: a value is listed twice", param="grid")
     return Axis(key, text, values, "list")
 
 
 def check_axes(axes: Sequence[Axis]) -> None:
     """One or two axes on different keys (UsageError otherwise)."""
     if not 1 <= len(axes) <= 2:
-        raise UsageError(f"--grid: give one or two axes (got {len(axes)}), e.g. "
-                         "--grid k=log:1e2:1e7:50 dt=log:1e-6:1e-2:50")
+        raise UsageError(f"grid: give one or two axes (got {len(axes)}), e.g. "
+                         "k=log:1e2:1e7:50 dt=log:1e-6:1e-2:50", param="grid")
     if len(axes) == 2 and axes[0].key == axes[1].key:
-        raise UsageError(f"--grid: {axes[0].text!r} and {axes[1].text!r} sweep the same key "
-                         f"{axes[0].key}")
+        raise UsageError(f"grid: {axes[0].text!r} and {axes[1].text!r} sweep the same key "
+                         f"{axes[0].key}", param="grid")
     if math.prod(len(a.values) for a in axes) > MAX_POINTS:
-        raise UsageError(f"--grid: {math.prod(len(a.values) for a in axes)} points; a sweep "
-                         f"allows at most {MAX_POINTS}")
+        raise UsageError(f"grid: {math.prod(len(a.values) for a in axes)} points; a sweep "
+                         f"allows at most {MAX_POINTS}", param="grid")
 
 
 @dataclass(frozen=True)
@@ -181,25 +181,25 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
         try:
             point_scene = scene.with_values(values)
         except DumbbellError as exc:
-            raise UsageError(f"--grid at {where}: {exc}") from None
+            raise UsageError(f"grid at {where}: {exc}", param="grid") from None
         reason = cls.supports(point_scene)
         if reason is not None:
-            raise UsageError(f"--grid at {where}: solver {solver!r} cannot run it: {reason}")
+            raise UsageError(f"grid at {where}: solver {solver!r} cannot run it: {reason}", param="grid")
         try:
             options = make_options(point_scene)
         except DumbbellError as exc:
-            raise UsageError(f"--grid at {where}: {exc}") from None
+            raise UsageError(f"grid at {where}: {exc}", param="grid") from None
         if options.n_steps > MAX_STEPS_PER_POINT:
             raise UsageError(
-                f"--grid at {where}: dt = {options.dt:g} s over t_end = {options.t_end:g} s is "
+                f"grid at {where}: dt = {options.dt:g} s over t_end = {options.t_end:g} s is "
                 f"{options.n_steps:.3g} steps; a sweep point may take at most "
-                f"{MAX_STEPS_PER_POINT:.0e}: raise dt or lower --t-end")
+                f"{MAX_STEPS_PER_POINT:.0e}: raise dt or lower t_end", param="grid")
         total += options.n_steps
         points.append(Point(index, values))
     if total > MAX_STEPS_TOTAL:
-        raise UsageError(f"--grid: the sweep would take {total:.3g} steps in all; at most "
+        raise UsageError(f"grid: the sweep would take {total:.3g} steps in all; at most "
                          f"{MAX_STEPS_TOTAL:.0e}: use fewer points, a larger dt or a smaller "
-                         "--t-end")
+                         "t_end", param="grid")
     return points
 
 
@@ -392,8 +392,8 @@ def run_dask(scene: Scene, points: list[Point], solver: str, scheduler: str,
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
-        raise UsageError("--scheduler needs dask.distributed: pip install 'dumbbell[dask]'"
-                         ) from None
+        raise UsageError("scheduler needs dask.distributed: pip install 'dumbbell[dask]'"
+                         , param="scheduler") from None
     import contextlib
 
     with contextlib.ExitStack() as stack:
@@ -408,8 +408,8 @@ def run_dask(scene: Scene, points: list[Point], solver: str, scheduler: str,
                 client = stack.enter_context(Client(scheduler, timeout="10s"))
             except (OSError, TimeoutError, ValueError) as exc:
                 text = " ".join(str(exc).split())[:200]
-                raise UsageError(f"--scheduler {scheduler}: cannot connect to a Dask "
-                                 f"scheduler there ({text})") from None
+                raise UsageError(f"scheduler {scheduler}: cannot connect to a Dask "
+                                 f"scheduler there ({text})", param="scheduler") from None
         n_workers = max(1, len(client.scheduler_info().get("workers", {})))
         scattered = client.scatter(scene, broadcast=True)
         futures = [client.submit(_evaluate_batch, scattered, batch, solver, pure=False)

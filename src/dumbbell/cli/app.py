@@ -99,6 +99,16 @@ def _check_outputs(args: argparse.Namespace) -> None:
             check_writable(value, flag, folder)
 
 
+def as_flags(exc: DumbbellError) -> str:
+    """The error's message as the command line says it: a library error that starts with
+    the parameter's name (``UsageError.param``) starts with its flag instead."""
+    text = str(exc)
+    param = getattr(exc, "param", None)
+    if param and text.startswith(param):
+        return "--" + param.replace("_", "-") + text[len(param):]
+    return text
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status."""
     # The command only writes files: matplotlib's file-only backend, unless the user chose one.
@@ -109,7 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _check_outputs(args)
         return int(args.func(args) or 0)
     except DumbbellError as exc:
-        sys.stderr.write(f"dumbbell {args.command}: error: {exc}\n")
+        sys.stderr.write(f"dumbbell {args.command}: error: {as_flags(exc)}\n")
         return EXIT_USAGE
     except BrokenPipeError:
         # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep

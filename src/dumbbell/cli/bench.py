@@ -63,7 +63,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.bench import run_bench, write_all
+    from ..analysis.bench import run_bench
+    from ..io.bench import write_all
     from ..model.scene import load_scene
 
     scene = load_scene(args.scene)
@@ -81,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
                 save_figure(convergence(result).figure, f"{stem}-convergence.png",
                             dpi="figure")]
     if not args.quiet:
-        from ..analysis.bench import markdown
+        from ..io.bench import markdown
 
         sys.stdout.write(markdown(result))
         for path in written:

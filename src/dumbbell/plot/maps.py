@@ -139,7 +139,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> No
     """A one-axis sweep: log10 of the largest relative energy error against the value, the
     failures marked by verdict and the value where w*dt = 2."""
     if not axis.numeric:
-        raise UsageError("--grid: a plot needs a numeric axis; use a list of numbers")
+        raise UsageError("grid: a plot needs a numeric axis; use a list of numbers", param="grid")
     xs = np.array(axis.values, float)
     order = np.argsort(xs)
     xs = xs[order]

@@ -1,0 +1,134 @@
+"""The truth's own error: the exact solution evaluated again in extended precision.
+
+numpy's ``longdouble`` (80-bit on x86: 64-bit mantissa) re-evaluates the same closed form,
+impact times refined by Newton's method there, at the exact solver's sample times; the
+differences are the exact solver's rounding and root-finding error. ``bench`` reports them
+as the truth's own point.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model.trajectory import Trajectory
+
+
+def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, float]:
+    """Largest position error (m) and impact time error (s) over [0, window] of an ``exact``
+    trajectory against the same
+    closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
+    with each impact time refined by Newton's method in that precision. It checks the
+    rounding of the double-precision solution, given its sequence of impacts."""
+    L = np.longdouble
+    scene = traj.scene
+    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
+    M = mA + mB
+    k = L(scene.spring.stiffness) if scene.spring else L(0)
+    b = L(scene.spring.rest_length) if scene.spring else L(0)
+    w = np.sqrt(k * M / (mA * mB))
+    e = L(scene.floor.elasticity) if scene.floor else L(1)
+
+    def state(seg, tau):
+        _t0, X0, V0, s0, sd0 = seg
+        X = X0 + V0 * tau - g * tau * tau / 2
+        V = V0 - g * tau
+        if w > 0:
+            c, s = np.cos(w * tau), np.sin(w * tau)
+            st, sdt = s0 * c + sd0 / w * s, -s0 * w * s + sd0 * c
+        else:
+            st, sdt = s0 + sd0 * tau, sd0 + 0 * tau
+        return (X + mB / M * (b + st), V + mB / M * sdt, X - mA / M * (b + st), V - mA / M * sdt)
+
+    def segment(t0, xA, vA, xB, vB):
+        return (t0, (mA * xA + mB * xB) / M, (mA * vA + mB * vB) / M, xA - xB - b, vA - vB)
+
+    seg = segment(L(0), L(scene.A.height), L(scene.A.vy), L(scene.B.height), L(scene.B.vy))
+    n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
+    t = traj.t[:n].astype(L)
+    worst = worst_t = 0.0
+    starts = [e_.t for e_ in traj.events if e_.t <= window] + [math.inf]
+    events = [e_ for e_ in traj.events if e_.t <= window]
+    lo = 0
+    for j, stop in enumerate(starts):
+        hi = int(np.searchsorted(traj.t[:n], stop, side="left"))
+        if hi > lo:
+            xA, _, xB, _ = state(seg, t[lo:hi] - seg[0])
+            worst = max(worst, float(np.max(np.abs(xA - traj["xA"][lo:hi]))),
+                        float(np.max(np.abs(xB - traj["xB"][lo:hi]))))
+        lo = hi
+        if j == len(events):
+            break
+        hit = events[j]
+        tau = L(hit.t) - seg[0]
+        idx = 0 if hit.body == "A" else 2
+        for _ in range(8):
+            s = state(seg, tau)
+            tau = tau - s[idx] / s[idx + 1]
+        worst_t = max(worst_t, abs(float(seg[0] + tau - L(hit.t))))
+        xA, vA, xB, vB = state(seg, tau)
+        if hit.body == "A":
+            xA, vA = L(0), -e * vA
+        else:
+            xB, vB = L(0), -e * vB
+        seg = segment(seg[0] + tau, xA, vA, xB, vB)
+    return worst, (worst_t if events else math.nan)
+
+
+def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, float]:
+    """:func:`extended_precision_exact` for the rigid 2D dumbbell: the parabola-and-rotation
+    closed form and the impulse law in numpy's extended precision, each impact time refined
+    by Newton's method there; largest position error (m) and impact time error (s)."""
+    from ..model.energy import rigid_moment
+
+    L = np.longdouble
+    scene = traj.scene
+    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
+    M = mA + mB
+    length = L(scene.rigid.length)  # type: ignore[union-attr]
+    arm = {"A": mB / M * length, "B": -mA / M * length}
+    moment = L(rigid_moment(scene))
+    e = L(scene.floor.elasticity) if scene.floor else L(1)
+    A, B = scene.A, scene.B
+    d = (L(A.x) - L(B.x), L(A.height) - L(B.height))
+    w = (L(A.vx) - L(B.vx), L(A.vy) - L(B.vy))
+    seg = [L(0), (mA * L(A.x) + mB * L(B.x)) / M, (mA * L(A.height) + mB * L(B.height)) / M,
+           (mA * L(A.vx) + mB * L(B.vx)) / M, (mA * L(A.vy) + mB * L(B.vy)) / M,
+           np.arctan2(d[1], d[0]), (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)]
+
+    def at(seg, tau):
+        t0, X, Y, VX, VY, th, om = seg
+        return [t0 + tau, X + VX * tau, Y + VY * tau - g * tau * tau / 2, VX, VY - g * tau,
+                th + om * tau, om]
+
+    n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
+    t = traj.t[:n].astype(L)
+    events = [e_ for e_ in traj.events if e_.t <= window]
+    worst = worst_t = 0.0
+    lo = 0
+    for j, stop in enumerate([e_.t for e_ in events] + [math.inf]):
+        hi = int(np.searchsorted(traj.t[:n], stop, side="left"))
+        if hi > lo:
+            _, X, Y, _, _, th, _ = at(seg, t[lo:hi] - seg[0])
+            for body in "AB":
+                worst = max(worst,
+                            float(np.max(np.abs(X + arm[body] * np.cos(th) - traj[f"x{body}"][lo:hi]))),
+                            float(np.max(np.abs(Y + arm[body] * np.sin(th) - traj[f"y{body}"][lo:hi]))))
+        lo = hi
+        if j == len(events):
+            break
+        hit = events[j]
+        a = arm[hit.body]
+        tau = L(hit.t) - seg[0]
+        if tau != 0:  # ends that hit together share the time: no new root to refine
+            for _ in range(8):
+                _, _, Y, _, VY, th, om = at(seg, tau)
+                tau = tau - (Y + a * np.sin(th)) / (VY + a * om * np.cos(th))
+        worst_t = max(worst_t, abs(float(seg[0] + tau - L(hit.t))))
+        seg = at(seg, tau)
+        rx = a * np.cos(seg[5])
+        J = -(1 + e) * (seg[4] + seg[6] * rx) / (1 / M + rx * rx / moment)
+        seg[4] += J / M
+        seg[6] += rx * J / moment
+    return worst, (worst_t if events else math.nan)

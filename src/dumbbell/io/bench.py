@@ -1,0 +1,163 @@
+"""The benchmark's files: CSV (one row per point), JSON (everything) and a Markdown table
+(:class:`dumbbell.analysis.bench.BenchResult` in, files out). The figures are
+:mod:`dumbbell.plot`'s."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from ..analysis.bench import (
+    CSV_COLUMNS,
+    FIT_MAX_ERROR,
+    FIT_MIN_ERROR,
+    MIN_TIMED,
+    BenchResult,
+    dt_label,
+)
+from .files import atomic_output
+
+
+def _fmt(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return "nan" if math.isnan(value) else repr(value)
+    return str(value)
+
+
+def write_csv(result: BenchResult, path: Path) -> Path:
+    """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
+    with atomic_output(path) as tmp, open(tmp, "w", newline="") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(CSV_COLUMNS)
+        for p in result.points:
+            row = asdict(p)
+            writer.writerow([_fmt(row[c]) for c in CSV_COLUMNS])
+    return path
+
+
+def _json_value(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _json_value(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_json_value(v) for v in value]
+    return value
+
+
+def to_json(result: BenchResult) -> dict[str, Any]:
+    """The result as plain JSON data (inf as the string "inf", nan as null)."""
+    data = {
+        "scene": result.scene, "source": result.source, "truth": result.truth,
+        "window_s": result.window, "t_end_s": result.t_end, "repeat": result.repeat,
+        "budget_s": result.budget, "sample_spacing_s": result.spacing,
+        "fit_max_error_m": FIT_MAX_ERROR, "fit_min_error_m": FIT_MIN_ERROR,
+        "notes": result.notes,
+        "points": [asdict(p) for p in result.points],
+        "orders": {n: asdict(f) for n, f in result.fits.items()},
+        "matched_error": result.speedups(),
+    }
+    return _json_value(data)
+
+
+def write_json(result: BenchResult, path: Path) -> Path:
+    with atomic_output(path) as tmp:
+        tmp.write_text(json.dumps(to_json(result), indent=1) + "\n")
+    return path
+
+
+def _sci(x: float | None, digits: int = 2) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    if isinstance(x, float) and math.isinf(x):
+        return "inf"
+    return f"{x:.{digits}e}"
+
+
+def markdown(result: BenchResult) -> str:
+    """The table, fitted orders and matched-error speed-ups as markdown."""
+    lines = [
+        (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
+        f"truth: `{result.truth}`; position error over [0, {result.window:g}] s; time: min "
+        f"(median) of at least {result.repeat} runs after a warm-up; short runs are "
+        f"repeated until {MIN_TIMED:g} s are timed."),
+        "",
+        ("| solver | dt (s) | steps | run time min (median) | position error (m) "
+        "| energy error (rel.) | impact time error (s) | verdict |"),
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for p in result.points:
+        dt = dt_label(p.dt) if p.dt is not None else f"(samples every {result.spacing:g} s)"
+        if p.ran:
+            time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
+        else:
+            time_s = f"~{_ms(p.seconds)} (estimate)"
+        verdict = p.verdict if p.ok else f"**{p.verdict}**" + (
+            f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
+        imp = _sci(p.impact_time_error)
+        if p.impacts_truth:
+            imp += f" ({p.impacts_compared}/{p.impacts_truth})"
+        steps = f"{p.steps:,}" if p.dt is not None else "-"
+        lines.append(f"| {p.solver} | {dt} | {steps} | {time_s} | {_sci(p.error)} "
+                     f"| {_sci(p.energy_error)} | {imp} | {verdict} |")
+    lines.append("")
+    if result.fits:
+        fit_text = "; ".join(
+            f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
+            f"{len(f.dts)} points)" for n, f in result.fits.items())
+        lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
+                     f"(least squares in log-log over the ok points with error between "
+                     f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")
+    sp = result.speedups()
+    if sp and sp.get("seconds"):
+        parts = [f"{n} {_ms(t)} ({sp['speedup'].get(n, math.nan):.3g}x)"
+                 for n, t in sp["seconds"].items()]
+        lines.append(f"Run time to reach {sp['baseline']}'s error at dt = 1e-5 s "
+                     f"({sp['target_error']:.2e} m), interpolated along each line "
+                     f"(speed-up against {sp['baseline']}): {'; '.join(parts)}.")
+    compile_parts = {p.solver: p.compile_seconds for p in result.points
+                     if math.isfinite(p.compile_seconds)}
+    if compile_parts:
+        lines.append("JIT compile (or load from numba's cache) before the runs, not in the "
+                     "times above: "
+                     + "; ".join(f"{n} {v:.3g} s" for n, v in compile_parts.items())
+                     + " (the first numba solver also pays numba's one-time start-up).")
+    for p in result.points:
+        if p.ran and p.window != result.window:
+            lines.append(f"The {p.solver} row's errors are {p.reason}.")
+    lines.extend(result.notes)
+    return "\n".join(lines) + "\n"
+
+
+def _ms(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "-"
+    if seconds >= 1:
+        return f"{seconds:.3g} s"
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds * 1e6:.3g} µs"
+
+
+def write_markdown(result: BenchResult, path: Path) -> Path:
+    with atomic_output(path) as tmp:
+        tmp.write_text(markdown(result))
+    return path
+
+
+def write_all(result: BenchResult, out: Path) -> list[Path]:
+    """CSV, JSON and markdown into ``out``, named bench-SCENE*. (The figures are
+    :mod:`dumbbell.plot`'s: :func:`~dumbbell.plot.work_precision` and
+    :func:`~dumbbell.plot.convergence`; the command saves them.)"""
+    stem = f"bench-{result.scene}"
+    return [
+        write_csv(result, out / f"{stem}.csv"),
+        write_json(result, out / f"{stem}.json"),
+        write_markdown(result, out / f"{stem}.md"),
+    ]
