@@ -177,3 +177,9 @@ def test_2d_scene_uses_the_reference_as_truth():
     assert 0 < truth.error < 1e-8  # its own estimate, from a run at 10x tighter tolerance
     assert 80 < coarse.error / fine.error < 120  # verlet stays second order in 2D
     assert fine.impacts_truth == fine.impacts_compared == 2
+
+
+def test_every_csv_column_has_a_unit():
+    from dumbbell.analysis.bench import CSV_UNITS
+
+    assert set(CSV_UNITS) == set(CSV_COLUMNS)

@@ -10,6 +10,7 @@ import shutil
 import pytest
 
 from dumbbell.cli import build_parser, main
+from dumbbell.cli.app import arguments, subcommands
 from tests.conftest import SCENES
 
 TEXTBOOK = str(SCENES / "textbook-1d.toml")
@@ -31,21 +32,18 @@ CHEAP = {"simulate": ["--t-end", "0.01"], "render": ["--t-end", "0.05"],
 
 
 def _commands() -> dict[str, argparse.ArgumentParser]:
-    parser = build_parser()
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    return dict(sub.choices)
+    return subcommands(build_parser())
 
 
 def _options(name: str) -> list[argparse.Action]:
-    return [a for a in _commands()[name]._actions
-            if a.option_strings and not isinstance(a, argparse._HelpAction)]
+    return [a for a in arguments(_commands()[name]) if a.option_strings]
 
 
 def _base(name: str, skip: str | None = None) -> list[str]:
     """A valid command line for ``name`` without the flag ``skip``."""
     parser = _commands()[name]
     argv = [name]
-    if any(a.dest == "scene" and not a.option_strings for a in parser._actions):
+    if any(a.dest == "scene" and not a.option_strings for a in arguments(parser)):
         argv.append(TEXTBOOK)
     cheap = CHEAP.get(name, [])
     i = 0
@@ -111,7 +109,7 @@ def test_unknown_flag_and_missing_scene(tmp_path, capsys, monkeypatch, name):
     monkeypatch.chdir(tmp_path)
     _check(tmp_path, capsys, _base(name) + ["--no-such-flag"], "--no-such-flag")
     scene_arg = any(a.dest == "scene" and not a.option_strings
-                    for a in _commands()[name]._actions)
+                    for a in arguments(_commands()[name]))
     if scene_arg:
         argv = [a if a != TEXTBOOK else str(tmp_path / "missing.toml") for a in _base(name)]
         _check(tmp_path, capsys, argv, "missing.toml")

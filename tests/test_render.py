@@ -204,22 +204,22 @@ def test_2d_drawing_keeps_the_aspect_ratio_and_follows_both_coordinates(tmp_path
 
 
 def test_range_since_previous_frame_matches_brute_force():
-    from dumbbell.animation.render import _since_previous
+    from dumbbell.animation.render import since_previous
 
     v = np.random.default_rng(1).random(50)
     idx = np.array([0, 0, 3, 7, 7, 8, 20, 49])     # frames may share a sample
     for ufunc, reduce in ((np.maximum, np.max), (np.minimum, np.min)):
         expected = [v[0]] + [reduce(v[a:b + 1]) for a, b in itertools.pairwise(idx)]
-        assert np.array_equal(_since_previous(v, idx, ufunc), expected)
+        assert np.array_equal(since_previous(v, idx, ufunc), expected)
 
 
 def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     """Index 255 marks 'unchanged' (transparent) in the GIF: a drawn pixel with it would show
     the previous frame's colour instead."""
     from dumbbell.animation.drawing import palette
-    from dumbbell.animation.render import _frames
+    from dumbbell.animation.render import frames_of
 
-    frames = _frames(short, 25, 1.0)
+    frames = frames_of(short, 25, 1.0)
     painter = Painter(short.scene, frames, (320, 180), True)
     clear = palette()[1]
     assert all(clear not in np.asarray(painter.frame(k)) for k in range(len(frames.t)))
@@ -230,10 +230,10 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
     put while the curves scroll under it, and in every frame the U_g curve just left of the
     cursor is drawn at U_g of that column's time (so the window's time axis is right)."""
     from dumbbell.animation import drawing
-    from dumbbell.animation.render import _frames
+    from dumbbell.animation.render import frames_of
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
-    frames = _frames(traj, 25, 2.0)
+    frames = frames_of(traj, 25, 2.0)
     painter = Painter(textbook, frames, (640, 360), True)
     assert painter.window == drawing.WINDOW < 2.0
     sx0, sy0, sx1, sy1 = painter.strip_box

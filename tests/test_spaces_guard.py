@@ -11,7 +11,7 @@ import pytest
 from dumbbell import spaces
 from dumbbell.model.scene import load_scene, scenes_dir
 from dumbbell.solvers import simulate
-from dumbbell.solvers.engine import _FLOOR_THICKNESS, build
+from dumbbell.solvers.engine import FLOOR_THICKNESS, build
 
 
 def _pair(mA: float, mB: float, k: float, static_b: bool = False) -> pymunk.Space:
@@ -87,7 +87,7 @@ def test_high_drop_tunnels_and_the_suggested_dt_does_not():
         driver.step()
         lowest = min(lowest, *(b.position.y for b in space.bodies))
     # Never past the floor box's middle (from where a contact would push it on through).
-    assert lowest > -scene.A.radius - 0.5 * _FLOOR_THICKNESS
+    assert lowest > -scene.A.radius - 0.5 * FLOOR_THICKNESS
     assert max(b.position.y for b in space.bodies) > 50.0  # it bounced back up
 
 

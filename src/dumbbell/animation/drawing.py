@@ -92,7 +92,8 @@ def palette() -> tuple[bytes, int]:
     for c in colours:
         if c not in unique:
             unique.append(c)
-    assert len(unique) <= 255, len(unique)
+    if len(unique) > 255:  # a GIF palette holds 256 colours, one kept for padding
+        raise RuntimeError(f"the GIF palette needs {len(unique)} colours, more than 255")
     # Pad with white: ties go to the lowest index, so padding is never chosen.
     unique += [WHITE] * (256 - len(unique))
     return bytes(v for c in unique for v in c), 255

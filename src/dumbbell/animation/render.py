@@ -94,7 +94,7 @@ def sample_every(dt: float, fps: int, t_end: float) -> int:
     return max(fitting) if fitting else 1
 
 
-def _frames(traj: Trajectory, fps: int, t_end: float) -> Frames:
+def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
     from .drawing import Frames
 
@@ -116,8 +116,8 @@ def _frames(traj: Trajectory, fps: int, t_end: float) -> Frames:
         B = np.column_stack([traj["xB"], traj["yB"]])
     energy = traj.energy
     # Least and largest value of each term from the previous frame's sample to this one's.
-    lo = {k: _since_previous(v, idx, np.minimum) for k, v in energy.items()}
-    hi = {k: _since_previous(v, idx, np.maximum) for k, v in energy.items()}
+    lo = {k: since_previous(v, idx, np.minimum) for k, v in energy.items()}
+    hi = {k: since_previous(v, idx, np.maximum) for k, v in energy.items()}
     # The animation lasts len(ft)/fps s; the strip shows the samples of that window.
     window = min(len(ft) / fps, float(t[-1]))
     keep = t <= window + 1e-12
@@ -129,7 +129,7 @@ def _frames(traj: Trajectory, fps: int, t_end: float) -> Frames:
     )
 
 
-def _since_previous(values: np.ndarray, idx: np.ndarray, ufunc: np.ufunc) -> np.ndarray:
+def since_previous(values: np.ndarray, idx: np.ndarray, ufunc: np.ufunc) -> np.ndarray:
     """For each frame k, ``ufunc`` (np.minimum or np.maximum) over the samples from frame
     k-1's index to frame k's, both included (frame 0: its own sample); ``idx`` non-decreasing."""
     v = values[: idx[-1] + 1]
@@ -204,7 +204,7 @@ def render_gif(
     if t_end is None or not (math.isfinite(t_end) and t_end > 0):
         raise UsageError(f"t_end = {t_end}: must be a finite number > 0 (s)")
     t0 = time.perf_counter()
-    frames = _frames(traj, fps, t_end)
+    frames = frames_of(traj, fps, t_end)
     painter = Painter(traj.scene, frames, (width, height), strip)
     pal, clear = palette()
     delays = delays_cs(len(frames.t), fps)

@@ -84,6 +84,17 @@ def build_parser() -> Parser:
     return parser
 
 
+def subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    """Command name -> its parser (argparse keeps them in a private list)."""
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(sub.choices)
+
+
+def arguments(parser: argparse.ArgumentParser) -> list[argparse.Action]:
+    """Every argument ``parser`` takes, flags and positionals, without ``--help``."""
+    return [a for a in parser._actions if not isinstance(a, argparse._HelpAction)]
+
+
 #: Output flags every command may have: argparse dest -> (flag, names a folder).
 OUTPUT_FLAGS = {"out": ("--out", True), "output": ("--output", False),
                 "events": ("--events", False)}

@@ -71,7 +71,7 @@ _BIG = 1e12
 _CHUNK = 200_000
 #: Half-width and thickness of the floor box (m): wider than anything a scene can reach.
 _FLOOR_HALF_WIDTH = 1e6
-_FLOOR_THICKNESS = 1.0
+FLOOR_THICKNESS = 1.0  # public: tests and the stability theory reason with it
 _FLOOR_TYPE = 1
 _PARTICLE_TYPE = {"A": 2, "B": 3}
 
@@ -165,7 +165,7 @@ def build(scene: Scene) -> World:
     if scene.floor is not None:
         radii = sorted({A.radius, B.radius})
         for bit, r in enumerate(radii):
-            W, T = _FLOOR_HALF_WIDTH, _FLOOR_THICKNESS
+            W, T = _FLOOR_HALF_WIDTH, FLOOR_THICKNESS
             box = pymunk.Poly(space.static_body, [(-W, -r - T), (W, -r - T), (W, -r), (-W, -r)])
             box.elasticity = scene.floor.elasticity
             box.friction = scene.floor.friction
@@ -315,7 +315,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                         if row[y_col[name]] < -radius[name] and row[vy_col[name]] < 0:
                             verdict = Verdict("tunnelled", j * every * dt, tunnel_reason(
                                 scene, name, row[y_col[name]], row[vy_col[name]], dt,
-                                depth=radius[name] + _FLOOR_THICKNESS / 2))
+                                depth=radius[name] + FLOOR_THICKNESS / 2))
                             break
                     if verdict is not None:
                         break
@@ -362,4 +362,4 @@ class Pymunk(Solver):
     def catch_depth(scene: Scene) -> float:
         """How far (m) a circle may travel in one step and still be caught by the floor: the
         floor box's thickness plus the smaller circle's diameter."""
-        return 2.0 * min(scene.A.radius, scene.B.radius) + _FLOOR_THICKNESS
+        return 2.0 * min(scene.A.radius, scene.B.radius) + FLOOR_THICKNESS
