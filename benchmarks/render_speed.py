@@ -39,7 +39,7 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
     from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.patches import Circle
 
-    from dumbbell.animation.render import _frames, sample_every
+    from dumbbell.animation.render import frames_of, sample_every
     from dumbbell.model.energy import energy_columns
     from dumbbell.model.scene import load_scene
     from dumbbell.plot.style import COLOURS
@@ -47,7 +47,7 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
 
     scene = load_scene(scene_path)
     traj = simulate(scene, t_end=t_end, every=sample_every(scene.run.dt, FPS, t_end))
-    fr = _frames(traj, FPS, t_end)
+    fr = frames_of(traj, FPS, t_end)
     t_ready = time.perf_counter()
     names = energy_columns(scene)
     terms = [n for n in names if n not in ("E", "E_lost")]

@@ -208,3 +208,9 @@ def test_every_solver_ends_a_blow_up_with_a_verdict(solver):
     assert v.status == "unstable" and "w*dt = 2.10 > 2" in v.reason, v
     assert len(traj.t) < 101 and traj.t[-1] <= v.t + 1e-12
     assert all(np.isfinite(col).all() for col in traj.state.values())
+
+
+def test_every_report_column_has_a_unit():
+    from dumbbell.analysis.stability import COLUMNS, UNITS
+
+    assert set(UNITS) == set(COLUMNS)

@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import UsageError
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
+from ..parallel import ordered_map
 
 if TYPE_CHECKING:
     import pandas
@@ -55,7 +56,6 @@ MAP_UNSTABLE_ENERGY = 1e3
 UNITS = {"case": "", "title": "", "solver": "", "dt": "s", "w_dt": "1", "verdict": "",
          "t_fail": "s", "max_rel_energy_error": "1", "dissipative": "", "predicted": "",
          "agreement": "", "reason": "", "theory": "", "wall_s": "s"}
-assert set(UNITS) == set(COLUMNS)
 
 
 @dataclass(frozen=True)
@@ -205,33 +205,6 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
     return runs, skipped
 
 
-def _in_pool(func: Any, jobs: list[tuple[Any, ...]], workers: int, quiet: bool, desc: str
-             ) -> list[Any]:
-    """``func(*job)`` for every job, on ``workers`` processes, results in job order."""
-    from ..progress import bar
-
-    results: list[Any] = [None] * len(jobs)
-    with bar(len(jobs), desc, "run", quiet=quiet) as pb:
-        if workers <= 1 or len(jobs) <= 1:
-            for i, job in enumerate(jobs):
-                results[i] = func(*job)
-                pb.update(1)
-            return results
-        from concurrent.futures import ProcessPoolExecutor, as_completed
-
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(func, *job): i for i, job in enumerate(jobs)}
-            try:
-                for fut in as_completed(futures):
-                    results[futures[fut]] = fut.result()
-                    pb.update(1)
-            except BaseException:
-                for fut in futures:
-                    fut.cancel()
-                raise
-    return results
-
-
 def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bool = True
               ) -> list[dict[str, Any]]:
     """Every (case path, solver) run as a report row, in the given order."""
@@ -239,7 +212,8 @@ def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bo
     # The longest runs first keep the pool busy to the end; results keep the given order.
     cost = {run: _cost(*run) for run in runs}
     order = sorted(range(len(runs)), key=lambda i: -cost[runs[i]])
-    done = _in_pool(run_case, [runs[i] for i in order], workers, quiet, "stability cases")
+    done = ordered_map(run_case, [runs[i] for i in order], workers=workers, quiet=quiet,
+                       desc="stability cases")
     results: list[dict[str, Any]] = [{}] * len(runs)
     for i, row in zip(order, done, strict=True):
         results[i] = row
@@ -378,15 +352,13 @@ def map_points(scene: Scene) -> list[Any]:
 def map_rows(solver: str, workers: int | None = None, quiet: bool = True
              ) -> list[dict[str, Any]]:
     """The map's rows for one solver, in grid order."""
-    from .sweep import run_pool, run_serial
+    from .sweep import evaluate, warm_up
 
     scene = map_scene()
     points = map_points(scene)
-    workers = workers or os.cpu_count() or 1
-    pairs = (run_serial(scene, points, solver, quiet) if workers <= 1
-             else run_pool(scene, points, solver, workers, quiet))
-    by_index = dict(pairs)
-    return [by_index[p.index] for p in points]
+    return ordered_map(evaluate, [(p.values, solver) for p in points], shared=scene,
+                       workers=workers or os.cpu_count() or 1, initializer=warm_up,
+                       initargs=(solver,), quiet=quiet, desc=f"stability map {solver}")
 
 
 def map_solvers(solvers: list[str] | None) -> list[str]:

@@ -25,8 +25,7 @@ import itertools
 import math
 import os
 import time
-from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import Future
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -36,6 +35,7 @@ import numpy as np
 from ..errors import DumbbellError, UsageError
 from ..io.files import atomic_output
 from ..model.scene import Scene
+from ..parallel import ordered_map
 
 if TYPE_CHECKING:
     import pandas
@@ -227,25 +227,11 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
                 "max_rel_energy_error": math.nan, "reason": f"solver error: {text}"}
 
 
-def _evaluate_batch(scene: Scene, batch: list[Point], solver: str
-                    ) -> list[tuple[int, dict[str, Any]]]:
-    """Run a batch of points (the unit of work sent to a worker)."""
-    return [(p.index, evaluate(scene, p.values, solver)) for p in batch]
-
-
-def _warm_up(solver: str) -> None:
+def warm_up(solver: str) -> None:
     """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
     from ..solvers import solver_class
 
     solver_class(solver).warm_up()
-
-
-def _batches(points: list[Point], workers: int) -> list[list[Point]]:
-    # A few batches per worker balance the load without drowning small points in overhead.
-    size = max(1, min(64, len(points) // (8 * max(1, workers))))
-    # Interleave so that each batch mixes cheap and costly points (small dt is costly).
-    count = math.ceil(len(points) / size)
-    return [points[i::count] for i in range(count)]
 
 
 #: Units of :data:`RESULT_COLUMNS` ("1": dimensionless).
@@ -340,89 +326,6 @@ def _cell(value: Any) -> str:
 # --- backends -------------------------------------------------------------------------------
 
 
-def _collect(futures: Iterable[Any], as_completed: Callable[[Any], Iterable[Any]],
-             n_points: int, quiet: bool, desc: str) -> list[tuple[int, dict[str, Any]]]:
-    from ..progress import bar
-
-    done: list[tuple[int, dict[str, Any]]] = []
-    with bar(n_points, desc, "run", quiet=quiet) as pb:
-        for fut in as_completed(futures):
-            part = fut.result()
-            done.extend(part)
-            pb.update(len(part))
-    return done
-
-
-def run_serial(scene: Scene, points: list[Point], solver: str, quiet: bool = True
-               ) -> list[tuple[int, dict[str, Any]]]:
-    """All points in this process, in order."""
-    from ..progress import bar
-
-    out = []
-    with bar(len(points), f"sweep {scene.name}", "run", quiet=quiet) as pb:
-        for p in points:
-            out.append((p.index, evaluate(scene, p.values, solver)))
-            pb.update(1)
-    return out
-
-
-def run_pool(scene: Scene, points: list[Point], solver: str, workers: int, quiet: bool = True
-             ) -> list[tuple[int, dict[str, Any]]]:
-    """The points on a local process pool of ``workers`` processes."""
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    with ProcessPoolExecutor(max_workers=workers, initializer=_warm_up,
-                             initargs=(solver,)) as pool:
-        futures: list[Future] = [pool.submit(_evaluate_batch, scene, batch, solver)
-                                 for batch in _batches(points, workers)]
-        try:
-            return _collect(futures, as_completed, len(points), quiet,
-                            f"sweep {scene.name} ({workers} processes)")
-        except BaseException:
-            for fut in futures:
-                fut.cancel()
-            raise
-
-
-def run_dask(scene: Scene, points: list[Point], solver: str, scheduler: str,
-             workers: int | None = None, quiet: bool = True, processes: bool = True
-             ) -> list[tuple[int, dict[str, Any]]]:
-    """The points on a Dask cluster at ``scheduler`` (``tcp://host:8786``), or on a new
-    LocalCluster of ``workers`` single-threaded workers when ``scheduler`` is 'local'."""
-    try:
-        from dask.distributed import Client, LocalCluster, as_completed
-    except ImportError:
-        raise UsageError("scheduler needs dask.distributed: pip install 'dumbbell[dask]'"
-                         , param="scheduler") from None
-    import contextlib
-
-    with contextlib.ExitStack() as stack:
-        if scheduler == "local":
-            n = workers or os.cpu_count() or 1
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=processes,
-                dashboard_address=None, silence_logs=50))
-            client = stack.enter_context(Client(cluster))
-        else:
-            try:
-                client = stack.enter_context(Client(scheduler, timeout="10s"))
-            except (OSError, TimeoutError, ValueError) as exc:
-                text = " ".join(str(exc).split())[:200]
-                raise UsageError(f"scheduler {scheduler}: cannot connect to a Dask "
-                                 f"scheduler there ({text})", param="scheduler") from None
-        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
-        scattered = client.scatter(scene, broadcast=True)
-        futures = [client.submit(_evaluate_batch, scattered, batch, solver, pure=False)
-                   for batch in _batches(points, n_workers)]
-        try:
-            return _collect(futures, as_completed, len(points), quiet,
-                            f"sweep {scene.name} (dask)")
-        except BaseException:
-            client.cancel(futures)
-            raise
-    raise AssertionError("unreachable")  # pragma: no cover
-
-
 def run_sweep(
     scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = None,
     workers: int | None = None, scheduler: str | None = None, quiet: bool = True,
@@ -433,19 +336,20 @@ def run_sweep(
     cluster ('local' for a new LocalCluster). Rows come back in grid order."""
     points = plan(scene, axes, solver, t_end) if points is None else points
     workers = workers or os.cpu_count() or 1
-    t0 = time.perf_counter()
     if scheduler is not None:
-        pairs = run_dask(scene, points, solver, scheduler, workers if scheduler == "local"
-                         else None, quiet, processes)
-        backend = f"dask {scheduler}"
+        backend, desc = f"dask {scheduler}", f"sweep {scene.name} (dask)"
+        workers = workers if scheduler == "local" else 0
     elif workers == 1 or len(points) == 1:
-        pairs = run_serial(scene, points, solver, quiet)
-        backend = "serial"
+        backend, desc, workers = "serial", f"sweep {scene.name}", 1
     else:
-        pairs = run_pool(scene, points, solver, workers, quiet)
         backend = f"process pool of {workers}"
+        desc = f"sweep {scene.name} ({workers} processes)"
+    t0 = time.perf_counter()
+    results = ordered_map(evaluate, [(p.values, solver) for p in points], shared=scene,
+                          workers=workers, scheduler=scheduler, processes=processes,
+                          initializer=warm_up, initargs=(solver,), quiet=quiet, desc=desc)
     wall = time.perf_counter() - t0
-    by_index = dict(pairs)
+    by_index = {p.index: r for p, r in zip(points, results, strict=True)}
     rows = [{**{a.key: v for a, v in zip(axes, combo, strict=True)}, **by_index[i]}
             for i, combo in enumerate(itertools.product(*(a.values for a in axes)))]
     return SweepResult(scene, list(axes), solver,
