@@ -3,6 +3,7 @@ drop."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pymunk
@@ -113,3 +114,36 @@ def test_bad_dt_is_one_clear_error():
 
     with pytest.raises(UsageError, match="dt = -1"):
         spaces.check(pymunk.Space(), -1)
+
+
+def test_a_row_of_springs_is_faster_than_each_spring():
+    # Three equal masses in a row, two springs: the fastest mode is sqrt(3 k/m), each spring
+    # alone says sqrt(2 k/m). At sqrt(2 k/m) dt = 1.8 every spring passes, yet pymunk blows up.
+    k, m = 100.0, 0.5
+    dt = 1.8 / math.sqrt(2 * k / m)
+    assert math.sqrt(3 * k / m) * dt > 2
+
+    def row() -> pymunk.Space:
+        space = pymunk.Space()
+        bodies = []
+        for i in range(3):
+            b = pymunk.Body(m, math.inf)
+            b.position = (float(i), 0.0)
+            bodies.append(b)
+            space.add(b)
+        for a, b in itertools.pairwise(bodies):
+            space.add(pymunk.DampedSpring(a, b, (0, 0), (0, 0), 1.0, k, 0.0))
+        bodies[0].position = (-0.05, 0.0)
+        return space
+
+    found = spaces.check(row(), dt)
+    assert [(f.kind, f.subject) for f in found] == [("spring-network", "body 1")]
+    space = row()
+    e0 = spaces.energy(space).E
+    spaces.step(space, 300 * dt, substeps=300)
+    assert spaces.energy(space).E > 1e6 * e0  # really unstable
+    space = row()
+    h = spaces.suggest_dt(space, dt)
+    assert spaces.check(space, h) == []
+    spaces.step(space, 300 * h, substeps=300)
+    assert spaces.energy(space).E < 2 * e0

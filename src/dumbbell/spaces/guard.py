@@ -7,6 +7,8 @@ Checks (each a :class:`Finding` with the number, its limit and the fix):
   (r_a x n)^2 / I_a + (r_b x n)^2 / I_b): the reduced mass mu for anchors at the centres of
   gravity, the other body's mass when one end is static;
 - ``rotary-spring``: the same for a ``DampedRotarySpring`` with w = sqrt(k (1/I_a + 1/I_b));
+- ``spring-network``: a body held by two or more springs, against an upper bound of its
+  fastest vibration (see :func:`_networks`);
 - ``tunnelling``: pymunk finds a contact only once shapes overlap (no swept collisions), so a
   body moving farther in one step than half the thinnest shape it can hit plus half its own
   size can pass through it. The speed is the larger of the present one (centre of gravity plus
@@ -175,6 +177,38 @@ def _level(space: Any, down: tuple[float, float], apart: set[tuple[int, int]]) -
     return low
 
 
+def _networks(space: Any, dt: float) -> list[tuple[Finding, bool]]:
+    """``spring-network``: a body held by two or more linear springs vibrates faster than any
+    one of them alone (a row of equal masses: up to 2 sqrt(k/m) against sqrt(2 k/m)). Bound
+    (Gershgorin, translations only): w^2 <= sum over its springs of k / m + k / sqrt(m m_other),
+    the other end's term dropped when it cannot move. An upper bound, so it can flag a step
+    that would still be stable; checked only for bodies with two or more springs."""
+    import pymunk
+
+    rows: list[tuple[Finding, bool]] = []
+    bound: dict[int, list[Any]] = {}
+    for c in space.constraints:
+        if not isinstance(c, pymunk.DampedSpring) or c.stiffness <= 0:
+            continue
+        for here, there in ((c.a, c.b), (c.b, c.a)):
+            inv_here, _ = _inverse_mass(here)
+            if inv_here == 0.0:
+                continue
+            inv_there, _ = _inverse_mass(there)
+            entry = bound.setdefault(id(here), [here, 0.0, 0])
+            entry[1] += c.stiffness * (inv_here + math.sqrt(inv_here * inv_there))
+            entry[2] += 1
+    for body, w2, count in bound.values():
+        if count < 2:
+            continue
+        w = math.sqrt(w2)
+        dt_max = SPRING_LIMIT / w
+        rows.append((Finding("spring-network", body_label(space, body), w * dt, SPRING_LIMIT,
+                             f"{count} springs on it, w <= {w:.4g} rad/s: dt < {dt_max:.4g} s",
+                             dt_max), w * dt < SPRING_LIMIT))
+    return rows
+
+
 def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, bool]]:
     """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
     ``speeds``: 'state' (the present speeds), 'energy' or 'both' (the larger)."""
@@ -195,6 +229,7 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
         rows.append((Finding(kind, constraint_label(space, c), w * dt, SPRING_LIMIT,
                              f"w = {w:.4g} rad/s: dt < {dt_max:.4g} s", dt_max),
                      w * dt < SPRING_LIMIT))
+    rows += _networks(space, dt)
 
     shapes = list(space.shapes)
     apart = _apart(space)
