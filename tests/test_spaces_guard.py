@@ -147,3 +147,20 @@ def test_a_row_of_springs_is_faster_than_each_spring():
     assert spaces.check(space, h) == []
     spaces.step(space, 300 * h, substeps=300)
     assert spaces.energy(space).E < 2 * e0
+
+
+def test_a_fast_kinematic_paddle_counts_as_the_closing_speed():
+    # A ball at rest, no gravity; a thin kinematic paddle sweeps at it at 20 m/s.
+    space = pymunk.Space()
+    space.collision_slop = 1e-4
+    ball = pymunk.Body(0.1, math.inf)
+    ball.position = (0.0, 0.0)
+    space.add(ball, pymunk.Circle(ball, 0.02))
+    paddle = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+    paddle.position, paddle.velocity = (-1.0, 0.0), (20.0, 0.0)
+    space.add(paddle, pymunk.Segment(paddle, (0, -0.5), (0, 0.5), 0.005))
+    limit = 0.005 + 0.02
+    found = spaces.check(space, 1.1 * limit / 20.0)
+    assert [(f.kind, f.subject) for f in found] == [("tunnelling", "body 0")]
+    assert found[0].value == pytest.approx(1.1 * limit, rel=1e-12)
+    assert spaces.check(space, 0.9 * limit / 20.0) == []

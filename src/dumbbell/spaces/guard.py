@@ -11,11 +11,12 @@ Checks (each a :class:`Finding` with the number, its limit and the fix):
   fastest vibration (see :func:`_networks`);
 - ``tunnelling``: pymunk finds a contact only once shapes overlap (no swept collisions), so a
   body moving farther in one step than half the thinnest shape it can hit plus half its own
-  size can pass through it. The speed is the larger of the present one (centre of gravity plus
-  spin times the reach of its shapes) and the speed from energy: the body's kinetic energy plus
-  ALL the potential energy (gravity down to the lowest static shape, or the lowest shape when
-  there is none, and the springs) turned into its kinetic energy. An estimate, not a bound:
-  another body's kinetic energy passed on is not counted;
+  size can pass through it. The speed is the larger of the present closing speed (its centre
+  of gravity plus spin times the reach of its shapes, plus the fastest obstacle's) and the
+  speed from energy (plus a kinematic obstacle's, which keeps its speed): the body's kinetic
+  energy plus ALL the potential energy (gravity down to the lowest static shape it can hit, or
+  the lowest shape when there is none, and the springs) turned into its kinetic energy. An
+  estimate, not a bound: another body's kinetic energy passed on is not counted;
 - ``slop``: ``space.collision_slop`` is the overlap left alone; more than a tenth of the
   smallest shape lets shapes sink visibly (pymunk's 0.1 is a pixel-sized default: 10 cm in SI);
 - ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart with an
@@ -150,6 +151,17 @@ def _apart(space: Any) -> set[tuple[int, int]]:
     return pairs
 
 
+def _speed(shape: Any) -> float:
+    """Fastest a shape's points move now (m/s): its body's speed plus spin times reach; 0 for
+    static bodies."""
+    import pymunk
+
+    body = shape.body
+    if body.body_type == pymunk.Body.STATIC:
+        return 0.0
+    return body.velocity.length + abs(body.angular_velocity) * _reach(body, shape)
+
+
 def _can_hit(s: Any, o: Any, apart: set[tuple[int, int]] = frozenset()) -> bool:
     return (o.body is not s.body and not o.sensor and not s.sensor
             and (id(s.body), id(o.body)) not in apart
@@ -255,8 +267,14 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
         thinnest = min(sizes[j] for j in targets)
         limit = 0.5 * thinnest + 0.5 * min(sizes[i] for i in own)
         reach = max(_reach(b, shapes[i]) for i in own)
-        v_state = b.velocity.length + abs(b.angular_velocity) * reach
-        v_energy = math.sqrt(b.velocity.length**2 + 2.0 * potential / b.mass)
+        # Closing speed: the obstacles may move too (their present speed; a kinematic one
+        # keeps its speed whatever the energy).
+        moving = [_speed(shapes[j]) for j in targets]
+        driven = [_speed(shapes[j]) for j in targets
+                  if shapes[j].body.body_type == pymunk.Body.KINEMATIC]
+        v_state = b.velocity.length + abs(b.angular_velocity) * reach + max(moving)
+        v_energy = (math.sqrt(b.velocity.length**2 + 2.0 * potential / b.mass)
+                    + max(driven, default=0.0))
         v = {"state": v_state, "energy": v_energy, "both": max(v_state, v_energy)}[speeds]
         if v == 0.0 or limit == 0.0:
             continue
