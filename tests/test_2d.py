@@ -72,7 +72,7 @@ def test_2d_columns(tilted_run, friction, rigid):
                                   "K_cm", "K_rot", "K_vib", "U_g", "U_spring", "E", "L_cm"]
     assert "U_spring" not in simulate(rigid, "pymunk", dt=1e-4, t_end=0.01).columns
     cols = simulate(friction, "pymunk", dt=1e-4, t_end=0.01).columns
-    assert cols[-3:] == ["E", "E_lost", "L_cm"] and "K_spin" in cols
+    assert cols[-5:] == ["E", "E_lost", "E_heat", "E_err", "L_cm"] and "K_spin" in cols
 
 
 def test_tilted_drop_produces_rotation(tilted_run):

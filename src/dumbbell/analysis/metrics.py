@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ..model.energy import energy_scale, relative_energy_error
+from ..model.energy import BOOKKEEPING, energy_scale, relative_energy_error
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 
@@ -108,5 +108,5 @@ def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
         return math.nan
     n = min(len(traj.t), len(truth.t))
     E, E_true = traj["E"][:n], truth["E"][:n]
-    terms = {k: float(v[0]) for k, v in truth.energy.items() if k not in ("E", "E_lost")}
+    terms = {k: float(v[0]) for k, v in truth.energy.items() if k not in BOOKKEEPING}
     return float(np.max(np.abs(E - E_true)) / energy_scale(float(E_true[0]), terms))

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from ..model.energy import energy_columns
+from ..model.energy import BOOKKEEPING, energy_columns
 from ..model.scene import Scene
 from ..plot.style import COLOURS
 
@@ -229,8 +229,9 @@ class Painter(Backdrop):
         self.W, self.H = size
         self.strip = strip
         self.u = min(self.W / 640, self.H / 360)  # length unit of fonts and lines (px)
-        self.names = energy_columns(scene)
-        self.terms = [n for n in self.names if n not in ("E", "E_lost")]
+        # The bars show E and its terms, and E_lost; its split (E_heat, E_err) is in the CSV.
+        self.names = [n for n in energy_columns(scene) if n not in ("E_heat", "E_err")]
+        self.terms = [n for n in self.names if n not in BOOKKEEPING]
         self.idx = {name: _ink_index(rgb) for name, rgb in TERM_RGB.items()}
         self.tint = {name: _ink_index(_blend(rgb, 0.33)) for name, rgb in TERM_RGB.items()}
         self.idx.update({"ink": _ink_index(INK), "grey": _ink_index(GREY)})

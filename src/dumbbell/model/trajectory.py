@@ -32,12 +32,14 @@ VERDICTS = ("ok", "unstable", "tunnelled", "failed")
 @dataclass(frozen=True)
 class Impact:
     """One impact with the floor: time (s), body ('A' or 'B'), the body's vertical velocity
-    just before and just after (m/s)."""
+    just before and just after (m/s), and the energy the impact dissipated (J) where the
+    solver states it (None: a free particle's ``1/2 m (v_before^2 - v_after^2)``)."""
 
     t: float
     body: str
     v_before: float
     v_after: float
+    heat: float | None = None
 
 
 @dataclass(frozen=True)

@@ -15,12 +15,14 @@ COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_
 #: Colour of the angular momentum L_cm (kept out of COLOURS: the GIF's palette is built from
 #: those, and L_cm is text there, drawn in ink).
 MOMENTUM_COLOUR = "#17becf"
+#: Colour of E_heat, the energy the contacts dissipated (figures only, like L_cm).
+HEAT_COLOUR = "#ff7f0e"
 
 #: Legend text of each energy term.
 LABELS = {"K_cm": "K_cm, centre of mass", "K_int": "K_int, relative to the centre of mass",
           "K_rot": "K_rot, rotation", "K_vib": "K_vib, vibration", "K_spin": "K_spin, own spin",
           "U_g": "U_g = M g X, external", "U_spring": "U_spring, internal", "E": "E, total",
-          "E_lost": "E_lost"}
+          "E_lost": "E_lost", "E_heat": "E_heat, dissipated by contacts"}
 
 #: Colour and marker of each solver in the benchmark figures.
 SOLVER_STYLES = {"euler-cromer": ("#d62728", "o"), "verlet": ("#1f77b4", "s"),

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..model.trajectory import Trajectory
-from .style import COLOURS, LABELS, MOMENTUM_COLOUR, pyplot
+from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, pyplot
 
 #: The textbook's time window (s).
 WINDOW = 2.0
@@ -70,7 +70,8 @@ def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) ->
     m = _window(traj, window)
     for name in names:
         style = {"ls": ":", "lw": 1.8} if name == "E" else {"lw": 1.2}
-        ax.plot(traj.t[m], traj[name][m], color=COLOURS.get(name), label=LABELS.get(name, name),
+        colour = HEAT_COLOUR if name == "E_heat" else COLOURS.get(name)
+        ax.plot(traj.t[m], traj[name][m], color=colour, label=LABELS.get(name, name),
                 **style)
     ax.set_ylabel("E [J]")
     values = np.concatenate([traj[name][m] for name in names])
@@ -202,7 +203,7 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     terms (K_cm, U_g) with E and E_lost, and the internal ones (K_int, or K_rot, K_vib,
     U_spring and K_spin); returns the centre-of-mass panel."""
     cols = traj.columns
-    outer = [n for n in ("K_cm", "U_g", "E", "E_lost") if n in cols]
+    outer = [n for n in ("K_cm", "U_g", "E", "E_lost", "E_heat") if n in cols]
     inner = [n for n in ("K_int", "K_rot", "K_vib", "U_spring", "K_spin") if n in cols]
     if ax is not None:
         _energy_panel(ax, traj, outer + inner, window)
@@ -219,7 +220,8 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     bottom = fig.add_subplot(grid[2, :], sharex=top)
     _energy_panel(middle, traj, outer, window)
     middle.set_title("centre of mass: K_cm and U_g trade on each parabola; " + (
-        "the floor takes energy out: E + E_lost stays at E(0)" if "E_lost" in cols
+        "the floor takes energy out: E + E_lost stays at E(0); E_heat is what the contacts "
+        "dissipated" if "E_lost" in cols
         else "E stays constant"), fontsize=9)
     if inner:
         _energy_panel(bottom, traj, inner, window)

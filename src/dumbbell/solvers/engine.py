@@ -266,6 +266,11 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     if world.rigid_body is not None and spins(scene):
         names += ["omegaA", "omegaB"]
 
+    # Heat of the contacts, from their impulses step by step (friction included).
+    from ..spaces.heat import HeatCounter
+
+    counter = HeatCounter(space)
+    heat = np.zeros(options.n_samples)
     events: list[Impact] = []
     pending: dict[str, list[float]] = {}
     i = 0  # step index; the callbacks read it (a closure cell), so the loop pays nothing
@@ -306,6 +311,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                 j += 1
                 row = read()
                 out[j] = row
+                heat[j] = counter.total
                 if not all(abs(v) < _BIG for v in row):
                     verdict = Verdict("unstable", j * every * dt, nonfinite_reason(scene, dt))
                     j -= 1  # keep only finite samples
@@ -327,6 +333,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 
     kept = j + 1
     state = {name: out[:kept, c].copy() for c, name in enumerate(names[: out.shape[1]])}
+    state["heat"] = heat[:kept]
     if world.rigid_body is not None and spins(scene):
         state["omegaA"] = state["omegaB"] = state["omega"]
     cfg = settings(scene)

@@ -40,7 +40,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
-from ..model.energy import rigid_moment, spins, state_columns
+from ..model.energy import impact_heat, rigid_moment, spins, state_columns
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
 
@@ -149,11 +149,16 @@ class RigidBody:
         return cols
 
     # --- impacts ---------------------------------------------------------------------------
+    def effective_mass(self, s: RigidState, body: str) -> float:
+        """Mass (kg) the floor's vertical impulse at ``body`` meets: 1 / (1/M + r_x^2 / I)."""
+        rx = self.arm[body] * math.cos(s.theta)
+        return 1.0 / (1.0 / self.M + rx * rx / self.moment)
+
     def impulse(self, s: RigidState, body: str, e: float) -> RigidState:
         """The state just after the floor's frictionless impulse on ``body`` (restitution
         ``e``), the end moving down at the contact."""
         rx = self.arm[body] * math.cos(s.theta)
-        J = -(1.0 + e) * self.vertical_velocity(s, body) / (1.0 / self.M + rx * rx / self.moment)
+        J = -(1.0 + e) * self.vertical_velocity(s, body) * self.effective_mass(s, body)
         return replace(s, VY=s.VY + J / self.M, omega=s.omega + rx * J / self.moment)
 
     def collide(self, s: RigidState, hit: list[str], e: float
@@ -174,7 +179,9 @@ class RigidBody:
                         f"{b} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
                         "inelastic floor has infinitely many impacts in finite time here")
                 s = self.impulse(s, b, e)
-                events.append(Impact(s.t, b, v, self.vertical_velocity(s, b)))
+                after = self.vertical_velocity(s, b)
+                events.append(Impact(s.t, b, v, after,
+                                     impact_heat(self.effective_mass(s, b), v, after)))
                 moved = True
             if not moved:
                 break

@@ -45,7 +45,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.energy import relative_energy_error, rigid_moment, spins, state_columns
+from ..model.energy import (
+    impact_heat,
+    relative_energy_error,
+    rigid_moment,
+    spins,
+    state_columns,
+)
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
@@ -83,6 +89,8 @@ class _Model:
     vertical_velocity: Callable[[np.ndarray, str], float]
     jump: Callable[[np.ndarray, str, float], np.ndarray]
     columns: Callable[[np.ndarray], dict[str, np.ndarray]]
+    #: Mass (kg) the floor's impulse meets at a body; None: the particle's own.
+    effective_mass: Callable[[np.ndarray, str], float] | None = None
 
 
 def _particles_model(scene: Scene) -> _Model:
@@ -155,9 +163,13 @@ def _rigid_model(scene: Scene) -> _Model:
     def vertical_velocity(y: np.ndarray, body: str) -> float:
         return y[3] + y[5] * offset(y, body)[0]
 
+    def effective_mass(y: np.ndarray, body: str) -> float:
+        rx = offset(y, body)[0]
+        return 1.0 / (1.0 / M + rx * rx / I)
+
     def jump(y: np.ndarray, body: str, e: float) -> np.ndarray:
         rx = offset(y, body)[0]
-        J = -(1.0 + e) * vertical_velocity(y, body) / (1.0 / M + rx * rx / I)
+        J = -(1.0 + e) * vertical_velocity(y, body) * effective_mass(y, body)
         y = y.copy()
         y[3] += J / M
         y[5] += rx * J / I
@@ -179,7 +191,7 @@ def _rigid_model(scene: Scene) -> _Model:
 
     return _Model(y0, rhs, {body: (lambda y, body=body: y[1] + offset(y, body)[1])
                             for body in "AB"},
-                  vertical_velocity, jump, columns)
+                  vertical_velocity, jump, columns, effective_mass)
 
 
 def _model(scene: Scene) -> _Model:
@@ -256,8 +268,12 @@ def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, rtol: float
             verdict = Verdict("failed", t_hit, f"{body} came to rest on the floor (impact speed "
                               f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
             break
+        mass = (model.effective_mass(y, body) if model.effective_mass is not None
+                else (scene.A.mass if body == "A" else scene.B.mass))
         y = model.jump(y, body, e)
-        impacts.append(Impact(t_hit, body, v_before, float(model.vertical_velocity(y, body))))
+        v_after = float(model.vertical_velocity(y, body))
+        impacts.append(Impact(t_hit, body, v_before, v_after,
+                              impact_heat(mass, v_before, v_after)))
         t = t_hit
         if len(impacts) >= MAX_IMPACTS:
             verdict = Verdict("failed", t, f"more than {MAX_IMPACTS} impacts")
