@@ -7,7 +7,8 @@ first roots of a particle's height, found by a search that cannot miss one: on a
 length h the height dips at most ``C h^2/8`` below its chord, with
 ``C = g + (m_other/M) w^2 S`` bounding its curvature (S the oscillation's amplitude), so an
 interval is either cleared, split, or known to hold one crossing that ``brentq`` refines to
-about 1e-14 s. Grazing impacts are found by the splitting. Positions and velocities are then
+about 1e-14 s. That is the precision of one impact: the chaotic map amplifies rounding about
+tenfold per impact, so late impacts are known less well. Grazing impacts are found by the splitting. Positions and velocities are then
 evaluated in closed form at the sample times.
 
 A particle that comes to rest on an inelastic floor would bounce infinitely often in finite
