@@ -210,7 +210,9 @@ def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | N
         truth_note = truth_name
         est = truth.info.get("estimated_error")
         if est:
-            truth_note += (f" (DOP853, rtol 1e-12; its own estimated error: "
+            method = ("RK8 on d = rA - rB, no impact missed" if truth.info.get("rk_steps")
+                      is not None else "DOP853, rtol 1e-12")
+            truth_note += (f" ({method}; its own estimated error: "
                            f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
                            f"energy {est['energy_relative']:.1e})")
         elif truth_name == "exact":
