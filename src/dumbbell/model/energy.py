@@ -250,11 +250,7 @@ def partition(traj: Trajectory) -> dict[str, np.ndarray]:
                 for p in (scene.A, scene.B)
             )
             parts["E"] = parts["E"] + parts["K_spin"]
-    if scene.dissipative:
-        parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
-        parts["E_heat"] = heat(traj)
-        parts["E_err"] = parts["E_lost"] - parts["E_heat"]
-    return {name: parts[name] for name in energy_columns(scene)}
+    return _with_losses(traj, parts)
 
 
 def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
@@ -273,6 +269,17 @@ def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
         total = total + sum(disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"]
                             for p in (scene.A, scene.B))
     return np.asarray(total, dtype=float)
+
+
+def _with_losses(traj: Trajectory, parts: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``parts`` in :func:`energy_columns` order, with E_lost = E(0) - E, E_heat (:func:`heat`)
+    and E_err = E_lost - E_heat added where the scene is dissipative (J)."""
+    scene = traj.scene
+    if scene.dissipative:
+        parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
+        parts["E_heat"] = heat(traj)
+        parts["E_err"] = parts["E_lost"] - parts["E_heat"]
+    return {name: parts[name] for name in energy_columns(scene)}
 
 
 def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -304,9 +311,7 @@ def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict
                 parts["K_spin"] = sum(
                     rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
                     for p in (scene.A, scene.B))
-    if scene.dissipative:
-        parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
-    return {name: parts[name] for name in energy_columns(scene)}
+    return _with_losses(traj, parts)
 
 
 def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
