@@ -343,7 +343,8 @@ def _estimate_error(traj: Trajectory) -> dict[str, float]:
 
 
 class Reference(Solver):
-    """scipy's DOP853 at tight tolerance with impacts as events (see the module docstring)."""
+    """RK8 on d = rA - rB with a curvature-bounded floor search (2D spring), or scipy's DOP853
+    at tight tolerance with impacts as events (1D, rigid); see the module docstring."""
 
     name = NAME
     order = None
@@ -355,6 +356,7 @@ class Reference(Solver):
     estimates_error = True
     supports = staticmethod(supports)
     solve = staticmethod(solve)
+    warm_up = staticmethod(warm_up)
 
     @staticmethod
     def truth_for(scene: Scene) -> bool:
