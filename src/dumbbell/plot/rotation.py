@@ -11,6 +11,7 @@ import numpy as np
 
 from ..analysis.rotation import Series, mean_after_first_cluster
 from .style import COLOURS, pyplot
+from .trajectory import momentum_axis
 
 
 def _overlay(ax: Any, s: Series) -> None:
@@ -38,7 +39,7 @@ def rotation(s: Series, ax: Any = None) -> Any:
     if ax is not None:
         _overlay(ax, s)
         return ax
-    fig, axes = pyplot().subplots(len(labels), 1, figsize=(10, 2.1 * len(labels) + 1.2),
+    fig, axes = pyplot().subplots(len(labels), 1, figsize=(10, 2.8 * len(labels) + 1.2),
                                   sharex=True, sharey=True)
     rigid_mean = mean_after_first_cluster(rigid, "K_rot")[0]
     top = max(float(np.max(r["K_rot"])) for r in s.runs.values())
@@ -74,9 +75,11 @@ def rotation(s: Series, ax: Any = None) -> Any:
         panel.text(0.01, 0.95, note, transform=panel.transAxes, va="top", fontsize=8,
                 bbox={"boxstyle": "round", "fc": "white", "ec": "0.7", "alpha": 0.9})
         panel.set_ylabel("E [J]")
-        panel.set_ylim(0, top * 1.25)
+        panel.set_ylim(0, top * 1.7)
         panel.grid(True, color="0.9", lw=0.6)
         panel.legend(loc="upper right", fontsize=7.5, framealpha=0.9)
+        if "L_cm" in r.columns:
+            momentum_axis(panel, r, float(r.t[-1]), loc="upper right", ncol=1)
     axes[-1].set_xlabel("t [s]")
     axes[-1].set_xlim(0, float(rigid.t[-1]))
     fig.suptitle(

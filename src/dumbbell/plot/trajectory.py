@@ -176,8 +176,10 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.set_title(f"in the plane, 0-{window:g} s\n(axis every 0.1 s, dark = later)", fontsize=8)
 
 
-def _momentum_axis(ax: Any, traj: Trajectory, window: float) -> None:
-    """L_cm (kg m^2/s) on a right-hand axis of ``ax``: flat in flight, a step at each impact."""
+def momentum_axis(ax: Any, traj: Trajectory, window: float, loc: str = "upper center",
+                  ncol: int = 3) -> None:
+    """L_cm (kg m^2/s) on a right-hand axis of ``ax``: flat in flight, a step at each impact.
+    The legend of ``ax`` moves to the right-hand axis (at ``loc``, in ``ncol`` columns)."""
     m = _window(traj, window)
     right = ax.twinx()
     L = traj["L_cm"][m]
@@ -193,8 +195,8 @@ def _momentum_axis(ax: Any, traj: Trajectory, window: float) -> None:
     extra = right.get_legend_handles_labels()
     if ax.get_legend() is not None:
         ax.get_legend().remove()
-    right.legend(handles + extra[0], labels + extra[1], loc="upper center", fontsize=8,
-                 framealpha=0.9, ncol=3)
+    right.legend(handles + extra[0], labels + extra[1], loc=loc, fontsize=8 if ncol > 1 else 7.5,
+                 framealpha=0.9, ncol=ncol)
 
 
 def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
@@ -228,6 +230,6 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
         bottom.set_title("internal: the impacts feed the motion relative to the centre of mass",
                          fontsize=9)
         if "L_cm" in cols:
-            _momentum_axis(bottom, traj, window)
+            momentum_axis(bottom, traj, window)
     _title(fig, [top, middle, bottom], traj, window, "how the energy is shared")
     return middle
