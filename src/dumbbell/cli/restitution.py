@@ -88,6 +88,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..analysis.restitution import restitution
+    from ..io.figures import save_figure
     from ..io.files import atomic_output
     from ..model.scene import load_scene
     from ..plot.rotation_chapter import restitution as draw
@@ -107,14 +108,9 @@ def run(args: argparse.Namespace) -> int:
     with atomic_output(csv) as tmp, open(tmp, "w") as fh:
         fh.write(",".join(cols) + "\n")
         fh.writelines(",".join(repr(float(cols[c][i])) for c in cols) + "\n" for i in range(len(result.theta)))
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(8.5, 9.0))
-    axes = fig.subplots(3, 1, sharex=True, gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
-    draw(result, ax=axes)
+    fig = draw(result)[0].figure
     fig.tight_layout()
-    with atomic_output(png) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
+    save_figure(fig, png)
     print(result.table())
     if not args.quiet:
         for path in (csv, png):
