@@ -125,3 +125,15 @@ def test_users_callbacks_still_fire():
     spaces.step(space, 1.0, substeps=1000)
     assert heat.total == counted and not heat.attached
     assert len(fired["wild"]) > calls and len(fired["post"]) == len(fired["wild"])
+
+
+def test_sliding_heat_holds_when_dt_changes_between_steps():
+    # pymunk scales the impulses it carries over by dt / previous dt.
+    mu, angle = 0.3, math.radians(30)
+    space, body = _slope(mu, angle)
+    start = body.position
+    heat = spaces.HeatCounter(space)
+    for i in range(4000):
+        space.step(1e-4 if i % 3 else 4e-4)
+    slid = (body.position - start).length
+    assert heat.total == pytest.approx(mu * 1.0 * 9.81 * math.cos(angle) * slid, rel=1e-3)

@@ -41,6 +41,7 @@ class HeatCounter:
         self.steps = 0
         self._ffi = ffi
         self._before: dict[int, list[tuple[float, float, float, float]]] = {}
+        self._last_dt: float | None = None
         old = space._handlers.get((None, None))
         self._user = {
             phase: (getattr(old, phase), old.data.get(phase)) if old is not None
@@ -88,12 +89,15 @@ class HeatCounter:
 
     def _pre_solve(self, arbiter: Any, space: Any, data: Any) -> None:
         raw, ba, bb = self._relative(arbiter)
-        # On a first contact pymunk keeps the impulse cached from an earlier touch in the
-        # accumulators without applying it; what this step applies is the growth from here.
-        first = arbiter.is_first_contact
+        # pymunk starts a step from the impulse accumulated in the last one, applied scaled by
+        # dt / previous dt ("warm starting"); on a first contact it keeps an impulse cached
+        # from an earlier touch there without applying it. What the step applies is the
+        # accumulator's growth from here plus the part applied at the start.
+        carried = 0.0 if arbiter.is_first_contact else (
+            space.current_time_step / self._last_dt if self._last_dt else 1.0)
         self._before[int(self._ffi.cast("uintptr_t", raw))] = [
-            (ux, uy, raw.contacts[i].jnAcc if first else 0.0,
-             raw.contacts[i].jtAcc if first else 0.0)
+            (ux, uy, raw.contacts[i].jnAcc * (1.0 - carried),
+             raw.contacts[i].jtAcc * (1.0 - carried))
             for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb))
         ]
         # A contact whose post_solve never comes (the user rejected it) must not linger.
@@ -104,6 +108,9 @@ class HeatCounter:
 
     def _end_step(self, space: Any, key: Any) -> None:
         self._before.clear()
+        # Arbiters that carry impulses into the next step had contacts in this one, so this
+        # is the 'previous dt' pymunk scales them by.
+        self._last_dt = space.current_time_step
 
     def _post_solve(self, arbiter: Any, space: Any, data: Any) -> None:
         raw, ba, bb = self._relative(arbiter)
