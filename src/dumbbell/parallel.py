@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import signal
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
@@ -22,6 +23,41 @@ from .errors import UsageError
 
 #: Marks "no shared argument".
 _NOTHING = object()
+
+
+def cap_workers(requested: int | None, jobs: int) -> tuple[int, bool]:
+    """(processes to start, whether that is fewer than ``requested``): min(requested, CPUs,
+    jobs), at least 1; ``requested`` None means the number of CPUs."""
+    if requested is not None and (isinstance(requested, bool) or not isinstance(requested, int)
+                                  or requested < 1):
+        raise UsageError(f"workers = {requested!r}: must be a whole number >= 1 (processes)",
+                         param="workers")
+    cpus = os.cpu_count() or 1
+    n = max(1, min(requested or cpus, cpus, jobs))
+    return n, requested is not None and n < requested
+
+
+def cap_note(flag: str, requested: int | None, jobs: int, what: str = "runs") -> str | None:
+    """The one line saying that ``flag`` was capped, or None when it was not."""
+    n, capped = cap_workers(requested, jobs)
+    if not capped:
+        return None
+    cpus = os.cpu_count() or 1
+    why = f"there are {cpus} CPUs" if n == cpus and cpus <= jobs else f"there are {jobs} {what}"
+    return f"{flag} {requested}: starting {n} processes, as {why}"
+
+
+def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -> None:
+    """Run first in each pool worker. The parent's stop handlers (inherited through fork)
+    would turn the pool's own SIGTERM into an exception inside the worker instead of ending
+    it, so SIGTERM and SIGHUP get their default back (end the process); SIGINT is ignored,
+    because a Ctrl-C reaches the whole process group and the parent stops the workers."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "SIGHUP"):
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if initializer is not None:
+        initializer(*initargs)
 
 
 def batches(n: int, workers: int) -> list[list[int]]:
@@ -35,6 +71,11 @@ def _run_batch(func: Callable[..., Any], shared: tuple, batch: list[tuple[int, t
                ) -> list[tuple[int, Any]]:
     """Run one batch in a worker: (index, result) pairs. ``shared`` is () or (value,)."""
     return [(i, func(*shared, *job)) for i, job in batch]
+
+
+def _run_pool_batch(item: tuple[Callable[..., Any], tuple, list[tuple[int, tuple]]]
+                    ) -> list[tuple[int, Any]]:
+    return _run_batch(*item)
 
 
 def _run_dask_batch(func: Callable[..., Any], *shared: Any, batch: list[tuple[int, tuple]]
@@ -56,7 +97,7 @@ def ordered_map(
     func: Callable[..., Any], jobs: Sequence[tuple], *, shared: Any = _NOTHING,
     workers: int = 1, scheduler: str | None = None, processes: bool = True,
     initializer: Callable[..., None] | None = None, initargs: tuple = (),
-    quiet: bool = True, desc: str = "", unit: str = "run",
+    quiet: bool = True, desc: str = "", unit: str = "run", connect_timeout: float = 10.0,
 ) -> list[Any]:
     """``[func(shared, *job) for job in jobs]`` in job order.
 
@@ -65,38 +106,56 @@ def ordered_map(
     cluster at that address, or 'local' for a new LocalCluster of ``workers``
     single-threaded workers (threads instead of processes with ``processes`` False);
     ``shared`` is then sent to every worker once. ``func`` must be a module-level function
-    (it is pickled). A progress bar counts the jobs on a terminal unless ``quiet``."""
+    (it is pickled). A progress bar counts the jobs on a terminal unless ``quiet``.
+
+    Local processes are capped at one per CPU and per job (:func:`cap_workers`). If anything
+    goes wrong here (an exception from a job, Ctrl-C, SIGTERM, SIGHUP) the pool's workers are
+    terminated before the exception goes on: none outlives the call. A Dask scheduler that
+    does not answer within ``connect_timeout`` s is a UsageError naming its address."""
     from .progress import bar
 
+    if scheduler is None or scheduler == "local":
+        workers, _ = cap_workers(workers, len(jobs))
     results: list[Any] = [None] * len(jobs)
     indexed = list(enumerate(jobs))
     lead = () if shared is _NOTHING else (shared,)
     with bar(len(jobs), desc, unit, quiet=quiet) as pb:
         if scheduler is not None:
-            _on_dask(func, indexed, lead, scheduler, workers, processes, results, pb)
+            _on_dask(func, indexed, lead, scheduler, workers, processes, results, pb,
+                     connect_timeout)
         elif workers <= 1 or len(jobs) <= 1:
             for i, job in indexed:
                 results[i] = func(*lead, *job)
                 pb.update(1)
         else:
-            from concurrent.futures import ProcessPoolExecutor, as_completed
-
-            with ProcessPoolExecutor(max_workers=workers, initializer=initializer,
-                                     initargs=initargs) as pool:
-                futures = [pool.submit(_run_batch, func, lead, [indexed[i] for i in b])
-                           for b in batches(len(jobs), workers)]
-                try:
-                    _collect(futures, as_completed, results, pb)
-                except BaseException:
-                    for fut in futures:
-                        fut.cancel()
-                    raise
+            _on_pool(func, indexed, lead, workers, initializer, initargs, results, pb)
     return results
 
 
+def _on_pool(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: tuple,
+             workers: int, initializer: Callable[..., None] | None, initargs: tuple,
+             results: list[Any], pb: Any) -> None:
+    import multiprocessing
+
+    items = [(func, lead, [indexed[i] for i in b]) for b in batches(len(indexed), workers)]
+    pool = multiprocessing.get_context().Pool(workers, initializer=worker_init,
+                                              initargs=(initializer, *initargs))
+    try:
+        for part in pool.imap_unordered(_run_pool_batch, items):
+            for i, value in part:
+                results[i] = value
+            pb.update(len(part))
+        pool.close()
+    except BaseException:
+        pool.terminate()
+        raise
+    finally:
+        pool.join()
+
+
 def _on_dask(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: tuple,
-             scheduler: str, workers: int, processes: bool, results: list[Any], pb: Any
-             ) -> None:
+             scheduler: str, workers: int, processes: bool, results: list[Any], pb: Any,
+             connect_timeout: float = 10.0) -> None:
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -109,12 +168,7 @@ def _on_dask(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: t
                 processes=processes, dashboard_address=None, silence_logs=50))
             client = stack.enter_context(Client(cluster))
         else:
-            try:
-                client = stack.enter_context(Client(scheduler, timeout="10s"))
-            except (OSError, TimeoutError, ValueError) as exc:
-                text = " ".join(str(exc).split())[:200]
-                raise UsageError(f"scheduler {scheduler}: cannot connect to a Dask "
-                                 f"scheduler there ({text})", param="scheduler") from None
+            client = stack.enter_context(_connect(Client, scheduler, connect_timeout))
         n_workers = max(1, len(client.scheduler_info().get("workers", {})))
         # The shared value goes to every worker once; each batch names it by its future.
         sent = [client.scatter(value, broadcast=True) for value in lead]
@@ -126,3 +180,57 @@ def _on_dask(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: t
         except BaseException:
             client.cancel(futures)
             raise
+
+
+class _NotDask(Exception):
+    """The peer at a scheduler address is not a Dask scheduler."""
+
+
+def _probe(scheduler: str, timeout: float) -> None:
+    """Raise unless something at the ``tcp://`` address ``scheduler`` speaks first within
+    ``timeout`` s, as a Dask scheduler does (it sends its handshake on accept): Dask's own
+    timeout bounds the TCP connect but not a peer that accepts and then stays silent, such
+    as an HTTP server. Other schemes are left to Dask."""
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(scheduler)
+    if parts.scheme != "tcp":
+        return
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError as exc:
+        raise _NotDask(f"not an address: {exc}") from None
+    if not host or port is None:
+        raise _NotDask("not an address: give tcp://HOST:PORT")
+    with socket.create_connection((host, port), timeout=timeout) as sock:
+        try:
+            first = sock.recv(1)
+        except TimeoutError:
+            raise _NotDask("it accepted the connection but did not answer as one") from None
+    if not first:
+        raise _NotDask("it closed the connection without answering")
+
+
+def _connect(client_class: Any, scheduler: str, timeout: float) -> Any:
+    """A Dask client of ``scheduler``, or one UsageError naming the address when nothing there
+    answers as a Dask scheduler within ``timeout`` s (a closed port, an HTTP server, ...)."""
+    import logging
+
+    # distributed logs each failed attempt; the one line below says it all.
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado")]
+    levels = [lg.level for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 1)
+    try:
+        _probe(scheduler, timeout)
+        return client_class(scheduler, timeout=f"{timeout}s")
+    except Exception as exc:  # noqa: BLE001 - any failure to connect is the same one line
+        text = exc.args[0] if isinstance(exc, _NotDask) else " ".join(
+            f"{type(exc).__name__}: {exc}".split())[:160]
+        raise UsageError(f"scheduler {scheduler}: no Dask scheduler answered there within "
+                         f"{timeout:g} s (--connect-timeout): {text}",
+                         param="scheduler") from None
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)

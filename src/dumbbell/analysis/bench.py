@@ -237,7 +237,7 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
 
 
 def run_bench(
-    scene: Scene,
+    scene: Scene | str | Path,
     solvers: list[str] | None = None,
     dts: list[float] | None = None,
     window: float = DEFAULT_WINDOW,
@@ -253,12 +253,20 @@ def run_bench(
     a step whose runs would take more than ``budget`` s in all is skipped. Samples are kept
     about every ``spacing`` s (default :func:`default_spacing`; the step-free solvers:
     exactly)."""
+    from ..model import args
     from ..progress import bar
+    from ..solvers import available
 
-    t_end = scene.run.t_end if t_end is None else t_end
-    spacing = default_spacing(scene) if spacing is None else spacing
-    solvers = default_solvers(scene) if solvers is None else list(dict.fromkeys(solvers))
-    dts = sorted(DEFAULT_DTS if dts is None else dts, reverse=True)
+    scene = args.scene(scene)
+    t_end = scene.run.t_end if t_end is None else args.real(t_end, "t_end", "s")
+    spacing = default_spacing(scene) if spacing is None else args.real(spacing, "spacing", "s")
+    solvers = (default_solvers(scene) if solvers is None
+               else list(dict.fromkeys(args.names(solvers, "solvers", available()))))
+    dts = sorted(DEFAULT_DTS if dts is None else args.positives(dts, "dts", "s"), reverse=True)
+    window = args.real(window, "window", "s")
+    repeat = args.whole(repeat, "repeat", "runs", hi=MAX_REPEAT)
+    budget = args.real(budget, "budget", "s")
+    quiet = args.flag(quiet, "quiet")
     check_request(scene, solvers, dts, window, t_end, spacing)
     truth = truth_solver(scene)
     notes: list[str] = []

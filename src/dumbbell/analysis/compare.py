@@ -171,17 +171,22 @@ def default_solvers(scene: Scene) -> list[str]:
     return [n for n in names if solver_class(n).supports(scene) is None]
 
 
-def compare(scene: Scene, solvers: list[str] | None = None, dts: list[float] | None = None,
-            window: float = WINDOW, t_end: float | None = None, quiet: bool = True
+def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
+            dts: list[float] | None = None, window: float = WINDOW, t_end: float | None = None, quiet: bool = True
             ) -> Comparison:
     """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
-    from ..solvers import make_options, simulate
+    from ..model import args
+    from ..solvers import available, make_options, simulate
 
-    solvers = solvers or default_solvers(scene)
-    dts = dts or [scene.run.dt]
-    t_end = scene.run.t_end if t_end is None else t_end
+    scene = args.scene(scene)
+    solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
+                                                                         available())
+    dts = [scene.run.dt] if dts is None else args.positives(dts, "dts", "s")
+    t_end = scene.run.t_end if t_end is None else args.real(t_end, "t_end", "s")
+    window = args.real(window, "window", "s")
+    quiet = args.flag(quiet, "quiet")
     for name in solvers:
         reason = solver_class(name).supports(scene)
         if reason is not None:

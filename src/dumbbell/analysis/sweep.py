@@ -329,13 +329,24 @@ def _cell(value: Any) -> str:
 def run_sweep(
     scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = None,
     workers: int | None = None, scheduler: str | None = None, quiet: bool = True,
-    processes: bool = True, points: list[Point] | None = None,
+    processes: bool = True, points: list[Point] | None = None, connect_timeout: float = 10.0,
 ) -> SweepResult:
-    """Run ``scene`` over the grid ``axes`` with ``solver``; ``t_end`` (s) overrides the
-    scene's. One worker runs in this process; more use a process pool; ``scheduler`` a Dask
-    cluster ('local' for a new LocalCluster). Rows come back in grid order."""
+    """Run ``scene`` (a Scene or a scene file's path) over the grid ``axes`` with ``solver``;
+    ``t_end`` (s) overrides the scene's. One worker runs in this process; more use a process
+    pool of at most one process per CPU and per point; ``scheduler`` a Dask cluster ('local'
+    for a new LocalCluster; ``connect_timeout`` s to reach it). Rows come back in grid order."""
+    from ..model import args
+    from ..parallel import cap_workers
+    from ..solvers import available
+
+    scene = args.scene(scene)
+    if not isinstance(axes, list | tuple) or not all(isinstance(a, Axis) for a in axes):
+        raise UsageError(f"axes = {args.show(axes)}: must be a list of Axis (parse_axis)",
+                         param="axes")
+    args.choice(solver, "solver", available())
+    connect_timeout = args.real(connect_timeout, "connect_timeout", "s")
     points = plan(scene, axes, solver, t_end) if points is None else points
-    workers = workers or os.cpu_count() or 1
+    workers, _ = cap_workers(workers, len(points))
     if scheduler is not None:
         backend, desc = f"dask {scheduler}", f"sweep {scene.name} (dask)"
         workers = workers if scheduler == "local" else 0
@@ -347,7 +358,8 @@ def run_sweep(
     t0 = time.perf_counter()
     results = ordered_map(evaluate, [(p.values, solver) for p in points], shared=scene,
                           workers=workers, scheduler=scheduler, processes=processes,
-                          initializer=warm_up, initargs=(solver,), quiet=quiet, desc=desc)
+                          initializer=warm_up, initargs=(solver,), quiet=quiet, desc=desc,
+                          connect_timeout=connect_timeout)
     wall = time.perf_counter() - t0
     by_index = {p.index: r for p, r in zip(points, results, strict=True)}
     rows = [{**{a.key: v for a, v in zip(axes, combo, strict=True)}, **by_index[i]}

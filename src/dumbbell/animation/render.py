@@ -40,6 +40,9 @@ if TYPE_CHECKING:
 
 #: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
 MAX_FPS = 50
+#: Most frames an animation may have unless told otherwise (``max_frames``, ``--max-frames``):
+#: 10 minutes at 25 fps, about a minute of drawing per 1,000 frames on one core.
+MAX_FRAMES = 15_000
 #: Samples per second the strip of the energy time series needs: it shows 1 s on ~390 px
 #: (about one sample per pixel column), and the textbook spring's 20 Hz energy oscillations
 #: keep their peaks to 1 % with 25 samples per oscillation.
@@ -73,6 +76,22 @@ def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, i
 def frame_count(t_end: float, fps: int) -> int:
     """Frames of an animation of ``t_end`` s at ``fps``: times 0, 1/fps, ... below t_end."""
     return max(1, math.ceil(t_end * fps - 1e-9))
+
+
+def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") -> int:
+    """The frame count of ``t_end`` s at ``fps``, or a UsageError when it passes
+    ``max_frames``; compared before multiplying, so a huge ``t_end`` cannot overflow."""
+    if t_end * fps <= max_frames + 1:
+        n = frame_count(t_end, fps)
+        if n <= max_frames:
+            return n
+        count = f"{n:,} frames"
+    else:
+        count = (f"{math.ceil(t_end * fps):,} frames" if math.isfinite(t_end * fps)
+                 else "more than 1e308 frames")
+    raise UsageError(f"{where} = {t_end:g} s at {fps} fps is {count}, past the budget of "
+                     f"{max_frames:,}: shorten the animation (--t-end), lower --fps or raise "
+                     "the budget (--max-frames)")
 
 
 def delays_cs(n: int, fps: int) -> list[int]:
@@ -188,13 +207,15 @@ def render_gif(
     strip: bool = True,
     t_end: float | None = None,
     timing: dict[str, float] | None = None,
+    max_frames: int = MAX_FRAMES,
 ) -> Path | Gif:
     """An animated GIF of ``traj``: written to ``path`` (atomically) and the path returned,
     or with no path its bytes returned as a :class:`Gif`, which a notebook shows inline.
 
     ``fps`` frames per second (1..50), ``size`` 'WxH' in px, ``strip`` adds the energy time
     series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
-    end). ``timing``, when given, receives the seconds spent drawing and encoding."""
+    end); more than ``max_frames`` frames are refused. ``timing``, when given, receives the
+    seconds spent drawing and encoding."""
     from .. import progress
     from .drawing import Painter, palette
 
@@ -203,6 +224,7 @@ def render_gif(
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
     if t_end is None or not (math.isfinite(t_end) and t_end > 0):
         raise UsageError(f"t_end = {t_end}: must be a finite number > 0 (s)")
+    check_frames(t_end, fps, max_frames)
     t0 = time.perf_counter()
     frames = frames_of(traj, fps, t_end)
     painter = Painter(traj.scene, frames, (width, height), strip)

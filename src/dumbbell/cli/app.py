@@ -2,17 +2,21 @@
 :mod:`dumbbell.cli` and provides ``register(subparsers)``.
 
 Exit status: 0 done; 2 bad input (one line naming the file, key or flag and what is allowed;
-nothing written); 3 a run ended with a verdict other than ``ok``.
+nothing written); 3 a run ended with a verdict other than ``ok``; 128+N stopped by signal N
+(SIGINT, SIGTERM, SIGHUP; nothing written, pool workers stopped).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import math
 import os
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 
 from ..errors import DumbbellError
 
@@ -24,12 +28,25 @@ EXIT_USAGE = 2
 EXIT_VERDICT = 3
 
 
+def one_line(text: str) -> str:
+    """``text`` with every character that is not printable (newlines, control characters,
+    line and record separators) escaped, so that a message echoing user input stays one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+
+
 class Parser(argparse.ArgumentParser):
     """An ArgumentParser whose errors are one line and exit status 2."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        sys.stderr.write(one_line(f"{self.prog}: error: {message} (see {self.prog} --help)")
+                         + "\n")
         sys.exit(EXIT_USAGE)
+
+
+def _shown(text: str) -> str:
+    """A flag's value for an error message: quoted, one line, at most 40 characters."""
+    text = repr(text)
+    return text if len(text) <= 40 else text[:36] + "...'"
 
 
 def positive_float(unit: str):
@@ -41,23 +58,29 @@ def positive_float(unit: str):
         except ValueError:
             value = math.nan
         if not (math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"{text!r}: must be a finite number > 0 ({unit})")
+            raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a finite number > 0 "
+                                             f"({unit})")
         return value
 
     parse.__name__ = f"number in {unit}"
     return parse
 
 
-def positive_int(what: str):
-    """An argparse type: a whole number >= 1."""
+#: Largest value of a count flag (--repeat, --workers, ...) unless the flag says otherwise.
+MAX_COUNT = 10**9
+
+
+def positive_int(what: str, hi: int = MAX_COUNT):
+    """An argparse type: a whole number from 1 to ``hi`` (ASCII digits: int() would also read
+    other scripts' digits, and reads huge strings slowly)."""
 
     def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = 0
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{text!r}: must be a whole number >= 1 ({what})")
+        digits = text.strip().lstrip("+")
+        value = int(digits) if digits.isascii() and digits.isdigit() and len(digits) <= 20 \
+            else 0
+        if not 1 <= value <= hi:
+            raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a whole number from 1 "
+                                             f"to {hi:,} ({what})")
         return value
 
     parse.__name__ = what
@@ -96,18 +119,63 @@ def arguments(parser: argparse.ArgumentParser) -> list[argparse.Action]:
 
 
 #: Output flags every command may have: argparse dest -> (flag, names a folder).
-OUTPUT_FLAGS = {"out": ("--out", True), "output": ("--output", False),
-                "events": ("--events", False)}
+OUTPUT_FLAGS = {"out": ("--out", True), "output": ("-o", False), "events": ("--events", False)}
+#: Input flags: argparse dest -> how a message names the input.
+INPUT_FLAGS = {"scene": "the scene"}
+#: Signals that end a command the way Ctrl-C does: workers stopped, no output kept.
+STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
 
 
-def _check_outputs(args: argparse.Namespace) -> None:
-    """Refuse output paths that cannot be written before any work is done (UsageError)."""
+class Stopped(KeyboardInterrupt):
+    """A stop signal arrived; every ``except KeyboardInterrupt`` cleanup runs for it too."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _stop(signum: int, frame: object) -> None:
+    # Once is enough: a second signal must not break the cleanup the first one started.
+    for name in STOP_SIGNALS:
+        signal.signal(getattr(signal, name), signal.SIG_IGN)
+    raise Stopped(signum)
+
+
+@contextlib.contextmanager
+def _stop_signals() -> Iterator[None]:
+    """Turn SIGINT, SIGTERM and SIGHUP into :class:`Stopped` for the block (main thread only),
+    then give back the caller's handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    numbers = [getattr(signal, n) for n in STOP_SIGNALS if hasattr(signal, n)]
+    before = {n: signal.getsignal(n) for n in numbers}
+    for n in numbers:
+        if before[n] is not signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
+            signal.signal(n, _stop)
+    try:
+        yield
+    finally:
+        for n, handler in before.items():
+            signal.signal(n, handler if handler is not None else signal.SIG_DFL)
+
+
+def _check_paths(args: argparse.Namespace, transaction) -> None:
+    """Before any work: every output can be written, none is an input or another output
+    (UsageError naming the flags)."""
     from ..io.files import check_writable
 
+    for dest, what in INPUT_FLAGS.items():
+        value = getattr(args, dest, None)
+        if isinstance(value, str) and value and os.path.exists(value):
+            transaction.inputs[os.path.realpath(value)] = f"{what} {value}"
     for dest, (flag, folder) in OUTPUT_FLAGS.items():
         value = getattr(args, dest, None)
-        if isinstance(value, str) and value:
-            check_writable(value, flag, folder)
+        if not isinstance(value, str) or not value or value == "-":
+            continue
+        check_writable(value, flag, folder)
+        if not folder:
+            transaction.claim(value, f"{flag} {value}")
 
 
 def as_flags(exc: DumbbellError) -> str:
@@ -121,28 +189,47 @@ def as_flags(exc: DumbbellError) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``dumbbell`` console script; returns the exit status."""
+    """Entry point of the ``dumbbell`` console script; returns the exit status: 0 done, 2 bad
+    input, 3 a verdict other than ok, 128+N stopped by signal N (SIGINT 130, SIGTERM 143,
+    SIGHUP 129)."""
     # The command only writes files: matplotlib's file-only backend, unless the user chose one.
     os.environ.setdefault("MPLBACKEND", "Agg")
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    command = "dumbbell"
+    with _stop_signals():
+        try:
+            parser = build_parser()
+            args = parser.parse_args(argv)
+            command = f"dumbbell {args.command}"
+            return _run(args, command)
+        except KeyboardInterrupt as exc:
+            signum = getattr(exc, "signum", signal.SIGINT)
+            sys.stderr.write(f"{command}: stopped by {signal.Signals(signum).name}; no output "
+                             "was kept\n")
+            return 128 + signum
+
+
+def _run(args: argparse.Namespace, command: str) -> int:
+    from ..io.files import output_transaction
+
     try:
-        _check_outputs(args)
-        return int(args.func(args) or 0)
+        with output_transaction() as transaction:
+            _check_paths(args, transaction)
+            return int(args.func(args) or 0)
     except DumbbellError as exc:
-        sys.stderr.write(f"dumbbell {args.command}: error: {as_flags(exc)}\n")
+        sys.stderr.write(one_line(f"{command}: error: {as_flags(exc)}") + "\n")
         return EXIT_USAGE
     except BrokenPipeError:
         # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep
         # Python from complaining again when it flushes stdout at exit.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except OSError as exc:
         # Backstop: an output that still cannot be written is one line, not a traceback.
         where = exc.filename or "an output file"
-        sys.stderr.write(f"dumbbell {args.command}: error: cannot write {where}: "
-                         f"{exc.strerror or exc}\n")
+        sys.stderr.write(one_line(f"{command}: error: cannot write {where}: "
+                                  f"{exc.strerror or exc}") + "\n")
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        sys.stderr.write(f"dumbbell {args.command}: interrupted; no partial output was kept\n")
-        return 130
+    except RecursionError:
+        sys.stderr.write(f"{command}: error: an input is nested too deeply\n")
+        return EXIT_USAGE

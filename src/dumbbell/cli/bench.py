@@ -14,6 +14,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         DEFAULT_BUDGET,
         DEFAULT_REPEAT,
         DEFAULT_WINDOW,
+        MAX_REPEAT,
         MIN_TIMED,
         SAMPLE_SPACING,
         SAMPLES_PER_PERIOD,
@@ -45,7 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "accuracy)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="simulated time of each run in s (default: the scene's run.t_end)")
-    p.add_argument("--repeat", type=positive_int("runs"), metavar="N", default=DEFAULT_REPEAT,
+    p.add_argument("--repeat", type=positive_int("runs", MAX_REPEAT), metavar="N", default=DEFAULT_REPEAT,
                    help=f"timed runs per point after one warm-up run (default {DEFAULT_REPEAT}"
                         f"; runs shorter than {MIN_TIMED:g} s in all are repeated until they "
                         "are not)")

@@ -6,7 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import EXIT_VERDICT, add_quiet, positive_float
+from ..animation.render import MAX_FRAMES
+from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,6 +35,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--size", metavar="WxH", help="width x height in pixels (default 640x360)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="length of the animation in s (default: the scene's run.t_end)")
+    p.add_argument("--max-frames", type=positive_int("frames"), metavar="N",
+                   default=MAX_FRAMES,
+                   help=f"refuse, before anything runs, an animation of more than N frames "
+                        f"(t_end x fps; default {MAX_FRAMES:,})")
     p.add_argument("--no-strip", dest="strip", action="store_false", default=None,
                    help="leave out the strip of the energy time series")
     add_quiet(p)
@@ -48,7 +53,7 @@ def _whole(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..animation.render import check_fps, check_size, render_gif, sample_every
+    from ..animation.render import check_fps, check_frames, check_size, render_gif, sample_every
     from ..model.scene import load_scene
     from ..solvers import make_options, simulate
 
@@ -66,10 +71,14 @@ def run(args: argparse.Namespace) -> int:
         from ..errors import UsageError
 
         raise UsageError(f"-o {out}: must end in .gif")
+    check_frames(t_end, fps, args.max_frames,
+                 "--t-end" if args.t_end else "outputs.gif.t_end" if "t_end" in gif
+                 else "run.t_end")
     options = make_options(scene, t_end=t_end)
     every = sample_every(options.dt, fps, options.t_end)
     traj = simulate(scene, args.solver, t_end=options.t_end, every=every, quiet=args.quiet)
-    render_gif(traj, out, quiet=args.quiet, fps=fps, size=size, strip=strip, t_end=t_end)
+    render_gif(traj, out, quiet=args.quiet, fps=fps, size=size, strip=strip, t_end=t_end,
+               max_frames=args.max_frames)
     if not args.quiet:
         sys.stderr.write(f"wrote {out}\n")
     if not traj.verdict.ok:

@@ -40,6 +40,13 @@ def run(args: argparse.Namespace) -> int:
              else [Path(args.scene) if args.scene else packaged_scene()])
     # Validate every scene before any output is written.
     scenes = [load_scene(p) for p in paths]
+    for scene in scenes:
+        if scene.outputs.gif is not None:
+            from ..animation.render import MAX_FRAMES, check_frames
+
+            gif = scene.outputs.gif
+            check_frames(gif["t_end"], gif["fps"], MAX_FRAMES,
+                         f"{scene.source}: outputs.gif.t_end")
     status = 0
     for scene in scenes:
         status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet))

@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..solvers import MAX_SAMPLES, MAX_STEPS
 from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int
 
 
@@ -26,10 +27,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="time step in s (default: the scene's run.dt)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="end time in s (default: the scene's run.t_end)")
-    p.add_argument("--every", type=positive_int("steps"), metavar="N",
+    p.add_argument("--every", type=positive_int("steps", MAX_STEPS), metavar="N",
                    help="keep every N-th step (default: the scene's run.every, else 1)")
+    p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
+                   default=MAX_SAMPLES,
+                   help=f"refuse, before anything runs, a run that would keep more than N "
+                        f"samples (t_end / dt / every + 1; default {MAX_SAMPLES:,}, about "
+                        f"{MAX_SAMPLES * 80 // 10**6} MB for a 1D scene)")
     p.add_argument("-o", "--output", metavar="FILE",
-                   help="CSV file to write (default: standard output)")
+                   help="CSV file to write (default, or '-': standard output)")
     p.add_argument("--events", metavar="FILE",
                    help="also write the impacts as CSV: t,body,v_before,v_after (s, -, m/s, m/s)")
     add_quiet(p)
@@ -42,8 +48,8 @@ def run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     traj = simulate(scene, args.solver, dt=args.dt, t_end=args.t_end, every=args.every,
-                    quiet=args.quiet)
-    if args.output:
+                    quiet=args.quiet, max_samples=args.max_samples)
+    if args.output and args.output != "-":
         traj.to_csv(args.output)
     else:
         import numpy as np

@@ -72,6 +72,12 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..parallel import cap_note
+
+    # Jobs are many (cases x solvers); the CPUs are the cap that binds.
+    note = cap_note("--workers", args.workers, 1 << 30)
+    if note:
+        sys.stderr.write(f"dumbbell stability: {note}\n")
     result = report(args.cases, args.solvers, args.out, args.workers, args.quiet)
     if not args.quiet:
         rows = result["rows"]

@@ -39,11 +39,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on the Dask cluster at ADDRESS (tcp://host:8786), or 'local' to "
                         "start a Dask LocalCluster here; needs pip install 'dumbbell[dask]'")
+    p.add_argument("--connect-timeout", type=positive_float("s"), metavar="S", default=10.0,
+                   help="seconds to wait for the Dask scheduler at --scheduler to answer "
+                        "(default 10)")
     add_quiet(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..parallel import cap_note
     from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
     from ..model.scene import load_scene
@@ -74,9 +78,12 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out}: exists and is not a folder")
     points = plan(scene, axes, solver, args.t_end)
+    note = cap_note("--workers", args.workers, len(points), "grid points")
+    if note:
+        sys.stderr.write(f"dumbbell sweep: {note}\n")
     result = run_sweep(scene, axes, solver, args.t_end, workers=args.workers,
                        scheduler=args.scheduler and args.scheduler.strip(), quiet=args.quiet,
-                       points=points)
+                       points=points, connect_timeout=args.connect_timeout)
     csv_path = result.write_csv(out / f"{scene.name}-sweep.csv")
     from ..io.figures import save_figure
     from ..plot.maps import sweep_map

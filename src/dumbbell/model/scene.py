@@ -16,6 +16,9 @@ from __future__ import annotations
 
 import copy
 import math
+import numbers
+import os
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +30,13 @@ from ..errors import SceneError
 FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
+#: Largest magnitude of any number in a scene (m, kg, m/s, N/m, ...), and the smallest mass
+#: (kg): the energy formulas multiply up to four of them (1/2 I w^2 = 1/4 m r^2 w^2), which then
+#: stay below 1e300, and positions stay far below the solvers' blow-up threshold (1e150).
+MAX_MAGNITUDE = 1e75
+MIN_MASS = 1e-75
+#: Largest scene file read (bytes).
+MAX_SCENE_BYTES = 1_000_000
 #: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
 DEFAULT_UNSTABLE_ENERGY = 10.0
 
@@ -178,6 +188,9 @@ class Scene:
 
         >>> scene.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})   # doctest: +SKIP
         """
+        if not isinstance(values, dict) or not all(isinstance(k, str) for k in values):
+            raise SceneError(f"values = {_show(values)}: must be a dict of dotted key names "
+                             "(str) to values")
         raw = copy.deepcopy(self.raw)
         for dotted, value in values.items():
             parts = dotted.split(".")
@@ -239,6 +252,7 @@ class _Checker:
             self.fail(self.key(name), value, allowed)
         if hi is not None and value > hi:
             self.fail(self.key(name), value, allowed)
+        _check_magnitude(self, self.key(name), value, unit)
         return value
 
     def integer(self, name: str, default: int, *, lo: int, hi: int | None = None) -> int:
@@ -247,7 +261,7 @@ class _Checker:
             return default
         value = self.table[name]
         allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
-        if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             self.fail(self.key(name), value, allowed)
         if value < lo or (hi is not None and value > hi):
             self.fail(self.key(name), value, allowed)
@@ -301,13 +315,20 @@ def _printable(text: str) -> str:
 def _finite(value: Any) -> float | None:
     """``value`` as a finite float, or None if it is not a finite number (a bool, a string, an
     integer too large for a float, nan or inf)."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         return None
     try:
         number = float(value)
-    except OverflowError:
+    except (OverflowError, ValueError, TypeError):
         return None
     return number if math.isfinite(number) else None
+
+
+def _check_magnitude(c: _Checker, dotted: str, value: float, unit: str) -> None:
+    if abs(value) > MAX_MAGNITUDE:
+        c.fail(dotted, value, f"must be at most {MAX_MAGNITUDE:g} in magnitude"
+                              + (f" ({unit})" if unit else "")
+                              + ": larger values overflow the energies")
 
 
 def _show(value: Any) -> str:
@@ -339,6 +360,7 @@ def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
     if dims == 1:
         if _finite(value) is None:
             c.fail(dotted, value, "must be a finite number (m/s, upward) in a 1D scene")
+        _check_magnitude(c, dotted, float(value), "m/s")
         return 0.0, float(value)
     ok = (
         isinstance(value, list)
@@ -347,11 +369,16 @@ def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
     )
     if not ok:
         c.fail(dotted, value, "must be a list of two finite numbers [vx, vy] (m/s) in a 2D scene")
+    for v in value:
+        _check_magnitude(c, dotted, float(v), "m/s")
     return float(value[0]), float(value[1])
 
 
 def _particle(c: _Checker, name: str, dims: int, placed: bool) -> Particle:
     mass = c.number("mass", lo=0.0, lo_open=True, unit="kg")
+    if mass < MIN_MASS:
+        c.fail(c.key("mass"), mass, f"must be at least {MIN_MASS:g} (kg): smaller masses "
+                                    "overflow the spring's frequency")
     radius = c.number("radius", DEFAULT_RADIUS, lo=0.0, unit="m")
     if placed:
         # A placed from B by the tilt: its own position would contradict it.
@@ -370,6 +397,17 @@ def _particle(c: _Checker, name: str, dims: int, placed: bool) -> Particle:
 
 def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
     """Validate a parsed TOML document and build a :class:`Scene` (raises SceneError)."""
+    if not isinstance(data, dict):
+        raise SceneError(f"data = {_show(data)}: must be a dict (a parsed scene document)")
+    if not isinstance(source, str):
+        raise SceneError(f"source = {_show(source)}: must be a str (the scene's file name)")
+    try:
+        return _scene_from_dict(data, source)
+    except RecursionError:
+        raise SceneError(f"{source}: nested too deeply to be a scene") from None
+
+
+def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
     top = _Checker(source, data, "")
     title = top.string("title", Path(source).stem)
     if not isinstance(title, str):
@@ -544,11 +582,15 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file (TOML). Raises :class:`SceneError` on any problem."""
+    """Read and validate a scene file (TOML) of at most :data:`MAX_SCENE_BYTES` bytes. Raises
+    :class:`SceneError` on any problem, also when ``path`` is not a regular file."""
+    if not isinstance(path, str | os.PathLike) or str(path) == "":
+        raise SceneError(f"path = {_show(path)}: must be the path of a scene file (str or "
+                         "pathlib.Path)")
     path = Path(path)
     source = str(path)
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = _read_scene_file(path).decode("utf-8")
     except FileNotFoundError:
         raise SceneError(f"{source}: no such scene file") from None
     except IsADirectoryError:
@@ -556,13 +598,49 @@ def load_scene(path: str | Path) -> Scene:
     except UnicodeDecodeError:
         raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
     except OSError as exc:
-        raise SceneError(f"{source}: cannot read: {exc.strerror}") from None
+        raise SceneError(f"{source}: cannot read: {exc.strerror or exc}") from None
     try:
         data = tomllib.loads(text)
     except ValueError as exc:  # TOMLDecodeError, or an integer too long to convert
         message = " ".join(str(exc).split())[:200]
         raise SceneError(f"{source}: not valid TOML: {message}") from None
+    except RecursionError:
+        raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
+
+
+def _read_scene_file(path: Path) -> bytes:
+    """The bytes of ``path`` if it is a regular file of at most MAX_SCENE_BYTES; SceneError
+    for a device, a FIFO, a socket or a larger file. Opened without blocking, so that a FIFO
+    with no writer is refused rather than waited on."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        info = os.fstat(fd)
+        if stat.S_ISDIR(info.st_mode):
+            raise IsADirectoryError
+        if not stat.S_ISREG(info.st_mode):
+            raise SceneError(f"{path}: is {_file_kind(info.st_mode)}, not a regular file; a "
+                             "scene is a TOML file")
+        if info.st_size > MAX_SCENE_BYTES:
+            raise SceneError(f"{path}: is {info.st_size:,} bytes; a scene file may be at most "
+                             f"{MAX_SCENE_BYTES:,} bytes (1 MB)")
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(MAX_SCENE_BYTES + 1)
+    finally:
+        os.close(fd)
+    if len(data) > MAX_SCENE_BYTES:  # it grew while we read it
+        raise SceneError(f"{path}: more than {MAX_SCENE_BYTES:,} bytes; a scene file may be at "
+                         "most 1 MB")
+    return data
+
+
+def _file_kind(mode: int) -> str:
+    """'a character device', 'a FIFO', ... for an ``st_mode``."""
+    for test, kind in ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                       (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return kind
+    return "not a regular file"
 
 
 def packaged_scene(name: str = "textbook-1d") -> Path:

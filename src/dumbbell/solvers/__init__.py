@@ -14,7 +14,10 @@ from __future__ import annotations
 from ..errors import SceneError, UsageError
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from .base import MAX_STEPS, RunOptions, Solver, make_options
+from pathlib import Path
+
+from ..model import args
+from .base import MAX_SAMPLES, MAX_STEPS, RunOptions, Solver, make_options
 from .engine import Pymunk
 from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
@@ -30,6 +33,7 @@ METHODS: dict[str, type[Solver]] = {
 REGISTRY = METHODS
 
 __all__ = [
+    "MAX_SAMPLES",
     "MAX_STEPS",
     "METHODS",
     "REGISTRY",
@@ -48,6 +52,9 @@ __all__ = [
 
 def solver_class(name: str) -> type[Solver]:
     """The class of solver ``name``; UsageError naming the choices when there is none."""
+    if not isinstance(name, str):
+        raise UsageError(f"solver = {args.show(name)}: must be a solver name, one of "
+                         f"{', '.join(available())}", param="solver")
     if name not in METHODS:
         raise UsageError(f"solver {name!r}: must be one of {', '.join(available())}")
     return METHODS[name]
@@ -95,19 +102,23 @@ def no_truth_reason(scene: Scene) -> str | None:
 
 
 def simulate(
-    scene: Scene,
+    scene: Scene | str | Path,
     solver: str | None = None,
     dt: float | None = None,
     t_end: float | None = None,
     every: int | None = None,
     quiet: bool = True,
+    max_samples: int | None = MAX_SAMPLES,
 ) -> Trajectory:
-    """Run ``scene`` with ``solver`` (default: the scene's). ``dt`` and ``t_end`` in s override
-    the scene's ``[run]``; ``every`` keeps every N-th step. Returns a :class:`Trajectory`
-    whose ``verdict`` says whether the run ended well."""
+    """Run ``scene`` (a Scene or the path of a scene file) with ``solver`` (default: the
+    scene's). ``dt`` and ``t_end`` in s override the scene's ``[run]``; ``every`` keeps every
+    N-th step; a run that would keep more than ``max_samples`` samples is refused before it
+    starts (None: no budget). Returns a :class:`Trajectory` whose ``verdict`` says whether
+    the run ended well."""
+    scene = args.scene(scene)
     cls = scene_solver(scene) if solver is None else solver_class(solver)
     name = cls.name
     reason = cls.supports(scene)
     if reason is not None:
         raise UsageError(f"solver {name!r} cannot run {scene.source}: {reason}")
-    return cls.solve(scene, make_options(scene, dt, t_end, every, quiet))
+    return cls.solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))

@@ -21,6 +21,9 @@ from ..model.trajectory import Trajectory
 
 #: Largest number of steps one run may take, so that no run can hang.
 MAX_STEPS = 10**10
+#: Samples :func:`~dumbbell.solvers.simulate` keeps unless told otherwise (``max_samples``,
+#: ``--max-samples``): 5e6 rows of about ten float64 columns are about 400 MB.
+MAX_SAMPLES = 5_000_000
 
 
 @dataclass(frozen=True)
@@ -137,24 +140,52 @@ def point_particle_limits(scene: Scene, name: str) -> str | None:
 
 def make_options(
     scene: Scene, dt: float | None = None, t_end: float | None = None, every: int | None = None,
-    quiet: bool = True,
+    quiet: bool = True, max_samples: int | None = None,
 ) -> RunOptions:
-    """Fill run options from the scene's ``[run]`` table and check them (UsageError)."""
-    dt = scene.run.dt if dt is None else dt
-    t_end = scene.run.t_end if t_end is None else t_end
-    every = scene.run.every if every is None else every
-    for name, value, unit in (("dt", dt, "s"), ("t_end", t_end, "s")):
-        if isinstance(value, bool) or not isinstance(value, int | float) or not (
-            math.isfinite(value) and value > 0
-        ):
-            raise UsageError(f"{name} = {value!r}: must be a finite number > 0 ({unit})")
+    """Fill run options from the scene's ``[run]`` table and check them (UsageError): ``dt``
+    and ``t_end`` in s, ``every`` in steps. The step count is checked against
+    :data:`MAX_STEPS` and, when ``max_samples`` is given, the samples kept against it, both as
+    exact integers before anything is allocated."""
+    from ..model import args
+
+    dt = args.real(scene.run.dt if dt is None else dt, "dt", "s")
+    t_end = args.real(scene.run.t_end if t_end is None else t_end, "t_end", "s")
     if dt > t_end:
-        raise UsageError(f"dt = {dt:g}: must be <= t_end = {t_end:g} (s)")
-    if isinstance(every, bool) or not isinstance(every, int) or every < 1:
-        raise UsageError(f"every = {every!r}: must be a whole number >= 1 (steps)")
-    options = RunOptions(float(dt), float(t_end), int(every), quiet)
-    if options.n_steps > MAX_STEPS:
-        raise UsageError(
-            f"t_end / dt = {options.n_steps:.3g} steps: must be at most {MAX_STEPS:.0e}"
-        )
+        raise UsageError(f"dt = {dt:g}: must be <= t_end = {t_end:g} (s)", param="dt")
+    every = args.whole(scene.run.every if every is None else every, "every", "steps",
+                       hi=MAX_STEPS)
+    quiet = args.flag(quiet, "quiet")
+    ratio = t_end / dt  # a float; inf when the quotient passes the largest float
+    if not ratio <= MAX_STEPS:
+        count = f"{round(ratio):,} steps" if math.isfinite(ratio) else "more than 1e308 steps"
+        raise UsageError(f"t_end / dt = {t_end:g} s / {dt:g} s = {count}: a run may take at "
+                         f"most {MAX_STEPS:,} steps; raise dt or lower t_end")
+    options = RunOptions(dt, t_end, every, quiet)
+    if max_samples is not None:
+        check_samples(scene, options, args.whole(max_samples, "max_samples", "samples"))
     return options
+
+
+def check_samples(scene: Scene, options: RunOptions, max_samples: int) -> None:
+    """UsageError when ``options`` would keep more than ``max_samples`` samples: the count is
+    exact integer arithmetic on the run options, so the refusal costs no time or memory."""
+    samples = options.n_samples
+    if samples <= max_samples:
+        return
+    from ..model.energy import energy_columns, state_columns
+
+    columns = 1 + len(state_columns(scene)) + len(energy_columns(scene))
+    size = samples * columns * 8  # float64 columns: t, the state, the energy terms
+    raise UsageError(
+        f"{options.n_steps:,} steps with every = {options.every:,} would keep "
+        f"{samples:,} samples (about {_bytes(size)} in memory), past the budget of "
+        f"{max_samples:,}: keep fewer with a larger every (--every) or raise the budget "
+        "max_samples (--max-samples)")
+
+
+def _bytes(size: int) -> str:
+    """``size`` bytes in words: '8.0 GB'."""
+    for unit, scale in (("TB", 10**12), ("GB", 10**9), ("MB", 10**6), ("kB", 10**3)):
+        if size >= scale:
+            return f"{size / scale:.1f} {unit}"
+    return f"{size} B"

@@ -1,0 +1,570 @@
+"""Hostile input, signals and resource bounds (docs/hardening.md): each refusal is exit 2 (or
+128+signal), one line naming what to fix, nothing left in the output folder, no process left."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import stat
+import threading
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import psutil
+import pytest
+
+import dumbbell
+from dumbbell import DumbbellError, SceneError, load_scene
+from dumbbell.model.scene import scene_from_dict
+from tests.conftest import SCENES
+from tests.hostile import (
+    SHORT_SCENE,
+    cli,
+    files_in,
+    refused,
+    send_when,
+    short_scene,
+    spawn,
+    wait_gone,
+)
+
+
+@pytest.fixture
+def work(tmp_path: Path) -> tuple[Path, Path]:
+    """(a short scene in its own folder, an empty output folder)."""
+    inputs, out = tmp_path / "in", tmp_path / "out"
+    inputs.mkdir()
+    out.mkdir()
+    return short_scene(inputs), out
+
+
+# --- 1. resource bounds before the work -----------------------------------------------------
+
+
+def test_a_billion_samples_are_refused_at_once_without_allocating(work):
+    scene, out = work
+    tracemalloc.start()
+    try:
+        status, _, err = cli("simulate", scene, "--t-end", "1e4", "--dt", "1e-5", "--every", "1",
+                             "-o", out / "x.csv")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    line = refused(status, err, out)
+    # It says the count, the budget, and both ways to raise it.
+    assert "1,000,000,001 samples" in line and "--every" in line and "--max-samples" in line
+    assert peak < 20 * 2**20  # nothing near the 8 GB the samples would need
+
+
+def test_the_sample_budget_is_exact_and_can_be_raised(work):
+    scene, out = work
+    # 0.05 s / 1e-4 s = 500 steps, every step kept: 501 samples.
+    status, _, err = cli("simulate", scene, "--every", "1", "--max-samples", "500",
+                         "-o", out / "x.csv")
+    assert "501 samples" in refused(status, err, out)
+    status, _, err = cli("simulate", scene, "--every", "1", "--max-samples", "501",
+                         "-o", out / "x.csv", "-q")
+    assert status == 0, err
+    assert len((out / "x.csv").read_text().splitlines()) == 1 + 501
+
+
+def test_the_sample_budget_binds_the_api_too():
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError, match="max_samples"):
+        dumbbell.simulate(scene, t_end=1e4, every=1)
+    traj = dumbbell.simulate(scene, t_end=0.01, every=1, max_samples=1001)
+    assert len(traj) == 1001
+
+
+@pytest.mark.parametrize("flags,words", [
+    (["--t-end", "1e4"], ["250,000 frames", "--max-frames"]),
+    (["--t-end", "700", "--fps", "50"], ["35,000 frames", "--max-frames"]),
+    (["--t-end", "2", "--max-frames", "49"], ["50 frames", "--max-frames"]),
+])
+def test_render_refuses_past_the_frame_budget_before_stepping(work, flags, words):
+    scene, out = work
+    status, _, err = cli("render", scene, *flags, "-o", out / "x.gif")
+    line = refused(status, err, out)
+    assert all(w in line for w in words), line
+
+
+def test_run_refuses_a_gif_past_the_frame_budget_before_stepping(work):
+    scene, out = work
+    long = short_scene(scene.parent, "long.toml", '[outputs]\ncsv = true\n'
+                       'gif = { fps = 25, t_end = 1e4 }\n')
+    status, _, err = cli("run", long, "--out", out)
+    assert "frames" in refused(status, err, out)
+
+
+def test_sweep_caps_workers_and_says_so_once(work):
+    scene, out = work
+    status, _, err = cli("sweep", scene, "--grid", "k=100,200,300", "--workers", "10000",
+                         "--out", out, "-q")
+    assert status == 0, err
+    assert "Traceback" not in err
+    lines = [line for line in err.splitlines() if "--workers" in line]
+    cap = min(os.cpu_count() or 1, 3)
+    assert len(lines) == 1 and f"{cap}" in lines[0] and "10000" in lines[0], err
+    assert sorted(files_in(out)) == ["short-sweep.csv", "short-sweep.png"]
+    assert not psutil.Process().children(recursive=True)
+
+
+def test_the_worker_cap():
+    from dumbbell.parallel import cap_workers
+
+    cpus = os.cpu_count() or 1
+    assert cap_workers(10_000, 3) == (min(cpus, 3), True)
+    assert cap_workers(None, 3)[0] == min(cpus, 3)
+    assert cap_workers(1, 3) == (1, False)
+    assert cap_workers(5, 0) == (1, True)
+
+
+# --- 2. arithmetic overflow -----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("flags,word", [
+    (["--dt", "5e-324"], "steps"),
+    (["--dt", "4.9e-324", "--t-end", "1e-300"], "steps"),
+    (["--t-end", "1e300", "--dt", "1e-300"], "steps"),
+    (["--t-end", "1.7e308", "--dt", "1e-5"], "steps"),
+    (["--every", "1234567890123456789012345"], "--every"),
+    (["--every", "9" * 5000], "--every"),
+    (["--max-samples", "1e999"], "--max-samples"),
+])
+def test_simulate_overflow_is_one_line(work, flags, word):
+    scene, out = work
+    status, _, err = cli("simulate", scene, *flags, "-o", out / "x.csv")
+    assert word in refused(status, err, out)
+
+
+@pytest.mark.parametrize("command,flags", [
+    ("render", ["--t-end", "1e300"]),
+    ("render", ["--fps", "9" * 30]),
+    ("compare", ["--t-end", "1e300", "--dt", "1e-300"]),
+    ("compare", ["--dt", "5e-324"]),
+    ("bench", ["--dts", "5e-324"]),
+    ("bench", ["--repeat", "9" * 25]),
+    ("sweep", ["--grid", "dt=5e-324,1e-4"]),
+    ("sweep", ["--grid", "k=log:1e-300:1e300:3", "--t-end", "1e300"]),
+    ("sweep", ["--grid", "k=lin:1:2:" + "9" * 25]),
+])
+def test_other_commands_overflow_is_one_line(work, command, flags):
+    scene, out = work
+    output = ["-o", out / "x.gif"] if command == "render" else ["--out", out]
+    status, _, err = cli(command, scene, *flags, *output)
+    refused(status, err, out)
+
+
+@pytest.mark.parametrize("kwargs,word", [
+    ({"t_end": 10**400}, "t_end"),
+    ({"t_end": 1e300, "dt": 1e-300}, "steps"),
+    ({"dt": 5e-324}, "steps"),
+    ({"every": 2**70}, "every"),
+    ({"every": 10**400}, "every"),
+    ({"dt": -(10**400)}, "dt"),
+])
+def test_api_overflow_raises_a_dumbbell_error(kwargs, word):
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError, match=word) as info:
+        dumbbell.simulate(scene, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("key,value", [
+    ("rigid.length", 1e200), ("rigid.length", 1e300), ("bodies.B.height", 1e300),
+    ("bodies.B.x", -1e250), ("gravity.g", 1e308), ("bodies.A.mass", 1e-320),
+    ("bodies.A.spin", 1e200), ("bodies.B.radius", 1e160),
+])
+def test_rigid_scene_magnitudes_are_checked_at_the_border(key, value):
+    rigid = load_scene(SCENES / "rigid-2d.toml")
+    with pytest.raises(SceneError, match=key.split(".")[-1]):
+        rigid.with_values({key: value})
+
+
+@pytest.mark.parametrize("key,value", [
+    ("spring.stiffness", 1e308), ("spring.rest_length", 1e200), ("bodies.A.velocity", 1e200),
+    ("bodies.A.mass", 1e300), ("bodies.A.height", 1e300),
+])
+def test_scene_magnitudes_are_checked_at_the_border(key, value):
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(SceneError, match=key.split(".")[-1]):
+        scene.with_values({key: value})
+
+
+def test_a_rigid_scene_file_of_huge_length_is_one_line(tmp_path):
+    text = (SCENES / "rigid-2d.toml").read_text().replace("length = 0.2", "length = 1e200")
+    path = tmp_path / "huge.toml"
+    path.write_text(text)
+    status, _, err = cli("simulate", path, "--t-end", "0.01", "-o", tmp_path / "x.csv")
+    assert "rigid.length" in refused(status, err, tmp_path, keep=("huge.toml",))
+
+
+# --- 3. signals -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
+def test_a_signal_stops_a_sweep_and_its_workers(tmp_path, sig):
+    scene = short_scene(tmp_path, "sweep-signal.toml")
+    out = tmp_path / "out"
+    proc = spawn("sweep", scene, "--grid", "k=log:1e2:1e3:16", "--t-end", "30",
+                 "--workers", "2", "--out", out)
+    workers = lambda: len(psutil.Process(proc.pid).children()) >= 2
+    send_when(proc, workers, sig)
+    _, err = proc.communicate(timeout=30)
+    assert not wait_gone(str(scene)), "pool workers outlived the sweep"
+    line = refused(proc.returncode, err, code=128 + sig)
+    assert signal.Signals(sig).name in line
+    assert not out.exists() or files_in(out) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_while_the_gif_is_written_leaves_no_part_file(tmp_path, sig):
+    scene = short_scene(tmp_path, "render-signal.toml")
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = spawn("render", scene, "--t-end", "60", "--fps", "10", "-o", out / "x.gif")
+    send_when(proc, lambda: any(".part" in n for n in os.listdir(out)), sig)
+    _, err = proc.communicate(timeout=30)
+    refused(proc.returncode, err, out, code=128 + sig)
+
+
+def test_sigterm_while_stepping_writes_nothing(tmp_path):
+    scene = tmp_path / "simulate-signal.toml"
+    # No floor: a long run that ends only when its 1e9 steps are done (or it is stopped).
+    scene.write_text(SHORT_SCENE.replace("[floor]\nelasticity = 1.0\n", ""))
+    out = tmp_path / "out"
+    out.mkdir()
+    proc = spawn("simulate", scene, "--t-end", "1e5", "--every", "1000000", "-o", out / "x.csv",
+                 "--events", out / "e.csv")
+    send_when(proc, lambda: psutil.Process(proc.pid).cpu_times().user > 1.5, signal.SIGTERM)
+    _, err = proc.communicate(timeout=30)
+    refused(proc.returncode, err, out, code=128 + signal.SIGTERM)
+
+
+def test_pool_workers_take_the_default_signal_handlers():
+    from dumbbell.parallel import worker_init
+
+    old = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)}
+    try:
+        signal.signal(signal.SIGTERM, lambda *a: None)
+        worker_init()
+        assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+        assert signal.getsignal(signal.SIGHUP) == signal.SIG_DFL
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN
+    finally:
+        for s, handler in old.items():
+            signal.signal(s, handler)
+
+
+def test_main_restores_the_callers_signal_handlers(work):
+    scene, out = work
+    before = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)}
+    cli("simulate", scene, "-o", out / "x.csv", "-q")
+    assert {s: signal.getsignal(s) for s in before} == before
+
+
+# --- 4. outputs -----------------------------------------------------------------------------
+
+
+def test_output_naming_the_scene_is_refused_and_the_scene_kept(work):
+    scene, out = work
+    before = scene.read_bytes()
+    for spelling in (scene, scene.parent / ".." / scene.parent.name / scene.name):
+        status, _, err = cli("simulate", scene, "-o", spelling)
+        assert "-o" in refused(status, err, out)
+        assert scene.read_bytes() == before
+
+
+def test_output_through_a_symlink_to_the_scene_is_refused(work):
+    scene, out = work
+    (out / "link.csv").symlink_to(scene)
+    before = scene.read_bytes()
+    status, _, err = cli("simulate", scene, "-o", out / "link.csv")
+    refused(status, err, out, keep=("link.csv",))
+    assert scene.read_bytes() == before and (out / "link.csv").is_symlink()
+
+
+@pytest.mark.parametrize("second", ["x.csv", "./x.csv", "sub/../x.csv"])
+def test_two_outputs_on_one_file_are_refused(work, second, monkeypatch):
+    scene, out = work
+    (out / "sub").mkdir()
+    monkeypatch.chdir(out)
+    status, _, err = cli("simulate", scene, "-o", "x.csv", "--events", second)
+    line = refused(status, err, out, keep=("sub",))
+    assert "-o" in line and "--events" in line
+
+
+def test_events_naming_the_scene_is_refused(work):
+    scene, out = work
+    status, _, err = cli("simulate", scene, "-o", out / "x.csv", "--events", scene)
+    assert "--events" in refused(status, err, out)
+
+
+def _char_device(folder: Path, name: str, minor: int) -> Path:
+    """A private character device (1, minor): 3 is null, 7 is full. Skips if not permitted."""
+    path = folder / name
+    try:
+        os.mknod(path, stat.S_IFCHR | 0o666, os.makedev(1, minor))
+    except (PermissionError, OSError) as exc:
+        pytest.skip(f"cannot make a device here: {exc}")
+    return path
+
+
+def test_a_device_output_is_written_not_replaced(work):
+    scene, out = work
+    null = _char_device(out, "null", 3)
+    status, _, err = cli("simulate", scene, "-o", null, "--events", null, "-q")
+    assert "--events" in refused(status, err, out, keep=("null",))  # still one file
+    status, _, err = cli("simulate", scene, "-o", null, "-q")
+    assert status == 0, err
+    assert stat.S_ISCHR(null.stat().st_mode)
+    assert files_in(out) == ["null"]
+
+
+def test_a_full_device_output_is_one_line_naming_it(work):
+    scene, out = work
+    full = _char_device(out, "full", 7)
+    status, _, err = cli("simulate", scene, "-o", full, "-q")
+    line = refused(status, err, out, keep=("full",))
+    assert str(full) in line and ".part" not in line
+    assert stat.S_ISCHR(full.stat().st_mode)
+
+
+def test_a_fifo_output_is_written_through(work):
+    scene, out = work
+    fifo = out / "pipe"
+    os.mkfifo(fifo)
+    got: list[bytes] = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_bytes()))
+    reader.start()
+    status, _, err = cli("simulate", scene, "-o", fifo, "-q")
+    reader.join(10)
+    assert status == 0, err
+    assert got and got[0].startswith(b"t,xA,vA")
+    assert stat.S_ISFIFO(fifo.stat().st_mode) and files_in(out) == ["pipe"]
+
+
+def test_dash_writes_to_stdout(work):
+    scene, out = work
+    status, text, err = cli("simulate", scene, "-o", "-", "--events", out / "e.csv", "-q")
+    assert status == 0, err
+    assert text.startswith("t,xA,vA") and len(text.splitlines()) == 1 + 51
+    assert files_in(out) == ["e.csv"]
+
+
+def test_a_failed_second_output_leaves_the_first_out_too(work, monkeypatch):
+    scene, out = work
+    from dumbbell.model.trajectory import Trajectory
+
+    def fail(self, path):
+        from dumbbell.io.files import atomic_output
+
+        with atomic_output(path) as tmp:
+            raise PermissionError(13, "Permission denied", str(tmp))
+
+    monkeypatch.setattr(Trajectory, "events_to_csv", fail)
+    status, _, err = cli("simulate", scene, "-o", out / "x.csv", "--events", out / "e.csv")
+    line = refused(status, err, out)
+    assert str(out / "e.csv") in line and ".part" not in line
+
+
+@pytest.mark.parametrize("flag,value", [
+    ("--events", "{scene}/e.csv"),        # the folder is a file
+    ("-o", "{out}"),                       # a folder given as the file
+    ("--events", "{out}/none/\0/e.csv"),   # not a path at all
+])
+def test_unwritable_outputs_are_refused_before_stepping(work, flag, value):
+    scene, out = work
+    target = value.format(scene=scene, out=out)
+    argv = ["simulate", scene, "--t-end", "1e3", "--dt", "1e-6", "--every", "100000"]
+    other = ["-o", out / "x.csv"] if flag == "--events" else []
+    status, _, err = cli(*argv, *other, flag, target)
+    assert flag in refused(status, err, out)
+
+
+def test_an_output_folder_that_is_a_file_is_refused(work):
+    scene, out = work
+    (out / "f").write_text("x")
+    status, _, err = cli("sweep", scene, "--grid", "k=100,200", "--out", out / "f")
+    assert "--out" in refused(status, err, out, keep=("f",))
+
+
+# --- 5. inputs that are not files -----------------------------------------------------------
+
+
+def test_dev_zero_as_the_scene_is_refused_at_once(tmp_path):
+    status, _, err = cli("simulate", "/dev/zero", "-o", tmp_path / "x.csv")
+    assert "/dev/zero" in refused(status, err, tmp_path)
+
+
+def test_a_fifo_as_the_scene_is_refused_without_blocking(tmp_path):
+    fifo = tmp_path / "scene.toml"
+    os.mkfifo(fifo)
+    status, _, err = cli("simulate", fifo, "-o", tmp_path / "x.csv")
+    assert "regular file" in refused(status, err, tmp_path, keep=("scene.toml",))
+
+
+def test_a_directory_as_the_scene_is_refused(tmp_path):
+    status, _, err = cli("simulate", tmp_path)
+    refused(status, err, tmp_path)
+
+
+def test_a_scene_file_past_the_size_cap_is_refused(tmp_path):
+    path = short_scene(tmp_path, extra="# " + "x" * 1_100_000 + "\n")
+    status, _, err = cli("simulate", path, "-o", tmp_path / "x.csv")
+    assert "1 MB" in refused(status, err, tmp_path, keep=("short.toml",))
+
+
+@pytest.mark.parametrize("text", [
+    "a = " + "[" * 5000 + "]" * 5000,
+    "a = " + "{b = " * 3000 + "1" + "}" * 3000,
+    "[" + ".".join(["a"] * 3000) + "]\nx = 1",
+])
+def test_deep_nesting_is_a_scene_error(tmp_path, text):
+    path = tmp_path / "deep.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError):
+        load_scene(path)
+    status, _, err = cli("simulate", path, "-o", tmp_path / "x.csv")
+    refused(status, err, tmp_path, keep=("deep.toml",))
+
+
+def test_a_deeply_nested_dict_is_a_scene_error():
+    deep: dict = {}
+    node = deep
+    for _ in range(5000):
+        node["a"] = {}
+        node = node["a"]
+    with pytest.raises(SceneError):
+        scene_from_dict(deep)
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(SceneError):
+        scene.with_values({"outputs.gif": deep})
+
+
+# --- 6. external services -------------------------------------------------------------------
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def http_port():
+    from http.server import HTTPServer, SimpleHTTPRequestHandler
+
+    server = HTTPServer(("127.0.0.1", 0), SimpleHTTPRequestHandler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield server.server_address[1]
+    server.shutdown()
+    server.server_close()
+
+
+@pytest.mark.parametrize("target", ["closed", "http"])
+def test_a_scheduler_that_is_not_dask_is_one_line(work, target, request):
+    pytest.importorskip("dask.distributed")
+    scene, out = work
+    port = _free_port() if target == "closed" else request.getfixturevalue("http_port")
+    address = f"tcp://127.0.0.1:{port}"
+    status, _, err = cli("sweep", scene, "--grid", "k=100,200", "--scheduler", address,
+                         "--connect-timeout", "1", "--out", out)
+    line = refused(status, err, out)
+    assert address in line and "--connect-timeout" in line
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "1e999", "x"])
+def test_connect_timeout_is_validated(work, value):
+    scene, out = work
+    status, _, err = cli("sweep", scene, "--grid", "k=100,200", "--scheduler", "tcp://h:1",
+                         "--connect-timeout", value, "--out", out)
+    assert "--connect-timeout" in refused(status, err, out)
+
+
+# --- 7. the Python API ----------------------------------------------------------------------
+
+
+def test_numpy_scalars_are_numbers():
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    plain = dumbbell.simulate(scene, dt=float(np.float32(1e-4)), t_end=0.02, every=10)
+    for kwargs in ({"dt": np.float32(1e-4), "t_end": np.float64(0.02), "every": np.int64(10)},
+                   {"dt": np.float32(1e-4), "t_end": np.float16(0.02), "every": np.uint8(10)}):
+        traj = dumbbell.simulate(scene, **kwargs)
+        if kwargs["t_end"].dtype == np.float16:
+            kwargs["t_end"] = float(kwargs["t_end"])
+            plain = dumbbell.simulate(scene, dt=float(np.float32(1e-4)),
+                                      t_end=kwargs["t_end"], every=10)
+        assert np.array_equal(traj.t, plain.t) and np.array_equal(traj["E"], plain["E"])
+    changed = scene.with_values({"spring.stiffness": np.float32(300.0),
+                                 "run.every": np.int64(7)})
+    assert changed.k == 300.0 and changed.run.every == 7
+
+
+def test_a_path_is_accepted_where_a_scene_is_expected():
+    path = SCENES / "textbook-1d.toml"
+    by_scene = dumbbell.simulate(load_scene(path), t_end=0.01)
+    for given in (path, str(path)):
+        traj = dumbbell.simulate(given, t_end=0.01)
+        assert np.array_equal(traj["E"], by_scene["E"])
+
+
+@pytest.mark.parametrize("call,argument", [
+    (lambda s: dumbbell.simulate(None), "scene"),
+    (lambda s: dumbbell.simulate(42), "scene"),
+    (lambda s: dumbbell.simulate(s, solver=["exact"]), "solver"),
+    (lambda s: dumbbell.simulate(s, solver=3), "solver"),
+    (lambda s: dumbbell.simulate(s, solver="nope"), "solver"),
+    (lambda s: dumbbell.simulate(s, dt="1e-4"), "dt"),
+    (lambda s: dumbbell.simulate(s, every=2.5), "every"),
+    (lambda s: dumbbell.simulate(s, every=True), "every"),
+    (lambda s: dumbbell.simulate(s, t_end=np.array([1.0, 2.0])), "t_end"),
+    (lambda s: dumbbell.simulate(s, quiet="no"), "quiet"),
+    (lambda s: dumbbell.simulate(s, max_samples=-1), "max_samples"),
+    (lambda s: dumbbell.load_scene(None), "path"),
+    (lambda s: dumbbell.load_scene(["a.toml"]), "path"),
+    (lambda s: scene_from_dict(None), "data"),
+    (lambda s: s.with_values(None), "values"),
+    (lambda s: s.with_values({None: 1}), "values"),
+    (lambda s: s.with_values(["k"]), "values"),
+])
+def test_wrong_types_raise_a_dumbbell_error_naming_the_argument(call, argument):
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError, match=argument) as info:
+        call(scene)
+    assert "\n" not in str(info.value)
+
+
+def test_analysis_functions_check_their_arguments():
+    from dumbbell.analysis.compare import compare
+    from dumbbell.analysis.sweep import run_sweep
+
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError, match="solvers"):
+        compare(scene, solvers="exact")
+    with pytest.raises(DumbbellError, match="scene"):
+        compare(None)
+    with pytest.raises(DumbbellError, match="axes"):
+        run_sweep(scene, None, "euler-cromer")
+    with pytest.raises(DumbbellError, match="solver"):
+        run_sweep(scene, [], None)
+
+
+def test_trajectory_outputs_check_their_path(tmp_path):
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    traj = dumbbell.simulate(scene, t_end=0.01)
+    with pytest.raises(DumbbellError, match="path"):
+        traj.to_csv(None)
+    with pytest.raises(DumbbellError, match="path"):
+        traj.events_to_csv(3)
+    assert traj.to_csv(str(tmp_path / "x.csv")).is_file()
+
+
+def test_a_step_count_past_the_floats_is_said_in_words():
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError) as info:
+        dumbbell.simulate(scene, t_end=1e10, dt=1e-300)
+    assert "inf" not in str(info.value) and "nan" not in str(info.value)
