@@ -23,7 +23,6 @@ import csv
 import io
 import itertools
 import math
-import os
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass

@@ -47,10 +47,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..parallel import cap_note
     from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
     from ..model.scene import load_scene
+    from ..parallel import cap_note
     from ..solvers import solver_class
 
     scene = load_scene(args.scene)

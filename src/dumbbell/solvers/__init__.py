@@ -11,12 +11,12 @@ kernels, pymunk, scipy) load only when that solver runs.
 
 from __future__ import annotations
 
-from ..errors import SceneError, UsageError
-from ..model.scene import Scene
-from ..model.trajectory import Trajectory
 from pathlib import Path
 
+from ..errors import SceneError, UsageError
 from ..model import args
+from ..model.scene import Scene
+from ..model.trajectory import Trajectory
 from .base import MAX_SAMPLES, MAX_STEPS, RunOptions, Solver, make_options
 from .engine import Pymunk
 from .euler_cromer import EulerCromer
