@@ -568,3 +568,27 @@ def test_a_step_count_past_the_floats_is_said_in_words():
     with pytest.raises(DumbbellError) as info:
         dumbbell.simulate(scene, t_end=1e10, dt=1e-300)
     assert "inf" not in str(info.value) and "nan" not in str(info.value)
+
+
+@pytest.mark.parametrize("call,argument", [
+    (lambda: dumbbell.compare(None), "scene"),
+    (lambda: dumbbell.compare(SCENES / "textbook-1d.toml", solvers=[None]), "solvers"),
+    (lambda: dumbbell.bench(SCENES / "textbook-1d.toml", dts=["1e-3"]), "dts"),
+    (lambda: dumbbell.sweep(SCENES / "textbook-1d.toml", None), "grid"),
+    (lambda: dumbbell.sweep(SCENES / "textbook-1d.toml", {"k": [1, 2]}, workers=[2]), "workers"),
+    (lambda: dumbbell.stability(solvers=3), "solvers"),
+    (lambda: dumbbell.render_gif(None), "traj"),
+    (lambda: dumbbell.render_gif(dumbbell.simulate(SCENES / "textbook-1d.toml", t_end=0.1),
+                                 t_end=10**400), "t_end"),
+])
+def test_the_public_entry_points_name_a_wrong_argument(call, argument):
+    with pytest.raises(DumbbellError, match=argument) as info:
+        call()
+    assert "\n" not in str(info.value)
+
+
+def test_render_gif_takes_numpy_scalars():
+    traj = dumbbell.simulate(SCENES / "textbook-1d.toml", t_end=0.2)
+    gif = dumbbell.render_gif(traj, fps=np.int64(10), t_end=np.float32(0.2),
+                              max_frames=np.int64(3), size="64x64")
+    assert bytes(gif[:6]) == b"GIF89a"

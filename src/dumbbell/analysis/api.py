@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import UsageError
-from ..model.scene import Scene, load_scene
+from ..model.scene import Scene
 
 if TYPE_CHECKING:
     from .bench import BenchResult
@@ -25,13 +25,32 @@ if TYPE_CHECKING:
 
 
 def _scene(scene: Scene | str | Path) -> Scene:
-    return scene if isinstance(scene, Scene) else load_scene(scene)
+    from ..model import args
+
+    return args.scene(scene)
 
 
-def _floats(values: float | Sequence[float] | None) -> list[float] | None:
+def _floats(values: float | Sequence[float] | None, name: str = "dts") -> list[float] | None:
+    """None, one number or a list of numbers (numpy scalars too) as a list of floats > 0."""
+    import numbers
+
+    from ..model import args
+
     if values is None:
         return None
-    return [float(values)] if isinstance(values, int | float) else [float(v) for v in values]
+    if isinstance(values, numbers.Real) and not isinstance(values, bool):
+        values = [values]
+    return args.positives(list(values) if isinstance(values, tuple) else values, name, "s")
+
+
+def _names(values: Sequence[str] | None, name: str = "solvers") -> list[str] | None:
+    """None, one solver name or a list of them, as a list of known names."""
+    from ..model import args
+    from ..solvers import available
+
+    if values is None or (isinstance(values, list | tuple) and not values):
+        return None  # the default set, as before
+    return args.names([values] if isinstance(values, str) else values, name, available())
 
 
 def compare(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
@@ -43,8 +62,7 @@ def compare(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
     times. ``.to_pandas()`` is the summary table, ``.impacts_to_pandas()`` the impacts."""
     from .compare import compare as run
 
-    return run(_scene(scene), list(solvers) if solvers else None, _floats(dts), window,
-               t_end, quiet)
+    return run(_scene(scene), _names(solvers), _floats(dts), window, t_end, quiet)
 
 
 def bench(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
@@ -57,8 +75,8 @@ def bench(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
     per (solver, dt)."""
     from .bench import run_bench
 
-    return run_bench(_scene(scene), list(solvers) if solvers else None, _floats(dts), window,
-                     repeat, t_end, budget, spacing, quiet)
+    return run_bench(_scene(scene), _names(solvers), _floats(dts), window, repeat, t_end,
+                     budget, spacing, quiet)
 
 
 def sweep(scene: Scene | str | Path,
@@ -78,11 +96,13 @@ def sweep(scene: Scene | str | Path,
         items = [f"{key}={spec}" if isinstance(spec, str)
                  else f"{key}={','.join(repr(v) if isinstance(v, float) else str(v) for v in spec)}"
                  for key, spec in grid.items()]
-    elif isinstance(grid, str):
-        raise UsageError(f"grid = {grid!r}: must be a mapping of key to spec, or a list of "
-                         "'NAME=SPEC' items")
-    else:
+    elif isinstance(grid, list | tuple) and all(isinstance(g, str) for g in grid):
         items = list(grid)
+    else:
+        from ..model.args import show
+
+        raise UsageError(f"grid = {show(grid)}: must be a mapping of key to spec, or a list "
+                         "of 'NAME=SPEC' items", param="grid")
     axes = [parse_axis(item) for item in items]
     check_axes(axes)
     the_scene = _scene(scene)
@@ -98,4 +118,4 @@ def stability(cases: str | Path | None = None, solvers: Sequence[str] | None = N
     one row per run; ``.markdown()`` is the report ``dumbbell stability`` writes."""
     from .stability import run_stability
 
-    return run_stability(cases, list(solvers) if solvers else None, workers, quiet)
+    return run_stability(cases, _names(solvers), workers, quiet)

@@ -217,13 +217,17 @@ def render_gif(
     end); more than ``max_frames`` frames are refused. ``timing``, when given, receives the
     seconds spent drawing and encoding."""
     from .. import progress
+    from ..model import args
     from .drawing import Painter, palette
 
+    if not isinstance(traj, Trajectory):
+        raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
+                         param="traj")
     fps = check_fps(fps)
     width, height = check_size(size)
+    max_frames = args.whole(max_frames, "max_frames", "frames")
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
-    if t_end is None or not (math.isfinite(t_end) and t_end > 0):
-        raise UsageError(f"t_end = {t_end}: must be a finite number > 0 (s)")
+    t_end = args.real(t_end, "t_end", "s")
     check_frames(t_end, fps, max_frames)
     t0 = time.perf_counter()
     frames = frames_of(traj, fps, t_end)
