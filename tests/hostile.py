@@ -16,33 +16,14 @@ import psutil
 
 import dumbbell
 from dumbbell.cli import main
+from tests.test_scene import GOOD
 
 #: The folder holding the package under test, so that a subprocess runs the same code.
 SRC = str(Path(dumbbell.__file__).resolve().parent.parent)
 
 #: A short textbook scene: 0.05 s at dt = 1e-4 s (500 steps), so that accepted runs are quick.
-SHORT_SCENE = """\
-title = "short"
-dimensions = 1
-[bodies.A]
-mass = 0.1
-height = 1.2
-[bodies.B]
-mass = 0.1
-height = 1.0
-[spring]
-stiffness = 200.0
-rest_length = 0.2
-[floor]
-elasticity = 1.0
-[gravity]
-g = 9.8
-[run]
-t_end = 0.05
-dt = 1e-4
-solver = "euler-cromer"
-every = 10
-"""
+SHORT_SCENE = GOOD.replace('title = "ok"', 'title = "short"').replace(
+    "t_end = 0.01\ndt = 1e-5\n", 't_end = 0.05\ndt = 1e-4\nsolver = "euler-cromer"\nevery = 10\n')
 
 
 def short_scene(folder: Path, name: str = "short.toml", extra: str = "") -> Path:
