@@ -22,9 +22,9 @@ import numpy as np
 
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
-from .base import RunOptions, Solver, kernel_params
+from .base import RunOptions, kernel_params
 from .kernels import EVENT_BUFFER
-from .stepping import kernel_verdict, run_kernel
+from .stepping import Stepper, kernel_verdict, run_kernel
 from .verdicts import below_floor_verdict
 
 NAME = "euler-cromer"
@@ -86,17 +86,11 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     return traj
 
 
-class EulerCromer(Solver):
+class EulerCromer(Stepper):
     """The textbook's Euler-Cromer in 1D (see the module docstring)."""
 
     name = NAME
     order = 1
-    has_step = True
-    explicit_spring = True
-    flip_floor = True
-    relative_cost = 1.0
-    is_truth = False
-    estimates_error = False
     supports = staticmethod(supports)
     solve = staticmethod(solve)
     warm_up = staticmethod(warm_up)

@@ -26,9 +26,9 @@ import numpy as np
 
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
-from .base import RunOptions, Solver, kernel_params, point_particle_limits
+from .base import RunOptions, kernel_params, point_particle_limits
 from .kernels import EVENT_BUFFER
-from .stepping import kernel_verdict, run_kernel
+from .stepping import Stepper, kernel_verdict, run_kernel
 
 NAME = "euler-cromer-2d"
 
@@ -84,17 +84,11 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     return traj
 
 
-class EulerCromer2D(Solver):
+class EulerCromer2D(Stepper):
     """A 2D Euler-Cromer in pymunk's step order (see the module docstring)."""
 
     name = NAME
     order = 1
-    has_step = True
-    explicit_spring = True
-    flip_floor = True
-    relative_cost = 1.0
-    is_truth = False
-    estimates_error = False
     supports = staticmethod(supports)
     solve = staticmethod(solve)
     warm_up = staticmethod(warm_up)

@@ -16,9 +16,22 @@ import numpy as np
 
 from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
-from .base import RunOptions
+from .base import RunOptions, Solver
 from .kernels import BIG, BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B
 from .verdicts import energy_verdict, keep_samples, nonfinite_reason
+
+
+class Stepper(Solver):
+    """The facts the compiled time-steppers share: a fixed step, an explicit spring step
+    (stable iff w*dt < 2), a floor that reverses velocities, the cost of one Euler-Cromer
+    step. A subclass adds its ``name`` and ``order`` and its ``supports`` and ``solve``."""
+
+    has_step = True
+    explicit_spring = True
+    flip_floor = True
+    relative_cost = 1.0
+    is_truth = False
+    estimates_error = False
 
 
 @dataclass

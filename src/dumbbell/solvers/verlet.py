@@ -29,9 +29,9 @@ import numpy as np
 
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
-from .base import RunOptions, Solver, kernel_params, point_particle_limits
+from .base import RunOptions, kernel_params, point_particle_limits
 from .kernels import EVENT_BUFFER
-from .stepping import kernel_verdict, run_kernel
+from .stepping import Stepper, kernel_verdict, run_kernel
 from .verdicts import tunnel_reason
 
 NAME = "verlet"
@@ -109,17 +109,11 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     return traj
 
 
-class Verlet(Solver):
+class Verlet(Stepper):
     """Velocity Verlet with impacts located inside the step (see the module docstring)."""
 
     name = NAME
     order = 2
-    has_step = True
-    explicit_spring = True
-    flip_floor = True
-    relative_cost = 1.0
-    is_truth = False
-    estimates_error = False
     supports = staticmethod(supports)
     solve = staticmethod(solve)
     warm_up = staticmethod(warm_up)
