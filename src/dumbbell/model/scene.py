@@ -408,16 +408,37 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
 
 
 def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
+    """The scene of a document: one reader per table, in the order a file is checked, so
+    the first problem found is the one reported."""
     top = _Checker(source, data, "")
     title = top.string("title", Path(source).stem)
     if not isinstance(title, str):
         top.fail("title", title, "must be a string")
     dims = top.integer("dimensions", 1, lo=1, hi=2)
-
     tilt = None
     if dims == 2 and top.has("tilt"):
         tilt = top.number("tilt", lo=-180.0, hi=180.0, unit="degrees of the axis from vertical")
+    cA, cB = _bodies_tables(top, source)
+    spring = _spring(top)
+    rigid = _rigid(top, dims, spring)
+    if tilt is not None and spring is None and rigid is None:
+        top.fail("tilt", tilt, "needs a [spring] or [rigid] to set the distance from B to A")
+    A, B = _particles(cA, cB, dims, tilt, spring, rigid, source)
+    floor = _floor(top, dims)
+    _check_placement(A, B, dims, floor, rigid, source)
+    g = _gravity(top)
+    run = _run(top, source)
+    outputs = _outputs(top, dims, floor is not None, rigid is not None, run.t_end)
+    pm = _pymunk(top)
+    top.done()
+    return Scene(
+        title=title, dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
+        run=run, outputs=outputs, pymunk=pm, source=source, raw=copy.deepcopy(data),
+    )
 
+
+def _bodies_tables(top: _Checker, source: str) -> tuple[_Checker, _Checker]:
+    """The checkers of [bodies.A] and [bodies.B], both required."""
     bodies = top.sub("bodies")
     if bodies is None:
         raise SceneError(f"{source}: [bodies] is missing: needs [bodies.A] and [bodies.B]")
@@ -426,26 +447,38 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
         missing = "bodies.A" if cA is None else "bodies.B"
         raise SceneError(f"{source}: [{missing}] is missing: a dumbbell has particles A and B")
     bodies.done()
+    return cA, cB
 
-    spring = rigid = None
+
+def _spring(top: _Checker) -> Spring | None:
+    """[spring]: stiffness (N/m) and rest length (m)."""
     cs = top.sub("spring")
-    if cs is not None:
-        spring = Spring(
-            cs.number("stiffness", lo=0.0, unit="N/m"),
-            cs.number("rest_length", lo=0.0, unit="m"),
-        )
-        cs.done()
-    cr = top.sub("rigid")
-    if cr is not None:
-        if dims != 2:
-            cr.fail("rigid", "[rigid]", "a rigid rod needs dimensions = 2")
-        if spring is not None:
-            cr.fail("rigid", "[rigid]", "a scene has either [spring] or [rigid], not both")
-        rigid = Rigid(cr.number("length", lo=0.0, lo_open=True, unit="m"))
-        cr.done()
-    if tilt is not None and spring is None and rigid is None:
-        top.fail("tilt", tilt, "needs a [spring] or [rigid] to set the distance from B to A")
+    if cs is None:
+        return None
+    spring = Spring(cs.number("stiffness", lo=0.0, unit="N/m"),
+                    cs.number("rest_length", lo=0.0, unit="m"))
+    cs.done()
+    return spring
 
+
+def _rigid(top: _Checker, dims: int, spring: Spring | None) -> Rigid | None:
+    """[rigid]: a massless rod of ``length`` (m) between A and B, in 2D only."""
+    cr = top.sub("rigid")
+    if cr is None:
+        return None
+    if dims != 2:
+        cr.fail("rigid", "[rigid]", "a rigid rod needs dimensions = 2")
+    if spring is not None:
+        cr.fail("rigid", "[rigid]", "a scene has either [spring] or [rigid], not both")
+    rigid = Rigid(cr.number("length", lo=0.0, lo_open=True, unit="m"))
+    cr.done()
+    return rigid
+
+
+def _particles(cA: _Checker, cB: _Checker, dims: int, tilt: float | None,
+               spring: Spring | None, rigid: Rigid | None, source: str
+               ) -> tuple[Particle, Particle]:
+    """A and B; with ``tilt`` (degrees from vertical) A is placed from B along the axis."""
     B = _particle(cB, "B", dims, placed=False)
     A = _particle(cA, "A", dims, placed=tilt is not None)
     M = A.mass + B.mass
@@ -460,16 +493,26 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
             "A", A.mass, B.x + length * math.sin(theta), B.height + length * math.cos(theta),
             A.vx, A.vy, A.radius, A.spin,
         )
+    return A, B
 
+
+def _floor(top: _Checker, dims: int) -> Floor | None:
+    """[floor]: elasticity (restitution) and Coulomb friction (2D only)."""
     cf = top.sub("floor")
-    floor = None
-    if cf is not None:
-        elasticity = cf.number("elasticity", 1.0, lo=0.0, hi=1.0, unit="restitution")
-        friction = cf.number("friction", 0.0, lo=0.0, unit="Coulomb coefficient")
-        if dims == 1 and friction > 0:
-            cf.fail("floor.friction", friction, "must be 0 in a 1D scene (no sideways motion)")
-        floor = Floor(elasticity, friction)
-        cf.done()
+    if cf is None:
+        return None
+    elasticity = cf.number("elasticity", 1.0, lo=0.0, hi=1.0, unit="restitution")
+    friction = cf.number("friction", 0.0, lo=0.0, unit="Coulomb coefficient")
+    if dims == 1 and friction > 0:
+        cf.fail("floor.friction", friction, "must be 0 in a 1D scene (no sideways motion)")
+    cf.done()
+    return Floor(elasticity, friction)
+
+
+def _check_placement(A: Particle, B: Particle, dims: int, floor: Floor | None,
+                     rigid: Rigid | None, source: str) -> None:
+    """Both particles above the floor, A above B in 1D, and a rod as long as A is from B."""
+    if floor is not None:
         for p in (A, B):
             if p.height < 0:
                 raise SceneError(
@@ -489,12 +532,19 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
                 f"from B to A ({dist:.6g} m)"
             )
 
-    cg = top.sub("gravity")
-    g = 0.0
-    if cg is not None:
-        g = cg.number("g", lo=0.0, unit="m/s^2, downward")
-        cg.done()
 
+def _gravity(top: _Checker) -> float:
+    """[gravity]: g (m/s^2, downward); 0 without the table."""
+    cg = top.sub("gravity")
+    if cg is None:
+        return 0.0
+    g = cg.number("g", lo=0.0, unit="m/s^2, downward")
+    cg.done()
+    return g
+
+
+def _run(top: _Checker, source: str) -> RunSettings:
+    """[run]: t_end and dt (s), solver, every, unstable_energy."""
     crun = top.sub("run")
     if crun is None:
         raise SceneError(f"{source}: [run] is missing: needs t_end and dt (s)")
@@ -510,55 +560,59 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
         unit="relative energy error that makes a run unstable",
     )
     crun.done()
+    return RunSettings(t_end, dt, solver, every, unstable)
 
+
+def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: float
+             ) -> Outputs:
+    """[outputs]: figures (names), csv, and [outputs.gif] (fps, size, strip, t_end in s)."""
     co = top.sub("outputs")
+    if co is None:
+        return Outputs((), False, None)
     figures: tuple[str, ...] = ()
-    csv = False
+    co.used.add("figures")
+    if co.has("figures"):
+        value = co.table["figures"]
+        if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
+            co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+        if "rotation" in value and dims != 2:
+            co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
+        if "contact" in value and (dims != 2 or not has_floor):
+            co.fail("outputs.figures", value, "'contact' needs a 2D scene with a [floor]")
+        if "topple" in value and not has_rigid:
+            co.fail("outputs.figures", value, "'topple' needs a rigid 2D dumbbell ([rigid])")
+        figures = tuple(value)
+    csv = bool(co.boolean("csv", False))
     gif = None
-    if co is not None:
-        co.used.add("figures")
-        if co.has("figures"):
-            value = co.table["figures"]
-            if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
-                co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
-            if "rotation" in value and dims != 2:
-                co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
-            if "contact" in value and (dims != 2 or cf is None):
-                co.fail("outputs.figures", value, "'contact' needs a 2D scene with a [floor]")
-            if "topple" in value and rigid is None:
-                co.fail("outputs.figures", value, "'topple' needs a rigid 2D dumbbell ([rigid])")
-            figures = tuple(value)
-        csv = bool(co.boolean("csv", False))
-        cgif = co.sub("gif")
-        if cgif is not None:
-            gif = {
-                "fps": cgif.integer("fps", 25, lo=1, hi=50),
-                "size": cgif.string("size", "640x360"),
-                "strip": cgif.boolean("strip", True),
-                "t_end": cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
-            }
-            if _parse_size(gif["size"]) is None:
-                cgif.fail("outputs.gif.size", gif["size"], "must be WIDTHxHEIGHT in pixels, "
-                          "each between 64 and 4096")
-            cgif.done()
-        co.done()
+    cgif = co.sub("gif")
+    if cgif is not None:
+        gif = {
+            "fps": cgif.integer("fps", 25, lo=1, hi=50),
+            "size": cgif.string("size", "640x360"),
+            "strip": cgif.boolean("strip", True),
+            "t_end": cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
+        }
+        if _parse_size(gif["size"]) is None:
+            cgif.fail("outputs.gif.size", gif["size"], "must be WIDTHxHEIGHT in pixels, "
+                      "each between 64 and 4096")
+        cgif.done()
+    co.done()
+    return Outputs(figures, csv, gif)
 
+
+def _pymunk(top: _Checker) -> PymunkSettings:
+    """[pymunk]: engine settings; None where the scene leaves the engine's default."""
     cp = top.sub("pymunk")
-    pm = PymunkSettings(None, None, None, None)
-    if cp is not None:
-        pm = PymunkSettings(
-            cp.number("collision_slop", lo=0.0, unit="m") if cp.has("collision_slop") else None,
-            cp.number("collision_bias", lo=0.0, hi=1.0) if cp.has("collision_bias") else None,
-            cp.integer("iterations", 10, lo=1, hi=10000) if cp.has("iterations") else None,
-            cp.boolean("spin", None),
-        )
-        cp.done()
-    top.done()
-    return Scene(
-        title=title, dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
-        run=RunSettings(t_end, dt, solver, every, unstable),
-        outputs=Outputs(figures, csv, gif), pymunk=pm, source=source, raw=copy.deepcopy(data),
+    if cp is None:
+        return PymunkSettings(None, None, None, None)
+    pm = PymunkSettings(
+        cp.number("collision_slop", lo=0.0, unit="m") if cp.has("collision_slop") else None,
+        cp.number("collision_bias", lo=0.0, hi=1.0) if cp.has("collision_bias") else None,
+        cp.integer("iterations", 10, lo=1, hi=10000) if cp.has("iterations") else None,
+        cp.boolean("spin", None),
     )
+    cp.done()
+    return pm
 
 
 def _parse_size(text: Any) -> tuple[int, int] | None:
