@@ -290,31 +290,10 @@ def run_bench(
     steppers = [n for n in solvers if solver_class(n).has_step]
     single = [n for n in solvers if not solver_class(n).has_step and n != truth]
     total = len(steppers) * len(dts) + len(single) + (truth is not None)
+    limits = _Limits(window, t_end, repeat, budget, spacing)
     with bar(total, f"bench {scene.name}", "point", quiet=quiet) as pb:
         for name in steppers:
-            cls = solver_class(name)
-            compile_s = cls.warm_up()
-            cost_per_step = None
-            for dt in dts:
-                pb.set_postfix_str(f"{name} dt={dt:g}")
-                options = make_options(scene, dt=dt, t_end=t_end, every=_every(dt, spacing))
-                base = Point(name, dt, window=window, t_end=t_end, truth=truth or "",
-                             steps=options.n_steps, every=options.every,
-                             compile_seconds=compile_s)
-                estimate = None if cost_per_step is None else cost_per_step * options.n_steps
-                if estimate is not None and estimate * (repeat + 1) > budget:
-                    base.verdict, base.seconds = "skipped", estimate
-                    base.reason = (f"estimated {estimate:.3g} s per run x {repeat + 1} runs > "
-                                   f"budget {budget:g} s")
-                    points.append(base)
-                    pb.update(1)
-                    continue
-                traj, point = _measure(cls, scene, options, repeat, base)
-                _score(point, traj, truth_at(options), window)
-                points.append(point)
-                if point.ok and point.steps:
-                    cost_per_step = point.seconds_call / point.steps
-                pb.update(1)
+            points += _stepper_points(scene, name, dts, limits, truth, truth_at, pb)
         for name in single:
             pb.set_postfix_str(name)
             points.append(_single_point(scene, name, t_end, window, repeat, truth, truth_at,
@@ -332,6 +311,49 @@ def run_bench(
             fits[name] = fit
     return BenchResult(scene.name, scene.source, truth, window, t_end, repeat, budget, points,
                        fits, notes, spacing)
+
+
+@dataclass(frozen=True)
+class _Limits:
+    """What every point of one benchmark shares: the error window and run length (s), the
+    timed runs per point, the time budget per point (s) and the sample spacing (s)."""
+
+    window: float
+    t_end: float
+    repeat: int
+    budget: float
+    spacing: float
+
+
+def _stepper_points(scene: Scene, name: str, dts: list[float], limits: _Limits,
+                    truth: str | None, truth_at: Any, pb: Any) -> list[Point]:
+    """One point per step in ``dts`` (largest first) for the stepping solver ``name``. A step
+    whose runs the cost per step measured so far says would pass the budget is skipped."""
+    cls = solver_class(name)
+    compile_s = cls.warm_up()
+    cost_per_step = None
+    points = []
+    for dt in dts:
+        pb.set_postfix_str(f"{name} dt={dt:g}")
+        options = make_options(scene, dt=dt, t_end=limits.t_end,
+                               every=_every(dt, limits.spacing))
+        base = Point(name, dt, window=limits.window, t_end=limits.t_end, truth=truth or "",
+                     steps=options.n_steps, every=options.every, compile_seconds=compile_s)
+        estimate = None if cost_per_step is None else cost_per_step * options.n_steps
+        if estimate is not None and estimate * (limits.repeat + 1) > limits.budget:
+            base.verdict, base.seconds = "skipped", estimate
+            base.reason = (f"estimated {estimate:.3g} s per run x {limits.repeat + 1} runs > "
+                           f"budget {limits.budget:g} s")
+            points.append(base)
+            pb.update(1)
+            continue
+        traj, point = _measure(cls, scene, options, limits.repeat, base)
+        _score(point, traj, truth_at(options), limits.window)
+        points.append(point)
+        if point.ok and point.steps:
+            cost_per_step = point.seconds_call / point.steps
+        pb.update(1)
+    return points
 
 
 def _every(dt: float, spacing: float) -> int:
