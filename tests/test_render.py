@@ -236,7 +236,7 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
     frames = frames_of(traj, 25, 2.0)
     painter = Painter(textbook, frames, (640, 360), True)
     assert painter.window == drawing.WINDOW < 2.0
-    sx0, sy0, sx1, sy1 = painter.strip_box
+    sx0, sy0, sx1, sy1 = painter.L.strip_box
     ink, brown = np.array(drawing.INK), np.array(TERM_RGB["U_g"])
     cursors = []
     for k in range(0, len(frames.t), 3):

@@ -220,6 +220,87 @@ class Backdrop:
         return crop, (x0, y0), done
 
 
+#: Layout of a frame, in units of ``u`` (the frame's size over the 640 x 360 reference, so a
+#: larger GIF scales everything alike), or as shares of the frame's width W or height H.
+TOP_MARGIN = 34          # above the scene: the time label and the ruler's title
+FLOOR_BAND = 18          # below the scene: the floor's band
+RULER = 36               # left of the scene: the height ruler
+RULER_GAP = 8            # between the ruler and the world's left edge
+SCENE_RIGHT_PAD = 30     # right of the scene, before the energy panel
+SCENE_MIN_WIDTH = 150    # the scene panel is at least this wide ...
+SCENE_MIN_SHARE = 0.3    # ... and at least this share of W ...
+SCENE_MAX_SHARE = 0.55   # ... and at most this share of W
+PANEL_GAP = 10           # between the scene and the energy panel
+EDGE = 8                 # between a panel and the frame's edge
+BARS_SHARE = 0.52        # the energy bars' panel ends at this share of H when a strip follows
+STRIP_TOP_SHARE = 0.59   # the strip starts at this share of H ...
+STRIP_LEFT = 34          # ... this far right of the bars' panel (its value axis) ...
+STRIP_RIGHT = 16         # ... and stops this far from the right edge ...
+STRIP_BOTTOM = 22        # ... and this far from the bottom (its time axis)
+WORLD_PAD = 0.05         # margin around everything the particles reach, a share of its span
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where everything goes on a ``W`` x ``H`` frame, computed once per animation: the length
+    unit ``u`` (px), the world's scale ``s`` (px per m) and origin (``ox``, ``oy``, px), the
+    world window (m) and the panels' boxes (px, left-top-right-bottom)."""
+
+    W: int
+    H: int
+    u: float
+    s: float
+    ox: float
+    oy: float
+    world: tuple[float, float, float, float]
+    ruler_x: int
+    scene_w: int
+    bars_box: tuple[int, int, int, int]
+    strip_box: tuple[int, int, int, int]
+
+    def px(self, x: float, y: float) -> tuple[float, float]:
+        """Pixel position of world point (x, y) in m."""
+        return self.ox + x * self.s, self.oy - y * self.s
+
+
+def layout(scene: Scene, frames: Frames, size: tuple[int, int], strip: bool) -> Layout:
+    """The layout of ``frames`` of ``scene`` on a frame of ``size`` (px): the world window
+    holds every position the particles reach (and the floor), at one scale in x and y."""
+    W, H = size
+    u = min(W / 640, H / 360)  # length unit of fonts and lines (px)
+    r = max(scene.A.radius, scene.B.radius)
+    xs = np.concatenate([frames.A[:, 0], frames.B[:, 0]])
+    ys = np.concatenate([frames.A[:, 1], frames.B[:, 1]])
+    finite = np.isfinite(xs) & np.isfinite(ys)
+    xs, ys = (xs[finite], ys[finite]) if finite.any() else (np.zeros(1), np.zeros(1))
+    x0, x1 = float(xs.min()) - r, float(xs.max()) + r
+    y0, y1 = float(ys.min()) - r, float(ys.max()) + r
+    if scene.floor is not None:
+        y0 = min(y0, 0.0)
+    span = max(x1 - x0, y1 - y0, 1e-6)
+    pad = WORLD_PAD * span
+    x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
+    top = round(TOP_MARGIN * u)
+    bottom = round(FLOOR_BAND * u)
+    ruler = round(RULER * u)
+    avail_h = H - top - bottom
+    want_w = ruler + (x1 - x0) * avail_h / (y1 - y0) + round(SCENE_RIGHT_PAD * u)
+    scene_w = int(min(max(want_w, SCENE_MIN_WIDTH * u, SCENE_MIN_SHARE * W),
+                      SCENE_MAX_SHARE * W))
+    avail_w = scene_w - ruler - round(SCENE_RIGHT_PAD * u)
+    s = min(avail_h / (y1 - y0), avail_w / max(x1 - x0, 1e-9))  # px per m
+    ox = ruler + round(RULER_GAP * u) + avail_w / 2 - (x0 + x1) / 2 * s
+    # World bottom on the panel's bottom: room left over (a wide world) goes to the sky.
+    oy = H - bottom + y0 * s
+    right = scene_w + round(PANEL_GAP * u)
+    bars_box = (right, round(EDGE * u), W - round(EDGE * u),
+                round(BARS_SHARE * H) if strip else H - round(EDGE * u))
+    strip_box = (right + round(STRIP_LEFT * u), round(STRIP_TOP_SHARE * H),
+                 W - round(STRIP_RIGHT * u), H - round(STRIP_BOTTOM * u))
+    return Layout(W, H, u, s, ox, oy, (x0, x1, y0, y1), round(ruler - 4 * u), scene_w,
+                  bars_box, strip_box)
+
+
 class Painter(Backdrop):
     """Draws the frames of one animation of ``scene`` at ``size`` (px) into the palette."""
 
@@ -228,7 +309,8 @@ class Painter(Backdrop):
         self.frames = frames
         self.W, self.H = size
         self.strip = strip
-        self.u = min(self.W / 640, self.H / 360)  # length unit of fonts and lines (px)
+        self.L = layout(scene, frames, size, strip)
+        self.u = self.L.u
         # The bars show E and its terms, and E_lost; its split (E_heat, E_err) is in the CSV.
         self.names = [n for n in energy_columns(scene) if n not in ("E_heat", "E_err")]
         self.terms = [n for n in self.names if n not in BOOKKEEPING]
@@ -241,7 +323,6 @@ class Painter(Backdrop):
         self.st_label = Stamps(font(max(8, round(11 * u)) * SS, bold=True))
         self.st_small = Stamps(font(max(8, round(11 * u)) * SS))
         self.st_note = Stamps(font(max(8, round(11 * u))))
-        self._layout()
         self._energy_scale()
         if strip:
             self._strip_window()
@@ -256,42 +337,9 @@ class Painter(Backdrop):
 
     # --- geometry --------------------------------------------------------------------------
 
-    def _layout(self) -> None:
-        W, H, u, fr = self.W, self.H, self.u, self.frames
-        r = max(self.scene.A.radius, self.scene.B.radius)
-        xs = np.concatenate([fr.A[:, 0], fr.B[:, 0]])
-        ys = np.concatenate([fr.A[:, 1], fr.B[:, 1]])
-        finite = np.isfinite(xs) & np.isfinite(ys)
-        xs, ys = (xs[finite], ys[finite]) if finite.any() else (np.zeros(1), np.zeros(1))
-        x0, x1 = float(xs.min()) - r, float(xs.max()) + r
-        y0, y1 = float(ys.min()) - r, float(ys.max()) + r
-        if self.scene.floor is not None:
-            y0 = min(y0, 0.0)
-        span = max(x1 - x0, y1 - y0, 1e-6)
-        pad = 0.05 * span
-        x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
-        top = round(34 * u)          # time label and ruler title
-        bottom = round(18 * u)       # floor band
-        ruler = round(36 * u)        # height ruler on the left
-        avail_h = H - top - bottom
-        want_w = ruler + (x1 - x0) * avail_h / (y1 - y0) + round(30 * u)
-        self.scene_w = int(min(max(want_w, 150 * u, 0.3 * W), 0.55 * W))
-        avail_w = self.scene_w - ruler - round(30 * u)
-        self.s = min(avail_h / (y1 - y0), avail_w / max(x1 - x0, 1e-9))  # px per m
-        self.ox = ruler + round(8 * u) + avail_w / 2 - (x0 + x1) / 2 * self.s
-        # World bottom on the panel's bottom: room left over (a wide world) goes to the sky.
-        self.oy = H - bottom + y0 * self.s
-        self.world = (x0, x1, y0, y1)
-        self.ruler_x = round(ruler - 4 * u)
-        right = self.scene_w + round(10 * u)
-        self.bars_box = (right, round(8 * u), W - round(8 * u),
-                         round(0.52 * H) if self.strip else H - round(8 * u))
-        self.strip_box = (right + round(34 * u), round(0.59 * H), W - round(16 * u),
-                          H - round(22 * u))
-
     def px(self, x: float, y: float) -> tuple[float, float]:
         """Pixel position of world point (x, y) in m."""
-        return self.ox + x * self.s, self.oy - y * self.s
+        return self.L.px(x, y)
 
     def _energy_scale(self) -> None:
         fr = self.frames
@@ -304,7 +352,7 @@ class Painter(Backdrop):
         self.e_hi = max(float(allv.max()), self.e_lo + 1e-12)
         span = self.e_hi - self.e_lo
         self.decimals = max(0, min(6, 2 - math.floor(math.log10(span))))
-        bx0, _, bx1, _ = self.bars_box
+        bx0, _, bx1, _ = self.L.bars_box
         self.bar_left = bx0 + round(82 * self.u)
         self.bar_right = bx1 - round(self.st_text.width(f"-{span:.{self.decimals}f}") + 12 * self.u)
         self.bar_zero = self.bar_left + round((self.bar_right - self.bar_left) * (-self.e_lo) / span)
@@ -316,7 +364,7 @@ class Painter(Backdrop):
 
     def _bar_rows(self) -> list[tuple[str, int, int]]:
         """(name, top px, bottom px) of each row of the energy panel."""
-        _, by0, _, by1 = self.bars_box
+        _, by0, _, by1 = self.L.bars_box
         head = round(22 * self.u)
         n = len(self.names)
         row = min((by1 - by0 - head) / n, 28 * self.u)
@@ -333,12 +381,12 @@ class Painter(Backdrop):
         ft = font(round(12 * u) * S)
         if self.scene.floor is not None:
             _, fy = self.px(0.0, 0.0)
-            d.rectangle([0, fy * S, self.scene_w * S, H * S], fill=FLOOR)
-            d.line([(0, fy * S), (self.scene_w * S, fy * S)], fill=GREY, width=round(2 * u * S))
+            d.rectangle([0, fy * S, self.L.scene_w * S, H * S], fill=FLOOR)
+            d.line([(0, fy * S), (self.L.scene_w * S, fy * S)], fill=GREY, width=round(2 * u * S))
         # Height ruler.
-        _, _, y0, y1 = self.world
+        _, _, y0, y1 = self.L.world
         step = _nice_step((y1 - y0) / 5)
-        rx = self.ruler_x * S
+        rx = self.L.ruler_x * S
         lo, hi = math.ceil(y0 / step - 1e-9), math.floor(y1 / step + 1e-9)
         ya, yb = self.px(0, lo * step)[1], self.px(0, hi * step)[1]
         d.line([(rx, ya * S), (rx, yb * S)], fill=GREY, width=S)
@@ -347,7 +395,7 @@ class Painter(Backdrop):
             d.line([(rx - 4 * u * S, y), (rx, y)], fill=GREY, width=S)
             d.text((rx - 6 * u * S, y), _fmt_tick(k * step), font=fs, fill=GREY, anchor="rm")
         d.text((4 * u * S, (H - 5 * u) * S), "height (m)", font=fs, fill=GREY, anchor="ls")
-        d.line([(self.scene_w * S, 8 * u * S), (self.scene_w * S, (H - 8 * u) * S)],
+        d.line([(self.L.scene_w * S, 8 * u * S), (self.L.scene_w * S, (H - 8 * u) * S)],
                fill=LIGHT, width=S)
         self._bars_static(d, S, ft)
         if self.strip:
@@ -356,11 +404,11 @@ class Painter(Backdrop):
 
     def _bars_static(self, d: ImageDraw.ImageDraw, S: int, ft) -> None:
         u = self.u
-        bx0, by0, _, _ = self.bars_box
+        bx0, by0, _, _ = self.L.bars_box
         d.text((bx0 * S, by0 * S), "Energy (J)", font=font(round(13 * u) * S, True),
                fill=INK, anchor="lt")
         note_font = font(round(10 * u) * S)
-        room = (self.bars_box[2] - bx0 - 80 * u) * S
+        room = (self.L.bars_box[2] - bx0 - 80 * u) * S
         for note in ("fixed scale; pale: largest value since the last frame",
                      "pale: largest since last frame", "pale: since last frame"):
             if note_font.getlength(note) <= room:
@@ -381,7 +429,7 @@ class Painter(Backdrop):
         """The parts of the strip that do not scroll: the frame (one crisp pixel on each side),
         the energy ticks and the axis names. The rest is pasted from the tape every frame."""
         u = self.u
-        sx0, sy0, sx1, sy1 = self.strip_box
+        sx0, sy0, sx1, sy1 = self.L.strip_box
         d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
         for v in self._energy_ticks():
             y = self.strip_y(v)
@@ -397,7 +445,7 @@ class Painter(Backdrop):
     def _strip_window(self) -> None:
         """Time scale of the strip: it shows :data:`WINDOW` s (the whole animation when
         shorter), :data:`AHEAD` of it after the cursor, and scrolls with the cursor."""
-        sx0, sy0, sx1, sy1 = self.strip_box
+        sx0, sy0, sx1, sy1 = self.L.strip_box
         self.inner_x, self.inner_w = sx0 + 1, sx1 - sx0 - 1    # inside the frame (px)
         self.tick_len = max(2, round(3 * self.u))
         self.tape_y, self.tape_h = sy0 + 1, sy1 + self.tick_len - sy0
@@ -420,7 +468,7 @@ class Painter(Backdrop):
         p, h = self.px_per_s, self.tape_h
         tape = Image.new("P", (self.tape_w, h))
         y_of = [(self.strip_y(v) - self.tape_y) * S for v in self._energy_ticks()]
-        edge = (self.strip_box[3] - self.tape_y) * S
+        edge = (self.L.strip_box[3] - self.tape_y) * S
         ticks = [k * self.t_step for k in range(math.floor(fr.t_end / self.t_step + 1e-9) + 1)]
         impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
         # Terms whose range per pixel column is mostly wider than 3 px (faster than a column
@@ -491,7 +539,7 @@ class Painter(Backdrop):
 
     def strip_y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
-        _, sy0, _, sy1 = self.strip_box
+        _, sy0, _, sy1 = self.L.strip_box
         pad = 4 * self.u
         return sy1 - pad - (sy1 - sy0 - 2 * pad) * (value - self.e_lo) / (self.e_hi - self.e_lo)
 
@@ -513,7 +561,7 @@ class Painter(Backdrop):
         left, x = self.strip_offset(k)
         img.paste(self.tape.crop((left, 0, left + self.inner_w, self.tape_h)),
                   (self.inner_x, self.tape_y))
-        sx0, _, _, sy1 = self.strip_box
+        sx0, _, _, sy1 = self.L.strip_box
         u, st = self.u, self.st_note
         y = sy1 + self.tick_len + 1
         # Labels may reach past the frame's left edge, short of the axis name 't (s)'.
@@ -538,10 +586,10 @@ class Painter(Backdrop):
         if not all(math.isfinite(v) for v in (ax, ay, bx, by)):
             return
         pa, pb = self.px(ax, ay), self.px(bx, by)
-        ra = max(sc.A.radius * self.s, MIN_RADIUS_PX * u)
-        rb = max(sc.B.radius * self.s, MIN_RADIUS_PX * u)
+        ra = max(sc.A.radius * self.L.s, MIN_RADIUS_PX * u)
+        rb = max(sc.B.radius * self.L.s, MIN_RADIUS_PX * u)
         rest = sc.spring.rest_length if sc.spring else sc.rigid.length if sc.rigid else 0.0
-        amp = max((CM_RADIUS + 1.5) * u, min(0.06 * rest * self.s, 8 * u))
+        amp = max((CM_RADIUS + 1.5) * u, min(0.06 * rest * self.L.s, 8 * u))
         two_d = sc.dimensions == 2
         m = max(ra, rb, amp) + (18 if two_d else 8) * u
         impact = k in self.impact_frames and sc.floor is not None
@@ -629,7 +677,7 @@ class Painter(Backdrop):
     def _time_label(self, img: Image.Image, k: int) -> None:
         u, fr = self.u, self.frames
         two_d = self.scene.dimensions == 2
-        box = (round(4 * u), round(2 * u), self.scene_w - round(4 * u),
+        box = (round(4 * u), round(2 * u), self.L.scene_w - round(4 * u),
                round((34 if two_d else 22) * u))
         crop, (cx, cy), done = self._patch(img, box, 1)
         self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), f"t = {fr.t[k]:.2f} s", INK, "lt")
@@ -647,11 +695,11 @@ class Painter(Backdrop):
         if fr.L_cm is None or not math.isfinite(float(fr.L_cm[k])):
             return
         below = self._bar_rows()[-1][2]
-        limit = self.strip_box[1] - round(6 * u) if self.strip else self.H - round(4 * u)
+        limit = self.L.strip_box[1] - round(6 * u) if self.strip else self.H - round(4 * u)
         if limit - below < 14 * u:
             return
         y = (below + limit) / 2
-        box = (self.bars_box[0], round(y - 8 * u), self.bars_box[2], round(y + 8 * u))
+        box = (self.L.bars_box[0], round(y - 8 * u), self.L.bars_box[2], round(y + 8 * u))
         text = f"L_cm = {float(fr.L_cm[k]):+.4f} kg m²/s (about the centre of mass)"
         if self.st_note.width(text) > box[2] - box[0]:
             text = f"L_cm = {float(fr.L_cm[k]):+.4f} kg m²/s"
@@ -673,7 +721,7 @@ class Painter(Backdrop):
             self._span(d, min(lo, 0.0) if lo > 0 else lo, hi, top, bot, self.tint.get(name, ink))
             self._span(d, min(e[name], 0.0), max(e[name], 0.0), top, bot, ink)
         # The numbers change every frame: pasted glyphs in RGB, smooth edges.
-        bx1 = self.bars_box[2]
+        bx1 = self.L.bars_box[2]
         box = (self.bar_right + round(4 * self.u), rows[0][1] - 3, bx1, rows[-1][2] + 3)
         crop, (cx, cy), done = self._patch(img, box, 1)
         for name, top, bot in rows:
