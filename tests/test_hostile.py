@@ -7,6 +7,8 @@ import os
 import signal
 import socket
 import stat
+import subprocess
+import sys
 import threading
 import tracemalloc
 from pathlib import Path
@@ -21,6 +23,7 @@ from dumbbell.model.scene import scene_from_dict
 from tests.conftest import SCENES
 from tests.hostile import (
     SHORT_SCENE,
+    SRC,
     cli,
     files_in,
     refused,
@@ -96,6 +99,13 @@ def test_run_refuses_a_gif_past_the_frame_budget_before_stepping(work):
                        'gif = { fps = 25, t_end = 1e4 }\n')
     status, _, err = cli("run", long, "--out", out)
     assert "frames" in refused(status, err, out)
+
+
+def test_compare_refuses_past_the_sample_budget_in_its_own_flags(work):
+    scene, out = work
+    status, _, err = cli("compare", scene, "--t-end", "1e5", "--out", out)
+    line = refused(status, err, out)
+    assert "--t-end" in line and "samples" in line and "--every" not in line
 
 
 def test_sweep_caps_workers_and_says_so_once(work):
@@ -592,3 +602,27 @@ def test_render_gif_takes_numpy_scalars():
     gif = dumbbell.render_gif(traj, fps=np.int64(10), t_end=np.float32(0.2),
                               max_frames=np.int64(3), size="64x64")
     assert bytes(gif[:6]) == b"GIF89a"
+
+
+def test_dev_stdout_is_written_not_replaced(tmp_path):
+    scene = short_scene(tmp_path, "stdout.toml")
+    link = os.readlink("/dev/stdout") if os.path.islink("/dev/stdout") else None
+    code = "import sys; from dumbbell.cli import main; sys.exit(main())"
+    with open(tmp_path / "out.txt", "w") as fh:
+        proc = subprocess.run([sys.executable, "-c", code, "simulate", scene, "-o", "/dev/stdout",
+                               "-q"], stdout=fh, stderr=subprocess.PIPE, text=True,
+                              env={**os.environ, "PYTHONPATH": SRC}, timeout=60, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "out.txt").read_text().startswith("t,xA,vA")
+    assert (os.readlink("/dev/stdout") if link else None) == link
+
+
+def test_an_output_through_a_symlink_writes_its_target(work):
+    scene, out = work
+    target = out / "target.csv"
+    target.write_text("old\n")
+    (out / "link.csv").symlink_to(target)
+    status, _, err = cli("simulate", scene, "-o", out / "link.csv", "-q")
+    assert status == 0, err
+    assert (out / "link.csv").is_symlink() and target.read_text().startswith("t,xA,vA")
+    assert files_in(out) == ["link.csv", "target.csv"]

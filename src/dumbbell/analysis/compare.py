@@ -178,7 +178,7 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
     from ..model import args
-    from ..solvers import available, make_options, simulate
+    from ..solvers import MAX_SAMPLES, available, make_options, simulate
 
     scene = args.scene(scene)
     solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
@@ -201,6 +201,12 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
         if abs(ratio - round(ratio)) > 1e-6 * ratio:
             raise UsageError(f"dt {dt:g}: must divide the sample spacing {spacing:g} s "
                              "(the largest dt, or the scene's dt * every) a whole number of times", param="dt")
+    # Every run keeps a sample each `spacing` s: refuse before running what would not fit.
+    samples = round(t_end / spacing) + 1  # finite: t_end / dt passed the step cap above
+    if samples > MAX_SAMPLES:
+        raise UsageError(f"t_end = {t_end:g}: each run keeps a sample every {spacing:g} s, "
+                         f"{samples:,} samples, past the budget of {MAX_SAMPLES:,}: lower "
+                         "t_end", param="t_end")
     truth_name = truth_solver(scene)
     notes = []
     if truth_name is None:

@@ -38,6 +38,15 @@ def is_special(path: str | Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
+def _under_system(path: Path) -> bool:
+    """True for a path in /dev or /proc (also through a link, as /dev/stdout is): written
+    directly, since a temporary file and a rename there would replace a system entry."""
+    for candidate in (os.path.abspath(path), os.path.realpath(path)):
+        if candidate.startswith(("/dev/", "/proc/")):
+            return True
+    return False
+
+
 class OutputTransaction:
     """The outputs of one command: claimed names, finished ``.part`` files waiting for their
     rename, folders created on the way (removed again if the command fails)."""
@@ -144,12 +153,15 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     transaction = _active.get()
     if transaction is not None:
         transaction.claim(path)
-    if is_special(path):
+    if is_special(path) or _under_system(path):
         try:
             yield path
         except OSError as exc:
             raise _user_error(exc, path, None) from None
         return
+    if path.is_symlink():
+        # Write the file the link names; a rename onto the link would replace the link.
+        path = Path(os.path.realpath(path))
     tmp: Path | None = None
     deferred = False
     try:
