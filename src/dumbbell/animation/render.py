@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..io.files import atomic_output
+from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -202,9 +203,9 @@ def render_gif(
     path: str | Path | None = None,
     *,
     quiet: bool = False,
-    fps: int = 25,
-    size: str | tuple[int, int] = "640x360",
-    strip: bool = True,
+    fps: int = GifSettings.fps,
+    size: str | tuple[int, int] = GifSettings.size,
+    strip: bool = GifSettings.strip,
     t_end: float | None = None,
     timing: dict[str, float] | None = None,
     max_frames: int = MAX_FRAMES,

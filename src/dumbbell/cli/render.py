@@ -54,25 +54,24 @@ def _whole(text: str) -> int:
 
 def run(args: argparse.Namespace) -> int:
     from ..animation.render import check_fps, check_frames, check_size, render_gif, sample_every
-    from ..model.scene import load_scene
+    from ..model.scene import GifSettings, load_scene
     from ..solvers import make_options, simulate
 
     scene = load_scene(args.scene)
-    gif = scene.outputs.gif or {}
+    gif = scene.outputs.gif or GifSettings(scene.run.t_end)
     # Validate every setting before anything runs or is written.
-    fps = check_fps(args.fps if args.fps is not None else gif.get("fps", 25),
+    fps = check_fps(args.fps if args.fps is not None else gif.fps,
                     "--fps" if args.fps is not None else "outputs.gif.fps")
-    size = check_size(args.size or gif.get("size", "640x360"),
-                      "--size" if args.size else "outputs.gif.size")
-    strip = args.strip if args.strip is not None else gif.get("strip", True)
-    t_end = args.t_end or gif.get("t_end", scene.run.t_end)
+    size = check_size(args.size or gif.size, "--size" if args.size else "outputs.gif.size")
+    strip = args.strip if args.strip is not None else gif.strip
+    t_end = args.t_end or gif.t_end
     out = Path(args.output) if args.output else Path("renders") / f"{scene.name}.gif"
     if out.suffix.lower() != ".gif":
         from ..errors import UsageError
 
         raise UsageError(f"-o {out}: must end in .gif")
     check_frames(t_end, fps, args.max_frames,
-                 "--t-end" if args.t_end else "outputs.gif.t_end" if "t_end" in gif
+                 "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")
     options = make_options(scene, t_end=t_end)
     every = sample_every(options.dt, fps, options.t_end)

@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
             from ..animation.render import MAX_FRAMES, check_frames
 
             gif = scene.outputs.gif
-            check_frames(gif["t_end"], gif["fps"], MAX_FRAMES,
+            check_frames(gif.t_end, gif.fps, MAX_FRAMES,
                          f"{scene.source}: outputs.gif.t_end")
     status = 0
     for scene in scenes:
@@ -73,8 +73,9 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
 
-        written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet,
-                                  **scene.outputs.gif))
+        gif = scene.outputs.gif
+        written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
+                                  size=gif.size, strip=gif.strip, t_end=gif.t_end))
     if not quiet:
         for path in written:
             sys.stderr.write(f"wrote {path}\n")

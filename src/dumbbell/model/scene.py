@@ -102,12 +102,23 @@ class PymunkSettings:
 
 
 @dataclass(frozen=True)
+class GifSettings:
+    """[outputs.gif]: the animation ``dumbbell run`` writes. ``t_end`` (s) is the scene's
+    ``run.t_end`` unless the table says otherwise; the other defaults are written only here."""
+
+    t_end: float
+    fps: int = 25
+    size: str = "640x360"  # WIDTHxHEIGHT in px
+    strip: bool = True
+
+
+@dataclass(frozen=True)
 class Outputs:
     """What ``dumbbell run`` makes for the scene."""
 
     figures: tuple[str, ...]
     csv: bool
-    gif: dict[str, Any] | None
+    gif: GifSettings | None
 
 
 @dataclass(frozen=True)
@@ -586,14 +597,14 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
     gif = None
     cgif = co.sub("gif")
     if cgif is not None:
-        gif = {
-            "fps": cgif.integer("fps", 25, lo=1, hi=50),
-            "size": cgif.string("size", "640x360"),
-            "strip": cgif.boolean("strip", True),
-            "t_end": cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
-        }
-        if _parse_size(gif["size"]) is None:
-            cgif.fail("outputs.gif.size", gif["size"], "must be WIDTHxHEIGHT in pixels, "
+        gif = GifSettings(
+            fps=cgif.integer("fps", GifSettings.fps, lo=1, hi=50),
+            size=cgif.string("size", GifSettings.size),
+            strip=bool(cgif.boolean("strip", GifSettings.strip)),
+            t_end=cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
+        )
+        if _parse_size(gif.size) is None:
+            cgif.fail("outputs.gif.size", gif.size, "must be WIDTHxHEIGHT in pixels, "
                       "each between 64 and 4096")
         cgif.done()
     co.done()
