@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from dumbbell.cli import main
-from dumbbell.model.scene import load_scene
+from dumbbell.model.scene import PymunkSettings, load_scene
 from dumbbell.solvers import simulate
-from dumbbell.solvers.engine import DEFAULT_BIAS, DEFAULT_SLOP, build
+from dumbbell.solvers.engine import build
 from tests.conftest import SCENES, make_scene
 
 pymunk = pytest.importorskip("pymunk")
@@ -100,7 +100,8 @@ def test_builds_only_what_the_scene_declares(textbook):
 
 def test_settings_are_si_and_overridable(textbook):
     space = build(textbook).space
-    assert space.collision_bias == DEFAULT_BIAS and space.collision_slop == DEFAULT_SLOP
+    assert space.collision_bias == PymunkSettings.DEFAULT_BIAS
+    assert space.collision_slop == PymunkSettings.DEFAULT_SLOP
     scene = textbook.with_values({"pymunk.collision_slop": 0.01, "pymunk.collision_bias": 0.5,
                                   "pymunk.iterations": 3})
     space = build(scene).space

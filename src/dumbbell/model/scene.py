@@ -22,7 +22,7 @@ import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from ..errors import SceneError
 
@@ -93,12 +93,35 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class PymunkSettings:
-    """Engine settings in SI units; ``None`` means the solver's documented default."""
+    """Engine settings of the ``pymunk`` solver in SI units, as the scene's ``[pymunk]`` table
+    gives them; ``None`` means the default below (:meth:`resolved` fills them in). Why these
+    defaults is explained in :mod:`dumbbell.solvers.engine`."""
 
     collision_slop: float | None
     collision_bias: float | None
     iterations: int | None
     spin: bool | None
+
+    #: Overlap tolerated before the position correction acts (m); pymunk's 0.1 is pixels.
+    DEFAULT_SLOP: ClassVar[float] = 1e-4
+    #: Share of an overlap left after one second: 1.0 turns the correction off, which would
+    #: otherwise add energy at each impact.
+    DEFAULT_BIAS: ClassVar[float] = 1.0
+    #: Contact-impulse iterations per step (pymunk's default).
+    DEFAULT_ITERATIONS: ClassVar[int] = 10
+    #: Circles as spinning discs (True) or point particles of infinite moment (False).
+    DEFAULT_SPIN: ClassVar[bool] = False
+
+    def resolved(self) -> dict[str, Any]:
+        """The settings used: the scene's values, else the defaults."""
+        return {
+            "collision_slop": (self.DEFAULT_SLOP if self.collision_slop is None
+                               else self.collision_slop),
+            "collision_bias": (self.DEFAULT_BIAS if self.collision_bias is None
+                               else self.collision_bias),
+            "iterations": self.DEFAULT_ITERATIONS if self.iterations is None else self.iterations,
+            "spin": self.DEFAULT_SPIN if self.spin is None else self.spin,
+        }
 
 
 @dataclass(frozen=True)

@@ -60,11 +60,6 @@ from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
 
 NAME = "pymunk"
 
-#: Defaults of the ``[pymunk]`` table (SI units): see the module docstring for the reasons.
-DEFAULT_SLOP = 1e-4
-DEFAULT_BIAS = 1.0
-DEFAULT_ITERATIONS = 10
-DEFAULT_SPIN = False
 #: A position or velocity beyond this (m, m/s) counts as blown up.
 _BIG = 1e12
 #: Steps between progress-bar updates.
@@ -77,14 +72,9 @@ _PARTICLE_TYPE = {"A": 2, "B": 3}
 
 
 def settings(scene: Scene) -> dict[str, Any]:
-    """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else defaults."""
-    pm = scene.pymunk
-    return {
-        "collision_slop": DEFAULT_SLOP if pm.collision_slop is None else pm.collision_slop,
-        "collision_bias": DEFAULT_BIAS if pm.collision_bias is None else pm.collision_bias,
-        "iterations": DEFAULT_ITERATIONS if pm.iterations is None else pm.iterations,
-        "spin": DEFAULT_SPIN if pm.spin is None else pm.spin,
-    }
+    """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else the
+    defaults declared on :class:`~dumbbell.model.scene.PymunkSettings`."""
+    return scene.pymunk.resolved()
 
 
 def supports(scene: Scene) -> str | None:
