@@ -57,8 +57,8 @@ def compare(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
             dts: float | Sequence[float] | None = None, window: float = 2.0,
             t_end: float | None = None, quiet: bool = True) -> Comparison:
     """Run ``solvers`` (default: pymunk and the hand-written method) at the steps ``dts``
-    (s; default the scene's) and the truth (exact in 1D, the reference in 2D) over ``t_end``
-    (s); measure position errors over [0, ``window``] s, energy spreads, impact times and run
+    (s; default the scene's) and the truth (exact in 1D and rigid 2D, the reference for 2D
+    springs) over ``t_end`` (s); measure position errors over [0, ``window``] s, energy spreads, impact times and run
     times. ``.to_pandas()`` is the summary table, ``.impacts_to_pandas()`` the impacts."""
     from .compare import compare as run
 
