@@ -16,7 +16,6 @@ chatter) before the dumbbell leaves the floor; :func:`bounce` measures the whole
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, field
 
@@ -24,8 +23,9 @@ import numpy as np
 
 from ..errors import UsageError
 from ..model.energy import rigid_moment
-from ..model.scene import Scene, scene_from_dict
+from ..model.scene import Scene
 from ..model.trajectory import Trajectory
+from .rotation import variant
 
 #: Impacts closer together than this (s) belong to one cluster.
 CLUSTER_GAP = 0.1
@@ -54,7 +54,7 @@ def k_rot_share_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -
 
 def rigid_q(scene: Scene) -> float:
     """q = M a_B^2 / I of the scene's dumbbell made rigid (dimensionless): a_B = mA L / M."""
-    s = scene if scene.rigid is not None else _variant(scene, "rigid", None)
+    s = scene if scene.rigid is not None else variant(scene, None)
     a_B = s.A.mass * s.rigid.length / s.M
     return s.M * a_B**2 / rigid_moment(s)
 
@@ -128,28 +128,10 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
                   float(K_rot[i_f]) / K_before, float(K_rot[i_c]) / K_before)
 
 
-def _variant(scene: Scene, kind: str, value: float | None, tilt: float | None = None) -> Scene:
-    raw = copy.deepcopy(scene.raw)
-    length = (scene.rigid.length if scene.rigid is not None else
-              scene.spring.rest_length if scene.spring is not None else
-              math.hypot(scene.A.x - scene.B.x, scene.A.height - scene.B.height))
-    raw.pop("spring", None)
-    raw.pop("rigid", None)
-    if kind == "rigid":
-        raw["rigid"] = {"length": length}
-    else:
-        raw["spring"] = {"stiffness": float(value), "rest_length": length}
-    if tilt is not None:
-        raw["tilt"] = float(tilt)
-    return scene_from_dict(raw, scene.source)
-
-
 def tilted(scene: Scene, theta_deg: float, stiffness: float | None = None) -> Scene:
     """``scene``'s dumbbell tilted ``theta_deg`` (degrees from vertical), rigid when
     ``stiffness`` is None, else a spring of that stiffness (N/m) at the same length."""
-    if stiffness is None:
-        return _variant(scene, "rigid", None, theta_deg)
-    return _variant(scene, "spring", stiffness, theta_deg)
+    return variant(scene, stiffness, theta_deg)
 
 
 def _check_scene(scene: Scene) -> None:

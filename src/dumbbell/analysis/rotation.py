@@ -48,24 +48,31 @@ def _length(scene: Scene) -> float:
     return math.hypot(scene.A.x - scene.B.x, scene.A.height - scene.B.height)
 
 
+def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) -> Scene:
+    """``scene``'s dumbbell with a spring of ``stiffness`` (N/m), or rigid when it is None, at
+    the same rest (or rod) length; tilted ``tilt`` degrees from vertical when given.
+    Everything else is kept."""
+    length = _length(scene)
+    raw = copy.deepcopy(scene.raw)
+    raw.pop("spring", None)
+    raw.pop("rigid", None)
+    if stiffness is None:
+        raw["rigid"] = {"length": length}
+    else:
+        raw["spring"] = {"stiffness": float(stiffness), "rest_length": length}
+    if tilt is not None:
+        raw["tilt"] = float(tilt)
+    return scene_from_dict(raw, scene.source)
+
+
 def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict[str, Scene]:
     """Spring dumbbells at ``stiffnesses`` (N/m) and the rigid one, built from ``scene``:
     label -> scene. The rest length (or rod length) and everything else are kept."""
     if scene.dimensions != 2:
         raise UsageError(f"{scene.source}: the rotation preview needs a 2D scene "
                          "(dimensions = 2)")
-    length = _length(scene)
-    raw = copy.deepcopy(scene.raw)
-    raw.pop("spring", None)
-    raw.pop("rigid", None)
-    out: dict[str, Scene] = {}
-    for k in stiffnesses:
-        data = copy.deepcopy(raw)
-        data["spring"] = {"stiffness": float(k), "rest_length": length}
-        out[f"k = {k:g} N/m"] = scene_from_dict(data, scene.source)
-    data = copy.deepcopy(raw)
-    data["rigid"] = {"length": length}
-    out["rigid"] = scene_from_dict(data, scene.source)
+    out = {f"k = {k:g} N/m": variant(scene, k) for k in stiffnesses}
+    out["rigid"] = variant(scene, None)
     return out
 
 
