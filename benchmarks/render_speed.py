@@ -69,7 +69,7 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
     for s in ("top", "right", "bottom"):
         ax.spines[s].set_visible(False)
     spring, = ax.plot([], [], color="0.3", lw=1.2)
-    discs = {p: ax.add_patch(Circle((0, 0), scene.A.radius, fc=COLOURS[p], ec="0.1"))
+    discs = {p: ax.add_patch(Circle((0, 0), scene.system.A.radius, fc=COLOURS[p], ec="0.1"))
              for p in ("A", "B")}
     cm, = ax.plot([], [], "o", mfc="white", mec="black", ms=6)
     time_text = fig.text(0.01, 0.95, "", fontsize=10, weight="bold")
@@ -107,7 +107,7 @@ def baseline(scene_path: str, out: str, t_end: float) -> None:
         n = np.array([-d[1], d[0]]) / length
         spring.set_data(b[0] + d[0] * zig + n[0] * side, b[1] + d[1] * zig + n[1] * side)
         discs["A"].center, discs["B"].center = tuple(a), tuple(b)
-        c = (scene.A.mass * a + scene.B.mass * b) / scene.M
+        c = (scene.system.A.mass * a + scene.system.B.mass * b) / scene.system.M
         cm.set_data([c[0]], [c[1]])
         time_text.set_text(f"t = {fr.t[k]:.2f} s")
         impact.set_text("impact" if k in impact_frames else "")

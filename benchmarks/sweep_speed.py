@@ -111,7 +111,7 @@ def critical_ratio(scene, solver: str, lo: float = 1.5, hi: float = 2.5, steps: 
     from dumbbell.solvers import simulate
 
     def ok(h: float) -> bool:
-        dt = h / scene.omega
+        dt = h / scene.system.omega
         return simulate(scene, solver, dt=dt, t_end=steps * dt).verdict.ok
 
     assert ok(lo) and not ok(hi)

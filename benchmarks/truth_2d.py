@@ -37,9 +37,9 @@ def old_reference(scene, times: np.ndarray, t_end: float, rtol: float = 1e-12,
     xA, yA, vxA, vyA, xB, yB, vxB, vyB) and the impacts (t, body)."""
     from scipy.integrate import solve_ivp
 
-    A, B = scene.A, scene.B
-    mA, mB, g, k, b = A.mass, B.mass, scene.g, scene.k, scene.b
-    e = scene.floor.elasticity
+    A, B = scene.system.A, scene.system.B
+    mA, mB, g, k, b = A.mass, B.mass, scene.system.g, scene.system.k, scene.system.b
+    e = scene.system.floor.elasticity
 
     def rhs(_t, y):
         dx, dy = y[0] - y[4], y[1] - y[5]

@@ -40,7 +40,7 @@ def tilted_run(tilted):
 
 
 def _sum_half_m_v2(traj) -> np.ndarray:
-    mA, mB = traj.scene.A.mass, traj.scene.B.mass
+    mA, mB = traj.scene.system.A.mass, traj.scene.system.B.mass
     return (0.5 * mA * (traj["vxA"] ** 2 + traj["vyA"] ** 2)
             + 0.5 * mB * (traj["vxB"] ** 2 + traj["vyB"] ** 2))
 
@@ -205,7 +205,7 @@ def test_euler_cromer_2d_differs_from_the_textbook_order_by_the_velocity_lag(til
                                               "bodies.B.velocity": [0.0, 1.0]})
     run = simulate(scene, "euler-cromer-2d", dt=1e-4, t_end=0.5, every=1)
     # The textbook's Euler-Cromer in 1D (vertical) from the shifted start.
-    A, B = scene.A, scene.B
+    A, B = scene.system.A, scene.system.B
     k, b, dt = 200.0, 0.2, 1e-4
     f = k * (A.height - B.height - b)
     xA, xB = A.height, B.height
@@ -268,9 +268,9 @@ def test_rotation_variants_and_the_stiff_limit(tilted):
     from dumbbell.analysis.rotation import variants
 
     scenes = variants(tilted)
-    assert [s.spring.stiffness for s in scenes.values() if s.spring] == [200.0, 2e3, 2e4]
-    assert scenes["rigid"].rigid.length == 0.2
-    assert (scenes["rigid"].A.x, scenes["rigid"].A.height) == (tilted.A.x, tilted.A.height)
+    assert [s.system.spring.stiffness for s in scenes.values() if s.system.spring] == [200.0, 2e3, 2e4]
+    assert scenes["rigid"].system.rigid.length == 0.2
+    assert (scenes["rigid"].system.A.x, scenes["rigid"].system.A.height) == (tilted.system.A.x, tilted.system.A.height)
     stiff = simulate(scenes["k = 20000 N/m"], "pymunk", dt=1e-5, t_end=0.6, every=10)
     v = math.sqrt(2 * G * 1.0)
     expected = 0.5 * 0.05 * (2 * v * 0.5) ** 2

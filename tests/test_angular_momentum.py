@@ -27,12 +27,12 @@ def about_contact(run, i: int, P: float, t_hit: float) -> float:
     """Angular momentum about the floor point (P, 0) at the impact time (kg m^2/s), carried
     from sample ``i`` by gravity's torque -M g (R_x - P) (the only external one in flight)."""
     scene = run.scene
-    M, mA, mB = scene.M, scene.A.mass, scene.B.mass
+    M, mA, mB = scene.system.M, scene.system.A.mass, scene.system.B.mass
     R = [(mA * run[f"{c}A"][i] + mB * run[f"{c}B"][i]) / M for c in "xy"]
     V = [(mA * run[f"v{c}A"][i] + mB * run[f"v{c}B"][i]) / M for c in "xy"]
     L = run["L_cm"][i] + M * ((R[0] - P) * V[1] - R[1] * V[0])
     span = t_hit - run.t[i]
-    return L - M * scene.g * (R[0] + V[0] * span / 2 - P) * span
+    return L - M * scene.system.g * (R[0] + V[0] * span / 2 - P) * span
 
 
 @pytest.mark.parametrize("name, solver", CASES)
@@ -57,7 +57,7 @@ def test_l_cm_is_a_column_of_2d_scenes_only(textbook):
     # mu (d x w) for the particles
     d = np.array([run["xA"] - run["xB"], run["yA"] - run["yB"]])
     w = np.array([run["vxA"] - run["vxB"], run["vyA"] - run["vyB"]])
-    mu = run.scene.mu
+    mu = run.scene.system.mu
     np.testing.assert_allclose(run["L_cm"], mu * (d[0] * w[1] - d[1] * w[0]), rtol=1e-12)
 
 

@@ -76,7 +76,7 @@ def test_error_equals_an_independent_computation(one_second):
 def test_sample_spacing_follows_the_spring():
     assert default_spacing(make_scene()) == 1e-3  # period 0.099 s
     stiff = make_scene({"spring.stiffness": 2e4})  # period 9.9 ms
-    assert default_spacing(stiff) == pytest.approx(2 * math.pi / stiff.omega / 50)
+    assert default_spacing(stiff) == pytest.approx(2 * math.pi / stiff.system.omega / 50)
 
 
 def test_textbook_accuracy_over_two_seconds():

@@ -68,8 +68,8 @@ def test_rigid_scene_never_below_floor_and_finds_the_fifth_impact(rigid, rigid_r
     assert rigid_run.verdict.ok
     assert rigid_run.t[-1] == pytest.approx(10.0)
     assert min(rigid_run["yA"].min(), rigid_run["yB"].min()) >= -1e-9
-    A, B = rigid.A, rigid.B
-    truth = brute_force_impacts(A.mass, B.mass, rigid.rigid.length, rigid.g, 1.0,
+    A, B = rigid.system.A, rigid.system.B
+    truth = brute_force_impacts(A.mass, B.mass, rigid.system.rigid.length, rigid.system.g, 1.0,
                                 (A.x, A.height), (B.x, B.height), (A.vx, A.vy), (B.vx, B.vy), 5)
     got = [(e.t, e.body) for e in rigid_run.events[:5]]
     assert [b for _, b in got] == [b for _, b in truth]
@@ -216,7 +216,7 @@ def test_a_truth_that_misses_an_impact_ends_failed(rigid, textbook):
     # Any sample of any truth more than 1e-9 m below the floor ends the run there.
     for run in (simulate(textbook, "exact", every=100, t_end=2.0),
                 simulate(rigid, "exact", every=100, t_end=2.0)):
-        key = "x" if run.scene.dimensions == 1 else "y"
+        key = "x" if run.scene.system.dimensions == 1 else "y"
         j = len(run.t) // 3
         assert truth_verdict(run, run.verdict).ok
         run.state[f"{key}B"][j] = -2e-9

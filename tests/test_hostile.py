@@ -511,7 +511,7 @@ def test_numpy_scalars_are_numbers():
         assert np.array_equal(traj.t, plain.t) and np.array_equal(traj["E"], plain["E"])
     changed = scene.with_values({"spring.stiffness": np.float32(300.0),
                                  "run.every": np.int64(7)})
-    assert changed.k == 300.0 and changed.run.every == 7
+    assert changed.system.k == 300.0 and changed.run.every == 7
 
 
 def test_a_path_is_accepted_where_a_scene_is_expected():

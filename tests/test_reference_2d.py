@@ -20,8 +20,8 @@ def brute_force_impacts(scene, t_end, scan=1e-6):
     """Impacts of the spring dumbbell from scipy's DOP853 on the full state (rtol 1e-11), the
     floor found by scanning both heights on a 1e-6 s grid of its dense output: independent
     of the reference's step and of its bound."""
-    A, B = scene.A, scene.B
-    mA, mB, k, b, g, e = A.mass, B.mass, scene.k, scene.b, scene.g, scene.elasticity
+    A, B = scene.system.A, scene.system.B
+    mA, mB, k, b, g, e = A.mass, B.mass, scene.system.k, scene.system.b, scene.system.g, scene.system.elasticity
 
     def rhs(_t, y):
         dx, dy = y[0] - y[4], y[1] - y[5]
@@ -60,7 +60,7 @@ def test_stiff_fast_spinning_spring_misses_no_impact(k, vx):
     scene = load_scene(SCENES / "tilted-2d.toml").with_values(
         {"spring.stiffness": k, "bodies.A.velocity": [vx, 0.0], "bodies.B.height": 0.3})
     spacing = 5e-3
-    assert scene.omega * spacing > 1
+    assert scene.system.omega * spacing > 1
     run = simulate(scene, "reference", dt=spacing, t_end=1.0, every=1)
     assert run.verdict.ok
     truth = brute_force_impacts(scene, 1.0)

@@ -169,8 +169,8 @@ def test_angular_momentum_about_the_contact_point(solver, tol):
     assert abs(c.change) < tol
     # L_cm jumps from 0 to I*omega with the impulse law's omega (rigid, e = 1, 30 degrees):
     # omega = J a sin(theta) / I, J = (1 + e) m_eff v, 1/m_eff = 1/M + (a sin theta)^2 / I.
-    M, L, g, h = scene.M, 0.2, scene.g, scene.B.height
-    I, a, s = scene.mu * L**2, L / 2, math.sin(math.radians(30.0))
+    M, L, g, h = scene.system.M, 0.2, scene.system.g, scene.system.B.height
+    I, a, s = scene.system.mu * L**2, L / 2, math.sin(math.radians(30.0))
     v = math.sqrt(2 * g * h)
     omega = -(1 + 1.0) * v / (1 / M + (a * s) ** 2 / I) * a * s / I
     assert c.L_cm_before == pytest.approx(0.0, abs=1e-12)

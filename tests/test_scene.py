@@ -66,9 +66,9 @@ def test_shipped_scenes_load():
 
 def test_textbook_scene_holds_the_textbook_values(textbook):
     s = textbook
-    assert (s.A.mass, s.B.mass, s.spring.stiffness, s.spring.rest_length) == (0.1, 0.1, 200.0, 0.2)
-    assert (s.B.height, s.A.height, s.g, s.run.t_end, s.run.dt) == (1.0, 1.2, 9.8, 10.0, 1e-5)
-    assert s.floor.elasticity == 1.0 and s.run.solver == "euler-cromer"
+    assert (s.system.A.mass, s.system.B.mass, s.system.spring.stiffness, s.system.spring.rest_length) == (0.1, 0.1, 200.0, 0.2)
+    assert (s.system.B.height, s.system.A.height, s.system.g, s.run.t_end, s.run.dt) == (1.0, 1.2, 9.8, 10.0, 1e-5)
+    assert s.system.floor.elasticity == 1.0 and s.run.solver == "euler-cromer"
 
 
 @pytest.mark.parametrize("what,old,new,key,allowed", BAD, ids=[b[0] for b in BAD])
@@ -107,7 +107,7 @@ def test_good_scene_loads(tmp_path):
     path = tmp_path / "good.toml"
     path.write_text(GOOD)
     scene = load_scene(path)
-    assert scene.floor is not None and scene.spring.stiffness == 200.0
+    assert scene.system.floor is not None and scene.system.spring.stiffness == 200.0
 
 
 def test_left_out_tables_are_not_built(tmp_path):
@@ -115,12 +115,12 @@ def test_left_out_tables_are_not_built(tmp_path):
     path = tmp_path / "bare.toml"
     path.write_text(text)
     scene = load_scene(path)
-    assert scene.floor is None and scene.g == 0.0
+    assert scene.system.floor is None and scene.system.g == 0.0
 
 
 def test_with_values_revalidates(textbook):
     stiff = textbook.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})
-    assert stiff.spring.stiffness == 2e4 and stiff.run.dt == 1e-4
-    assert textbook.spring.stiffness == 200.0  # the original is untouched
+    assert stiff.system.spring.stiffness == 2e4 and stiff.run.dt == 1e-4
+    assert textbook.system.spring.stiffness == 200.0  # the original is untouched
     with pytest.raises(SceneError, match="spring.stiffness"):
         textbook.with_values({"spring.stiffness": -5.0})

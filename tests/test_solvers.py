@@ -78,13 +78,13 @@ class Still(Solver):
 
     @classmethod
     def supports(cls, scene):
-        return None if scene.dimensions == 1 else "still is 1D only"
+        return None if scene.system.dimensions == 1 else "still is 1D only"
 
     @classmethod
     def solve(cls, scene, options: RunOptions) -> Trajectory:
         t = options.sample_times()
-        state = {"xA": np.full_like(t, scene.A.height), "vA": np.zeros_like(t),
-                 "xB": np.full_like(t, scene.B.height), "vB": np.zeros_like(t)}
+        state = {"xA": np.full_like(t, scene.system.A.height), "vA": np.zeros_like(t),
+                 "xB": np.full_like(t, scene.system.B.height), "vB": np.zeros_like(t)}
         return Trajectory(scene=scene, solver=cls.name, t=t, state=state, events=[],
                           dt=options.dt, every=options.every, wall_time=0.0)
 

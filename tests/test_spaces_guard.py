@@ -88,7 +88,7 @@ def test_high_drop_tunnels_and_the_suggested_dt_does_not():
         driver.step()
         lowest = min(lowest, *(b.position.y for b in space.bodies))
     # Never past the floor box's middle (from where a contact would push it on through).
-    assert lowest > -scene.A.radius - 0.5 * FLOOR_THICKNESS
+    assert lowest > -scene.system.A.radius - 0.5 * FLOOR_THICKNESS
     assert max(b.position.y for b in space.bodies) > 50.0  # it bounced back up
 
 

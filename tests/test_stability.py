@@ -33,10 +33,10 @@ def _need(solver: str) -> None:
 def _stiff(ratio: float, w_dt: float):
     """The stiff no-floor case with mB/mA = ratio and dt set so that w*dt is ``w_dt``."""
     base = load_scene(EXTREME / "stiff-wdt-1.9.toml")
-    mA = base.B.mass / ratio
+    mA = base.system.B.mass / ratio
     scene = base.with_values({"bodies.A.mass": mA})
-    return scene.with_values({"run.dt": w_dt / scene.omega, "run.t_end": 400 * w_dt /
-                              scene.omega})
+    return scene.with_values({"run.dt": w_dt / scene.system.omega, "run.t_end": 400 * w_dt /
+                              scene.system.omega})
 
 
 @pytest.mark.parametrize("ratio", [1.0, 100.0])
@@ -55,7 +55,7 @@ def test_verdict_flips_between_wdt_1_9_and_2_1(solver, ratio):
     assert 0 < v.t < scene.run.t_end and len(blown.t) < 401
     assert blown.t[-1] <= v.t + 1e-12
     assert all(np.isfinite(col).all() for col in blown.state.values())
-    limit = 2.0 / scene.omega
+    limit = 2.0 / scene.system.omega
     assert "w*dt = 2.10 > 2" in v.reason and f"use dt < {seconds(limit)} s" in v.reason
     assert re.fullmatch(r"unstable at t = [0-9.e-]+ s: w\*dt = 2\.10 > 2 .*", str(v))
 
@@ -83,7 +83,7 @@ def test_high_drop_tunnels_only_in_pymunk(solver, status):
     scene = load_scene(EXTREME / "high-drop.toml")
     traj = simulate(scene, solver)
     assert traj.verdict.status == status, traj.verdict
-    fall = math.sqrt(2 * scene.B.height / scene.g)
+    fall = math.sqrt(2 * scene.system.B.height / scene.system.g)
     if status == "tunnelled":
         # It goes through at the first impact, and the run stops there.
         assert fall <= traj.verdict.t <= fall + 3 * scene.run.dt

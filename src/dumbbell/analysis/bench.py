@@ -208,8 +208,8 @@ def time_for_error(line: list[tuple[float, float]], target: float) -> float | No
 def default_spacing(scene: Scene) -> float:
     """Spacing of the compared samples (s): SAMPLE_SPACING, or 1/SAMPLES_PER_PERIOD of the
     spring's period when that is shorter."""
-    if scene.omega > 0:
-        return min(SAMPLE_SPACING, 2 * math.pi / scene.omega / SAMPLES_PER_PERIOD)
+    if scene.system.omega > 0:
+        return min(SAMPLE_SPACING, 2 * math.pi / scene.system.omega / SAMPLES_PER_PERIOD)
     return SAMPLE_SPACING
 
 
@@ -396,7 +396,7 @@ def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: flo
         point.error = math.inf
     else:
         point.error = position_error(traj, truth, window)
-    if traj.scene.floor is not None:
+    if traj.scene.system.floor is not None:
         point.impact_time_error, point.impacts_compared, point.impacts_truth = (
             impact_time_error(traj, truth, window))
 
@@ -419,7 +419,7 @@ def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: 
         return point
     point.energy_error = energy_error(traj, None)
     if not cls.estimates_error:
-        check = extended_precision_rigid if scene.rigid is not None else extended_precision_exact
+        check = extended_precision_rigid if scene.system.rigid is not None else extended_precision_exact
         point.error, point.impact_time_error = check(traj, window)
         point.reason = "errors against the same closed form in extended precision"
     else:

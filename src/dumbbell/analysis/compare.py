@@ -167,7 +167,7 @@ class Comparison:
 
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
-    names = ["pymunk", "euler-cromer" if scene.dimensions == 1 else "euler-cromer-2d"]
+    names = ["pymunk", "euler-cromer" if scene.system.dimensions == 1 else "euler-cromer-2d"]
     return [n for n in names if solver_class(n).supports(scene) is None]
 
 

@@ -48,7 +48,7 @@ def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> Con
     trajectory, over ``window`` s either side. Sample finely (every step or two) for a sharp
     before and after."""
     s = traj.scene
-    if s.dimensions != 2:
+    if s.system.dimensions != 2:
         raise UsageError(f"{s.source}: angular momentum about a contact point needs a 2D scene")
     if not 0 <= index < len(traj.events):
         raise UsageError(f"index = {index}: the run has {len(traj.events)} impacts")
@@ -58,15 +58,15 @@ def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> Con
     # Where the particle touched: its x at the last sample before the impact, moved on to the
     # impact's time (x does not jump at a frictionless impact).
     px = float(traj[f"x{imp.body}"][i - 1] + traj[f"vx{imp.body}"][i - 1] * (imp.t - t[i - 1]))
-    M = s.M
-    X = (s.A.mass * traj["xA"] + s.B.mass * traj["xB"]) / M
-    Y = (s.A.mass * traj["yA"] + s.B.mass * traj["yB"]) / M
-    VX = (s.A.mass * traj["vxA"] + s.B.mass * traj["vxB"]) / M
-    VY = (s.A.mass * traj["vyA"] + s.B.mass * traj["vyB"]) / M
+    M = s.system.M
+    X = (s.system.A.mass * traj["xA"] + s.system.B.mass * traj["xB"]) / M
+    Y = (s.system.A.mass * traj["yA"] + s.system.B.mass * traj["yB"]) / M
+    VX = (s.system.A.mass * traj["vxA"] + s.system.B.mass * traj["vxB"]) / M
+    VY = (s.system.A.mass * traj["vyA"] + s.system.B.mass * traj["vyB"]) / M
     L_cm = traj["L_cm"]
     L_orbit = angular_momentum(M, X, Y, VX, VY, px, 0.0)
     L_P = L_cm + L_orbit
-    torque = -M * s.g * (X - px)  # gravity's torque about P, N m
+    torque = -M * s.system.g * (X - px)  # gravity's torque about P, N m
 
     def at_impact(j: int) -> tuple[float, float]:
         return float(L_P[j] + torque[j] * (imp.t - t[j])), float(L_cm[j])

@@ -23,12 +23,12 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     rounding of the double-precision solution, given its sequence of impacts."""
     L = np.longdouble
     scene = traj.scene
-    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
+    mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
     M = mA + mB
-    k = L(scene.spring.stiffness) if scene.spring else L(0)
-    b = L(scene.spring.rest_length) if scene.spring else L(0)
+    k = L(scene.system.spring.stiffness) if scene.system.spring else L(0)
+    b = L(scene.system.spring.rest_length) if scene.system.spring else L(0)
     w = np.sqrt(k * M / (mA * mB))
-    e = L(scene.floor.elasticity) if scene.floor else L(1)
+    e = L(scene.system.floor.elasticity) if scene.system.floor else L(1)
 
     def state(seg, tau):
         _t0, X0, V0, s0, sd0 = seg
@@ -44,7 +44,7 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     def segment(t0, xA, vA, xB, vB):
         return (t0, (mA * xA + mB * xB) / M, (mA * vA + mB * vB) / M, xA - xB - b, vA - vB)
 
-    seg = segment(L(0), L(scene.A.height), L(scene.A.vy), L(scene.B.height), L(scene.B.vy))
+    seg = segment(L(0), L(scene.system.A.height), L(scene.system.A.vy), L(scene.system.B.height), L(scene.system.B.vy))
     n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
     t = traj.t[:n].astype(L)
     worst = worst_t = 0.0
@@ -84,13 +84,13 @@ def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, fl
 
     L = np.longdouble
     scene = traj.scene
-    mA, mB, g = L(scene.A.mass), L(scene.B.mass), L(scene.g)
+    mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
     M = mA + mB
-    length = L(scene.rigid.length)  # type: ignore[union-attr]
+    length = L(scene.system.rigid.length)  # type: ignore[union-attr]
     arm = {"A": mB / M * length, "B": -mA / M * length}
     moment = L(rigid_moment(scene))
-    e = L(scene.floor.elasticity) if scene.floor else L(1)
-    A, B = scene.A, scene.B
+    e = L(scene.system.floor.elasticity) if scene.system.floor else L(1)
+    A, B = scene.system.A, scene.system.B
     d = (L(A.x) - L(B.x), L(A.height) - L(B.height))
     w = (L(A.vx) - L(B.vx), L(A.vy) - L(B.vy))
     seg = [L(0), (mA * L(A.x) + mB * L(B.x)) / M, (mA * L(A.height) + mB * L(B.height)) / M,

@@ -43,7 +43,7 @@ def _check_shared_times(run: Trajectory, truth: Trajectory, n: int) -> None:
 
 def position_columns(scene: Scene) -> list[str]:
     """The position columns of a scene (m)."""
-    return ["xA", "xB"] if scene.dimensions == 1 else ["xA", "yA", "xB", "yB"]
+    return ["xA", "xB"] if scene.system.dimensions == 1 else ["xA", "yA", "xB", "yB"]
 
 
 def coordinate_error(run: Trajectory, truth: Trajectory) -> np.ndarray:
@@ -102,7 +102,7 @@ def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     dissipative scene the distance from the truth's E at the same times (dimensionless)."""
     if len(traj.t) == 0:
         return math.nan
-    if not traj.scene.dissipative:
+    if not traj.scene.system.dissipative:
         return float(np.max(relative_energy_error(traj)))
     if truth is None:
         return math.nan

@@ -54,9 +54,9 @@ def k_rot_share_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -
 
 def rigid_q(scene: Scene) -> float:
     """q = M a_B^2 / I of the scene's dumbbell made rigid (dimensionless): a_B = mA L / M."""
-    s = scene if scene.rigid is not None else variant(scene, None)
-    a_B = s.A.mass * s.rigid.length / s.M
-    return s.M * a_B**2 / rigid_moment(s)
+    s = scene if scene.system.rigid is not None else variant(scene, None)
+    a_B = s.system.A.mass * s.system.rigid.length / s.system.M
+    return s.system.M * a_B**2 / rigid_moment(s)
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,7 @@ class Bounce:
 
 def _cm_vy(traj: Trajectory) -> np.ndarray:
     s = traj.scene
-    return (s.A.mass * traj["vyA"] + s.B.mass * traj["vyB"]) / s.M
+    return (s.system.A.mass * traj["vyA"] + s.system.B.mass * traj["vyB"]) / s.system.M
 
 
 def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
@@ -98,14 +98,14 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
         raise UsageError(f"{s.source}: the run ends before the first impact cluster is over "
                          f"(last impact at {t_last:g} s); run longer")
     vy = _cm_vy(traj)
-    g = s.g
+    g = s.system.g
     i_before = int(np.searchsorted(traj.t, t0, side="left")) - 1
     # The sample before the impact, carried forward to the impact's time.
     v_before = vy[i_before] - g * (t0 - traj.t[i_before])
     K_before = float(traj["K_cm"][i_before] + traj["K_rot"][i_before] + traj["K_vib"][i_before])
     # Gravity does work between that sample and the impact: carry K by the change of K_cm only
     # (between impacts, gravity acts on the centre of mass alone).
-    K_before += 0.5 * s.M * (v_before**2 - vy[i_before] ** 2)
+    K_before += 0.5 * s.system.M * (v_before**2 - vy[i_before] ** 2)
 
     spacing = float(traj.t[1] - traj.t[0]) if len(traj.t) > 1 else 0.0
 
@@ -135,22 +135,22 @@ def tilted(scene: Scene, theta_deg: float, stiffness: float | None = None) -> Sc
 
 
 def _check_scene(scene: Scene) -> None:
-    if scene.dimensions != 2 or (scene.spring is None and scene.rigid is None):
+    if scene.system.dimensions != 2 or (scene.system.spring is None and scene.system.rigid is None):
         raise UsageError(f"{scene.source}: restitution needs a 2D dumbbell with a [spring] or "
                          "[rigid] (dimensions = 2)")
-    if scene.floor is None or scene.g <= 0:
+    if scene.system.floor is None or scene.system.g <= 0:
         raise UsageError(f"{scene.source}: restitution needs a [floor] and gravity (g > 0)")
-    if scene.floor.friction != 0:
+    if scene.system.floor.friction != 0:
         raise UsageError(f"{scene.source}: restitution needs a frictionless floor "
                          "(floor.friction = 0): the formula has no friction")
-    if scene.B.height <= 0 or scene.B.vy > 0:
+    if scene.system.B.height <= 0 or scene.system.B.vy > 0:
         raise UsageError(f"{scene.source}: restitution drops the dumbbell: bodies.B.height "
                          "must be > 0 and B must not move up")
 
 
 def drop_duration(scene: Scene) -> float:
     """Run time (s) that covers the fall, the first cluster of impacts and the gap after it."""
-    g, h, v = scene.g, scene.B.height, -scene.B.vy
+    g, h, v = scene.system.g, scene.system.B.height, -scene.system.B.vy
     t_fall = (-v + math.sqrt(v * v + 2 * g * h)) / g if g > 0 else h / max(v, 1e-9)
     return t_fall + 0.4
 
@@ -222,7 +222,7 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
     _check_scene(scene)
     thetas = np.asarray(thetas, dtype=float)
     t_end = drop_duration(scene)
-    e = scene.floor.elasticity
+    e = scene.system.floor.elasticity
     q = rigid_q(scene)
     truth, pm, shares, impacts = [], [], [], []
     springs: dict[float, dict[str, list[float]]] = {
@@ -241,7 +241,7 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
         for k in stiffnesses:
             sp = tilted(scene, float(th), k)
             # Keep w*dt small: the impact is resolved over the spring's own fast time scale.
-            step = min(dt, 0.02 / sp.omega)
+            step = min(dt, 0.02 / sp.system.omega)
             bs = bounce(simulate(sp, "pymunk", dt=step, t_end=t_end,
                                  every=max(1, round(1e-4 / step))))
             springs[k]["e_eff"].append(bs.e_cluster)

@@ -41,11 +41,11 @@ CLUSTER_GAP = 0.1
 
 
 def _length(scene: Scene) -> float:
-    if scene.rigid is not None:
-        return scene.rigid.length
-    if scene.spring is not None:
-        return scene.spring.rest_length
-    return math.hypot(scene.A.x - scene.B.x, scene.A.height - scene.B.height)
+    if scene.system.rigid is not None:
+        return scene.system.rigid.length
+    if scene.system.spring is not None:
+        return scene.system.spring.rest_length
+    return math.hypot(scene.system.A.x - scene.system.B.x, scene.system.A.height - scene.system.B.height)
 
 
 def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) -> Scene:
@@ -68,7 +68,7 @@ def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) ->
 def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict[str, Scene]:
     """Spring dumbbells at ``stiffnesses`` (N/m) and the rigid one, built from ``scene``:
     label -> scene. The rest length (or rod length) and everything else are kept."""
-    if scene.dimensions != 2:
+    if scene.system.dimensions != 2:
         raise UsageError(f"{scene.source}: the rotation preview needs a 2D scene "
                          "(dimensions = 2)")
     out = {f"k = {k:g} N/m": variant(scene, k) for k in stiffnesses}
@@ -94,7 +94,7 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
     from ..solvers import simulate, solver_class
 
     scenes = variants(scene, stiffnesses)
-    w_max = max(s.omega for s in scenes.values())
+    w_max = max(s.system.omega for s in scenes.values())
     dt = min(dt, 0.05 / w_max) if w_max > 0 else dt
     t_end = min(t_end, scene.run.t_end)
     every = max(1, round(SAMPLE / dt))

@@ -124,20 +124,20 @@ def default_solvers(scene: Scene) -> list[str]:
 def _impact_speed(scene: Scene) -> float:
     """Speed (m/s) at which the lower particle meets the floor, as a point falling from its
     height with its starting vertical velocity (the spring's vibration is left out)."""
-    low = min((scene.A, scene.B), key=lambda p: p.height)
-    return math.sqrt(low.vy**2 + 2.0 * scene.g * max(low.height, 0.0))
+    low = min((scene.system.A, scene.system.B), key=lambda p: p.height)
+    return math.sqrt(low.vy**2 + 2.0 * scene.system.g * max(low.height, 0.0))
 
 
 def rest_time(scene: Scene) -> float:
     """When a point mass dropped like the lower particle comes to rest on an inelastic floor:
     t1 + 2 e v1 / (g (1 - e)) (s); inf on an elastic floor or without gravity."""
-    if scene.floor is None or scene.g <= 0 or scene.floor.elasticity >= 1.0:
+    if scene.system.floor is None or scene.system.g <= 0 or scene.system.floor.elasticity >= 1.0:
         return math.inf
-    low = min((scene.A, scene.B), key=lambda p: p.height)
+    low = min((scene.system.A, scene.system.B), key=lambda p: p.height)
     v1 = _impact_speed(scene)
-    t1 = (low.vy + v1) / scene.g
-    e = scene.floor.elasticity
-    return t1 + 2.0 * e * v1 / (scene.g * (1.0 - e))
+    t1 = (low.vy + v1) / scene.system.g
+    e = scene.system.floor.elasticity
+    return t1 + 2.0 * e * v1 / (scene.system.g * (1.0 - e))
 
 
 def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
@@ -146,11 +146,11 @@ def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     from ..solvers import solver_class
 
     cls = solver_class(solver)
-    w_dt = scene.omega * dt
-    if cls.explicit_spring and scene.spring is not None and w_dt >= 2.0:
+    w_dt = scene.system.omega * dt
+    if cls.explicit_spring and scene.system.spring is not None and w_dt >= 2.0:
         return Prediction("unstable", f"w*dt = {w_dt:.2f} >= 2")
     reach = cls.catch_depth(scene)
-    if reach is not None and scene.floor is not None and scene.g > 0:
+    if reach is not None and scene.system.floor is not None and scene.system.g > 0:
         v = _impact_speed(scene)
         if v * dt > reach:
             return Prediction("tunnelled", f"moves {v * dt:.3g} m per step at impact "
@@ -160,7 +160,7 @@ def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     if cls.flip_floor and t_rest < t_end:
         return Prediction("failed", f"a point mass comes to rest at {t_rest:.2f} s "
                                     f"< t_end = {t_end:g} s")
-    if scene.spring is not None and cls.explicit_spring:
+    if scene.system.spring is not None and cls.explicit_spring:
         return Prediction("ok", f"w*dt = {w_dt:.2g} < 2")
     return Prediction("ok", "no step limit applies")
 
@@ -178,7 +178,7 @@ def run_case(path: str, solver: str) -> dict[str, Any]:
         agreement = "agrees"
     else:
         agreement = f"DISAGREES: theory expects {expected.status}, got {result['verdict']}"
-    return {"case": scene.name, "title": scene.title, "dissipative": scene.dissipative,
+    return {"case": scene.name, "title": scene.title, "dissipative": scene.system.dissipative,
             "solver": solver,
             "dt": scene.run.dt, **result, "predicted": expected.status,
             "agreement": agreement, "theory": expected.why, "wall_s": wall}
@@ -341,9 +341,9 @@ def map_points(scene: Scene) -> list[Any]:
     points = []
     for h in MAP_WDT:
         for ratio in MAP_RATIOS:
-            mA = scene.B.mass / ratio
-            mu = mA * scene.B.mass / (mA + scene.B.mass)
-            dt = h / math.sqrt(scene.spring.stiffness / mu)  # type: ignore[union-attr]
+            mA = scene.system.B.mass / ratio
+            mu = mA * scene.system.B.mass / (mA + scene.system.B.mass)
+            dt = h / math.sqrt(scene.system.spring.stiffness / mu)  # type: ignore[union-attr]
             points.append(Point(len(points), {"bodies.A.mass": mA, "run.dt": dt,
                                               "run.t_end": MAP_STEPS * dt}))
     return points

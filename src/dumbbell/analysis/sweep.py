@@ -211,7 +211,7 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
     point = scene.with_values(values)
     options = make_options(point)
     every = max(1, math.ceil(options.n_steps / (MAX_SAMPLES - 1)))
-    w_dt = point.omega * options.dt
+    w_dt = point.system.omega * options.dt
     try:
         traj = simulate(point, solver, every=every, quiet=True)
         err = relative_energy_error(traj)

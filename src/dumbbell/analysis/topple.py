@@ -139,22 +139,22 @@ def closed_form(scene: Scene) -> ToppleClosedForm:
     at height 0, A above it, tilted by a small nonzero angle. Raises UsageError naming what
     does not fit."""
     where = scene.source
-    if scene.dimensions != 2 or scene.rigid is None:
+    if scene.system.dimensions != 2 or scene.system.rigid is None:
         raise UsageError(f"{where}: the topple needs a rigid 2D dumbbell ([rigid], dimensions = 2)")
-    if scene.floor is None or scene.floor.friction != 0:
+    if scene.system.floor is None or scene.system.floor.friction != 0:
         raise UsageError(f"{where}: the topple needs a frictionless [floor] (friction = 0)")
-    if scene.g <= 0:
+    if scene.system.g <= 0:
         raise UsageError(f"{where}: the topple needs gravity ([gravity] g > 0)")
-    B, A = scene.B, scene.A
+    B, A = scene.system.B, scene.system.A
     if B.height != 0 or B.vx != 0 or B.vy != 0 or A.vx != 0 or A.vy != 0:
         raise UsageError(f"{where}: the topple starts with B at rest on the floor (bodies.B."
                          "height = 0) and no velocities")
-    L = scene.rigid.length
+    L = scene.system.rigid.length
     theta0 = math.atan2(A.x - B.x, A.height - B.height)
     if not (0 < abs(theta0) < math.pi / 2):
         raise UsageError(f"{where}: tilt = {math.degrees(theta0):g}: the topple needs A above "
                          "B, tilted by an angle strictly between 0 and 90 degrees")
-    cf = ToppleClosedForm(A.mass, B.mass, L, rigid_moment(scene), scene.g, abs(theta0))
+    cf = ToppleClosedForm(A.mass, B.mass, L, rigid_moment(scene), scene.system.g, abs(theta0))
     reason = cf.check()
     if reason:
         raise UsageError(f"{where}: {reason}")
@@ -191,9 +191,9 @@ def measure(traj: Trajectory) -> ToppleMeasure:
     i = int(hit[0])
     t0, t1, y0, y1 = traj.t[i - 1], traj.t[i], yA[i - 1], yA[i]
     t_land = float(t0 + (t1 - t0) * y0 / (y0 - y1))
-    M = s.M
-    xcm = (s.A.mass * traj["xA"] + s.B.mass * traj["xB"]) / M
-    vcm = (s.A.mass * traj["vyA"] + s.B.mass * traj["vyB"]) / M
+    M = s.system.M
+    xcm = (s.system.A.mass * traj["xA"] + s.system.B.mass * traj["xB"]) / M
+    vcm = (s.system.A.mass * traj["vyA"] + s.system.B.mass * traj["vyB"]) / M
     speed = np.hypot(traj["vxA"][:i], traj["vyA"][:i])
     theta = np.arctan2(np.abs(traj["xA"][:i] - traj["xB"][:i]), traj["yA"][:i] - traj["yB"][:i])
     drift = xcm[:i] - xcm[0]

@@ -268,14 +268,14 @@ def layout(scene: Scene, frames: Frames, size: tuple[int, int], strip: bool) -> 
     holds every position the particles reach (and the floor), at one scale in x and y."""
     W, H = size
     u = min(W / 640, H / 360)  # length unit of fonts and lines (px)
-    r = max(scene.A.radius, scene.B.radius)
+    r = max(scene.system.A.radius, scene.system.B.radius)
     xs = np.concatenate([frames.A[:, 0], frames.B[:, 0]])
     ys = np.concatenate([frames.A[:, 1], frames.B[:, 1]])
     finite = np.isfinite(xs) & np.isfinite(ys)
     xs, ys = (xs[finite], ys[finite]) if finite.any() else (np.zeros(1), np.zeros(1))
     x0, x1 = float(xs.min()) - r, float(xs.max()) + r
     y0, y1 = float(ys.min()) - r, float(ys.max()) + r
-    if scene.floor is not None:
+    if scene.system.floor is not None:
         y0 = min(y0, 0.0)
     span = max(x1 - x0, y1 - y0, 1e-6)
     pad = WORLD_PAD * span
@@ -379,7 +379,7 @@ class Painter(Backdrop):
         d = ImageDraw.Draw(img)
         fs = font(round(11 * u) * S)
         ft = font(round(12 * u) * S)
-        if self.scene.floor is not None:
+        if self.scene.system.floor is not None:
             _, fy = self.px(0.0, 0.0)
             d.rectangle([0, fy * S, self.L.scene_w * S, H * S], fill=FLOOR)
             d.line([(0, fy * S), (self.L.scene_w * S, fy * S)], fill=GREY, width=round(2 * u * S))
@@ -586,13 +586,13 @@ class Painter(Backdrop):
         if not all(math.isfinite(v) for v in (ax, ay, bx, by)):
             return
         pa, pb = self.px(ax, ay), self.px(bx, by)
-        ra = max(sc.A.radius * self.L.s, MIN_RADIUS_PX * u)
-        rb = max(sc.B.radius * self.L.s, MIN_RADIUS_PX * u)
-        rest = sc.spring.rest_length if sc.spring else sc.rigid.length if sc.rigid else 0.0
+        ra = max(sc.system.A.radius * self.L.s, MIN_RADIUS_PX * u)
+        rb = max(sc.system.B.radius * self.L.s, MIN_RADIUS_PX * u)
+        rest = sc.system.spring.rest_length if sc.system.spring else sc.system.rigid.length if sc.system.rigid else 0.0
         amp = max((CM_RADIUS + 1.5) * u, min(0.06 * rest * self.L.s, 8 * u))
-        two_d = sc.dimensions == 2
+        two_d = sc.system.dimensions == 2
         m = max(ra, rb, amp) + (18 if two_d else 8) * u
-        impact = k in self.impact_frames and sc.floor is not None
+        impact = k in self.impact_frames and sc.system.floor is not None
         mx = m + (34 * u if two_d else 0)
         x0, x1 = min(pa[0], pb[0]) - mx, max(pa[0], pb[0]) + mx + 16 * u
         y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + (mx if two_d else m)
@@ -608,7 +608,7 @@ class Painter(Backdrop):
         def P(p: tuple[float, float]) -> tuple[float, float]:
             return ((p[0] - cx) * S, (p[1] - cy) * S)
 
-        w = sc.A.mass / sc.M
+        w = sc.system.A.mass / sc.system.M
         pc = (w * pa[0] + (1 - w) * pb[0], w * pa[1] + (1 - w) * pb[1])
         if two_d:
             self._angle(d, P, pa, pb, pc)
@@ -618,9 +618,9 @@ class Painter(Backdrop):
             x, y = P((low[0], fy))
             d.line([(x - 14 * u * S, y), (x + 14 * u * S, y)], fill=BLACK, width=round(3 * u * S))
             self.st_small.draw(crop, (x, y + 4 * u * S), "impact", INK, "mt")
-        if sc.rigid is not None:
+        if sc.system.rigid is not None:
             d.line([P(pa), P(pb)], fill=SPRING, width=round(3 * u * S))
-        elif sc.spring is not None:
+        elif sc.system.spring is not None:
             d.line([P(p) for p in _zigzag(pb, pa, amp, COILS)], fill=SPRING,
                    width=max(2, round(1.5 * u * S)), joint="curve")
         else:
@@ -632,7 +632,7 @@ class Painter(Backdrop):
         dx, dy = pa[0] - pb[0], pa[1] - pb[1]
         dist = math.hypot(dx, dy)
         ex, ey = (dx / dist, dy / dist) if two_d and dist > 0 else (0.0, 0.0)
-        floor_y = self.px(0.0, 0.0)[1] if sc.floor is not None else math.inf
+        floor_y = self.px(0.0, 0.0)[1] if sc.system.floor is not None else math.inf
         for p, r, name, sign in ((pa, ra, "A", 1), (pb, rb, "B", -1)):
             x, y = P(p)
             d.ellipse([x - r * S, y - r * S, x + r * S, y + r * S], fill=TERM_RGB[name],
@@ -676,7 +676,7 @@ class Painter(Backdrop):
 
     def _time_label(self, img: Image.Image, k: int) -> None:
         u, fr = self.u, self.frames
-        two_d = self.scene.dimensions == 2
+        two_d = self.scene.system.dimensions == 2
         box = (round(4 * u), round(2 * u), self.L.scene_w - round(4 * u),
                round((34 if two_d else 22) * u))
         crop, (cx, cy), done = self._patch(img, box, 1)

@@ -128,7 +128,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     i = np.clip(np.searchsorted(t, ft), 1, max(1, len(t) - 1))
     idx = np.where(np.abs(t[i - 1] - ft) <= np.abs(t[np.minimum(i, len(t) - 1)] - ft), i - 1,
                    np.minimum(i, len(t) - 1))
-    if traj.scene.dimensions == 1:
+    if traj.scene.system.dimensions == 1:
         zero = np.zeros(len(t))
         A, B = np.column_stack([zero, traj["xA"]]), np.column_stack([zero, traj["xB"]])
     else:
@@ -145,7 +145,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
         t=ft, A=A[idx], B=B[idx], energy={k: v[idx] for k, v in energy.items()}, lo=lo, hi=hi,
         series_t=t[keep], series={k: v[keep] for k, v in energy.items()},
         impacts=tuple(e.t for e in traj.events), t_end=max(window, 1e-9),
-        L_cm=traj["L_cm"][idx] if traj.scene.dimensions == 2 else None,
+        L_cm=traj["L_cm"][idx] if traj.scene.system.dimensions == 2 else None,
     )
 
 

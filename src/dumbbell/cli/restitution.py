@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     from ..progress import bar
 
     scene = load_scene(args.scene)
-    if args.elasticity is not None and scene.floor is not None:
+    if args.elasticity is not None and scene.system.floor is not None:
         scene = scene.with_values({"floor.elasticity": args.elasticity})
     runs = len(args.theta) * (1 + len(args.stiffness))
     with bar(runs, "restitution", unit="run", quiet=args.quiet) as progress:

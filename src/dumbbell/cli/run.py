@@ -68,7 +68,7 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
             written.append(save_figure(ax.figure, out / f"{scene.name}-{name}.png"))
     if scene.outputs.csv:
         written.append(traj.to_csv(out / f"{scene.name}.csv"))
-        if scene.floor is not None:
+        if scene.system.floor is not None:
             written.append(traj.events_to_csv(out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif

@@ -37,7 +37,7 @@ if TYPE_CHECKING:
 
 def state_columns(scene: Scene) -> list[str]:
     """Position and velocity columns of a scene (m, m/s), in CSV order."""
-    if scene.dimensions == 1:
+    if scene.system.dimensions == 1:
         return ["xA", "vA", "xB", "vB"]
     return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
 
@@ -61,22 +61,22 @@ def column_unit(name: str) -> str:
 
 def spins(scene: Scene) -> bool:
     """True when the particles may spin about their own centres (2D pymunk with spin on)."""
-    return scene.dimensions == 2 and bool(scene.pymunk.spin)
+    return scene.system.dimensions == 2 and bool(scene.pymunk.spin)
 
 
 def energy_columns(scene: Scene) -> list[str]:
     """The energy terms (J) a scene can have, in CSV order; those it cannot have are left out."""
-    if scene.dimensions == 1:
+    if scene.system.dimensions == 1:
         cols = ["K_cm", "K_int", "U_g", "U_spring", "E"]
     else:
         cols = ["K_cm", "K_rot", "K_vib"]
         if spins(scene):
             cols.append("K_spin")
         cols.append("U_g")
-        if scene.spring is not None:
+        if scene.system.spring is not None:
             cols.append("U_spring")
         cols.append("E")
-    if scene.dissipative:
+    if scene.system.dissipative:
         cols += ["E_lost", "E_heat", "E_err"]
     return cols
 
@@ -88,7 +88,7 @@ BOOKKEEPING = ("E", "E_lost", "E_heat", "E_err")
 def momentum_columns(scene: Scene) -> list[str]:
     """The angular-momentum columns (kg m^2/s) of a scene, after the energy terms in the CSV:
     ``L_cm`` in 2D, none in 1D."""
-    return ["L_cm"] if scene.dimensions == 2 else []
+    return ["L_cm"] if scene.system.dimensions == 2 else []
 
 
 def partition_1d(
@@ -206,7 +206,7 @@ def heat(traj: Trajectory) -> np.ndarray:
     (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
     if "heat" in traj.state:
         return np.asarray(traj.state["heat"], dtype=float)
-    mass = {"A": traj.scene.A.mass, "B": traj.scene.B.mass}
+    mass = {"A": traj.scene.system.A.mass, "B": traj.scene.system.B.mass}
     times = np.array([e.t for e in traj.events])
     amounts = np.array([e.heat if e.heat is not None
                         else impact_heat(mass[e.body], e.v_before, e.v_after)
@@ -224,30 +224,30 @@ def disc_inertia(mass: float, radius: float) -> float:
 def rigid_moment(scene: Scene) -> float:
     """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
     two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
-    moment = scene.mu * scene.rigid.length**2
+    moment = scene.system.mu * scene.system.rigid.length**2
     if spins(scene):
-        moment += disc_inertia(scene.A.mass, scene.A.radius) + disc_inertia(scene.B.mass,
-                                                                           scene.B.radius)
+        moment += disc_inertia(scene.system.A.mass, scene.system.A.radius) + disc_inertia(scene.system.B.mass,
+                                                                           scene.system.B.radius)
     return moment
 
 
 def partition(traj: Trajectory) -> dict[str, np.ndarray]:
     """All energy columns of ``traj`` (J), in :func:`energy_columns` order."""
     scene = traj.scene
-    k, b = scene.k, scene.b
-    if scene.dimensions == 1:
-        parts = partition_1d(scene.A.mass, scene.B.mass, k, b, scene.g,
+    k, b = scene.system.k, scene.system.b
+    if scene.system.dimensions == 1:
+        parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
                              traj["xA"], traj["vA"], traj["xB"], traj["vB"])
     else:
         rA = np.column_stack([traj["xA"], traj["yA"]])
         rB = np.column_stack([traj["xB"], traj["yB"]])
         vA = np.column_stack([traj["vxA"], traj["vyA"]])
         vB = np.column_stack([traj["vxB"], traj["vyB"]])
-        parts = partition_2d(scene.A.mass, scene.B.mass, k, b, scene.g, rA, vA, rB, vB)
+        parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g, rA, vA, rB, vB)
         if spins(scene):
             parts["K_spin"] = sum(
                 rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
-                for p in (scene.A, scene.B)
+                for p in (scene.system.A, scene.system.B)
             )
             parts["E"] = parts["E"] + parts["K_spin"]
     return _with_losses(traj, parts)
@@ -258,16 +258,16 @@ def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
     ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus the discs'
     own spin ``1/2 m r^2 omega_i`` where particles may spin."""
     scene = traj.scene
-    mA, mB = scene.A.mass, scene.B.mass
+    mA, mB = scene.system.A.mass, scene.system.B.mass
     M = mA + mB
     Rx = (mA * traj["xA"] + mB * traj["xB"]) / M
     Ry = (mA * traj["yA"] + mB * traj["yB"]) / M
     total = sum(angular_momentum(p.mass, traj[f"x{p.name}"], traj[f"y{p.name}"],
                                  traj[f"vx{p.name}"], traj[f"vy{p.name}"], Rx, Ry)
-                for p in (scene.A, scene.B))
+                for p in (scene.system.A, scene.system.B))
     if spins(scene):
         total = total + sum(disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"]
-                            for p in (scene.A, scene.B))
+                            for p in (scene.system.A, scene.system.B))
     return np.asarray(total, dtype=float)
 
 
@@ -275,7 +275,7 @@ def _with_losses(traj: Trajectory, parts: dict[str, np.ndarray]) -> dict[str, np
     """``parts`` in :func:`energy_columns` order, with E_lost = E(0) - E, E_heat (:func:`heat`)
     and E_err = E_lost - E_heat added where the scene is dissipative (J)."""
     scene = traj.scene
-    if scene.dissipative:
+    if scene.system.dissipative:
         parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
         parts["E_heat"] = heat(traj)
         parts["E_err"] = parts["E_lost"] - parts["E_heat"]
@@ -294,23 +294,23 @@ def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict
     :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces.md)."""
     scene = traj.scene
     parts = {name: terms[name] for name in ("K_cm", "U_g", "U_spring", "E")}
-    if scene.dimensions == 1:
+    if scene.system.dimensions == 1:
         parts["K_int"] = terms["K_int"]
     else:
         rA = np.column_stack([traj["xA"], traj["yA"]])
         rB = np.column_stack([traj["xB"], traj["yB"]])
         vA = np.column_stack([traj["vxA"], traj["vyA"]])
         vB = np.column_stack([traj["vxB"], traj["vyB"]])
-        axis = partition_2d(scene.A.mass, scene.B.mass, scene.k, scene.b, scene.g,
+        axis = partition_2d(scene.system.A.mass, scene.system.B.mass, scene.system.k, scene.system.b, scene.system.g,
                             rA, vA, rB, vB)
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
         if spins(scene):
-            if scene.rigid is None:
+            if scene.system.rigid is None:
                 parts["K_spin"] = terms["K_rot"]
             else:
                 parts["K_spin"] = sum(
                     rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
-                    for p in (scene.A, scene.B))
+                    for p in (scene.system.A, scene.system.B))
     return _with_losses(traj, parts)
 
 

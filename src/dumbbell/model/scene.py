@@ -4,7 +4,7 @@ A scene says only what it needs; a table it leaves out is not built (no ``[floor
 handling; no ``[gravity]``: no gravity; no ``[spring]``: the particles do not interact).
 
 >>> scene = load_scene("scenes/textbook-1d.toml")      # doctest: +SKIP
->>> scene.spring.stiffness, scene.run.dt
+>>> scene.system.spring.stiffness, scene.run.dt
 (200.0, 1e-05)
 
 Every failure raises one :class:`SceneError` naming the file, the dotted key and what is
@@ -136,8 +136,8 @@ class GifSettings:
 
 
 @dataclass(frozen=True)
-class Outputs:
-    """What ``dumbbell run`` makes for the scene."""
+class OutputSettings:
+    """[outputs]: what ``dumbbell run`` makes for the scene (figure names, a CSV, a GIF)."""
 
     figures: tuple[str, ...]
     csv: bool
@@ -145,10 +145,13 @@ class Outputs:
 
 
 @dataclass(frozen=True)
-class Scene:
-    """A validated scene. Build it with :func:`load_scene` or :func:`scene_from_dict`."""
+class System:
+    """The physics of a scene: the dumbbell, its spring or rod, the floor and gravity.
 
-    title: str
+    ``dimensions`` is 1 (vertical line) or 2; ``g`` in m/s^2 (downward, 0 without gravity).
+    Solvers, energy formulas and closed forms need only this, not the run or output settings.
+    """
+
     dimensions: int
     A: Particle
     B: Particle
@@ -156,11 +159,6 @@ class Scene:
     rigid: Rigid | None
     floor: Floor | None
     g: float
-    run: RunSettings
-    outputs: Outputs
-    pymunk: PymunkSettings
-    source: str = "<scene>"
-    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def M(self) -> float:
@@ -193,11 +191,6 @@ class Scene:
         return self.floor.elasticity if self.floor else 1.0
 
     @property
-    def name(self) -> str:
-        """The scene file's stem, used to name outputs."""
-        return Path(self.source).stem if self.source != "<scene>" else "scene"
-
-    @property
     def dissipative(self) -> bool:
         """True when energy can leave the system (elasticity below 1, or friction in 2D)."""
         if self.floor is None:
@@ -216,6 +209,29 @@ class Scene:
                         "contact needs a contact solver such as pymunk; impacts alone cannot "
                         "hold it")
         return None
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene: a title, the physics (:class:`System`), the default run options, the
+    outputs ``dumbbell run`` makes and the pymunk engine's settings. Build it with
+    :func:`load_scene` or :func:`scene_from_dict`.
+
+    >>> scene.system.spring.stiffness, scene.system.omega, scene.run.dt  # doctest: +SKIP
+    """
+
+    title: str
+    system: System
+    run: RunSettings
+    outputs: OutputSettings
+    pymunk: PymunkSettings
+    source: str = "<scene>"
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def name(self) -> str:
+        """The scene file's stem, used to name outputs."""
+        return Path(self.source).stem if self.source != "<scene>" else "scene"
 
     def with_values(self, values: dict[str, Any]) -> Scene:
         """A new scene with keys replaced by dotted name, validated like a file.
@@ -465,10 +481,9 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
     outputs = _outputs(top, dims, floor is not None, rigid is not None, run.t_end)
     pm = _pymunk(top)
     top.done()
-    return Scene(
-        title=title, dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
-        run=run, outputs=outputs, pymunk=pm, source=source, raw=copy.deepcopy(data),
-    )
+    system = System(dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g)
+    return Scene(title=title, system=system, run=run, outputs=outputs, pymunk=pm,
+                 source=source, raw=copy.deepcopy(data))
 
 
 def _bodies_tables(top: _Checker, source: str) -> tuple[_Checker, _Checker]:
@@ -598,11 +613,11 @@ def _run(top: _Checker, source: str) -> RunSettings:
 
 
 def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: float
-             ) -> Outputs:
+             ) -> OutputSettings:
     """[outputs]: figures (names), csv, and [outputs.gif] (fps, size, strip, t_end in s)."""
     co = top.sub("outputs")
     if co is None:
-        return Outputs((), False, None)
+        return OutputSettings((), False, None)
     figures: tuple[str, ...] = ()
     co.used.add("figures")
     if co.has("figures"):
@@ -631,7 +646,7 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
                       "each between 64 and 4096")
         cgif.done()
     co.done()
-    return Outputs(figures, csv, gif)
+    return OutputSettings(figures, csv, gif)
 
 
 def _pymunk(top: _Checker) -> PymunkSettings:

@@ -106,7 +106,7 @@ class Trajectory:
             return self.t
         if name in self.state:
             return self.state[name]
-        if name == "L_cm" and self.scene.dimensions == 2:
+        if name == "L_cm" and self.scene.system.dimensions == 2:
             if self._momentum is None or len(self._momentum) != len(self.t):
                 from .energy import angular_momentum_cm
 

@@ -18,7 +18,7 @@ def _shown(result: Comparison) -> float:
 
 
 def _heights_panel(ax: Any, result: Comparison, body: str) -> None:
-    key = "x" if result.scene.dimensions == 1 else "y"
+    key = "x" if result.scene.system.dimensions == 1 else "y"
     truth = result.truth
     shown = _shown(result)
     m = truth.t <= shown + 1e-12

@@ -59,11 +59,11 @@ def rotation(s: Series, ax: Any = None) -> Any:
             if math.isfinite(mean):
                 panel.hlines(mean, a, b, colors=COLOURS["K_rot"], linestyles=(0, (1, 1)), lw=2.2,
                           label="its mean after the first impacts")
-            note = (f"{label}: w = {r.scene.omega:.0f} rad/s\n"
+            note = (f"{label}: w = {r.scene.system.omega:.0f} rad/s\n"
                     f"mean K_rot after the first impacts ({a:.2f}-{b:.2f} s): {mean:.2f} J\n"
                     f"(rigid dumbbell after its 1st impact: {rigid_mean:.2f} J)")
         else:
-            I = rigid.info.get("moment", r.scene.mu * r.scene.rigid.length**2)
+            I = rigid.info.get("moment", r.scene.system.mu * r.scene.system.rigid.length**2)
             panel.plot(r.t, r["K_rot"], color="black", lw=1.2,
                     label="K_rot = 1/2 mu |w x u|^2 (partition)")
             half = slice(None, None, max(1, len(r.t) // 120))

@@ -31,20 +31,20 @@ def _window(traj: Trajectory, window: float) -> np.ndarray:
 def heights(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Vertical positions of A, B and the centre of mass (m), in 1D or 2D."""
     scene = traj.scene
-    key = "x" if scene.dimensions == 1 else "y"
+    key = "x" if scene.system.dimensions == 1 else "y"
     a, b = traj[f"{key}A"], traj[f"{key}B"]
-    return a, b, (scene.A.mass * a + scene.B.mass * b) / scene.M
+    return a, b, (scene.system.A.mass * a + scene.system.B.mass * b) / scene.system.M
 
 
 def _positions_panel(ax: Any, traj: Trajectory, window: float) -> None:
     m = _window(traj, window)
     t = traj.t[m]
     a, b, cm = (h[m] for h in heights(traj))
-    name = "x" if traj.scene.dimensions == 1 else "y"
+    name = "x" if traj.scene.system.dimensions == 1 else "y"
     ax.plot(t, a, color=COLOURS["A"], lw=1.3, label=f"{name}_A, top particle")
     ax.plot(t, b, color=COLOURS["B"], lw=1.3, label=f"{name}_B, bottom particle")
     ax.plot(t, cm, color=COLOURS["cm"], lw=1.6, ls=":", label="centre of mass")
-    if traj.scene.floor is not None:
+    if traj.scene.system.floor is not None:
         ax.axhspan(min(0.0, float(np.nanmin([a.min(), b.min()]))) - 1.0, 0.0, color="0.88",
                    zorder=0)
         ax.axhline(0.0, color="0.4", lw=1.0)
@@ -133,7 +133,7 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
 def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.14: the kinetic energy split into K_cm and K_int (in 2D K_rot, K_vib, K_spin),
     and E (J); without ``ax``, below the positions."""
-    names = ["K_cm", "K_int", "E"] if traj.scene.dimensions == 1 else [
+    names = ["K_cm", "K_int", "E"] if traj.scene.system.dimensions == 1 else [
         n for n in ("K_cm", "K_rot", "K_vib", "K_spin", "E") if n in traj.columns]
     return _two_panel(traj, ax, names, window,
                       "kinetic energy: centre of mass against internal motion")
@@ -165,7 +165,7 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
     xs = np.concatenate([xA, xB])
     mid = 0.5 * (float(np.nanmin(xs)) + float(np.nanmax(xs)))
     half = max(0.5 * (float(np.nanmax(xs)) - float(np.nanmin(xs))) + 0.05, 0.35 * (hi - lo))
-    if traj.scene.floor is not None:
+    if traj.scene.system.floor is not None:
         ax.axhline(0.0, color="0.4", lw=1.0)
         ax.axhspan(lo - 1.0, 0.0, color="0.88", zorder=0)
     ax.set_xlim(mid - half, mid + half)
@@ -212,7 +212,7 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
         _frame([ax], traj, window)
         return ax
     fig = pyplot().figure(figsize=(10, 8.6))
-    wide = traj.scene.dimensions == 2
+    wide = traj.scene.system.dimensions == 2
     grid = fig.add_gridspec(3, 3 if wide else 1, height_ratios=[1.1, 1, 1])
     top = fig.add_subplot(grid[0, :2] if wide else grid[0, 0])
     _positions_panel(top, traj, window)

@@ -122,16 +122,16 @@ class Solver:
 def kernel_params(scene: Scene) -> tuple[float, float, float, float, float, float, bool]:
     """The scalars the compiled time-steppers take: mA, mB (kg), k (N/m), b (m), g (m/s^2),
     the floor's elasticity, and whether there is a floor."""
-    return (scene.A.mass, scene.B.mass, scene.k, scene.b, scene.g, scene.elasticity,
-            scene.floor is not None)
+    return (scene.system.A.mass, scene.system.B.mass, scene.system.k, scene.system.b, scene.system.g, scene.system.elasticity,
+            scene.system.floor is not None)
 
 
 def point_particle_limits(scene: Scene, name: str) -> str | None:
     """Why a hand-written 2D solver of two point particles, a spring and a frictionless floor
     cannot run ``scene``, or None if it can."""
-    if scene.rigid is not None:
+    if scene.system.rigid is not None:
         return f"{name} handles two particles and a spring, not a rigid body"
-    if scene.floor is not None and scene.floor.friction > 0:
+    if scene.system.floor is not None and scene.system.floor.friction > 0:
         return f"{name} has a frictionless floor only; use pymunk for friction"
     if scene.pymunk.spin:
         return f"{name} has point particles (no spin); use pymunk for spinning particles"

@@ -102,11 +102,11 @@ def build(scene: Scene) -> World:
 
     cfg = settings(scene)
     space = pymunk.Space()
-    space.gravity = (0.0, -scene.g)
+    space.gravity = (0.0, -scene.system.g)
     space.collision_slop = cfg["collision_slop"]
     space.collision_bias = cfg["collision_bias"]
     space.iterations = cfg["iterations"]
-    A, B = scene.A, scene.B
+    A, B = scene.system.A, scene.system.B
     points: dict[str, tuple[Any, Any, tuple[float, float]]] = {}
     world = World(space, points)
 
@@ -118,10 +118,10 @@ def build(scene: Scene) -> World:
         points[p.name] = (body, shape, offset)
         return shape
 
-    if scene.rigid is not None:
-        M = scene.M
+    if scene.system.rigid is not None:
+        M = scene.system.M
         R = ((A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M)
-        moment = scene.mu * scene.rigid.length**2
+        moment = scene.system.mu * scene.system.rigid.length**2
         if cfg["spin"]:
             moment += disc_inertia(A.mass, A.radius) + disc_inertia(B.mass, B.radius)
         body = pymunk.Body(M, moment)
@@ -144,21 +144,21 @@ def build(scene: Scene) -> World:
             if cfg["spin"]:
                 body.angular_velocity = p.spin
             space.add(body, circle(body, p, (0.0, 0.0)))
-        if scene.spring is not None:
+        if scene.system.spring is not None:
             bA, bB = points["A"][0], points["B"][0]
             spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0),
-                                         scene.spring.rest_length, scene.spring.stiffness, 0.0)
+                                         scene.system.spring.rest_length, scene.system.spring.stiffness, 0.0)
             spring.collide_bodies = False
             space.add(spring)
             world.spring = spring
 
-    if scene.floor is not None:
+    if scene.system.floor is not None:
         radii = sorted({A.radius, B.radius})
         for bit, r in enumerate(radii):
             W, T = _FLOOR_HALF_WIDTH, FLOOR_THICKNESS
             box = pymunk.Poly(space.static_body, [(-W, -r - T), (W, -r - T), (W, -r), (-W, -r)])
-            box.elasticity = scene.floor.elasticity
-            box.friction = scene.floor.friction
+            box.elasticity = scene.system.floor.elasticity
+            box.friction = scene.system.floor.friction
             box.collision_type = _FLOOR_TYPE
             if len(radii) > 1:
                 # Each particle meets only the box placed for its own radius.
@@ -188,7 +188,7 @@ def _reader(scene: Scene, world: World) -> Any:
             w = body.angular_velocity
             return (pA[0], pA[1], vA[0], vA[1], pB[0], pB[1], vB[0], vB[1], w)
         return read2
-    if scene.dimensions == 1:
+    if scene.system.dimensions == 1:
         def read1() -> tuple[float, ...]:
             return (bA.position[1], bA.velocity[1], bB.position[1], bB.velocity[1])
         return read1
@@ -224,12 +224,12 @@ def _energy(scene: Scene, world: World, traj: Trajectory) -> dict[str, np.ndarra
     n = len(traj.t)
     zero = np.zeros(n)
     if world.rigid_body is not None:
-        mA, mB, M = scene.A.mass, scene.B.mass, scene.M
+        mA, mB, M = scene.system.A.mass, scene.system.B.mass, scene.system.M
         cols = [[(mA * traj[f"{c}A"] + mB * traj[f"{c}B"]) / M]
                 for c in ("x", "y", "vx", "vy")]
         omega = [traj.state["omega"]]
     else:
-        if scene.dimensions == 1:
+        if scene.system.dimensions == 1:
             cols = [[zero, zero], [traj["xA"], traj["xB"]], [zero, zero], [traj["vA"], traj["vB"]]]
         else:
             cols = [[traj[f"{c}A"], traj[f"{c}B"]] for c in ("x", "y", "vx", "vy")]
@@ -282,10 +282,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
             space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=begin,
                                post_solve=post_solve)
 
-    radius = {"A": scene.A.radius, "B": scene.B.radius}
-    y_col = {name: names.index(f"{'x' if scene.dimensions == 1 else 'y'}{name}")
+    radius = {"A": scene.system.A.radius, "B": scene.system.B.radius}
+    y_col = {name: names.index(f"{'x' if scene.system.dimensions == 1 else 'y'}{name}")
              for name in "AB"}
-    vy_col = {name: names.index(f"{'v' if scene.dimensions == 1 else 'vy'}{name}")
+    vy_col = {name: names.index(f"{'v' if scene.system.dimensions == 1 else 'vy'}{name}")
               for name in "AB"}
     step = space.step
     verdict: Verdict | None = None
@@ -359,4 +359,4 @@ class Pymunk(Solver):
     def catch_depth(scene: Scene) -> float:
         """How far (m) a circle may travel in one step and still be caught by the floor: the
         floor box's thickness plus the smaller circle's diameter."""
-        return 2.0 * min(scene.A.radius, scene.B.radius) + FLOOR_THICKNESS
+        return 2.0 * min(scene.system.A.radius, scene.system.B.radius) + FLOOR_THICKNESS

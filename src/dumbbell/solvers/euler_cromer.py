@@ -35,7 +35,7 @@ _CHUNK = 4_000_000
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    if scene.dimensions != 1:
+    if scene.system.dimensions != 1:
         return "euler-cromer is the 1D textbook method; use euler-cromer-2d or pymunk in 2D"
     return None
 
@@ -63,7 +63,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     dt, every = options.dt, options.every
     # One contiguous row per column, so the Trajectory's columns are views, not copies.
     out = np.empty((4, options.n_samples))
-    st = np.array([scene.A.height, scene.A.vy, scene.B.height, scene.B.vy], dtype=np.float64)
+    st = np.array([scene.system.A.height, scene.system.A.vy, scene.system.B.height, scene.system.B.vy], dtype=np.float64)
     out[:, 0] = st
     run = run_kernel(advance, (mA, mB, k, b, g, e, floor), st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)

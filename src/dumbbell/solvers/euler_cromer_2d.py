@@ -38,7 +38,7 @@ _COLUMNS = ("xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB")
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    if scene.dimensions != 2:
+    if scene.system.dimensions != 2:
         return "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
     return point_particle_limits(scene, NAME)
 
@@ -58,7 +58,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` in pymunk's step order at step ``options.dt`` (s)."""
     from .kernels.euler_cromer_2d import advance
 
-    A, B = scene.A, scene.B
+    A, B = scene.system.A, scene.system.B
     mA, mB, k, b, g, e, floor = kernel_params(scene)
     dt, every = options.dt, options.every
     out = np.empty((options.n_samples, 8))

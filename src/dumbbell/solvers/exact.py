@@ -57,12 +57,12 @@ class _Motion:
     """Closed-form motion of one segment; ``tau`` is the time since the segment began (s)."""
 
     def __init__(self, scene: Scene):
-        self.g = scene.g
-        self.M = scene.M
-        self.cA = scene.B.mass / scene.M  # xA = X + cA (b + s)
-        self.cB = scene.A.mass / scene.M  # xB = X - cB (b + s)
-        self.b = scene.b
-        self.w = scene.omega
+        self.g = scene.system.g
+        self.M = scene.system.M
+        self.cA = scene.system.B.mass / scene.system.M  # xA = X + cA (b + s)
+        self.cB = scene.system.A.mass / scene.system.M  # xB = X - cB (b + s)
+        self.b = scene.system.b
+        self.w = scene.system.omega
 
     def stretch(self, seg: Segment, tau):
         if self.w > 0:
@@ -174,25 +174,25 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    if scene.dimensions != 1:
-        if scene.rigid is not None:
+    if scene.system.dimensions != 1:
+        if scene.system.rigid is not None:
             from .exact_rigid import supports as rigid_supports
 
             return rigid_supports(scene)
         return ("the exact solution covers 1D scenes and the rigid 2D dumbbell; use the "
                 "reference solver for a 2D spring")
-    return scene.resting_contact()
+    return scene.system.resting_contact()
 
 
 def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], Verdict]:
     """The free-flight segments up to ``t_end`` (s), the impacts between them, and a verdict."""
     motion = _Motion(scene)
-    A, B = scene.A, scene.B
+    A, B = scene.system.A, scene.system.B
     seg = motion.segment_at(0.0, A.height, A.vy, B.height, B.vy)
     segs, events = [seg], []
-    if scene.floor is None:
+    if scene.system.floor is None:
         return segs, events, Verdict()
-    e = scene.floor.elasticity
+    e = scene.system.floor.elasticity
     # After an impact the particle is on the floor moving up: no new root before this time.
     start = {"A": 0.0, "B": 0.0}
     while len(events) < MAX_IMPACTS:
@@ -228,7 +228,7 @@ def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], V
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Evaluate the exact solution at the sample times ``i * every * dt`` (s)."""
-    if scene.rigid is not None:
+    if scene.system.rigid is not None:
         return _solve_rigid(scene, options)
     t0 = time.perf_counter()
     segs, events, verdict = segments(scene, options.t_end)
@@ -293,4 +293,4 @@ class Exact(Solver):
     @staticmethod
     def truth_for(scene: Scene) -> bool:
         """The truth for 1D scenes and the rigid 2D dumbbell."""
-        return scene.dimensions == 1 or scene.rigid is not None
+        return scene.system.dimensions == 1 or scene.system.rigid is not None

@@ -77,19 +77,19 @@ class RigidBody:
     """Masses, arms and moment of one rigid scene, and its closed-form motion."""
 
     def __init__(self, scene: Scene):
-        if scene.rigid is None:
+        if scene.system.rigid is None:
             raise ValueError("RigidBody needs a scene with [rigid]")
-        self.M = scene.M
-        self.g = scene.g
-        self.L = scene.rigid.length
-        self.arm = {"A": scene.B.mass / scene.M * self.L, "B": -scene.A.mass / scene.M * self.L}
+        self.M = scene.system.M
+        self.g = scene.system.g
+        self.L = scene.system.rigid.length
+        self.arm = {"A": scene.system.B.mass / scene.system.M * self.L, "B": -scene.system.A.mass / scene.system.M * self.L}
         self.moment = rigid_moment(scene)
 
     # --- the state -------------------------------------------------------------------------
     def initial(self, scene: Scene) -> RigidState:
         """The state at t = 0 from the particles' positions and velocities; the velocity
         along the rod (which a rigid rod cannot have) is dropped."""
-        A, B, M = scene.A, scene.B, self.M
+        A, B, M = scene.system.A, scene.system.B, self.M
         d = (A.x - B.x, A.height - B.height)
         w = (A.vx - B.vx, A.vy - B.vy)
         theta = math.atan2(d[1], d[0])
@@ -253,11 +253,11 @@ class RigidBody:
 
 def supports(scene: Scene) -> str | None:
     """None if the closed-form rigid flight can run ``scene``, else why not."""
-    if scene.rigid is None:
+    if scene.system.rigid is None:
         return "the closed-form 2D solution is for a rigid dumbbell ([rigid]); use reference"
-    if scene.resting_contact():
-        return scene.resting_contact()
-    if scene.floor is not None and scene.floor.friction > 0:
+    if scene.system.resting_contact():
+        return scene.system.resting_contact()
+    if scene.system.floor is not None and scene.system.floor.friction > 0:
         return ("the exact rigid solution has a frictionless floor only (a contact with "
                 "friction can slide and stick, not a single impulse); compare pymunk at a "
                 "smaller dt instead")
@@ -270,9 +270,9 @@ def flight(scene: Scene, t_end: float) -> tuple[list[RigidState], list[Impact], 
     body = RigidBody(scene)
     seg = body.initial(scene)
     segs, events = [seg], []
-    if scene.floor is None:
+    if scene.system.floor is None:
         return segs, events, Verdict()
-    e = scene.floor.elasticity
+    e = scene.system.floor.elasticity
     start = {"A": 0.0, "B": 0.0}
     while len(events) < MAX_IMPACTS:
         horizon = t_end - seg.t

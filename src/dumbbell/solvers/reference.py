@@ -70,9 +70,9 @@ MAX_IMPACTS = 100_000
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    if scene.resting_contact():
-        return scene.resting_contact()
-    if scene.floor is not None and scene.floor.friction > 0:
+    if scene.system.resting_contact():
+        return scene.system.resting_contact()
+    if scene.system.floor is not None and scene.system.floor.friction > 0:
         return ("the reference handles frictionless floors only (friction makes a contact "
                 "slide and stick, not a single impulse); compare pymunk at smaller dt instead")
     return None
@@ -94,11 +94,11 @@ class _Model:
 
 
 def _particles_model(scene: Scene) -> _Model:
-    A, B = scene.A, scene.B
-    mA, mB, g = A.mass, B.mass, scene.g
-    k, b = scene.k, scene.b
+    A, B = scene.system.A, scene.system.B
+    mA, mB, g = A.mass, B.mass, scene.system.g
+    k, b = scene.system.k, scene.system.b
 
-    if scene.dimensions == 1:
+    if scene.system.dimensions == 1:
         # The 1D force law keeps its sign when A passes below B, as in the other 1D solvers.
         def rhs1(_t: float, y: np.ndarray) -> list[float]:
             f = k * (y[0] - y[2] - b)
@@ -143,8 +143,8 @@ def _particles_model(scene: Scene) -> _Model:
 
 
 def _rigid_model(scene: Scene) -> _Model:
-    A, B = scene.A, scene.B
-    M, g, L = scene.M, scene.g, scene.rigid.length  # type: ignore[union-attr]
+    A, B = scene.system.A, scene.system.B
+    M, g, L = scene.system.M, scene.system.g, scene.system.rigid.length  # type: ignore[union-attr]
     I = rigid_moment(scene)
     cA, cB = B.mass / M, A.mass / M  # rA = R + cA L u, rB = R - cB L u
     d = (A.x - B.x, A.height - B.height)
@@ -195,7 +195,7 @@ def _rigid_model(scene: Scene) -> _Model:
 
 
 def _model(scene: Scene) -> _Model:
-    return _rigid_model(scene) if scene.rigid is not None else _particles_model(scene)
+    return _rigid_model(scene) if scene.system.rigid is not None else _particles_model(scene)
 
 
 def integrate(scene: Scene, times: np.ndarray, t_end: float, tight: bool = False,
@@ -206,7 +206,7 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, tight: bool = False
 
     Returns the columns at the samples reached, the impacts, a verdict, and the number of
     right-hand-side evaluations (2D spring: Runge-Kutta steps)."""
-    if scene.dimensions == 2 and scene.rigid is None:
+    if scene.system.dimensions == 2 and scene.system.rigid is None:
         from .reference_2d import STEP_ANGLE
         from .reference_2d import integrate as integrate_2d
 
@@ -224,8 +224,8 @@ def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, rtol: float
     model = _model(scene)
     if len(times):
         t_end = max(t_end, float(times[-1]))  # j * every * dt can round past t_end
-    e = scene.floor.elasticity if scene.floor is not None else 1.0
-    bodies = list(model.height) if scene.floor is not None else []
+    e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
+    bodies = list(model.height) if scene.system.floor is not None else []
     events = []
     for body in bodies:
         def event(_t: float, y: np.ndarray, body: str = body) -> float:
@@ -269,7 +269,7 @@ def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, rtol: float
                               f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
             break
         mass = (model.effective_mass(y, body) if model.effective_mass is not None
-                else (scene.A.mass if body == "A" else scene.B.mass))
+                else (scene.system.A.mass if body == "A" else scene.system.B.mass))
         y = model.jump(y, body, e)
         v_after = float(model.vertical_velocity(y, body))
         impacts.append(Impact(t_hit, body, v_before, v_after,
@@ -298,7 +298,7 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
     from ..progress import bar
 
     times = options.sample_times()
-    if scene.dimensions == 2 and scene.rigid is None:
+    if scene.system.dimensions == 2 and scene.system.rigid is None:
         warm_up()  # numba compiles (or loads) the kernel outside the solver's clock
     t0 = time.perf_counter()
     with bar(options.t_end, f"{NAME} {scene.name}", "s", quiet=options.quiet) as pb:
@@ -308,12 +308,12 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
     traj = Trajectory(scene=scene, solver=NAME, t=times[:n], state=cols, events=impacts,
                       dt=options.dt, every=options.every, wall_time=wall,
                       info={"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev})
-    if scene.dimensions == 2 and scene.rigid is None:
+    if scene.system.dimensions == 2 and scene.system.rigid is None:
         from .reference_2d import STEP_ANGLE
 
         traj.info = {"method": "RK8 (DOP853 stages) on d = rA - rB, fixed step",
                      "step_angle": STEP_ANGLE, "rk_steps": nfev}
-    if scene.rigid is not None:
+    if scene.system.rigid is not None:
         traj.info["moment"] = rigid_moment(scene)
     traj.verdict = truth_verdict(traj, verdict)
     if estimate_error and len(traj.t):
@@ -361,4 +361,4 @@ class Reference(Solver):
     @staticmethod
     def truth_for(scene: Scene) -> bool:
         """The truth for the 2D spring dumbbell."""
-        return scene.dimensions == 2 and scene.rigid is None
+        return scene.system.dimensions == 2 and scene.system.rigid is None

@@ -137,13 +137,13 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, step_angle: float =
     """The 2D spring dumbbell sampled at ``times`` (s, sorted): state columns of the samples
     reached, impacts, verdict, and the number of Runge-Kutta steps taken."""
     step, run = _kernels()
-    A, B = scene.A, scene.B
-    M, g = scene.M, scene.g
+    A, B = scene.system.A, scene.system.B
+    M, g = scene.system.M, scene.system.g
     cA, cB = B.mass / M, A.mass / M
-    w2 = scene.omega**2
-    b = scene.b
-    e = scene.floor.elasticity if scene.floor is not None else 1.0
-    floor = scene.floor is not None
+    w2 = scene.system.omega**2
+    b = scene.system.b
+    e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
+    floor = scene.system.floor is not None
     times = np.ascontiguousarray(times, dtype=np.float64)
     out = np.empty((len(times), 4))
     # Centre-of-mass segments: (t0, X0, Y0, VX, VY0); relative state s = (d, d').
@@ -281,7 +281,7 @@ def _columns(scene: Scene, segs: list[tuple[float, float, float, float, float]],
              t: np.ndarray, rel: np.ndarray, cA: float, cB: float) -> dict[str, np.ndarray]:
     """Particle positions (m) and velocities (m/s) at the samples from the centre-of-mass
     segments (closed form) and the relative state."""
-    g = scene.g
+    g = scene.system.g
     R = np.empty((len(t), 4))
     bounds = np.searchsorted(t, [s[0] for s in segs[1:]], side="left")
     for (t0, X0, Y0, VX, VY0), lo, hi in zip(segs, [0, *bounds], [*bounds, len(t)],
@@ -298,6 +298,6 @@ def _columns(scene: Scene, segs: list[tuple[float, float, float, float, float]],
         "vxB": R[:, 2] - cB * rel[:, 2], "vyB": R[:, 3] - cB * rel[:, 3],
     }
     if spins(scene):  # frictionless: the circles keep their initial spins
-        cols["omegaA"] = np.full(len(t), scene.A.spin)
-        cols["omegaB"] = np.full(len(t), scene.B.spin)
+        cols["omegaA"] = np.full(len(t), scene.system.A.spin)
+        cols["omegaB"] = np.full(len(t), scene.system.B.spin)
     return cols

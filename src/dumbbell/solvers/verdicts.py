@@ -28,13 +28,13 @@ STEP_LIMIT = 2.0
 
 def stability_limit(scene: Scene) -> float | None:
     """The largest stable step of the explicit spring, 2/w (s); None without a spring force."""
-    w = scene.omega
+    w = scene.system.omega
     return STEP_LIMIT / w if w > 0 else None
 
 
 def step_ratio(scene: Scene, dt: float | None) -> float:
     """w*dt (dimensionless) for step ``dt`` (s); 0 without a spring or without a step."""
-    return scene.omega * dt if dt else 0.0
+    return scene.system.omega * dt if dt else 0.0
 
 
 def seconds(value: float) -> str:
@@ -61,7 +61,7 @@ def stable_swing(ratio: float) -> float:
 
 def nonfinite_reason(scene: Scene, dt: float) -> str:
     """Why a state most likely blew up at step ``dt`` (s), with the fix when it is the step."""
-    w = scene.omega
+    w = scene.system.omega
     limit = stability_limit(scene)
     if limit is not None and w * dt >= STEP_LIMIT:
         return (f"w*dt = {ratio_text(w * dt)} > 2 (w = sqrt(k/mu) = {w:.4g} rad/s); "
@@ -106,13 +106,13 @@ def below_floor_verdict(
     ``tunnelled``."""
     scene = traj.scene
     pressed = max(push, 0.0)
-    if abs(speed) <= 3.0 * (scene.g + pressed) * dt:
-        how = (f"pressed onto it by the spring at {pressed:.3g} m/s^2" if pressed > scene.g
+    if abs(speed) <= 3.0 * (scene.system.g + pressed) * dt:
+        how = (f"pressed onto it by the spring at {pressed:.3g} m/s^2" if pressed > scene.system.g
                else "at rest on it")
         reason = (f"{body} stays on the floor, {how} ({abs(height):.2g} m below it, moving at "
                   f"{abs(speed):.2g} m/s): a velocity-flip floor cannot hold a particle in "
                   "lasting contact")
-        if len(traj.t) and scene.floor is not None and scene.floor.elasticity >= 1.0:
+        if len(traj.t) and scene.system.floor is not None and scene.system.floor.elasticity >= 1.0:
             E = traj["E"]
             left = float(E[-1] / E[0]) if E[0] else math.nan
             if left < 0.5:
@@ -120,7 +120,7 @@ def below_floor_verdict(
                            f"energy to {left:.0%} of its start: use a smaller dt")
         return Verdict("failed", t, reason)
     reason = tunnel_reason(scene, body, height, speed, dt, depth)
-    if push > scene.g:
+    if push > scene.system.g:
         reason += (f"; the spring pushed it back down (at {push:.3g} m/s^2) before it climbed "
                    f"out, with w*dt = {ratio_text(step_ratio(scene, dt))}: use a smaller dt")
     return Verdict("tunnelled", t, reason)
@@ -146,8 +146,8 @@ def truth_verdict(traj: Trajectory, verdict: Verdict) -> Verdict:
     such sample (the trajectory is cut after it: the truth missed an impact); else the
     solver's own verdict, or when that is ok :func:`energy_verdict`."""
     scene = traj.scene
-    if scene.floor is not None and len(traj.t):
-        key = "x" if scene.dimensions == 1 else "y"
+    if scene.system.floor is not None and len(traj.t):
+        key = "x" if scene.system.dimensions == 1 else "y"
         heights = np.vstack([traj.state[f"{key}{body}"] for body in "AB"])
         bad = np.flatnonzero(np.min(heights, axis=0) < -FLOOR_TOLERANCE)
         if bad.size:
@@ -173,7 +173,7 @@ def energy_verdict(traj: Trajectory, dt: float | None) -> Verdict:
     if len(traj.t) == 0:
         return Verdict()
     err = relative_energy_error(traj)
-    if scene.dissipative:
+    if scene.system.dissipative:
         E = traj["E"]
         err = np.where(E > E[0], err, 0.0)
     bad = np.flatnonzero(~(err <= scene.run.unstable_energy))

@@ -42,7 +42,7 @@ _CHUNK = 2_000_000
 
 def supports(scene: Scene) -> str | None:
     """None if this solver can run ``scene``, else why not."""
-    return point_particle_limits(scene, NAME) if scene.dimensions == 2 else None
+    return point_particle_limits(scene, NAME) if scene.system.dimensions == 2 else None
 
 
 def warm_up() -> float:
@@ -68,15 +68,15 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 
     mA, mB, k, b, g, e, floor = kernel_params(scene)
     dt, every = options.dt, options.every
-    A, B = scene.A, scene.B
-    if scene.dimensions == 1:
+    A, B = scene.system.A, scene.system.B
+    if scene.system.dimensions == 1:
         kernel, columns = advance, ("xA", "vA", "xB", "vB")
         st = np.array([A.height, A.vy, B.height, B.vy], dtype=np.float64)
     else:
         kernel, columns = advance_2d, ("xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB")
         st = np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)
     # Columns of each particle's height and vertical velocity.
-    vertical = {"A": (0, 1), "B": (2, 3)} if scene.dimensions == 1 else {"A": (1, 3),
+    vertical = {"A": (0, 1), "B": (2, 3)} if scene.system.dimensions == 1 else {"A": (1, 3),
                                                                          "B": (5, 7)}
     out = np.empty((options.n_samples, len(columns)))
     out[0] = st
