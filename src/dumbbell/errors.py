@@ -27,6 +27,14 @@ class UsageError(DumbbellError, ValueError):
         self.param = param
 
 
+class ColumnError(UsageError, KeyError):
+    """A trajectory column asked for by a name it does not have (also a ``KeyError``, as
+    for a dict): ``traj["nope"]`` names the column and lists the columns there are."""
+
+    def __str__(self) -> str:  # KeyError's own would quote the message
+        return str(self.args[0]) if self.args else ""
+
+
 class MissingExtraError(DumbbellError, ImportError):
     """An optional dependency is not installed; the message names the extra that brings it,
     e.g. ``to_pandas() needs pandas: pip install 'dumbbell[pandas]'``."""

@@ -116,6 +116,8 @@ def stability(cases: str | Path | None = None, solvers: Sequence[str] | None = N
     """Run the extreme-case catalogue (or the scenes in the folder ``cases``) with every
     solver that can run each case, each verdict beside the theory's. ``.to_pandas()`` has
     one row per run; ``.markdown()`` is the report ``dumbbell stability`` writes."""
+    from ..model import args
     from .stability import run_stability
 
+    cases = None if cases is None else args.path(cases, "cases")
     return run_stability(cases, _names(solvers), workers, quiet)

@@ -229,7 +229,10 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
     if not solvers:
         raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
     for dt in dts:
-        make_options(scene, dt=dt, t_end=t_end)
+        try:
+            make_options(scene, dt=dt, t_end=t_end)
+        except UsageError as exc:
+            raise UsageError(f"dts: {exc}", param="dts") from None
     if window > t_end:
         raise UsageError(f"window {window:g}: must be <= the run's t_end = {t_end:g} (s)", param="window")
     if not 0 < spacing <= window:

@@ -196,11 +196,15 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     # One sample spacing for every run, so that they compare point by point.
     spacing = max(max(dts), scene.run.dt * scene.run.every)
     for dt in dts:
-        make_options(scene, dt, t_end)  # validates dt against t_end
+        try:
+            make_options(scene, dt, t_end)  # validates dt against t_end
+        except UsageError as exc:
+            raise UsageError(f"dts: {exc}", param="dts") from None
         ratio = spacing / dt
         if abs(ratio - round(ratio)) > 1e-6 * ratio:
-            raise UsageError(f"dt {dt:g}: must divide the sample spacing {spacing:g} s "
-                             "(the largest dt, or the scene's dt * every) a whole number of times", param="dt")
+            raise UsageError(f"dts: dt {dt:g}: must divide the sample spacing {spacing:g} s "
+                             "(the largest dt, or the scene's dt * every) a whole number of "
+                             "times", param="dts")
     # Every run keeps a sample each `spacing` s: refuse before running what would not fit.
     samples = round(t_end / spacing) + 1  # finite: t_end / dt passed the step cap above
     if samples > MAX_SAMPLES:

@@ -27,7 +27,7 @@ import itertools
 import math
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, overload
+from typing import TYPE_CHECKING, Any, Self, overload
 
 import numpy as np
 
@@ -57,8 +57,8 @@ def check_fps(fps: Any, where: str = "fps") -> int:
     if isinstance(fps, bool) or not isinstance(fps, int | np.integer) or not 1 <= fps <= MAX_FPS:
         raise UsageError(
             f"{where} = {fps}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
-            "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)"
-        )
+            "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)",
+            param=where.lstrip("-"))
     return int(fps)
 
 
@@ -66,12 +66,12 @@ def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, i
     """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
     from ..model.scene import parse_size
 
-    if isinstance(size, tuple):
+    if isinstance(size, tuple | list) and len(size) == 2:
         size = f"{size[0]}x{size[1]}"
     try:
         return parse_size(size)
     except ValueError as exc:
-        raise UsageError(f"{where}: {exc}") from None
+        raise UsageError(f"{where}: {exc}", param=where.lstrip("-")) from None
 
 
 def frame_count(t_end: float, fps: int) -> int:
@@ -163,6 +163,13 @@ class Gif(bytes):
     """The bytes of a GIF file that shows itself in a notebook: ``_repr_html_`` embeds the
     animation, ``_repr_png_`` gives its first frame. It is ``bytes`` in every other way."""
 
+    def __new__(cls, data: bytes | bytearray | memoryview = b"") -> Self:
+        if not isinstance(data, bytes | bytearray | memoryview):
+            from ..model import args
+
+            raise UsageError(f"data = {args.show(data)}: must be the GIF's bytes", param="data")
+        return super().__new__(cls, data)
+
     @property
     def data(self) -> bytes:
         """The GIF file's bytes as plain ``bytes``."""
@@ -186,7 +193,9 @@ class Gif(bytes):
 
     def save(self, path: str | Path) -> Path:
         """Write the GIF to ``path`` (atomically) and return the path."""
-        path = Path(path)
+        from ..model import args
+
+        path = args.path(path, "path")
         with atomic_output(path) as tmp:
             Path(tmp).write_bytes(self)
         return path
@@ -224,8 +233,13 @@ def render_gif(
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
                          param="traj")
+    path = None if path is None else args.path(path, "path")
+    quiet = args.flag(quiet, "quiet")
     fps = check_fps(fps)
     width, height = check_size(size)
+    strip = args.flag(strip, "strip")
+    if timing is not None:
+        args.instance(timing, "timing", dict, "a dict (it receives the seconds spent) or None")
     max_frames = args.whole(max_frames, "max_frames", "frames")
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
     t_end = args.real(t_end, "t_end", "s")

@@ -53,7 +53,13 @@ def run(args: argparse.Namespace) -> int:
         if unknown or not solvers:
             raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
                              + ", ".join(available()))
-    result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
+    try:
+        result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
+    except UsageError as exc:
+        if exc.param != "dts":
+            raise
+        # The library's dts is this command's --dt: "dts: dt = ..." reads "--dt = ...".
+        raise UsageError(str(exc).removeprefix("dts: "), param="dt") from None
     paths = write(result, Path(args.out))
     from .. import plot
     from ..io.figures import save_figure

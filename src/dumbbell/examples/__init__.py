@@ -14,10 +14,67 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+#: The examples, each a module with ``build()``, ``measure(dt, seconds, ...)`` and ``main()``.
+__all__ = ["newtons_cradle", "pendulum", "slope"]
+
+#: Most steps one ``measure`` may take (``seconds / dt``): a few minutes of pymunk.
+MAX_STEPS = 10**8
+
+
+def check_run(dt: Any, seconds: Any, fps: Any, space: Any, recorder: Any = None,
+              heat: Any = None) -> tuple[float, float, int]:
+    """The arguments of an example's ``measure`` checked at the border (UsageError naming
+    the one that is not valid): ``dt`` (s) > 0 and at most one frame 1/``fps`` (fps 1..50),
+    ``seconds`` (s) > 0 with at most :data:`MAX_STEPS` steps, ``space`` None or a
+    pymunk.Space with a dynamic body, ``recorder`` None or a Recorder, ``heat`` None or a
+    HeatCounter. Returns (dt, seconds, fps)."""
+    from ..animation.render import check_fps
+    from ..errors import UsageError
+    from ..model import args
+
+    dt = args.real(dt, "dt", "s")
+    seconds = args.real(seconds, "seconds", "s")
+    fps = check_fps(fps)
+    if dt > 1.0 / fps:
+        raise UsageError(f"dt = {dt:g}: must be at most one frame, 1/fps = {1.0 / fps:g} s",
+                         param="dt")
+    if seconds / dt > MAX_STEPS:
+        raise UsageError(f"seconds = {seconds:g}: {seconds:g} s / dt {dt:g} s is more than "
+                         f"{MAX_STEPS:,} steps; lower seconds or raise dt", param="seconds")
+    if space is not None:
+        import pymunk
+
+        args.space(space)
+        if not any(b.body_type == pymunk.Body.DYNAMIC for b in space.bodies):
+            raise UsageError("space: holds no dynamic body; give the example's build() or None",
+                             param="space")
+    if recorder is not None:
+        from ..spaces.recorder import Recorder
+
+        args.instance(recorder, "recorder", Recorder, "a dumbbell.spaces.Recorder or None")
+    if heat is not None:
+        from ..spaces.heat import HeatCounter
+
+        args.instance(heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
+    return dt, seconds, fps
+
+
+def check_argv(argv: Any) -> list[str] | None:
+    """``argv`` as None (the command line) or a list of str, else a UsageError."""
+    from ..errors import UsageError
+    from ..model import args
+
+    if argv is not None and (not isinstance(argv, list | tuple)
+                             or not all(isinstance(a, str) for a in argv)):
+        raise UsageError(f"argv = {args.show(argv)}: must be a list of str or None",
+                         param="argv")
+    return None if argv is None else list(argv)
+
 
 def arguments(name: str, doc: str, seconds: float, argv: list[str] | None) -> argparse.Namespace:
     """The examples' command line: ``--out`` (``NAME.gif``), ``--seconds``, ``--fps``, ``--dt``
     (s; each example also runs at dt / 10). Bad values: one line and exit status 2."""
+    argv = check_argv(argv)
     parser = argparse.ArgumentParser(prog=f"python -m dumbbell.examples.{name}",
                                      description=doc.splitlines()[0])
     parser.add_argument("--out", default=f"{name}.gif", help="GIF or MP4 to write")
@@ -33,6 +90,8 @@ def arguments(name: str, doc: str, seconds: float, argv: list[str] | None) -> ar
         parser.error(f"--fps {args.fps}: must be a whole number from 1 to 50")
     if args.dt > 1.0 / args.fps:
         parser.error(f"--dt {args.dt}: must be at most one frame, 1/fps s")
+    if args.seconds / args.dt > MAX_STEPS:
+        parser.error(f"--seconds {args.seconds}: more than {MAX_STEPS:,} steps of --dt")
     return args
 
 

@@ -16,7 +16,9 @@ import math
 import sys
 from typing import Any
 
-from . import arguments, print_guard
+from . import arguments, check_run, print_guard
+
+__all__ = ["build", "measure"]
 
 #: Ball radius (m), mass (kg), pin length (m), gap between hanging balls (m), start angle.
 RADIUS, MASS, LENGTH, GAP, LIFT = 0.025, 0.5, 0.3, 1e-4, math.radians(30)
@@ -58,6 +60,7 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     run (default: a new one); ``recorder`` captures each frame."""
     from .. import spaces
 
+    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
     space = build() if space is None else space
     balls = [b for b in space.bodies]
     e0 = spaces.energy(space).E

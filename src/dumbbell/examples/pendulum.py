@@ -20,7 +20,9 @@ import math
 import sys
 from typing import Any
 
-from . import arguments, print_guard
+from . import arguments, check_run, print_guard
+
+__all__ = ["amplitude_corrected_period", "build", "measure", "small_angle_period"]
 
 #: Rod mass (kg), length (m), width (m), spring stiffness (N m/rad), pivot height (m: the rod
 #: hangs with its centre of gravity at y = 0, where U_g is zero), starting angle (rad).
@@ -31,6 +33,9 @@ def build(theta0: float = THETA0) -> Any:
     """The pendulum's space: the rod on a PivotJoint and a DampedRotarySpring to the world."""
     import pymunk
 
+    from ..model import args
+
+    theta0 = args.real(theta0, "theta0", "rad", positive=False)
     space = pymunk.Space()
     space.gravity = (0.0, -9.81)
     rod = pymunk.Body(MASS, pymunk.moment_for_box(MASS, (WIDTH, LENGTH)))
@@ -54,6 +59,9 @@ def small_angle_period() -> float:
 def amplitude_corrected_period(theta0: float = THETA0) -> float:
     """The small-angle period with gravity's first finite-amplitude correction: its share of
     the stiffness times theta0^2 / 16 (the spring's torque is linear, gravity's is sin)."""
+    from ..model import args
+
+    theta0 = args.real(theta0, "theta0", "rad", positive=False)
     share = MASS * 9.81 * LENGTH / 2 / (MASS * 9.81 * LENGTH / 2 + KAPPA)
     return small_angle_period() * (1 + share * theta0**2 / 16)
 
@@ -64,6 +72,7 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     of the rod's angle (s) and the largest |E - E0| / E0."""
     from .. import spaces
 
+    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
     space = build() if space is None else space
     rod = next(iter(space.bodies))
     e0 = spaces.energy(space).E

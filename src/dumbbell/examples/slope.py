@@ -16,7 +16,9 @@ import math
 import sys
 from typing import Any
 
-from . import arguments, print_guard
+from . import arguments, check_run, print_guard
+
+__all__ = ["build", "measure"]
 
 #: Slope angle (rad), friction coefficient, restitution, box size (m), mass (kg), spin (rad/s).
 ANGLE, MU, ELASTICITY, SIZE, MASS, SPIN = math.radians(30), 0.4, 0.2, (0.2, 0.1), 1.0, -12.0
@@ -55,6 +57,7 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
     box travelled (m)."""
     from .. import spaces
 
+    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder, heat)
     space = build() if space is None else space
     heat = spaces.HeatCounter(space) if heat is None else heat
     box = next(iter(space.bodies))

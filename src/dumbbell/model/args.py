@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import sys
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -27,18 +29,53 @@ def show(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def real(value: Any, name: str, unit: str, positive: bool = True) -> float:
-    """``value`` as a finite float (> 0 if ``positive``), in ``unit``."""
-    allowed = f"must be a finite number{' > 0' if positive else ''} ({unit})"
+def _range(unit: str, positive: bool, lo: float | None, hi: float | None) -> str:
+    """What a number must be, in words: 'a finite number > 0 (s)', '... from 0 to 1 (-)'."""
+    if lo is not None and hi is not None:
+        bounds = f" from {lo:g} to {hi:g}"
+    elif lo is not None:
+        bounds = f" >= {lo:g}"
+    elif hi is not None:
+        bounds = f" <= {hi:g}"
+    else:
+        bounds = " > 0" if positive else ""
+    return f"a finite number{bounds} ({unit})"
+
+
+def real(value: Any, name: str, unit: str, positive: bool = True, *, lo: float | None = None,
+         hi: float | None = None) -> float:
+    """``value`` as a finite float, in ``unit``: > 0 if ``positive``, or between the
+    inclusive bounds ``lo`` and ``hi`` when either is given (``positive`` is then unused)."""
+    allowed = f"must be {_range(unit, positive, lo, hi)}"
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise UsageError(f"{name} = {show(value)}: {allowed}", param=name)
     try:
         number = float(value)
     except (OverflowError, ValueError, TypeError):
         number = math.nan
-    if not math.isfinite(number) or (positive and number <= 0):
+    if lo is not None or hi is not None:
+        bad = (lo is not None and number < lo) or (hi is not None and number > hi)
+    else:
+        bad = positive and number <= 0
+    if not math.isfinite(number) or bad:
         raise UsageError(f"{name} = {show(value)}: {allowed}", param=name)
     return number
+
+
+def reals(values: Any, name: str, unit: str, positive: bool = True, *, lo: float | None = None,
+          hi: float | None = None, empty: bool = False) -> list[float]:
+    """``values`` (a list, tuple or 1-d numpy array; one number is a list of one) as a list
+    of floats that :func:`real` accepts; an empty list only if ``empty``."""
+    if isinstance(values, numbers.Real) and not isinstance(values, bool):
+        values = [values]
+    elif type(values).__name__ == "ndarray" and getattr(values, "ndim", 0) == 1:
+        values = values.tolist()
+    if isinstance(values, str) or not isinstance(values, list | tuple) or (
+            not values and not empty):
+        raise UsageError(f"{name} = {show(values)}: must be a list of "
+                         f"{_range(unit, positive, lo, hi).replace('a finite number', 'finite numbers')}",
+                         param=name)
+    return [real(v, name, unit, positive, lo=lo, hi=hi) for v in values]
 
 
 def positives(values: Any, name: str, unit: str) -> list[float]:
@@ -103,3 +140,91 @@ def scene(value: Any, name: str = "scene") -> Any:
         return load_scene(value)
     raise UsageError(f"{name} = {show(value)}: must be a Scene or the path of a scene file",
                      param=name)
+
+
+def text(value: Any, name: str, what: str = "a str") -> str:
+    """``value`` as a str (``what`` says what it is for in the message)."""
+    if not isinstance(value, str):
+        raise UsageError(f"{name} = {show(value)}: must be {what}", param=name)
+    return value
+
+
+def instance(value: Any, name: str, kind: type | tuple[type, ...], what: str) -> Any:
+    """``value`` if it is a ``kind``, else a UsageError saying it must be ``what`` (e.g. 'a
+    Trajectory (from dumbbell.simulate)')."""
+    if not isinstance(value, kind):
+        raise UsageError(f"{name} = {show(value)}: must be {what}", param=name)
+    return value
+
+
+def trajectory(value: Any, name: str = "traj") -> Any:
+    """``value`` as a Trajectory."""
+    from .trajectory import Trajectory
+
+    return instance(value, name, Trajectory, "a Trajectory (from dumbbell.simulate)")
+
+
+def pair(value: Any, name: str, unit: str) -> tuple[float, float]:
+    """``value`` (two finite numbers: a tuple, list, 1-d array or pymunk Vec2d) as a tuple
+    of two floats, in ``unit``."""
+    if type(value).__name__ == "ndarray":
+        value = value.tolist() if getattr(value, "ndim", 0) == 1 else None
+    if not isinstance(value, tuple | list) or len(value) != 2:
+        raise UsageError(f"{name} = {show(value)}: must be two finite numbers (x, y) ({unit})",
+                         param=name)
+    return (real(value[0], name, unit, positive=False), real(value[1], name, unit,
+                                                            positive=False))
+
+
+def function(value: Any, name: str, what: str = "a function") -> Callable[..., Any]:
+    """``value`` if it can be called."""
+    if not callable(value):
+        raise UsageError(f"{name} = {show(value)}: must be {what}", param=name)
+    return value
+
+
+def mapping(value: Any, name: str, what: str) -> Mapping[Any, Any]:
+    """``value`` if it is a mapping (a dict)."""
+    if not isinstance(value, Mapping):
+        raise UsageError(f"{name} = {show(value)}: must be {what}", param=name)
+    return value
+
+
+def axes(value: Any, name: str = "ax", count: int = 1) -> Any:
+    """``value`` as matplotlib axes to draw on: None (the function makes its figure), one
+    ``matplotlib.axes.Axes`` (``count`` 1) or a sequence of ``count`` of them. Never imports
+    matplotlib: an Axes can exist only once ``matplotlib.axes`` has been imported."""
+    if value is None:
+        return None
+    module = sys.modules.get("matplotlib.axes")
+    kind = module.Axes if module is not None else ()
+    if count == 1:
+        if not isinstance(value, kind):
+            raise UsageError(f"{name} = {show(value)}: must be a matplotlib Axes or None",
+                             param=name)
+        return value
+    if type(value).__name__ == "ndarray":
+        value = list(value.ravel())
+    if (not isinstance(value, list | tuple) or len(value) != count
+            or not all(isinstance(a, kind) for a in value)):
+        raise UsageError(f"{name} = {show(value)}: must be {count} matplotlib Axes (a list "
+                         "or tuple) or None", param=name)
+    return value
+
+
+def _pymunk(name: str) -> Any:
+    """The pymunk class ``name`` if pymunk is loaded, else an empty tuple: without pymunk
+    loaded no pymunk object can exist, so nothing passes an isinstance check against it."""
+    module = sys.modules.get("pymunk")
+    return getattr(module, name) if module is not None else ()
+
+
+def space(value: Any, name: str = "space") -> Any:
+    """``value`` as a ``pymunk.Space`` (pymunk is not imported here)."""
+    return instance(value, name, _pymunk("Space"), "a pymunk.Space")
+
+
+def pymunk_object(value: Any, name: str, kinds: tuple[str, ...]) -> Any:
+    """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle')."""
+    classes = tuple(c for c in (_pymunk(k) for k in kinds) if c != ())
+    return instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))

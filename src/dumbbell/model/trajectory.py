@@ -102,6 +102,12 @@ class Trajectory:
         return self._energy
 
     def __getitem__(self, name: str) -> np.ndarray:
+        if not isinstance(name, str):
+            from ..errors import ColumnError
+            from .args import show
+
+            raise ColumnError(f"name = {show(name)}: must be a column name (str), one of "
+                              f"{', '.join(self.columns)}", param="name")
         if name == "t":
             return self.t
         if name in self.state:
@@ -115,7 +121,10 @@ class Trajectory:
         energy = self.energy
         if name in energy:
             return energy[name]
-        raise KeyError(f"{name!r}: no such column; columns are {', '.join(self.columns)}")
+        from ..errors import ColumnError
+
+        raise ColumnError(f"name = {name!r}: no such column; columns are "
+                          f"{', '.join(self.columns)}", param="name")
 
     def __len__(self) -> int:
         return len(self.t)
@@ -192,4 +201,8 @@ class Trajectory:
 
     def first_impact(self, body: str | None = None) -> Impact | None:
         """The first impact (of ``body`` if given), or None."""
+        if body is not None:
+            from . import args
+
+            args.choice(body, "body", ("A", "B"))
         return next((e for e in self.events if body in (None, e.body)), None)

@@ -38,6 +38,10 @@ from ..model.energy import (
     translational_ke,
 )
 
+__all__ = ["BodyEnergy", "Inventory", "Skipped", "SpaceEnergy", "Spring", "SpringEnergy",
+           "State", "body_label", "constraint_label", "energy", "evaluate", "inventory",
+           "read_state"]
+
 #: Joints that hold no energy and, ideally, do no work.
 _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
              "RotaryLimitJoint", "RatchetJoint")
@@ -90,6 +94,10 @@ class Inventory:
 
 def body_label(space: Any, body: Any) -> str:
     """A body's name in reports: 'body N' by its place in ``space.bodies``, or 'static body'."""
+    from ..model import args
+
+    args.space(space)
+    args.pymunk_object(body, "body", ("Body",))
     if body is space.static_body:
         return "static body"
     for i, other in enumerate(space.bodies):
@@ -100,6 +108,10 @@ def body_label(space: Any, body: Any) -> str:
 
 def constraint_label(space: Any, constraint: Any) -> str:
     """A constraint's name in reports: its class and place in ``space.constraints``."""
+    from ..model import args
+
+    args.space(space)
+    args.pymunk_object(constraint, "constraint", ("Constraint",))
     for i, other in enumerate(space.constraints):
         if other is constraint:
             return f"{type(constraint).__name__} {i}"
@@ -110,6 +122,9 @@ def inventory(space: Any) -> Inventory:
     """Take stock of ``space`` (see the module docstring for what is counted and reported)."""
     import pymunk
 
+    from ..model import args
+
+    args.space(space)
     dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
     tracked = list(dyn)
     labels = [body_label(space, b) for b in dyn]
@@ -196,6 +211,9 @@ class State:
 
 def read_state(inv: Inventory) -> State:
     """The present state of the tracked bodies, as one sample."""
+    from ..model import args
+
+    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
     rows = []
     for b in inv.bodies:
         cg = b.local_to_world(b.center_of_gravity)
@@ -221,6 +239,11 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
 
     K_int is summed as each body's motion relative to the centre of mass plus its spin
     (Koenig's theorem), which equals K_trans + K_rot - K_cm without the cancellation."""
+    from ..model import args
+
+    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
+    args.instance(st, "st", State, "a State (from read_state(inv))")
+    about = args.pair(about, "about", "m")
     n = inv.dynamic
     m, moment = inv.mass, inv.moment
     gx, gy = inv.gravity
@@ -343,7 +366,10 @@ class SpaceEnergy:
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
     """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
     See the module docstring for what is counted."""
-    ox, oy = (float(about[0]), float(about[1]))
+    from ..model import args
+
+    args.space(space)
+    ox, oy = args.pair(about, "about", "m")
     inv = inventory(space)
     terms = evaluate(inv, read_state(inv), (ox, oy))
 

@@ -33,8 +33,11 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import UsageError
+from ..model import args
 from .accounting import body_label, constraint_label, energy
+
+__all__ = ["Driver", "Finding", "check", "report", "shape_size", "spring_omega", "step",
+           "substeps", "suggest_dt", "survey"]
 
 #: w*dt limit of the explicit spring step.
 SPRING_LIMIT = 2.0
@@ -62,11 +65,14 @@ class Finding:
         return f"{self.kind}: {self.subject}: {self.value:.4g} > {self.limit:.4g}; {self.fix}"
 
 
-def _check_dt(dt: Any) -> float:
-    if isinstance(dt, bool) or not isinstance(dt, int | float) or not (
-            math.isfinite(dt) and dt > 0):
-        raise UsageError(f"dt = {dt!r}: must be a finite number > 0 (s)")
-    return float(dt)
+#: What ``speeds`` may be: the present speeds, the speeds from energy, or the larger.
+SPEEDS = ("state", "energy", "both")
+
+
+def _check(space: Any, dt: Any, speeds: Any = "both") -> tuple[Any, float, str]:
+    """The guard's arguments checked at the border (UsageError naming the one that is not
+    valid): a pymunk.Space, a step > 0 (s) and one of :data:`SPEEDS`."""
+    return (args.space(space), args.real(dt, "dt", "s"), args.choice(speeds, "speeds", SPEEDS))
 
 
 def _inverse_mass(body: Any) -> tuple[float, float]:
@@ -85,6 +91,7 @@ def spring_omega(spring: Any) -> float:
     bodies as they are now (0 if neither can move); see the module docstring."""
     import pymunk
 
+    args.pymunk_object(spring, "spring", ("DampedSpring", "DampedRotarySpring"))
     a, b = spring.a, spring.b
     ma, ia = _inverse_mass(a)
     mb, ib = _inverse_mass(b)
@@ -107,6 +114,7 @@ def shape_size(shape: Any) -> float:
     (2 x radius), a polygon's least width across an edge plus 2 x radius."""
     import pymunk
 
+    args.pymunk_object(shape, "shape", ("Shape",))
     if isinstance(shape, pymunk.Circle):
         return 2.0 * shape.radius
     if isinstance(shape, pymunk.Segment):
@@ -226,9 +234,7 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
     ``speeds``: 'state' (the present speeds), 'energy' or 'both' (the larger)."""
     import pymunk
 
-    dt = _check_dt(dt)
-    if speeds not in ("state", "energy", "both"):
-        raise UsageError(f"speeds = {speeds!r}: must be one of state, energy, both")
+    space, dt, speeds = _check(space, dt, speeds)
     rows: list[tuple[Finding, bool]] = []
     for c in space.constraints:
         if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
@@ -313,7 +319,7 @@ def check(space: Any, dt: float, speeds: str = "both") -> list[Finding]:
 
 def substeps(space: Any, dt: float, speeds: str = "both") -> int:
     """The fewest whole sub-steps of ``dt`` (s) that clear every finding a step can clear."""
-    dt = _check_dt(dt)
+    space, dt, speeds = _check(space, dt, speeds)
     limits = [f.dt_max for f in check(space, dt, speeds) if f.dt_max is not None]
     if not limits:
         return 1
@@ -323,11 +329,13 @@ def substeps(space: Any, dt: float, speeds: str = "both") -> int:
 def suggest_dt(space: Any, dt: float, speeds: str = "both") -> float:
     """A step (s) that clears every finding a step can clear: ``dt`` divided into the fewest
     whole sub-steps (so frames at ``dt`` stay whole); ``dt`` itself when nothing fails."""
-    return _check_dt(dt) / substeps(space, dt, speeds)
+    space, dt, speeds = _check(space, dt, speeds)
+    return dt / substeps(space, dt, speeds)
 
 
 def report(space: Any, dt: float, speeds: str = "both") -> str:
     """The guard's report as text: every check with ok or its fix, and the suggestion."""
+    space, dt, speeds = _check(space, dt, speeds)
     rows = survey(space, dt, speeds)
     lines = [f"step-size guard at dt = {dt:g} s:"]
     for f, ok in rows:
@@ -346,7 +354,9 @@ def report(space: Any, dt: float, speeds: str = "both") -> str:
 
 def step(space: Any, dt: float, substeps: int = 1) -> None:
     """Advance ``space`` by ``dt`` (s) in ``substeps`` equal steps."""
-    h = _check_dt(dt) / substeps
+    args.space(space)
+    substeps = args.whole(substeps, "substeps", "sub-steps")
+    h = args.real(dt, "dt", "s") / substeps
     for _ in range(substeps):
         space.step(h)
 
@@ -358,13 +368,10 @@ class Driver:
 
     def __init__(self, space: Any, dt: float, substeps: int | None = None,
                  speeds: str = "both") -> None:
-        self.space = space
-        self.dt = _check_dt(dt)
+        self.space, self.dt, speeds = _check(space, dt, speeds)
         if substeps is None:
-            substeps = globals()["substeps"](space, dt, speeds)
-        if isinstance(substeps, bool) or not isinstance(substeps, int) or substeps < 1:
-            raise UsageError(f"substeps = {substeps!r}: must be a whole number >= 1")
-        self.substeps = substeps
+            substeps = globals()["substeps"](space, self.dt, speeds)
+        self.substeps = args.whole(substeps, "substeps", "sub-steps")
         self.h = self.dt / substeps
         self.frames = 0
 
@@ -375,6 +382,7 @@ class Driver:
 
     def step(self, frames: int = 1) -> None:
         """Advance ``frames`` frames."""
+        frames = args.whole(frames, "frames", "frames", lo=0)
         step_ = self.space.step
         h = self.h
         for _ in range(frames * self.substeps):

@@ -28,6 +28,8 @@ from __future__ import annotations
 
 from typing import Any
 
+__all__ = ["HeatCounter"]
+
 
 class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
@@ -36,7 +38,9 @@ class HeatCounter:
     def __init__(self, space: Any) -> None:
         from pymunk._chipmunk_cffi import ffi
 
-        self.space = space
+        from ..model import args
+
+        self.space = args.space(space)
         self.total = 0.0
         self.steps = 0
         self._ffi = ffi

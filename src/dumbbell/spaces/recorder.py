@@ -63,6 +63,8 @@ TERMS = {"K_trans": TERM_RGB["K_cm"], "K_rot": TERM_RGB["K_rot"], "U_g": TERM_RG
 HEAT_RGB = TERM_RGB["E_lost"]
 STATIC_FILL = (232, 232, 232)
 
+__all__ = ["PaletteDrawOptions", "Recorder", "draw_options"]  # noqa: F822 - see __getattr__
+
 
 @functools.cache
 def _options_class() -> type:
@@ -86,6 +88,9 @@ def _options_class() -> type:
 
         def ink_of(self, body: Any) -> int:
             """Index into :data:`BODY_INKS` of a dynamic body; -1 for static/kinematic."""
+            from ..model import args
+
+            args.pymunk_object(body, "body", ("Body",))
             if body.body_type != pymunk.Body.DYNAMIC:
                 return -1
             key = id(body)
@@ -125,6 +130,9 @@ def _options_class() -> type:
 
         def capture(self, space: Any) -> list[tuple]:
             """The primitives of ``space`` now (dynamic and kinematic shapes, constraints)."""
+            from ..model import args
+
+            args.space(space)
             self.items = []
             first = self.static is None
             self._static_sink: list[tuple] = []
@@ -221,23 +229,32 @@ class Recorder:
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
-        self.space = space
-        self.path = Path(path)
+        from ..model import args
+        from .heat import HeatCounter
+
+        self.space = args.space(space)
+        self.path = args.path(path, "path")
         if self.path.suffix.lower() not in (".gif", ".mp4"):
-            raise UsageError(f"path {self.path}: must end in .gif or .mp4")
+            raise UsageError(f"path {self.path}: must end in .gif or .mp4", param="path")
         self.fps = check_fps(fps)
         self.W, self.H = check_size(size)
-        self.energy = bool(energy)
-        self.strip = bool(strip) and self.energy
-        self.heat = heat
+        self.energy = args.flag(energy, "energy")
+        self.strip = args.flag(strip, "strip") and self.energy
+        self.heat = None if heat is None else args.instance(
+            heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
         if world is not None:
-            x0, x1, y0, y1 = (float(v) for v in world)
-            if not all(math.isfinite(v) for v in world) or not (x1 > x0 and y1 > y0):
-                raise UsageError(f"world = {world}: must be finite (x0, x1, y0, y1) with "
-                                 "x1 > x0 and y1 > y0 (m)")
+            allowed = "must be four finite numbers (x0, x1, y0, y1) with x1 > x0 and y1 > y0 (m)"
+            if type(world).__name__ == "ndarray":
+                world = tuple(world.tolist()) if world.ndim == 1 else None
+            if not isinstance(world, tuple | list) or len(world) != 4:
+                raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
+            x0, x1, y0, y1 = (args.real(v, "world", "m", positive=False) for v in world)
+            if not (x1 > x0 and y1 > y0):
+                raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
+            world = (x0, x1, y0, y1)
         self.world = world
-        self.title = title
-        self.about = about
+        self.title = args.text(title, "title", "a str (written at the top)")
+        self.about = args.pair(about, "about", "m")
         self.options = draw_options()
         self.items: list[list[tuple]] = []
         self.terms: dict[str, list[float]] = {n: [] for n in (*TERMS, "heat")}

@@ -1,0 +1,344 @@
+"""Every public function checks its arguments at the border (docs/hardening.md, class 7).
+
+The public callables are found, not listed: every name in ``__all__`` of :data:`PACKAGES` and
+of their public submodules, and every public method of the public classes. :data:`VALID`
+holds one set of valid arguments for each. Each argument in turn is replaced by each of
+:data:`HOSTILE` while the others stay valid: the call must either succeed or raise a
+``DumbbellError`` whose message names that argument; any other exception fails the test.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import importlib
+import inspect
+import pkgutil
+import sys
+import types
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from dumbbell import DumbbellError
+
+#: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
+PACKAGES = ("dumbbell.spaces", "dumbbell.examples")
+#: Packages whose own ``__all__`` counts, but not their submodules'.
+TOP = ("dumbbell",)
+
+#: Values that are wrong for nearly every argument.
+HOSTILE = (None, "text", [1, 2], float("nan"), -1, object())
+
+
+def _modules() -> list[types.ModuleType]:
+    out = [importlib.import_module(name) for name in TOP]
+    for name in PACKAGES:
+        package = importlib.import_module(name)
+        out.append(package)
+        for info in pkgutil.walk_packages(package.__path__, prefix=f"{name}."):
+            if not any(part.startswith("_") for part in info.name.split(".")):
+                out.append(importlib.import_module(info.name))
+    return out
+
+
+def _own_methods(cls: type) -> dict[str, Callable[..., Any]]:
+    """Public methods a class defines itself: not dataclass or builtin machinery, and not
+    overrides of a base class's methods (a protocol others call, as pymunk calls a
+    SpaceDebugDrawOptions' draw_circle)."""
+    out = {}
+    for name, value in vars(cls).items():
+        if (name.startswith("_") and name != "__getitem__") or not inspect.isfunction(value):
+            continue
+        if any(hasattr(base, name) for base in cls.__mro__[1:]):
+            continue
+        out[name] = value
+    return out
+
+
+@functools.cache
+def public() -> dict[str, Any]:
+    """Qualified name -> the public callable (a function, a class or a class's method)."""
+    found: dict[str, Any] = {}
+    for module in _modules():
+        names = getattr(module, "__all__", None)
+        assert names is not None, f"{module.__name__} has no __all__"
+        for name in names:
+            obj = getattr(module, name)
+            if isinstance(obj, types.ModuleType) or not callable(obj):
+                continue
+            qualname = getattr(obj, "__qualname__", name)
+            key = f"{obj.__module__}.{name if '<' in qualname else qualname}"
+            if inspect.isclass(obj) and issubclass(obj, BaseException):
+                continue  # an exception takes any message
+            found.setdefault(key, obj)
+            if inspect.isclass(obj):
+                for method, fn in _own_methods(obj).items():
+                    if _parameters(fn)[1:]:
+                        found.setdefault(f"{key}.{method}", fn)
+    return found
+
+
+def _parameters(fn: Any) -> list[str]:
+    """Names of the parameters a caller can give (no *args or **kwargs)."""
+    try:
+        signature = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return []
+    return [p.name for p in signature.parameters.values()
+            if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+
+
+# --- valid arguments -----------------------------------------------------------------------
+
+
+class Fixtures:
+    """Small valid objects, built on first use; ``fresh`` ones are built anew at each call
+    (they change when used)."""
+
+    def __init__(self, tmp: Path):
+        self.tmp = tmp
+
+    # scenes and runs -----------------------------------------------------------------------
+    @functools.cached_property
+    def scene_file(self) -> Path:
+        """A short textbook scene (0.05 s, 500 steps) alone in its folder."""
+        from tests.hostile import short_scene
+
+        folder = self.tmp / "cases"
+        folder.mkdir()
+        return short_scene(folder)
+
+    @functools.cached_property
+    def scene(self) -> Any:
+        from dumbbell import load_scene
+
+        return load_scene(self.scene_file)
+
+    @functools.cached_property
+    def traj(self) -> Any:
+        import dumbbell
+
+        return dumbbell.simulate(self.scene, "exact", t_end=0.5, dt=1e-2)
+
+    # pymunk ---------------------------------------------------------------------------------
+    def space(self) -> Any:
+        """A ball above a floor, on a spring to a second ball."""
+        import pymunk
+
+        space = pymunk.Space()
+        space.gravity = (0.0, -9.81)
+        floor = pymunk.Segment(space.static_body, (-1, 0), (1, 0), 0.05)
+        floor.elasticity = 1.0
+        a = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.05))
+        a.position = (0.0, 0.5)
+        b = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.05))
+        b.position = (0.0, 0.8)
+        shapes = [pymunk.Circle(a, 0.05), pymunk.Circle(b, 0.05)]
+        for s in shapes:
+            s.elasticity = 1.0
+        spring = pymunk.DampedSpring(a, b, (0, 0), (0, 0), 0.3, 100.0, 0.0)
+        space.add(floor, a, b, *shapes, spring)
+        return space
+
+    def heat(self, space: Any = None) -> Any:
+        from dumbbell import spaces
+
+        return spaces.HeatCounter(space if space is not None else self.space())
+
+    def recorder(self, space: Any = None) -> Any:
+        from dumbbell import spaces
+
+        return spaces.Recorder(space if space is not None else self.space(),
+                               self.tmp / "rec.gif", fps=10, size="64x64")
+
+    @functools.cached_property
+    def inventory(self) -> Any:
+        from dumbbell.spaces.accounting import inventory
+
+        return inventory(self.space())
+
+    @functools.cached_property
+    def state(self) -> Any:
+        from dumbbell.spaces.accounting import read_state
+
+        return read_state(self.inventory)
+
+    @functools.cached_property
+    def space_energy(self) -> Any:
+        from dumbbell import spaces
+
+        return spaces.energy(self.space())
+
+    @functools.cached_property
+    def finding(self) -> Any:
+        from dumbbell import spaces
+
+        return spaces.check(self.space(), 1.0)[0]
+
+
+def fields(record: Any) -> dict[str, Any]:
+    """The constructor arguments that rebuild a dataclass record."""
+    return {f.name: getattr(record, f.name) for f in dataclasses.fields(record) if f.init}
+
+
+#: Qualified name -> f -> keyword arguments that are valid (and cheap).
+VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
+    # dumbbell
+    "dumbbell.model.scene.load_scene": lambda f: {"path": f.scene_file},
+    "dumbbell.model.scene.Scene": lambda f: fields(f.scene),
+    "dumbbell.model.scene.Scene.with_values": lambda f: {"values": {"spring.stiffness": 300.0}},
+    "dumbbell.solvers.simulate": lambda f: {
+        "scene": f.scene, "solver": "exact", "dt": 1e-2, "t_end": 0.05, "every": 1,
+        "quiet": True, "max_samples": 1000},
+    "dumbbell.solvers.available": lambda f: {},
+    "dumbbell.model.trajectory.Trajectory": lambda f: fields(f.traj),
+    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: {"path": f.tmp / "t.csv"},
+    "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: {"path": f.tmp / "e.csv"},
+    "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: {"body": "B"},
+    "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: {"name": "E"},
+    "dumbbell.model.trajectory.Impact": lambda f: fields(f.traj.events[0]),
+    "dumbbell.model.trajectory.Verdict": lambda f: fields(f.traj.verdict),
+    "dumbbell.animation.render.render_gif": lambda f: {
+        "traj": f.traj, "path": None, "quiet": True, "fps": 10, "size": "64x64",
+        "strip": True, "t_end": 0.2, "timing": {}, "max_frames": 100},
+    "dumbbell.animation.render.Gif": lambda f: {"data": b"GIF89a"},
+    "dumbbell.animation.render.Gif.save": lambda f: {"path": f.tmp / "g.gif"},
+    "dumbbell.analysis.api.compare": lambda f: {
+        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
+        "t_end": 0.02, "quiet": True},
+    "dumbbell.analysis.api.bench": lambda f: {
+        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
+        "repeat": 1, "t_end": 0.02, "budget": 10.0, "spacing": None, "quiet": True},
+    "dumbbell.analysis.api.sweep": lambda f: {
+        "scene": f.scene, "grid": {"k": [100.0, 200.0]}, "solver": "euler-cromer",
+        "t_end": 0.02, "workers": 1, "scheduler": None, "quiet": True},
+    "dumbbell.analysis.api.stability": lambda f: {
+        "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
+        "quiet": True},
+    # dumbbell.spaces.accounting
+    "dumbbell.spaces.accounting.energy": lambda f: {"space": f.space(), "about": (0.0, 0.0)},
+    "dumbbell.spaces.accounting.inventory": lambda f: {"space": f.space()},
+    "dumbbell.spaces.accounting.read_state": lambda f: {"inv": f.inventory},
+    "dumbbell.spaces.accounting.evaluate": lambda f: {"inv": f.inventory, "st": f.state,
+                                                      "about": (0.0, 1.0)},
+    "dumbbell.spaces.accounting.body_label": lambda f: {
+        "space": f.space(), "body": next(iter(f.space().bodies))},
+    "dumbbell.spaces.accounting.constraint_label": lambda f: {
+        "space": f.space(), "constraint": next(iter(f.space().constraints))},
+    "dumbbell.spaces.accounting.SpaceEnergy": lambda f: fields(f.space_energy),
+    "dumbbell.spaces.accounting.BodyEnergy": lambda f: fields(f.space_energy.bodies[0]),
+    "dumbbell.spaces.accounting.SpringEnergy": lambda f: fields(f.space_energy.springs[0]),
+    "dumbbell.spaces.accounting.Skipped": lambda f: {"subject": "body 0", "reason": "static"},
+    "dumbbell.spaces.accounting.Spring": lambda f: fields(f.inventory.springs[0]),
+    "dumbbell.spaces.accounting.Inventory": lambda f: fields(f.inventory),
+    "dumbbell.spaces.accounting.State": lambda f: fields(f.state),
+    # dumbbell.spaces.guard
+    "dumbbell.spaces.guard.check": lambda f: {"space": f.space(), "dt": 1e-3, "speeds": "both"},
+    "dumbbell.spaces.guard.survey": lambda f: {"space": f.space(), "dt": 1e-3,
+                                               "speeds": "state"},
+    "dumbbell.spaces.guard.substeps": lambda f: {"space": f.space(), "dt": 1e-2,
+                                                 "speeds": "energy"},
+    "dumbbell.spaces.guard.suggest_dt": lambda f: {"space": f.space(), "dt": 1e-2,
+                                                   "speeds": "both"},
+    "dumbbell.spaces.guard.report": lambda f: {"space": f.space(), "dt": 1e-2, "speeds": "both"},
+    "dumbbell.spaces.guard.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
+    "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
+    "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
+    "dumbbell.spaces.guard.Finding": lambda f: fields(f.finding),
+    "dumbbell.spaces.guard.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
+                                               "speeds": "both"},
+    "dumbbell.spaces.guard.Driver.step": lambda f: {"frames": 2},
+    # dumbbell.spaces.heat, recorder
+    "dumbbell.spaces.heat.HeatCounter": lambda f: {"space": f.space()},
+    "dumbbell.spaces.recorder.Recorder": lambda f: {
+        "space": f.space(), "path": f.tmp / "r.gif", "fps": 10, "energy": True,
+        "size": "64x64", "strip": False, "heat": f.heat(), "world": (-1.0, 1.0, -0.2, 1.0),
+        "title": "t", "about": (0.0, 0.0)},
+    "dumbbell.spaces.recorder.PaletteDrawOptions": lambda f: {},
+    "dumbbell.spaces.recorder.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
+    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of": lambda f: {
+        "body": next(iter(f.space().bodies))},
+    "dumbbell.spaces.recorder.draw_options": lambda f: {},
+    # dumbbell.examples
+    "dumbbell.examples.newtons_cradle.build": lambda f: {},
+    "dumbbell.examples.newtons_cradle.measure": lambda f: {
+        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder()},
+    "dumbbell.examples.pendulum.build": lambda f: {"theta0": 0.1},
+    "dumbbell.examples.pendulum.small_angle_period": lambda f: {},
+    "dumbbell.examples.pendulum.amplitude_corrected_period": lambda f: {"theta0": 0.1},
+    "dumbbell.examples.pendulum.measure": lambda f: {
+        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder()},
+    "dumbbell.examples.slope.build": lambda f: {},
+    "dumbbell.examples.slope.measure": lambda f: {
+        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder(),
+        "heat": None},
+}
+
+#: Method case -> f -> the object whose method it is (fresh at each call).
+OWNER: dict[str, Callable[[Fixtures], Any]] = {
+    "dumbbell.spaces.guard.Driver.step": lambda f: __import__("dumbbell").spaces.Driver(
+        f.space(), 1e-2, 1),
+    "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
+    "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
+        lambda f: __import__("dumbbell").spaces.draw_options(),
+    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
+        lambda f: __import__("dumbbell").spaces.draw_options(),
+    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
+    "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: f.traj,
+    "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
+    "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
+    "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
+}
+
+
+def test_every_public_callable_has_valid_arguments():
+    found = set(public())
+    assert sorted(found - set(VALID)) == [], "public callables without a row in VALID"
+    assert sorted(set(VALID) - found) == [], "rows in VALID that are not public callables"
+
+
+def _target(key: str, f: Fixtures) -> Any:
+    if key in OWNER:
+        return getattr(OWNER[key](f), key.rsplit(".", 1)[1])
+    return public()[key]
+
+
+def names(message: str, name: str, value: Any) -> bool:
+    """True when ``message`` names the argument ``name``; a path given as a str may be named
+    by itself instead, as every message about a file starts ('text: no such scene file')."""
+    return name in message or (isinstance(value, str) and message.startswith(f"{value}:"))
+
+
+def _close_figures() -> None:
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
+
+
+@pytest.mark.parametrize("key", sorted(VALID))
+def test_hostile_arguments_are_refused_naming_them(key, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # a hostile "text" path is written here, if accepted
+    f = Fixtures(tmp_path)
+    params = _parameters(_target(key, f))
+    _target(key, f)(**VALID[key](f))  # the row itself is valid
+    _close_figures()
+    failures = []
+    for name in params:
+        for bad in HOSTILE:
+            kwargs = VALID[key](f)
+            kwargs[name] = bad
+            try:
+                _target(key, f)(**kwargs)
+            except DumbbellError as exc:
+                if not names(str(exc), name, bad):
+                    failures.append(f"{name}={bad!r}: {type(exc).__name__} does not name "
+                                    f"{name!r}: {exc}")
+                elif "\n" in str(exc):
+                    failures.append(f"{name}={bad!r}: more than one line: {exc!r}")
+            except Exception as exc:  # noqa: BLE001 - the point: no other exception may escape
+                failures.append(f"{name}={bad!r}: {type(exc).__name__}: {exc}")
+            finally:
+                _close_figures()
+    assert not failures, f"{key}:\n" + "\n".join(failures)
