@@ -41,6 +41,7 @@ def _sweep(scene, n: int, workers: int, t_end: float = 1.0):
 
 
 def speed(n: int, workers: int, repeat: int) -> None:
+    from dumbbell.io.sweep import csv_text
     from dumbbell.model.scene import load_scene
     from dumbbell.solvers.euler_cromer import warm_up
 
@@ -51,11 +52,11 @@ def speed(n: int, workers: int, repeat: int) -> None:
         t, cpu, res = _sweep(scene, n, 1)
         serial.append(t)
         cpu_s.append(cpu)
-        texts.add(res.csv_text())
+        texts.add(csv_text(res))
         t, cpu, res = _sweep(scene, n, workers)
         pooled.append(t)
         cpu_p.append(cpu)
-        texts.add(res.csv_text())
+        texts.add(csv_text(res))
     load = os.getloadavg()[0]
     print(f"## {n}x{n} Euler-Cromer sweep, t_end = 1 s ({os.cpu_count()} CPUs here, load "
           f"average {load:.1f} at the end)\n")

@@ -9,6 +9,8 @@ import pytest
 
 import dumbbell
 from dumbbell.errors import MissingExtraError
+from dumbbell.io.stability import markdown
+from dumbbell.io.sweep import csv_text
 
 from .conftest import SCENES
 
@@ -170,7 +172,7 @@ def test_sweep_from_python(textbook):
     assert np.allclose(w_dt[2:], [1.0, 2.1])
     assert df["verdict"][3] == "unstable" and df["verdict"][0] == "ok"
     same = dumbbell.sweep(textbook, ["k=200.0,50000.0", "dt=lin:1e-3:2.1e-3:2"], t_end=0.3)
-    assert same.csv_text() == result.csv_text()
+    assert csv_text(same) == csv_text(result)
     with pytest.raises(dumbbell.UsageError, match="grid"):
         dumbbell.sweep(textbook, "k=1,2")
 
@@ -189,4 +191,4 @@ def test_stability_from_python(tmp_path):
     assert verdicts[("stiff-wdt-1.9", "euler-cromer")] == "ok"
     assert verdicts[("stiff-wdt-2.1", "exact")] == "ok"
     assert result.disagreements == []
-    assert "stiff-wdt-2.1" in result.markdown() and df.attrs["units"]["t_fail"] == "s"
+    assert "stiff-wdt-2.1" in markdown(result) and df.attrs["units"]["t_fail"] == "s"

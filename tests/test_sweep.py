@@ -11,6 +11,7 @@ import pytest
 from dumbbell.analysis.sweep import parse_axis, plan, run_sweep
 from dumbbell.cli import main
 from dumbbell.errors import UsageError
+from dumbbell.io.sweep import csv_text
 from dumbbell.model.scene import load_scene
 from tests.conftest import SCENES
 
@@ -94,8 +95,8 @@ def test_same_csv_from_serial_pool_and_dask(tmp_path):
     pytest.importorskip("dask.distributed")
     scene = load_scene(TEXTBOOK)
     axes = [parse_axis("k=log:1e2:1e5:3"), parse_axis("dt=log:1e-4:3e-3:3")]
-    serial = run_sweep(scene, axes, "euler-cromer", 0.3, workers=1).csv_text()
-    pooled = run_sweep(scene, axes, "euler-cromer", 0.3, workers=2).csv_text()
+    serial = csv_text(run_sweep(scene, axes, "euler-cromer", 0.3, workers=1))
+    pooled = csv_text(run_sweep(scene, axes, "euler-cromer", 0.3, workers=2))
     out = tmp_path / "dask"
     assert main(["sweep", TEXTBOOK, "--grid", "k=log:1e2:1e5:3", "dt=log:1e-4:3e-3:3",
                  "--t-end", "0.3", "--out", str(out), "-q", "--scheduler", "local",

@@ -115,7 +115,8 @@ def stability(cases: str | Path | None = None, solvers: Sequence[str] | None = N
               workers: int | None = None, quiet: bool = True) -> StabilityResult:
     """Run the extreme-case catalogue (or the scenes in the folder ``cases``) with every
     solver that can run each case, each verdict beside the theory's. ``.to_pandas()`` has
-    one row per run; ``.markdown()`` is the report ``dumbbell stability`` writes."""
+    one row per run; :func:`dumbbell.io.stability.markdown` is the report ``dumbbell stability``
+    writes."""
     from ..model import args
     from .stability import run_stability
 

@@ -1,7 +1,7 @@
 """The stability report: extreme scenes run by every solver, each result beside the theory.
 
 >>> rows = run_cases(find_cases(default_cases()), None)       # doctest: +SKIP
->>> print(markdown(rows))                                       # doctest: +SKIP
+>>> print(dumbbell.io.stability.markdown(StabilityResult(tuple(rows))))  # doctest: +SKIP
 
 Theory (docs/physics.md: the stability limit, how pymunk collides), which :func:`predict` turns into an expected verdict:
 
@@ -23,8 +23,6 @@ floor and no gravity, so only the spring's limit counts.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 import time
@@ -66,14 +64,6 @@ class StabilityResult:
     rows: tuple[dict[str, Any], ...]
     skipped: tuple[str, ...] = ()
     guard: tuple[str, ...] = ()
-
-    def markdown(self) -> str:
-        """The report as the markdown ``dumbbell stability`` writes."""
-        return markdown(list(self.rows), list(self.skipped), list(self.guard))
-
-    def csv_text(self) -> str:
-        """The report as the CSV ``dumbbell stability`` writes."""
-        return csv_text(list(self.rows))
 
     @property
     def disagreements(self) -> list[dict[str, Any]]:
@@ -229,18 +219,6 @@ def _cost(path: str, solver: str) -> float:
     return steps * solver_class(solver).relative_cost
 
 
-def _fmt(value: Any, kind: str = "") -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    if kind == "err":
-        return f"{value:.2g}"
-    if kind == "t":
-        return f"{value:.4g}"
-    if isinstance(value, float):
-        return f"{value:.3g}"
-    return str(value)
-
-
 def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
     """What the step-size guard (:func:`dumbbell.spaces.check`) says about each case run by
     pymunk, on the space the solver builds, at the case's dt: its findings and the sub-steps
@@ -263,60 +241,6 @@ def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
                else "settings, not the step: " + "; ".join(f.fix for f in found))
         lines.append(f"- {scene.name} (dt = {dt:g} s): {what}; {fix}")
     return lines
-
-
-def markdown(rows: list[dict[str, Any]], skipped: list[str] | None = None,
-             guard: list[str] | None = None) -> str:
-    """The report as a markdown table, then the verdict lines of the runs that did not end ok
-    or disagree with the theory, the step-size guard on the pymunk runs and the runs not
-    made."""
-    out = [("| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | "
-            "t_fail [s] | largest rel. energy error | theory expects | agreement |"),
-           "|---|---|---|---|---|---|---|---|---|---|"]
-    previous = None
-    for r in rows:
-        agree = "agrees" if r["agreement"] == "agrees" else "**DISAGREES**"
-        case, title = (r["case"], r["title"]) if r["case"] != previous else ("", "")
-        previous = r["case"]
-        out.append(f"| {case} | {title} | {r['solver']} | {_fmt(r['dt'])} | "
-                   f"{_fmt(r['w_dt'])} | {r['verdict']} | {_fmt(r['t_fail'], 't')} | "
-                   f"{_fmt(r['max_rel_energy_error'], 'err')}{' (a)' if r['dissipative'] else ''}"
-                   f" | {r['predicted']} "
-                   f"({r['theory']}) | {agree} |")
-    if any(r["dissipative"] for r in rows):
-        out += ["", ("(a) The floor takes energy on purpose in this scene (elasticity below 1 "
-                     "or friction), so this is the energy lost, not an error.")]
-    notes = [r for r in rows if r["verdict"] != "ok" or r["agreement"] != "agrees"]
-    if notes:
-        out += ["", "Runs that did not end ok, or disagree with the theory:", ""]
-        for r in notes:
-            line = f"- {r['case']}, {r['solver']}: {r['verdict']}"
-            if r["t_fail"] is not None:
-                line += f" at t = {r['t_fail']:.4g} s"
-            if r["reason"]:
-                line += f": {r['reason']}"
-            if r["agreement"] != "agrees":
-                line += f". {r['agreement']} ({r['theory']})"
-            out.append(line)
-    if guard:
-        out += ["", ("Step-size guard (`dumbbell.spaces.check` on the space the pymunk solver "
-                     "builds, at the case's dt):"), ""]
-        out += guard
-    if skipped:
-        out += ["", "Not run (the solver cannot run the scene):", ""]
-        out += [f"- {s}" for s in skipped]
-    return "\n".join(out) + "\n"
-
-
-def csv_text(rows: list[dict[str, Any]]) -> str:
-    """The report as CSV with :data:`COLUMNS`."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(COLUMNS)
-    for r in rows:
-        writer.writerow(["" if r[c] is None else repr(r[c]) if isinstance(r[c], float)
-                         else r[c] for c in COLUMNS])
-    return buf.getvalue()
 
 
 # --- the stability map ----------------------------------------------------------------------

@@ -2,15 +2,15 @@
 
 >>> axes = [parse_axis("k=log:1e2:1e7:50"), parse_axis("dt=log:1e-6:1e-2:50")]  # doctest: +SKIP
 >>> result = run_sweep(load_scene("scenes/textbook-1d.toml"), axes, "euler-cromer", 1.0)  # doctest: +SKIP
->>> result.write_csv("sweep.csv"); dumbbell.plot.sweep_map(result)                 # doctest: +SKIP
+>>> dumbbell.io.sweep.write_csv(result, "sweep.csv"); dumbbell.plot.sweep_map(result)  # doctest: +SKIP
 
 A grid axis is ``NAME=SPEC``: NAME a dotted scene key (``spring.stiffness``, ``bodies.A.mass``,
 ``run.dt``; ``k`` and ``dt`` are short for the first and last), SPEC one of ``log:A:B:N``
 (N values spaced evenly in log), ``lin:A:B:N`` or a comma-separated list. Every point is
 validated as a scene before anything runs. Each point records its verdict, w*dt, the time of
 failure and the largest relative energy error over its samples. Rows come back in grid order
-whichever backend ran them, and floats are written with ``repr``, so the CSV is byte-identical
-on one process, a local pool or a Dask cluster.
+whichever backend ran them, and :mod:`dumbbell.io.sweep` writes floats with ``repr``, so the CSV
+is byte-identical on one process, a local pool or a Dask cluster.
 
 Work is bounded: a point may take at most :data:`MAX_STEPS_PER_POINT` steps and a sweep
 :data:`MAX_STEPS_TOTAL`; a point keeps at most :data:`MAX_SAMPLES` samples (every N-th step),
@@ -19,20 +19,16 @@ so the largest energy error is taken over those samples.
 
 from __future__ import annotations
 
-import csv
-import io
 import itertools
 import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import DumbbellError, UsageError
-from ..io.files import atomic_output
 from ..model.scene import Scene
 from ..parallel import ordered_map
 
@@ -254,20 +250,6 @@ class SweepResult:
     def columns(self) -> list[str]:
         return [a.key for a in self.axes] + list(RESULT_COLUMNS)
 
-    def csv_text(self) -> str:
-        """The CSV as text: same bytes whichever backend produced the rows."""
-        buf = io.StringIO()
-        writer = csv.writer(buf, lineterminator="\n")
-        writer.writerow(self.columns)
-        for row in self.rows:
-            writer.writerow([_cell(row[c]) for c in self.columns])
-        return buf.getvalue()
-
-    def write_csv(self, path: str | Path) -> Path:
-        with atomic_output(path) as tmp:
-            tmp.write_text(self.csv_text())
-        return Path(path)
-
     def to_pandas(self) -> pandas.DataFrame:
         """One row per grid point in grid order, the CSV's columns, units in
         ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).
@@ -310,16 +292,6 @@ class SweepResult:
                         "first_failing_dt": first_bad,
                         "theory_dt": 2.0 / w if w > 0 else math.inf})
         return out
-
-
-def _cell(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return repr(value)
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return str(value)
 
 
 # --- backends -------------------------------------------------------------------------------

@@ -40,8 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.compare import compare, write
+    from ..analysis.compare import compare
     from ..errors import UsageError
+    from ..io.compare import write
     from ..model.scene import load_scene
     from ..solvers import available
 

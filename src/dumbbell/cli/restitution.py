@@ -89,7 +89,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.restitution import restitution
     from ..io.figures import save_figure
-    from ..io.files import atomic_output
+    from ..io.restitution import write_csv
     from ..model.scene import load_scene
     from ..plot.rotation_chapter import restitution as draw
     from ..progress import bar
@@ -102,12 +102,8 @@ def run(args: argparse.Namespace) -> int:
         result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
                              progress=progress.update)
     out = Path(args.out)
-    cols = result.columns()
-    csv = out / f"{scene.name}-restitution.csv"
+    csv = write_csv(result, out / f"{scene.name}-restitution.csv")
     png = out / f"{scene.name}-restitution.png"
-    with atomic_output(csv) as tmp, open(tmp, "w") as fh:
-        fh.write(",".join(cols) + "\n")
-        fh.writelines(",".join(repr(float(cols[c][i])) for c in cols) + "\n" for i in range(len(result.theta)))
     fig = draw(result)[0].figure
     fig.tight_layout()
     save_figure(fig, png)

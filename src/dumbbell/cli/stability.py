@@ -47,7 +47,7 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     )
     from ..errors import UsageError
     from ..io.figures import save_figure
-    from ..io.files import atomic_output
+    from ..io.stability import write
     from ..plot.maps import stability_map
 
     runs, skipped = plan_runs(cases, solvers)
@@ -56,13 +56,7 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
         raise UsageError(f"--out {out}: exists and is not a folder")
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
-    written = []
-    with atomic_output(out / "stability.md") as tmp:
-        tmp.write_text(result.markdown())
-    written.append(out / "stability.md")
-    with atomic_output(out / "stability.csv") as tmp:
-        tmp.write_text(result.csv_text())
-    written.append(out / "stability.csv")
+    written = write(result, out)
     steppers = map_solvers(solvers)
     if steppers:
         maps = {name: map_rows(name, workers, quiet) for name in steppers}

@@ -84,8 +84,10 @@ def run(args: argparse.Namespace) -> int:
     result = run_sweep(scene, axes, solver, args.t_end, workers=args.workers,
                        scheduler=args.scheduler and args.scheduler.strip(), quiet=args.quiet,
                        points=points, connect_timeout=args.connect_timeout)
-    csv_path = result.write_csv(out / f"{scene.name}-sweep.csv")
     from ..io.figures import save_figure
+    from ..io.sweep import write_csv
+
+    csv_path = write_csv(result, out / f"{scene.name}-sweep.csv")
     from ..plot.maps import sweep_map
 
     png_path = save_figure(sweep_map(result).figure, out / f"{scene.name}-sweep.png", dpi=100)

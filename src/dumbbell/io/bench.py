@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from dataclasses import asdict
@@ -19,26 +18,13 @@ from ..analysis.bench import (
     BenchResult,
     dt_label,
 )
-from .files import atomic_output
-
-
-def _fmt(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return "nan" if math.isnan(value) else repr(value)
-    return str(value)
+from .tables import csv_text, write_text
 
 
 def write_csv(result: BenchResult, path: Path) -> Path:
     """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
-    with atomic_output(path) as tmp, open(tmp, "w", newline="") as fh:
-        writer = csv.writer(fh, lineterminator="\n")
-        writer.writerow(CSV_COLUMNS)
-        for p in result.points:
-            row = asdict(p)
-            writer.writerow([_fmt(row[c]) for c in CSV_COLUMNS])
-    return path
+    rows = ([row[c] for c in CSV_COLUMNS] for row in map(asdict, result.points))
+    return write_text(path, csv_text(CSV_COLUMNS, rows))
 
 
 def _json_value(value: Any) -> Any:
@@ -67,9 +53,8 @@ def to_json(result: BenchResult) -> dict[str, Any]:
 
 
 def write_json(result: BenchResult, path: Path) -> Path:
-    with atomic_output(path) as tmp:
-        tmp.write_text(json.dumps(to_json(result), indent=1) + "\n")
-    return path
+    """:func:`to_json` as indented JSON."""
+    return write_text(path, json.dumps(to_json(result), indent=1) + "\n")
 
 
 def _sci(x: float | None, digits: int = 2) -> str:
@@ -146,9 +131,8 @@ def _ms(seconds: float) -> str:
 
 
 def write_markdown(result: BenchResult, path: Path) -> Path:
-    with atomic_output(path) as tmp:
-        tmp.write_text(markdown(result))
-    return path
+    """:func:`markdown` as a file."""
+    return write_text(path, markdown(result))
 
 
 def write_all(result: BenchResult, out: Path) -> list[Path]:

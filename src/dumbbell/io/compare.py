@@ -1,0 +1,59 @@
+"""The comparison's files (:class:`dumbbell.analysis.compare.Comparison` in, CSVs out): the
+summary, the impact times side by side and the position-error series. The figures are
+:mod:`dumbbell.plot`'s; the command saves them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.compare import Comparison
+from ..analysis.metrics import energy_spread
+from .files import atomic_output
+from .tables import csv_text, write_text
+
+#: Columns of SCENE-compare.csv (times in s, errors in m, the energy spread dimensionless).
+SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m", "window_s",
+                   "error_passes_1mm_at_s", "energy_spread", "impacts", "verdict")
+
+
+def summary_csv(result: Comparison) -> str:
+    """One line per run, the truth first, with :data:`SUMMARY_COLUMNS`."""
+    rows = []
+    for row in [None, *result.rows]:
+        r = result.truth if row is None else row.traj
+        rows.append((r.solver if row is None else row.label, r.dt if r.dt else "",
+                     f"{r.wall_time:.6g}", r.info.get("steps", ""),
+                     None if row is None else row.window_error, result.window,
+                     None if row is None else row.diverged_at,
+                     energy_spread(r), len(r.events), r.verdict.status))
+    return csv_text(SUMMARY_COLUMNS, rows)
+
+
+def impacts_csv(result: Comparison) -> str:
+    """:meth:`Comparison.impacts` as CSV: number, body, the truth's time, then each run's
+    time and its difference from the truth (s)."""
+    keys = ["n", "body", "truth_t"] + [k for row in result.rows
+                                       for k in (f"{row.label}_t", f"{row.label}_diff")]
+    return csv_text(keys, ([rec[k] for k in keys] for rec in result.impacts()))
+
+
+def write_errors(result: Comparison, path: Path) -> Path:
+    """The position-error series (m) of every run at the samples all runs have, beside t (s)."""
+    n = min(len(row.error) for row in result.rows) if result.rows else 0
+    table = np.column_stack([result.truth.t[:n], *[row.error[:n] for row in result.rows]])
+    with atomic_output(path) as tmp:
+        np.savetxt(tmp, table, delimiter=",", comments="", fmt="%.17g",
+                   header=",".join(["t"] + [f"{row.label}_position_error_m"
+                                            for row in result.rows]))
+    return path
+
+
+def write(result: Comparison, out: Path) -> list[Path]:
+    """SCENE-compare.csv, -compare-impacts.csv and -compare-errors.csv into ``out``; returns
+    the paths."""
+    stem = out / f"{result.scene.name}-compare"
+    return [write_text(f"{stem}.csv", summary_csv(result)),
+            write_text(f"{stem}-impacts.csv", impacts_csv(result)),
+            write_errors(result, Path(f"{stem}-errors.csv"))]

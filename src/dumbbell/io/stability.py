@@ -1,0 +1,81 @@
+"""The stability report's files (:class:`dumbbell.analysis.stability.StabilityResult` in):
+stability.md, a table beside the theory with notes, and stability.csv, one line per run. The
+map is :mod:`dumbbell.plot`'s."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from ..analysis.stability import COLUMNS, StabilityResult
+from .tables import csv_text as _csv_text
+from .tables import write_text
+
+
+def _fmt(value: Any, kind: str = "") -> str:
+    """A table cell: "-" when missing, 2 significant digits for an error (kind "err"), 4 for
+    a time ("t"), 3 for any other float."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if kind == "err":
+        return f"{value:.2g}"
+    if kind == "t":
+        return f"{value:.4g}"
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    return str(value)
+
+
+def markdown(result: StabilityResult) -> str:
+    """The report as a markdown table, then the verdict lines of the runs that did not end ok
+    or disagree with the theory, the step-size guard on the pymunk runs and the runs not
+    made."""
+    rows, skipped, guard = result.rows, result.skipped, result.guard
+    out = [("| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | "
+            "t_fail [s] | largest rel. energy error | theory expects | agreement |"),
+           "|---|---|---|---|---|---|---|---|---|---|"]
+    previous = None
+    for r in rows:
+        agree = "agrees" if r["agreement"] == "agrees" else "**DISAGREES**"
+        case, title = (r["case"], r["title"]) if r["case"] != previous else ("", "")
+        previous = r["case"]
+        out.append(f"| {case} | {title} | {r['solver']} | {_fmt(r['dt'])} | "
+                   f"{_fmt(r['w_dt'])} | {r['verdict']} | {_fmt(r['t_fail'], 't')} | "
+                   f"{_fmt(r['max_rel_energy_error'], 'err')}{' (a)' if r['dissipative'] else ''}"
+                   f" | {r['predicted']} "
+                   f"({r['theory']}) | {agree} |")
+    if any(r["dissipative"] for r in rows):
+        out += ["", ("(a) The floor takes energy on purpose in this scene (elasticity below 1 "
+                     "or friction), so this is the energy lost, not an error.")]
+    notes = [r for r in rows if r["verdict"] != "ok" or r["agreement"] != "agrees"]
+    if notes:
+        out += ["", "Runs that did not end ok, or disagree with the theory:", ""]
+        for r in notes:
+            line = f"- {r['case']}, {r['solver']}: {r['verdict']}"
+            if r["t_fail"] is not None:
+                line += f" at t = {r['t_fail']:.4g} s"
+            if r["reason"]:
+                line += f": {r['reason']}"
+            if r["agreement"] != "agrees":
+                line += f". {r['agreement']} ({r['theory']})"
+            out.append(line)
+    if guard:
+        out += ["", ("Step-size guard (`dumbbell.spaces.check` on the space the pymunk solver "
+                     "builds, at the case's dt):"), ""]
+        out += guard
+    if skipped:
+        out += ["", "Not run (the solver cannot run the scene):", ""]
+        out += [f"- {s}" for s in skipped]
+    return "\n".join(out) + "\n"
+
+
+def csv_text(result: StabilityResult) -> str:
+    """The report as CSV with :data:`~dumbbell.analysis.stability.COLUMNS`."""
+    return _csv_text(COLUMNS, ([r[c] for c in COLUMNS] for r in result.rows))
+
+
+def write(result: StabilityResult, out: Path) -> list[Path]:
+    """OUT/stability.md and OUT/stability.csv; returns the paths."""
+    return [write_text(out / "stability.md", markdown(result)),
+            write_text(out / "stability.csv", csv_text(result))]
