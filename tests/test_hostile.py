@@ -121,6 +121,20 @@ def test_sweep_caps_workers_and_says_so_once(work):
     assert not psutil.Process().children(recursive=True)
 
 
+def test_stability_refuses_a_case_past_the_step_cap_before_any_runs(work):
+    scene, out = work
+    cases = scene.parent / "cases"
+    cases.mkdir()
+    short_scene(cases, "quick.toml")
+    short_scene(cases, "endless.toml").write_text(
+        SHORT_SCENE.replace("t_end = 0.05", "t_end = 1e7"), encoding="utf-8")
+    # The workers note would come first if the case were checked only when it runs.
+    status, _, err = cli("stability", "--cases", cases, "--workers", "10000", "--out", out,
+                         "--solvers", "euler-cromer")
+    line = refused(status, err, out)
+    assert "endless.toml" in line and "steps" in line
+
+
 def test_the_worker_cap():
     from dumbbell.parallel import cap_workers
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ..errors import UsageError
+from ..errors import DumbbellError, UsageError
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 from ..parallel import ordered_map
 
@@ -178,13 +178,17 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
                                                                         list[str]]:
     """The (case, solver) runs to make, every scene validated first, and the pairs skipped
     (with why). ``solvers`` None means :func:`default_solvers` per case."""
-    from ..solvers import solver_class
+    from ..solvers import make_options, solver_class
 
     for name in solvers or ():
         solver_class(name)
     runs, skipped = [], []
     for path in paths:
         scene = load_scene(path)
+        try:
+            make_options(scene)  # the step cap, before any case runs
+        except DumbbellError as exc:
+            raise UsageError(f"{path}: {exc}") from None
         names = default_solvers(scene) if solvers is None else solvers
         for name in names:
             reason = solver_class(name).supports(scene)

@@ -34,9 +34,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
-           workers: int | None = None, quiet: bool = True) -> dict[str, Any]:
+           workers: int | None = None, quiet: bool = True,
+           note: str | None = None) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
-    Everything is validated before anything runs. Returns rows, paths and skipped runs."""
+    Everything is validated before anything runs, and only then is ``note`` (a line about
+    the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
+    runs."""
     from ..analysis.stability import (
         StabilityResult,
         guard_lines,
@@ -54,6 +57,8 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
+    if note:
+        sys.stderr.write(f"dumbbell stability: {note}\n")
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
     written = write(result, out)
@@ -70,9 +75,7 @@ def run(args: argparse.Namespace) -> int:
 
     # Jobs are many (cases x solvers); the CPUs are the cap that binds.
     note = cap_note("--workers", args.workers, 1 << 30)
-    if note:
-        sys.stderr.write(f"dumbbell stability: {note}\n")
-    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet)
+    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note)
     if not args.quiet:
         rows = result["rows"]
         bad = sum(r["agreement"] != "agrees" for r in rows)
