@@ -2,7 +2,7 @@
 result with ``to_pandas()``, and writes nothing (the CLI writes the files).
 
 >>> result = dumbbell.compare("scenes/textbook-1d.toml")               # doctest: +SKIP
->>> result.to_pandas()[["dt", "window_error", "energy_spread"]]          # doctest: +SKIP
+>>> result.to_pandas()[["dt", "window_error", "energy_error"]]           # doctest: +SKIP
 
 A scene may be given as a loaded :class:`Scene` or as the path of its file. The analysis
 modules are imported only when their function is called.
@@ -58,7 +58,7 @@ def compare(scene: Scene | str | Path, solvers: Sequence[str] | None = None,
             t_end: float | None = None, quiet: bool = True) -> Comparison:
     """Run ``solvers`` (default: pymunk and the hand-written method) at the steps ``dts``
     (s; default the scene's) and the truth (exact in 1D and rigid 2D, the reference for 2D
-    springs) over ``t_end`` (s); measure position errors over [0, ``window``] s, energy spreads, impact times and run
+    springs) over ``t_end`` (s); measure position errors over [0, ``window``] s, energy errors, impact times and run
     times. ``.to_pandas()`` is the summary table, ``.impacts_to_pandas()`` the impacts."""
     from .compare import compare as run
 

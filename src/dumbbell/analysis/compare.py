@@ -6,11 +6,15 @@ scene with friction has neither, so there the truth is pymunk at a ten times sma
 report says so). Each other run is measured against it:
 
 - impact times side by side, matched in order, with their differences;
-- the largest position error of either particle over a window (default 2 s): the motion is
-  chaotic, so later errors say nothing about the method (docs/physics.md, on chaos), and the time
-  at which the error first passes 1 mm;
-- the energy spread over the whole run, ``(max E - min E) / |E(0)|``;
+- the position error (the distance of either particle from its true place) at each sample,
+  its largest value over a window (default 2 s): the motion is chaotic, so later errors say
+  nothing about the method (docs/physics.md, on chaos), and the time at which it first passes
+  1 mm;
+- the energy error over the whole run (drift from E(0) relative to the energy scale; for a
+  dissipative scene the distance from the truth's E);
 - the run time.
+
+The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` reports.
 
 >>> result = compare(load_scene("scenes/textbook-1d.toml"))       # doctest: +SKIP
 >>> print(result.table())                                          # doctest: +SKIP
@@ -29,7 +33,7 @@ from ..errors import UsageError
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from ..solvers import no_truth_reason, solver_class, truth_solver
-from .metrics import coordinate_error, energy_spread
+from .metrics import energy_error, position_error, position_error_series
 
 if TYPE_CHECKING:
     import pandas
@@ -42,20 +46,23 @@ DIVERGED = 1e-3
 
 #: Columns of :meth:`Comparison.summary` and their units.
 SUMMARY_UNITS = {"solver": "", "dt": "s", "wall_time": "s", "steps_per_s": "1/s",
-                 "window_error": "m", "diverged_at": "s", "energy_spread": "1", "impacts": "",
+                 "window_error": "m", "diverged_at": "s", "energy_error": "1", "impacts": "",
                  "verdict": ""}
 
 
 @dataclass(frozen=True)
 class Row:
-    """One compared run: its trajectory and the measures against the truth."""
+    """One compared run: its trajectory and the measures against the truth: the position
+    error series (m, at the samples both have), its largest value over the window (m; inf if
+    the run stopped before the window ended), when it first passed 1 mm (s) and the energy
+    error (dimensionless)."""
 
     label: str
     traj: Trajectory
     error: np.ndarray
     window_error: float
     diverged_at: float | None
-    spread: float
+    energy_error: float
 
 
 @dataclass(frozen=True)
@@ -72,8 +79,9 @@ class Comparison:
     def summary(self) -> list[dict[str, object]]:
         """One record per run, the truth first, keyed by label: solver, dt (s; None for the
         step-free truths), run time (s), steps/s, the largest position error over the window
-        (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy spread,
-        impacts and verdict (see :data:`SUMMARY_UNITS`)."""
+        (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy error
+        (the truth's own drift; NaN for a dissipative truth, which has nothing to be measured
+        against), impacts and verdict (see :data:`SUMMARY_UNITS`)."""
         out = []
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
@@ -85,18 +93,20 @@ class Comparison:
                 "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
                 "diverged_at": None if row is None else row.diverged_at,
-                "energy_spread": energy_spread(r), "impacts": len(r.events),
+                "energy_error": energy_error(r, None) if row is None else row.energy_error,
+                "impacts": len(r.events),
                 "verdict": r.verdict})
         return out
 
     def table(self) -> str:
         """The summary as a fixed-width text table."""
         head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'steps/s':>10}"
-                f"{'max |dx| [m]':>14}{'|dx|>1mm at':>13}{'E spread':>11}{'impacts':>9}"
+                f"{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}{'impacts':>9}"
                 "  verdict")
         lines = [f"{self.scene.title}  ({self.scene.source})",
                  f"truth: {self.truth_note}",
-                 (f"position error: largest of either particle over [0, {self.window:g}] s "
+                 (f"position error: largest distance of either particle from its true place over "
+                  f"[0, {self.window:g}] s "
                  "(chaotic motion: later errors do not measure the method)"),
                  "", head, "-" * len(head)]
         for i, rec in enumerate(self.summary()):
@@ -104,9 +114,10 @@ class Comparison:
             dt = "-" if rec["dt"] is None else f"{rec['dt']:g}"
             err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
             div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
+            energy = "-" if math.isnan(rec["energy_error"]) else f"{rec['energy_error']:.2e}"
             lines.append(
                 f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}"
-                f"{rate:>10}{err:>14}{div:>13}{rec['energy_spread']:>11.2e}"
+                f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
                 f"{rec['impacts']:>9}  {rec['verdict']}")
         lines += ["", *self.impact_lines(), *self.notes]
         return "\n".join(lines)
@@ -238,13 +249,12 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
         for dt in dts:
             run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
                            quiet=quiet)
-            err = coordinate_error(run, truth)
-            inside = run.t[: len(err)] <= window + 1e-12
+            err = position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
             label = name if len(dts) == 1 else f"{name} dt={dt:g}"
-            rows.append(Row(label, run, err, float(err[inside].max()) if inside.any()
-                            else math.nan, float(run.t[over[0]]) if over.size else None,
-                            energy_spread(run)))
+            rows.append(Row(label, run, err, position_error(run, truth, window),
+                            float(run.t[over[0]]) if over.size else None,
+                            energy_error(run, truth)))
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
     return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)

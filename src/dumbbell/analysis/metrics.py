@@ -1,24 +1,14 @@
 """How far a run is from the truth: each measure defined once, used by compare and bench.
 
-Positions (m):
-
-- :func:`coordinate_error`: at each sample both runs have, the largest |difference| of any
-  position coordinate of either particle (a series; ``compare`` reports its largest value in
-  the window and when it first passes 1 mm);
-- :func:`position_error`: over the samples in [0, window], the largest distance between a
-  particle and its true position, sqrt(dx^2 + dy^2) (one number; ``bench`` reports it). In 1D
-  both are the same; in 2D the distance is up to sqrt(2) times the coordinate difference.
-
-Impacts: :func:`impact_time_error`, the largest |t_i - t_i(truth)| (s), impacts paired in order.
-
-Energy (dimensionless):
-
-- :func:`energy_spread`: (max E - min E) / |E(0)| over the whole run, the width of the band E
-  stays in (``compare``);
-- :func:`energy_error`: the largest relative drift |E - E(0)| / scale over the whole run, or
-  for a dissipative scene the largest distance from the truth's E at the same times
-  (``bench``). A run whose E swings symmetrically about E(0) has a spread about twice its
-  error.
+- Position (m): the distance |r - r_truth| of either particle, the larger of A and B, at each
+  shared sample (:func:`position_error_series`; in 1D the height difference, in 2D
+  sqrt(dx^2 + dy^2)), and its largest value over [0, window] (:func:`position_error`). The
+  motion is chaotic, so errors after the window say nothing about the method.
+- Impact times (s): :func:`impact_time_error`, the largest |t_i - t_i(truth)|, impacts paired
+  in order.
+- Energy (dimensionless): :func:`energy_error`, the largest relative drift |E - E(0)| / scale
+  over the whole run, or for a dissipative scene the largest distance from the truth's E at the
+  same times.
 
 Every measure needs the two runs sampled at the same times (the first samples of both): a
 run with other sample times is an error, not silently compared sample by sample.
@@ -31,7 +21,6 @@ import math
 import numpy as np
 
 from ..model.energy import BOOKKEEPING, energy_scale, relative_energy_error
-from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 
 
@@ -41,42 +30,26 @@ def _check_shared_times(run: Trajectory, truth: Trajectory, n: int) -> None:
         raise ValueError(f"{run.solver} and {truth.solver} do not share their sample times")
 
 
-def position_columns(scene: Scene) -> list[str]:
-    """The position columns of a scene (m)."""
-    return ["xA", "xB"] if scene.system.dimensions == 1 else ["xA", "yA", "xB", "yB"]
-
-
-def coordinate_error(run: Trajectory, truth: Trajectory) -> np.ndarray:
-    """Largest |position coordinate difference| of either particle at each sample both runs
-    have (m): as long as the shorter run."""
+def position_error_series(run: Trajectory, truth: Trajectory) -> np.ndarray:
+    """The position error at each sample both runs have (m): the distance |r - r_truth| of
+    either particle, the larger of A and B (in 1D the height difference)."""
     n = min(len(run.t), len(truth.t))
     _check_shared_times(run, truth, n)
-    return np.max([np.abs(run[c][:n] - truth[c][:n]) for c in position_columns(run.scene)],
-                  axis=0)
-
-
-def energy_spread(traj: Trajectory) -> float:
-    """(max E - min E) / |E(0)| over the whole run (dimensionless)."""
-    E = traj["E"]
-    if not len(E):
-        return math.nan
-    scale = abs(float(E[0])) or 1.0
-    return float((np.max(E) - np.min(E)) / scale)
-
-
-def position_error(traj: Trajectory, truth: Trajectory, window: float) -> float:
-    """Largest distance |r - r_truth| of either particle over the samples in [0, window] (m);
-    inf if the run stopped before the window ended. Both must share their sample times."""
-    n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
-    if len(traj.t) < n:
-        return math.inf
-    _check_shared_times(traj, truth, n)
-    worst = 0.0
+    per_body = []
     for body in "AB":
-        cols = [c for c in (f"x{body}", f"y{body}") if c in traj.state]
-        sq = sum((traj.state[c][:n] - truth.state[c][:n]) ** 2 for c in cols)
-        worst = max(worst, float(np.sqrt(np.max(sq))))
-    return worst
+        cols = [c for c in (f"x{body}", f"y{body}") if c in run.state]
+        per_body.append(np.sqrt(sum((run.state[c][:n] - truth.state[c][:n]) ** 2
+                                    for c in cols)))
+    return np.max(per_body, axis=0)
+
+
+def position_error(run: Trajectory, truth: Trajectory, window: float) -> float:
+    """The largest :func:`position_error_series` over the samples in [0, window] (m); inf if
+    the run stopped before the window ended. Both must share their sample times."""
+    n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
+    if len(run.t) < n:
+        return math.inf
+    return float(np.max(position_error_series(run, truth)[:n]))
 
 
 def impact_time_error(traj: Trajectory, truth: Trajectory, window: float

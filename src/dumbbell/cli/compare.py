@@ -17,7 +17,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "the most accurate solution there is (exact in 1D and for the rigid 2D "
                     "dumbbell, the RK8 reference for a 2D spring), then print and write: impact times side by side, the largest position "
                     "error over a window before the chaotic motion parts the runs, each "
-                    "solver's energy spread over the whole run, and run times. Writes "
+                    "solver's energy error over the whole run, and run times. Writes "
                     "SCENE-compare.csv, -compare-impacts.csv, -compare-errors.csv and three "
                     "PNG figures (positions, error, energy) into DIR.",
     )

@@ -9,25 +9,25 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.compare import Comparison
-from ..analysis.metrics import energy_spread
 from .files import atomic_output
 from .tables import csv_text, write_text
 
-#: Columns of SCENE-compare.csv (times in s, errors in m, the energy spread dimensionless).
+#: Columns of SCENE-compare.csv (times in s, position errors in m, the energy error
+#: dimensionless; the measures of :mod:`dumbbell.analysis.metrics`).
 SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m", "window_s",
-                   "error_passes_1mm_at_s", "energy_spread", "impacts", "verdict")
+                   "error_passes_1mm_at_s", "energy_error", "impacts", "verdict")
 
 
 def summary_csv(result: Comparison) -> str:
     """One line per run, the truth first, with :data:`SUMMARY_COLUMNS`."""
     rows = []
-    for row in [None, *result.rows]:
+    for row, rec in zip([None, *result.rows], result.summary(), strict=True):
         r = result.truth if row is None else row.traj
         rows.append((r.solver if row is None else row.label, r.dt if r.dt else "",
                      f"{r.wall_time:.6g}", r.info.get("steps", ""),
                      None if row is None else row.window_error, result.window,
                      None if row is None else row.diverged_at,
-                     energy_spread(r), len(r.events), r.verdict.status))
+                     rec["energy_error"], len(r.events), r.verdict.status))
     return csv_text(SUMMARY_COLUMNS, rows)
 
 

@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.compare import DIVERGED, Comparison, energy_spread
+from ..analysis.compare import DIVERGED, Comparison
+from ..analysis.metrics import energy_error
 from .style import ROW_COLOURS, ROW_DASHES, pyplot
 
 
@@ -89,6 +90,14 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     return ax
 
 
+def _truth_label(truth: Any) -> str:
+    """The truth's legend entry: its own energy drift, or only its name in a dissipative
+    scene (nothing to measure its energy against)."""
+    error = energy_error(truth, None)
+    name = f"{truth.solver} (truth)"
+    return f"{name}: energy error {error:.1e}" if np.isfinite(error) else name
+
+
 def compare_energy(result: Comparison, ax: Any = None) -> Any:
     """E(t)/E(0) - 1 of each solver and of the truth."""
     own = ax is None
@@ -100,9 +109,9 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
         r = row.traj
         ax.plot(r.t, r["E"] / E0 - 1.0, color=colour, lw=1.0,
                 ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
-                label=f"{row.label}: spread {row.spread:.2e}")
+                label=f"{row.label}: energy error {row.energy_error:.2e}")
     ax.plot(truth.t, truth["E"] / E0 - 1.0, color="black", lw=1.2,
-            label=f"{truth.solver}: spread {energy_spread(truth):.1e}")
+            label=_truth_label(truth))
     ax.set_xlabel("t [s]")
     ax.set_ylabel("E(t) / E(0) - 1")
     ax.set_xlim(0, float(truth.t[-1]))
