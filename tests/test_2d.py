@@ -268,9 +268,11 @@ def test_rotation_variants_and_the_stiff_limit(tilted):
     from dumbbell.analysis.rotation import variants
 
     scenes = variants(tilted)
-    assert [s.system.spring.stiffness for s in scenes.values() if s.system.spring] == [200.0, 2e3, 2e4]
+    springs = [s.system.spring for s in scenes.values() if s.system.spring]
+    assert [spring.stiffness for spring in springs] == [200.0, 2e3, 2e4]
     assert scenes["rigid"].system.rigid.length == 0.2
-    assert (scenes["rigid"].system.A.x, scenes["rigid"].system.A.height) == (tilted.system.A.x, tilted.system.A.height)
+    rigid_A, tilted_A = scenes["rigid"].system.A, tilted.system.A
+    assert (rigid_A.x, rigid_A.height) == (tilted_A.x, tilted_A.height)
     stiff = simulate(scenes["k = 20000 N/m"], "pymunk", dt=1e-5, t_end=0.6, every=10)
     v = math.sqrt(2 * G * 1.0)
     expected = 0.5 * 0.05 * (2 * v * 0.5) ** 2

@@ -97,7 +97,8 @@ def _check(make) -> None:
         return
     assert isinstance(scene, Scene)
     # A valid scene's derived quantities exist and are numbers.
-    for value in (scene.system.M, scene.system.mu, scene.system.omega, scene.run.dt, scene.run.t_end):
+    system = scene.system
+    for value in (system.M, system.mu, system.omega, scene.run.dt, scene.run.t_end):
         assert isinstance(value, float) and not math.isnan(value)
     assert scene.system.M > 0 and scene.system.mu > 0 and 0 < scene.run.dt <= scene.run.t_end
     assert isinstance(scene.name, str) and isinstance(scene.system.dissipative, bool)

@@ -21,7 +21,8 @@ def brute_force_impacts(scene, t_end, scan=1e-6):
     floor found by scanning both heights on a 1e-6 s grid of its dense output: independent
     of the reference's step and of its bound."""
     A, B = scene.system.A, scene.system.B
-    mA, mB, k, b, g, e = A.mass, B.mass, scene.system.k, scene.system.b, scene.system.g, scene.system.elasticity
+    system = scene.system
+    mA, mB, k, b, g, e = A.mass, B.mass, system.k, system.b, system.g, system.elasticity
 
     def rhs(_t, y):
         dx, dy = y[0] - y[4], y[1] - y[5]

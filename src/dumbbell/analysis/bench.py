@@ -422,7 +422,8 @@ def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: 
         return point
     point.energy_error = energy_error(traj, None)
     if not cls.estimates_error:
-        check = extended_precision_rigid if scene.system.rigid is not None else extended_precision_exact
+        rigid = scene.system.rigid is not None
+        check = extended_precision_rigid if rigid else extended_precision_exact
         point.error, point.impact_time_error = check(traj, window)
         point.reason = "errors against the same closed form in extended precision"
     else:

@@ -44,7 +44,8 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     def segment(t0, xA, vA, xB, vB):
         return (t0, (mA * xA + mB * xB) / M, (mA * vA + mB * vB) / M, xA - xB - b, vA - vB)
 
-    seg = segment(L(0), L(scene.system.A.height), L(scene.system.A.vy), L(scene.system.B.height), L(scene.system.B.vy))
+    A, B = scene.system.A, scene.system.B
+    seg = segment(L(0), L(A.height), L(A.vy), L(B.height), L(B.vy))
     n = int(np.searchsorted(traj.t, window * (1 + 1e-12), side="right"))
     t = traj.t[:n].astype(L)
     worst = worst_t = 0.0

@@ -45,7 +45,8 @@ def _length(scene: Scene) -> float:
         return scene.system.rigid.length
     if scene.system.spring is not None:
         return scene.system.spring.rest_length
-    return math.hypot(scene.system.A.x - scene.system.B.x, scene.system.A.height - scene.system.B.height)
+    A, B = scene.system.A, scene.system.B
+    return math.hypot(A.x - B.x, A.height - B.height)
 
 
 def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) -> Scene:

@@ -588,7 +588,8 @@ class Painter(Backdrop):
         pa, pb = self.px(ax, ay), self.px(bx, by)
         ra = max(sc.system.A.radius * self.L.s, MIN_RADIUS_PX * u)
         rb = max(sc.system.B.radius * self.L.s, MIN_RADIUS_PX * u)
-        rest = sc.system.spring.rest_length if sc.system.spring else sc.system.rigid.length if sc.system.rigid else 0.0
+        spring, rigid = sc.system.spring, sc.system.rigid
+        rest = spring.rest_length if spring else rigid.length if rigid else 0.0
         amp = max((CM_RADIUS + 1.5) * u, min(0.06 * rest * self.L.s, 8 * u))
         two_d = sc.system.dimensions == 2
         m = max(ra, rb, amp) + (18 if two_d else 8) * u

@@ -224,10 +224,11 @@ def disc_inertia(mass: float, radius: float) -> float:
 def rigid_moment(scene: Scene) -> float:
     """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
     two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
-    moment = scene.system.mu * scene.system.rigid.length**2
+    system = scene.system
+    moment = system.mu * system.rigid.length**2
     if spins(scene):
-        moment += disc_inertia(scene.system.A.mass, scene.system.A.radius) + disc_inertia(scene.system.B.mass,
-                                                                           scene.system.B.radius)
+        moment += (disc_inertia(system.A.mass, system.A.radius)
+                   + disc_inertia(system.B.mass, system.B.radius))
     return moment
 
 
@@ -243,7 +244,8 @@ def partition(traj: Trajectory) -> dict[str, np.ndarray]:
         rB = np.column_stack([traj["xB"], traj["yB"]])
         vA = np.column_stack([traj["vxA"], traj["vyA"]])
         vB = np.column_stack([traj["vxB"], traj["vyB"]])
-        parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g, rA, vA, rB, vB)
+        parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
+                             rA, vA, rB, vB)
         if spins(scene):
             parts["K_spin"] = sum(
                 rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
@@ -301,7 +303,8 @@ def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict
         rB = np.column_stack([traj["xB"], traj["yB"]])
         vA = np.column_stack([traj["vxA"], traj["vyA"]])
         vB = np.column_stack([traj["vxB"], traj["vyB"]])
-        axis = partition_2d(scene.system.A.mass, scene.system.B.mass, scene.system.k, scene.system.b, scene.system.g,
+        system = scene.system
+        axis = partition_2d(system.A.mass, system.B.mass, system.k, system.b, system.g,
                             rA, vA, rB, vB)
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
         if spins(scene):

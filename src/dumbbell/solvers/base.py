@@ -16,7 +16,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..errors import UsageError
-from ..model.scene import Scene
+from ..model.scene import Scene, System
 from ..model.trajectory import Trajectory
 
 #: Largest number of steps one run may take, so that no run can hang.
@@ -119,11 +119,11 @@ class Solver:
         return math.nan
 
 
-def kernel_params(scene: Scene) -> tuple[float, float, float, float, float, float, bool]:
+def kernel_params(system: System) -> tuple[float, float, float, float, float, float, bool]:
     """The scalars the compiled time-steppers take: mA, mB (kg), k (N/m), b (m), g (m/s^2),
     the floor's elasticity, and whether there is a floor."""
-    return (scene.system.A.mass, scene.system.B.mass, scene.system.k, scene.system.b, scene.system.g, scene.system.elasticity,
-            scene.system.floor is not None)
+    return (system.A.mass, system.B.mass, system.k, system.b, system.g, system.elasticity,
+            system.floor is not None)
 
 
 def point_particle_limits(scene: Scene, name: str) -> str | None:

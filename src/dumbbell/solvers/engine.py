@@ -146,8 +146,8 @@ def build(scene: Scene) -> World:
             space.add(body, circle(body, p, (0.0, 0.0)))
         if scene.system.spring is not None:
             bA, bB = points["A"][0], points["B"][0]
-            spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0),
-                                         scene.system.spring.rest_length, scene.system.spring.stiffness, 0.0)
+            rest, stiffness = scene.system.spring.rest_length, scene.system.spring.stiffness
+            spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0), rest, stiffness, 0.0)
             spring.collide_bodies = False
             space.add(spring)
             world.spring = spring

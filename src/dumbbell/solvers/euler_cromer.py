@@ -59,11 +59,12 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` with the textbook's Euler-Cromer method. See the module docstring."""
     from .kernels.euler_cromer import advance
 
-    mA, mB, k, b, g, e, floor = kernel_params(scene)
+    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
     dt, every = options.dt, options.every
     # One contiguous row per column, so the Trajectory's columns are views, not copies.
     out = np.empty((4, options.n_samples))
-    st = np.array([scene.system.A.height, scene.system.A.vy, scene.system.B.height, scene.system.B.vy], dtype=np.float64)
+    A, B = scene.system.A, scene.system.B
+    st = np.array([A.height, A.vy, B.height, B.vy], dtype=np.float64)
     out[:, 0] = st
     run = run_kernel(advance, (mA, mB, k, b, g, e, floor), st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)

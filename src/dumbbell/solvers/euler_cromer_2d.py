@@ -59,7 +59,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     from .kernels.euler_cromer_2d import advance
 
     A, B = scene.system.A, scene.system.B
-    mA, mB, k, b, g, e, floor = kernel_params(scene)
+    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
     dt, every = options.dt, options.every
     out = np.empty((options.n_samples, 8))
     st = np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)

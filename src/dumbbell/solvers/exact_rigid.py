@@ -82,7 +82,8 @@ class RigidBody:
         self.M = scene.system.M
         self.g = scene.system.g
         self.L = scene.system.rigid.length
-        self.arm = {"A": scene.system.B.mass / scene.system.M * self.L, "B": -scene.system.A.mass / scene.system.M * self.L}
+        A, B = scene.system.A, scene.system.B
+        self.arm = {"A": B.mass / self.M * self.L, "B": -A.mass / self.M * self.L}
         self.moment = rigid_moment(scene)
 
     # --- the state -------------------------------------------------------------------------

@@ -66,7 +66,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     verdict or the energy."""
     from .kernels.verlet import advance, advance_2d
 
-    mA, mB, k, b, g, e, floor = kernel_params(scene)
+    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
     dt, every = options.dt, options.every
     A, B = scene.system.A, scene.system.B
     if scene.system.dimensions == 1:
