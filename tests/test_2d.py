@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
@@ -175,7 +174,7 @@ def test_reference_energy_and_limits(tilted):
 
 
 def _free_flight(tilted):
-    raw = copy.deepcopy(tilted.raw)
+    raw = tilted.to_dict()
     raw.pop("floor")
     raw["bodies"]["A"]["velocity"] = [-0.4, 2.5]
     raw["bodies"]["B"]["velocity"] = [0.7, 1.0]

@@ -102,6 +102,8 @@ def _check(make) -> None:
         assert isinstance(value, float) and not math.isnan(value)
     assert scene.system.M > 0 and scene.system.mu > 0 and 0 < scene.run.dt <= scene.run.t_end
     assert isinstance(scene.name, str) and isinstance(scene.system.dissipative, bool)
+    # The document rebuilt from the fields reads back as the same scene.
+    assert scene_from_dict(scene.to_dict(), scene.source) == scene
 
 
 @FUZZ

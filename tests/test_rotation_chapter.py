@@ -114,7 +114,7 @@ def test_topple_refuses_what_it_cannot_describe(topple_scene):
 
     with pytest.raises(UsageError, match="frictionless"):
         closed_form(topple_scene.with_values({"floor.friction": 0.3}))
-    raw = dict(topple_scene.raw, tilt=0.0)
+    raw = dict(topple_scene.to_dict(), tilt=0.0)
     with pytest.raises(UsageError, match="strictly between 0 and 90"):
         closed_form(scene_from_dict(raw, "upright.toml"))
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from dumbbell import SceneError, load_scene
 from dumbbell.cli import main
+from dumbbell.model.scene import scene_from_dict
 from dumbbell.solvers import scene_solver
 from tests.conftest import SCENES
 
@@ -62,6 +65,43 @@ def test_shipped_scenes_load():
     assert paths, "no scenes shipped"
     for path in paths:
         load_scene(path)
+
+
+def test_every_shipped_scene_reads_back_from_its_dict():
+    paths = sorted(SCENES.rglob("*.toml"))
+    placed = 0
+    for path in paths:
+        scene = load_scene(path)
+        doc = scene.to_dict()
+        assert scene_from_dict(doc, scene.source) == scene, path.name
+        placed += "tilt" in doc and "height" not in doc["bodies"]["A"]
+        doc["bodies"]["B"]["mass"] = 99.0  # a fresh dict: the scene does not change
+        assert scene.system.B.mass != 99.0 and scene.to_dict()["bodies"]["B"]["mass"] != 99.0
+    assert placed >= 3  # tilt-placed scenes are among them
+
+
+def test_a_scene_is_physics_plus_settings_with_no_document_kept(textbook):
+    assert not hasattr(textbook, "raw") and not hasattr(textbook, "A")
+    assert textbook.system.A.height == 1.2 and textbook.system.M == 0.2
+
+
+def test_with_values_moves_a_tilt_placed_a_with_the_length():
+    tilted = load_scene(SCENES / "tilted-2d.toml")
+    tilt = tilted.system.tilt
+    longer = tilted.with_values({"spring.rest_length": 0.35})
+    A, B = longer.system.A, longer.system.B
+    assert math.hypot(A.x - B.x, A.height - B.height) == pytest.approx(0.35, rel=1e-12)
+    assert math.degrees(math.atan2(A.x - B.x, A.height - B.height)) == pytest.approx(tilt)
+    with pytest.raises(SceneError, match="left out when 'tilt' places A"):
+        tilted.with_values({"bodies.A.height": 1.0})
+
+
+def test_the_gif_length_follows_the_run_unless_given(textbook):
+    gif = textbook.with_values({"outputs.gif.fps": 10})
+    assert gif.outputs.gif.t_end == textbook.run.t_end
+    assert gif.with_values({"run.t_end": 0.5}).outputs.gif.t_end == 0.5
+    own = gif.with_values({"outputs.gif.t_end": 2.0})
+    assert own.with_values({"run.t_end": 0.5}).outputs.gif.t_end == 2.0
 
 
 def test_textbook_scene_holds_the_textbook_values(textbook):

@@ -22,7 +22,6 @@ dumbbell's 1.25 J. The figure quotes these means (:func:`mean_after_first_cluste
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass
 
@@ -54,16 +53,18 @@ def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) ->
     the same rest (or rod) length; tilted ``tilt`` degrees from vertical when given.
     Everything else is kept."""
     length = _length(scene)
-    raw = copy.deepcopy(scene.raw)
-    raw.pop("spring", None)
-    raw.pop("rigid", None)
+    doc = scene.to_dict()
+    doc.pop("spring", None)
+    doc.pop("rigid", None)
     if stiffness is None:
-        raw["rigid"] = {"length": length}
+        doc["rigid"] = {"length": length}
     else:
-        raw["spring"] = {"stiffness": float(stiffness), "rest_length": length}
+        doc["spring"] = {"stiffness": float(stiffness), "rest_length": length}
     if tilt is not None:
-        raw["tilt"] = float(tilt)
-    return scene_from_dict(raw, scene.source)
+        doc["tilt"] = float(tilt)
+        for key in ("x", "height"):  # the tilt places A now
+            doc["bodies"]["A"].pop(key, None)
+    return scene_from_dict(doc, scene.source)
 
 
 def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict[str, Scene]:

@@ -7,20 +7,23 @@ handling; no ``[gravity]``: no gravity; no ``[spring]``: the particles do not in
 >>> scene.system.spring.stiffness, scene.run.dt
 (200.0, 1e-05)
 
+A :class:`Scene` is the physics (:class:`System`: what solvers and energy formulas read)
+plus the settings of the run, the outputs and the pymunk engine. The parsed document is not
+kept: :meth:`Scene.to_dict` rebuilds it from the fields, and :meth:`Scene.with_values`
+re-validates a copy with keys changed by their dotted names, which is how sweeps vary a scene.
+
 Every failure raises one :class:`SceneError` naming the file, the dotted key and what is
-allowed. :meth:`Scene.with_values` re-validates after changing keys by their dotted names, which
-is how sweeps vary a scene.
+allowed.
 """
 
 from __future__ import annotations
 
-import copy
 import math
 import numbers
 import os
 import stat
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -148,7 +151,8 @@ class OutputSettings:
 class System:
     """The physics of a scene: the dumbbell, its spring or rod, the floor and gravity.
 
-    ``dimensions`` is 1 (vertical line) or 2; ``g`` in m/s^2 (downward, 0 without gravity).
+    ``dimensions`` is 1 (vertical line) or 2; ``g`` in m/s^2 (downward, 0 without gravity);
+    ``tilt`` in degrees.
     Solvers, energy formulas and closed forms need only this, not the run or output settings.
     """
 
@@ -159,6 +163,9 @@ class System:
     rigid: Rigid | None
     floor: Floor | None
     g: float
+    #: The axis's angle from vertical (degrees) that placed A from B, or None when the scene
+    #: gives A's position. Kept so that changing the length moves A, as in the file.
+    tilt: float | None = None
 
     @property
     def M(self) -> float:
@@ -226,12 +233,44 @@ class Scene:
     outputs: OutputSettings
     pymunk: PymunkSettings
     source: str = "<scene>"
-    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def name(self) -> str:
         """The scene file's stem, used to name outputs."""
         return Path(self.source).stem if self.source != "<scene>" else "scene"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as a parsed TOML document, built afresh from the fields:
+        ``scene_from_dict(scene.to_dict(), scene.source) == scene``. Every key is written
+        except two that follow another key, as they do in a file: A's position when ``tilt``
+        places it, and ``outputs.gif.t_end`` when it is the run's ``t_end``."""
+        s, run, out = self.system, self.run, self.outputs
+        doc: dict[str, Any] = {"title": self.title, "dimensions": s.dimensions}
+        if s.tilt is not None:
+            doc["tilt"] = s.tilt
+        doc["bodies"] = {"A": _particle_table(s.A, s.dimensions, placed=s.tilt is not None),
+                         "B": _particle_table(s.B, s.dimensions, placed=False)}
+        if s.spring is not None:
+            doc["spring"] = {"stiffness": s.spring.stiffness, "rest_length": s.spring.rest_length}
+        if s.rigid is not None:
+            doc["rigid"] = {"length": s.rigid.length}
+        if s.floor is not None:
+            doc["floor"] = {"elasticity": s.floor.elasticity, "friction": s.floor.friction}
+        doc["gravity"] = {"g": s.g}
+        doc["run"] = {"t_end": run.t_end, "dt": run.dt, "solver": run.solver,
+                      "every": run.every, "unstable_energy": run.unstable_energy}
+        doc["outputs"] = {"figures": list(out.figures), "csv": out.csv}
+        if out.gif is not None:
+            gif = {"fps": out.gif.fps, "size": out.gif.size, "strip": out.gif.strip}
+            if out.gif.t_end != run.t_end:
+                gif["t_end"] = out.gif.t_end
+            doc["outputs"]["gif"] = gif
+        pymunk = {key: getattr(self.pymunk, key) for key in
+                  ("collision_slop", "collision_bias", "iterations", "spin")}
+        pymunk = {key: value for key, value in pymunk.items() if value is not None}
+        if pymunk:
+            doc["pymunk"] = pymunk
+        return doc
 
     def with_values(self, values: dict[str, Any]) -> Scene:
         """A new scene with keys replaced by dotted name, validated like a file.
@@ -241,7 +280,7 @@ class Scene:
         if not isinstance(values, dict) or not all(isinstance(k, str) for k in values):
             raise SceneError(f"values = {_show(values)}: must be a dict of dotted key names "
                              "(str) to values")
-        raw = copy.deepcopy(self.raw)
+        raw = self.to_dict()
         for dotted, value in values.items():
             parts = dotted.split(".")
             table = raw
@@ -445,6 +484,20 @@ def _particle(c: _Checker, name: str, dims: int, placed: bool) -> Particle:
     return Particle(name, mass, x, height, vx, vy, radius, spin)
 
 
+def _particle_table(p: Particle, dims: int, placed: bool) -> dict[str, Any]:
+    """The [bodies.NAME] table of ``p``, as :func:`_particle` reads it; without the position
+    when the tilt places the particle."""
+    table: dict[str, Any] = {"mass": p.mass, "radius": p.radius}
+    if not placed:
+        table["height"] = p.height
+        if dims == 2:
+            table["x"] = p.x
+    table["velocity"] = [p.vx, p.vy] if dims == 2 else p.vy
+    if dims == 2:
+        table["spin"] = p.spin
+    return table
+
+
 def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
     """Validate a parsed TOML document and build a :class:`Scene` (raises SceneError)."""
     if not isinstance(data, dict):
@@ -481,9 +534,9 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
     outputs = _outputs(top, dims, floor is not None, rigid is not None, run.t_end)
     pm = _pymunk(top)
     top.done()
-    system = System(dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g)
-    return Scene(title=title, system=system, run=run, outputs=outputs, pymunk=pm,
-                 source=source, raw=copy.deepcopy(data))
+    system = System(dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
+                    tilt=tilt)
+    return Scene(title=title, system=system, run=run, outputs=outputs, pymunk=pm, source=source)
 
 
 def _bodies_tables(top: _Checker, source: str) -> tuple[_Checker, _Checker]:
