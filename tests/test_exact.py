@@ -84,7 +84,7 @@ def test_grazing_impacts_are_found_and_near_misses_are_not(gap):
         # The touch is tangential: the speed is that of a 1e-10 m dip, sqrt(2 a d).
         assert abs(first.v_before) < 1e-2
     else:
-        assert traj.events == []
+        assert traj.events == ()
     assert traj["xB"].min() > -2e-10
 
 

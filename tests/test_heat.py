@@ -20,7 +20,7 @@ ELASTIC = [(name, solver) for name in ("textbook-1d", "tilted-2d", "rigid-2d")
 def test_no_heat_on_an_elastic_frictionless_floor(name, solver):
     run = simulate(load_scene(SCENES / f"{name}.toml"), solver, dt=1e-4, t_end=2.0, every=10)
     assert len(run.events) >= 3
-    assert np.max(np.abs(heat(run))) < 1e-12
+    assert np.max(np.abs(heat(run.scene, run.t, run.state, run.events))) < 1e-12
 
 
 def test_friction_first_impact_heat():

@@ -21,7 +21,7 @@ def test_pymunk_energy_columns_equal_the_partition(name):
     scene = load_scene(scenes_dir() / name)
     traj = simulate(scene, "pymunk", t_end=min(scene.run.t_end, 0.5))
     general = traj.energy           # from dumbbell.spaces.accounting on pymunk's own bodies
-    own = partition(traj)           # model/energy.py's formulas on the sampled state
+    own = partition(traj.scene, traj.t, traj.state, traj.events)  # model/energy.py's formulas
     assert list(general) == list(own) == energy_columns(scene)
     scale = energy_scale(float(own["E"][0]),
                          {k: float(v[0]) for k, v in own.items() if k not in ("E", "E_lost")})
@@ -34,7 +34,7 @@ def test_variants_rigid_and_spinning(spin):
     for name in ("tilted-2d.toml", "rigid-2d.toml"):
         scene = load_scene(scenes_dir() / name).with_values({"pymunk.spin": spin})
         traj = simulate(scene, "pymunk", t_end=0.3)
-        own = partition(traj)
+        own = partition(traj.scene, traj.t, traj.state, traj.events)
         scale = abs(float(own["E"][0]))
         for column in own:
             assert np.max(np.abs(traj.energy[column] - own[column])) <= 1e-12 * scale
@@ -46,7 +46,7 @@ def test_soft_spring_pymunk_conserves_its_own_spring_energy():
     scene = load_scene(scenes_dir() / "extreme" / "soft-spring.toml")
     traj = simulate(scene, "pymunk", every=10)
     assert np.min(traj["xA"] - traj["xB"]) < -0.1  # A did pass B
-    E, E_1d = traj["E"], partition(traj)["E"]
+    E, E_1d = traj["E"], partition(traj.scene, traj.t, traj.state, traj.events)["E"]
     assert np.ptp(E) / E[0] < 1e-3
     assert np.ptp(E_1d) / E_1d[0] > 0.1
 

@@ -76,7 +76,7 @@ def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     if len(traj.t) == 0:
         return math.nan
     if not traj.scene.system.dissipative:
-        return float(np.max(relative_energy_error(traj)))
+        return float(np.max(relative_energy_error(traj.energy)))
     if truth is None:
         return math.nan
     n = min(len(traj.t), len(truth.t))

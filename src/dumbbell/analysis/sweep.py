@@ -210,7 +210,7 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
     w_dt = point.system.omega * options.dt
     try:
         traj = simulate(point, solver, every=every, quiet=True)
-        err = relative_energy_error(traj)
+        err = relative_energy_error(traj.energy)
         finite = err[np.isfinite(err)]
         max_err = float(finite.max()) if finite.size else math.nan
         verdict = traj.verdict

@@ -26,13 +26,17 @@ particles (``I omega`` with ``I = mu L^2`` when they form a rigid body), plus ea
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
     from .scene import Scene
-    from .trajectory import Trajectory
+    from .trajectory import Impact
+
+#: State columns by name (m, m/s, rad/s), one value per sample.
+Columns = Mapping[str, np.ndarray]
 
 
 def state_columns(scene: Scene) -> list[str]:
@@ -200,20 +204,20 @@ def impact_heat(mass: float, v_before: float, v_after: float) -> float:
     return 0.5 * mass * (v_before * v_before - v_after * v_after)
 
 
-def heat(traj: Trajectory) -> np.ndarray:
-    """Energy the contacts dissipated up to each sample (J): counted by the solver where it
-    gives a ``heat`` state column (pymunk), else summed over the impacts up to each sample
-    (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
-    if "heat" in traj.state:
-        return np.asarray(traj.state["heat"], dtype=float)
-    mass = {"A": traj.scene.system.A.mass, "B": traj.scene.system.B.mass}
-    times = np.array([e.t for e in traj.events])
+def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) -> np.ndarray:
+    """Energy the contacts dissipated up to each sample time ``t`` (s), in J: counted by the
+    solver where the state has a ``heat`` column (pymunk), else summed over the impacts up to
+    each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
+    if "heat" in state:
+        return np.asarray(state["heat"], dtype=float)
+    events = list(events)
+    mass = {"A": scene.system.A.mass, "B": scene.system.B.mass}
+    times = np.array([e.t for e in events])
     amounts = np.array([e.heat if e.heat is not None
                         else impact_heat(mass[e.body], e.v_before, e.v_after)
-                        for e in traj.events])
+                        for e in events])
     total = np.concatenate([[0.0], np.cumsum(amounts)])
-    return total[np.searchsorted(times, traj.t, side="right")] if len(times) else (
-        np.zeros(len(traj.t)))
+    return total[np.searchsorted(times, t, side="right")] if len(times) else np.zeros(len(t))
 
 
 def disc_inertia(mass: float, radius: float) -> float:
@@ -232,89 +236,94 @@ def rigid_moment(scene: Scene) -> float:
     return moment
 
 
-def partition(traj: Trajectory) -> dict[str, np.ndarray]:
-    """All energy columns of ``traj`` (J), in :func:`energy_columns` order."""
-    scene = traj.scene
+def _positions_velocities(state: Columns) -> tuple[np.ndarray, ...]:
+    """rA, vA, rB, vB of a 2D state as (n, 2) arrays (m, m/s)."""
+    return tuple(np.column_stack([state[f"{x}{body}"], state[f"{y}{body}"]])
+                 for body in "AB" for x, y in (("x", "y"), ("vx", "vy")))
+
+
+def _disc_spin(scene: Scene, state: Columns) -> np.ndarray:
+    """K_spin, the discs' own 1/2 I omega^2 summed (J)."""
+    return sum(rotational_ke(disc_inertia(p.mass, p.radius), state[f"omega{p.name}"])
+               for p in (scene.system.A, scene.system.B))
+
+
+def partition(
+    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact] = (),
+) -> dict[str, np.ndarray]:
+    """All energy columns (J, :func:`energy_columns` order) of ``scene`` at the sample times
+    ``t`` (s) with the state columns ``state`` (m, m/s, rad/s) and the impacts ``events``
+    (needed for E_heat on dissipative scenes)."""
     k, b = scene.system.k, scene.system.b
     if scene.system.dimensions == 1:
         parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
-                             traj["xA"], traj["vA"], traj["xB"], traj["vB"])
+                             state["xA"], state["vA"], state["xB"], state["vB"])
     else:
-        rA = np.column_stack([traj["xA"], traj["yA"]])
-        rB = np.column_stack([traj["xB"], traj["yB"]])
-        vA = np.column_stack([traj["vxA"], traj["vyA"]])
-        vB = np.column_stack([traj["vxB"], traj["vyB"]])
+        rA, vA, rB, vB = _positions_velocities(state)
         parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
                              rA, vA, rB, vB)
         if spins(scene):
-            parts["K_spin"] = sum(
-                rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
-                for p in (scene.system.A, scene.system.B)
-            )
+            parts["K_spin"] = _disc_spin(scene, state)
             parts["E"] = parts["E"] + parts["K_spin"]
-    return _with_losses(traj, parts)
+    return _with_losses(scene, t, state, events, parts)
 
 
-def angular_momentum_cm(traj: Trajectory) -> np.ndarray:
-    """Angular momentum about the centre of mass at each sample (kg m^2/s): the particles'
-    ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus the discs'
-    own spin ``1/2 m r^2 omega_i`` where particles may spin."""
-    scene = traj.scene
+def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
+    """Angular momentum about the centre of mass at each sample of a 2D ``state`` (kg m^2/s):
+    the particles' ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus
+    the discs' own spin ``1/2 m r^2 omega_i`` where particles may spin."""
     mA, mB = scene.system.A.mass, scene.system.B.mass
     M = mA + mB
-    Rx = (mA * traj["xA"] + mB * traj["xB"]) / M
-    Ry = (mA * traj["yA"] + mB * traj["yB"]) / M
-    total = sum(angular_momentum(p.mass, traj[f"x{p.name}"], traj[f"y{p.name}"],
-                                 traj[f"vx{p.name}"], traj[f"vy{p.name}"], Rx, Ry)
+    Rx = (mA * state["xA"] + mB * state["xB"]) / M
+    Ry = (mA * state["yA"] + mB * state["yB"]) / M
+    total = sum(angular_momentum(p.mass, state[f"x{p.name}"], state[f"y{p.name}"],
+                                 state[f"vx{p.name}"], state[f"vy{p.name}"], Rx, Ry)
                 for p in (scene.system.A, scene.system.B))
     if spins(scene):
-        total = total + sum(disc_inertia(p.mass, p.radius) * traj.state[f"omega{p.name}"]
+        total = total + sum(disc_inertia(p.mass, p.radius) * state[f"omega{p.name}"]
                             for p in (scene.system.A, scene.system.B))
     return np.asarray(total, dtype=float)
 
 
-def _with_losses(traj: Trajectory, parts: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def _with_losses(
+    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    parts: dict[str, np.ndarray],
+) -> dict[str, np.ndarray]:
     """``parts`` in :func:`energy_columns` order, with E_lost = E(0) - E, E_heat (:func:`heat`)
     and E_err = E_lost - E_heat added where the scene is dissipative (J)."""
-    scene = traj.scene
     if scene.system.dissipative:
         parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
-        parts["E_heat"] = heat(traj)
+        parts["E_heat"] = heat(scene, t, state, events)
         parts["E_err"] = parts["E_lost"] - parts["E_heat"]
     return {name: parts[name] for name in energy_columns(scene)}
 
 
-def partition_from_terms(traj: Trajectory, terms: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def partition_from_terms(
+    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    terms: Columns,
+) -> dict[str, np.ndarray]:
     """The dumbbell's energy columns (J, :func:`energy_columns` order) from the general
     accounting of its bodies over the same samples (``terms``: K_cm, K_int, K_rot (the bodies'
-    own spin), U_g, U_spring, E, as :func:`dumbbell.spaces.accounting.evaluate` gives them).
+    own spin), U_g, U_spring, E, as :func:`dumbbell.spaces.accounting.evaluate` gives them);
+    ``t``, ``state`` and ``events`` as for :func:`partition`.
 
     K_cm, K_int (1D), U_g, U_spring and E are the accounting's. In 2D the internal motion is
     split the dumbbell's way, which the general accounting does not know: K_rot and K_vib of
     the axis from :func:`partition_2d`, and K_spin, the particles' own spin (the bodies' K_rot
     when each particle is a body; the discs' share of the one body when rigid). Equal to
     :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces.md)."""
-    scene = traj.scene
     parts = {name: terms[name] for name in ("K_cm", "U_g", "U_spring", "E")}
     if scene.system.dimensions == 1:
         parts["K_int"] = terms["K_int"]
     else:
-        rA = np.column_stack([traj["xA"], traj["yA"]])
-        rB = np.column_stack([traj["xB"], traj["yB"]])
-        vA = np.column_stack([traj["vxA"], traj["vyA"]])
-        vB = np.column_stack([traj["vxB"], traj["vyB"]])
         system = scene.system
         axis = partition_2d(system.A.mass, system.B.mass, system.k, system.b, system.g,
-                            rA, vA, rB, vB)
+                            *_positions_velocities(state))
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
         if spins(scene):
-            if scene.system.rigid is None:
-                parts["K_spin"] = terms["K_rot"]
-            else:
-                parts["K_spin"] = sum(
-                    rotational_ke(disc_inertia(p.mass, p.radius), traj.state[f"omega{p.name}"])
-                    for p in (scene.system.A, scene.system.B))
-    return _with_losses(traj, parts)
+            parts["K_spin"] = (terms["K_rot"] if system.rigid is None
+                               else _disc_spin(scene, state))
+    return _with_losses(scene, t, state, events, parts)
 
 
 def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
@@ -328,10 +337,11 @@ def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> f
     return scale if scale > 0 else 1.0
 
 
-def relative_energy_error(traj: Trajectory) -> np.ndarray:
-    """|E(t) - E(0)| / scale for every sample (dimensionless), scale from :func:`energy_scale`."""
-    E = traj["E"]
+def relative_energy_error(energy: Columns) -> np.ndarray:
+    """|E(t) - E(0)| / scale for every sample (dimensionless) of the energy columns ``energy``
+    (J, as :func:`partition` gives them), scale from :func:`energy_scale`."""
+    E = energy["E"]
     if len(E) == 0:
         return E
-    terms = {name: float(v[0]) for name, v in traj.energy.items() if name not in BOOKKEEPING}
+    terms = {name: float(v[0]) for name, v in energy.items() if name not in BOOKKEEPING}
     return np.abs(E - E[0]) / energy_scale(float(E[0]), terms)

@@ -5,13 +5,18 @@
 >>> traj.verdict.status, len(traj.events)                   # doctest: +SKIP
 ('ok', 22)
 
-State columns (positions in m, velocities in m/s) come from the solver; energy columns (J)
-are computed on first use by :mod:`dumbbell.model.energy`, the one place that knows the formulas.
+A Trajectory is frozen: a solver builds it once, after its verdict has decided where the run
+ends, and nobody changes it afterwards (its arrays are read-only). State columns (positions in m,
+velocities in m/s) come from the solver; energy columns (J) come from the solver where it
+counts them itself (pymunk), else from :mod:`dumbbell.model.energy`, the one place that knows
+the formulas, at construction.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -61,27 +66,61 @@ class Verdict:
         return f"{self.status} at t = {self.t:.6g} s: {self.reason}"
 
 
-@dataclass
+def read_only(values: Any) -> np.ndarray:
+    """A read-only view of the array ``values``; the caller's own array stays writeable."""
+    view = np.asarray(values).view()
+    view.flags.writeable = False
+    return view
+
+
+def _columns(columns: Mapping[str, Any], n: int, what: str) -> dict[str, np.ndarray]:
+    """Read-only views of ``columns``, each checked to hold ``n`` samples."""
+    out = {name: read_only(col) for name, col in columns.items()}
+    for name, col in out.items():
+        if len(col) != n:
+            raise ValueError(f"{what} column {name!r} has {len(col)} samples, t has {n}")
+    return out
+
+
+@dataclass(frozen=True, eq=False)
 class Trajectory:
     """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
 
     ``dt`` is the step used (s; None for the exact solution), ``every`` how many steps lie
     between samples, ``wall_time`` the solver's run time (s), ``info`` solver-specific notes
-    (for example settings used, or an estimated error).
+    (for example settings used, or an estimated error). ``energy`` holds the energy columns
+    (J) when the solver counted them itself; left None they are computed from the state by
+    :func:`dumbbell.model.energy.partition`. Every array is read-only and every column as long
+    as ``t``; a run that failed ends at its failure, energy columns included.
     """
 
     scene: Scene
     solver: str
     t: np.ndarray
-    state: dict[str, np.ndarray]
-    events: list[Impact] = field(default_factory=list)
+    state: Mapping[str, np.ndarray]
+    events: tuple[Impact, ...] = ()
     verdict: Verdict = field(default_factory=Verdict)
     dt: float | None = None
     every: int = 1
     wall_time: float = 0.0
-    info: dict[str, Any] = field(default_factory=dict)
-    _energy: dict[str, np.ndarray] | None = field(default=None, repr=False)
-    _momentum: np.ndarray | None = field(default=None, repr=False)
+    info: Mapping[str, Any] = field(default_factory=dict)
+    energy: Mapping[str, np.ndarray] | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        # The one place a frozen Trajectory's fields are set: copies and read-only views, so
+        # neither the solver nor a user can change the result afterwards.
+        put = object.__setattr__
+        t = read_only(self.t)
+        put(self, "t", t)
+        put(self, "state", _columns(self.state, len(t), "state"))
+        put(self, "events", tuple(self.events))
+        put(self, "info", dict(self.info))
+        energy = self.energy
+        if energy is None:
+            from .energy import partition
+
+            energy = partition(self.scene, self.t, self.state, self.events)
+        put(self, "energy", _columns(energy, len(t), "energy"))
 
     @property
     def columns(self) -> list[str]:
@@ -92,14 +131,12 @@ class Trajectory:
         return ["t", *state_columns(self.scene), *energy_columns(self.scene),
                 *momentum_columns(self.scene)]
 
-    @property
-    def energy(self) -> dict[str, np.ndarray]:
-        """Energy terms (J) by column name, computed once."""
-        if self._energy is None:
-            from .energy import partition
+    @cached_property
+    def _momentum(self) -> np.ndarray:
+        """L_cm (kg m^2/s), computed on first use (2D only)."""
+        from .energy import angular_momentum_cm
 
-            self._energy = partition(self)
-        return self._energy
+        return read_only(angular_momentum_cm(self.scene, self.state))
 
     def __getitem__(self, name: str) -> np.ndarray:
         if not isinstance(name, str):
@@ -113,14 +150,9 @@ class Trajectory:
         if name in self.state:
             return self.state[name]
         if name == "L_cm" and self.scene.system.dimensions == 2:
-            if self._momentum is None or len(self._momentum) != len(self.t):
-                from .energy import angular_momentum_cm
-
-                self._momentum = angular_momentum_cm(self)
             return self._momentum
-        energy = self.energy
-        if name in energy:
-            return energy[name]
+        if name in self.energy:
+            return self.energy[name]
         from ..errors import ColumnError
 
         raise ColumnError(f"name = {name!r}: no such column; columns are "

@@ -55,8 +55,7 @@ from ..model.energy import disc_inertia, partition_from_terms, spins, state_colu
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
-from .stepping import blowup_verdict
-from .verdicts import energy_verdict, nonfinite_reason, tunnel_reason
+from .verdicts import conclude, nonfinite_reason, tunnel_reason
 
 NAME = "pymunk"
 
@@ -215,31 +214,35 @@ def _vertical_velocity(body: Any, shape: Any) -> float:
     return float(body.velocity_at_world_point(body.local_to_world(shape.offset))[1])
 
 
-def _energy(scene: Scene, world: World, traj: Trajectory) -> dict[str, np.ndarray]:
+def _energy(
+    scene: Scene, world: World, t: np.ndarray, state: dict[str, np.ndarray],
+    events: list[Impact],
+) -> dict[str, np.ndarray]:
     """The energy columns (J) from the general accounting of pymunk's own bodies, springs and
     gravity (:mod:`dumbbell.spaces.accounting`), evaluated over all samples at once."""
     from ..spaces.accounting import State, evaluate, inventory
 
     inv = inventory(world.space)
-    n = len(traj.t)
+    n = len(t)
     zero = np.zeros(n)
     if world.rigid_body is not None:
         mA, mB, M = scene.system.A.mass, scene.system.B.mass, scene.system.M
-        cols = [[(mA * traj[f"{c}A"] + mB * traj[f"{c}B"]) / M]
+        cols = [[(mA * state[f"{c}A"] + mB * state[f"{c}B"]) / M]
                 for c in ("x", "y", "vx", "vy")]
-        omega = [traj.state["omega"]]
+        omega = [state["omega"]]
     else:
         if scene.system.dimensions == 1:
-            cols = [[zero, zero], [traj["xA"], traj["xB"]], [zero, zero], [traj["vA"], traj["vB"]]]
+            cols = [[zero, zero], [state["xA"], state["xB"]], [zero, zero],
+                    [state["vA"], state["vB"]]]
         else:
-            cols = [[traj[f"{c}A"], traj[f"{c}B"]] for c in ("x", "y", "vx", "vy")]
-        omega = ([traj.state["omegaA"], traj.state["omegaB"]] if spins(scene)
+            cols = [[state[f"{c}A"], state[f"{c}B"]] for c in ("x", "y", "vx", "vy")]
+        omega = ([state["omegaA"], state["omegaB"]] if spins(scene)
                  else [zero, zero])
     # Tracked bodies beyond the dynamic ones (a floor's static body) never move.
     extra = len(inv.bodies) - len(omega)
     pad = [zero] * extra
     st = State(*(np.column_stack(c + pad) for c in (*cols, [zero] * len(omega), omega)))
-    return partition_from_terms(traj, evaluate(inv, st))
+    return partition_from_terms(scene, t, state, events, evaluate(inv, st))
 
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
@@ -327,18 +330,13 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     if world.rigid_body is not None and spins(scene):
         state["omegaA"] = state["omegaB"] = state["omega"]
     cfg = settings(scene)
-    traj = Trajectory(
-        scene=scene, solver=NAME, t=options.sample_times(kept), state=state,
-        events=[e for e in events if verdict is None or e.t <= verdict.t], dt=dt, every=every,
-        wall_time=wall, info={"steps": min(n, kept * every) if verdict else n, **cfg},
-    )
+    info = {"steps": min(n, kept * every) if verdict else n, **cfg}
     if world.rigid_body is not None:
-        traj.info["moment"] = world.rigid_body.moment
-    traj._energy = _energy(scene, world, traj)
-    if verdict is not None and verdict.status == "unstable":
-        verdict = blowup_verdict(traj, verdict.t, dt)
-    traj.verdict = verdict if verdict is not None else energy_verdict(traj, dt)
-    return traj
+        info["moment"] = world.rigid_body.moment
+    t = options.sample_times(kept)
+    events = [e for e in events if verdict is None or e.t <= verdict.t]
+    return conclude(scene, NAME, t, state, events, verdict or Verdict(), dt=dt, every=every,
+                    wall_time=wall, info=info, energy=_energy(scene, world, t, state, events))
 
 
 class Pymunk(Solver):

@@ -20,11 +20,12 @@ import time
 
 import numpy as np
 
+from ..model.energy import partition_1d
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params
 from .kernels import EVENT_BUFFER
-from .stepping import Stepper, kernel_verdict, run_kernel
+from .stepping import Stepper, finish, run_kernel
 from .verdicts import below_floor_verdict
 
 NAME = "euler-cromer"
@@ -43,7 +44,6 @@ def supports(scene: Scene) -> str | None:
 def warm_up() -> float:
     """Compile (or load from numba's cache) the loop and the 1D energy partition; returns the
     seconds it took."""
-    from ..model.energy import partition_1d
     from .kernels.euler_cromer import advance
 
     t0 = time.perf_counter()
@@ -68,23 +68,19 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     out[:, 0] = st
     run = run_kernel(advance, (mA, mB, k, b, g, e, floor), st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
-    i, events, wall = run.steps, run.events, run.wall
+    i = run.steps
 
     kept = i // every + 1
-    traj = Trajectory(
-        scene=scene, solver=NAME, t=options.sample_times(kept),
-        state={name: out[c, :kept] for c, name in enumerate(("xA", "vA", "xB", "vB"))},
-        events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
-    )
+    state = {name: out[c, :kept] for c, name in enumerate(("xA", "vA", "xB", "vB"))}
 
     def below_floor(body: str) -> Verdict:
         c = 0 if body == "A" else 2
         f = k * (st[0] - st[2] - b)
         push = f / mA if body == "A" else -f / mB  # the spring's downward pull on the body
-        return below_floor_verdict(traj, i * dt, body, st[c], st[c + 1], dt, push)
+        E = partition_1d(mA, mB, k, b, g, *out[:, [0, kept - 1]])["E"]  # at the start and end
+        return below_floor_verdict(scene, i * dt, body, st[c], st[c + 1], dt, push, E=E)
 
-    traj.verdict = kernel_verdict(traj, run, dt, below_floor)
-    return traj
+    return finish(scene, NAME, run, options, state, below_floor)
 
 
 class EulerCromer(Stepper):

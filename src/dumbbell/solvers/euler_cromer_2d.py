@@ -28,7 +28,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params, point_particle_limits
 from .kernels import EVENT_BUFFER
-from .stepping import Stepper, kernel_verdict, run_kernel
+from .stepping import Stepper, finish, run_kernel
 
 NAME = "euler-cromer-2d"
 
@@ -67,12 +67,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     warm_up()  # compiling is not part of the run time
     run = run_kernel(advance, (mA, mB, k, b, g, e, floor, A.radius, B.radius), st, out,
                      options, f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
-    i, events, wall = run.steps, run.events, run.wall
+    i = run.steps
 
     kept = i // every + 1
-    traj = Trajectory(scene=scene, solver=NAME, t=options.sample_times(kept),
-                      state={name: out[:kept, c].copy() for c, name in enumerate(_COLUMNS)},
-                      events=events, dt=dt, every=every, wall_time=wall, info={"steps": i})
+    state = {name: out[:kept, c].copy() for c, name in enumerate(_COLUMNS)}
 
     def below_floor(body: str) -> Verdict:
         y = st[1] if body == "A" else st[5]
@@ -80,8 +78,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                        f"{body} is {-y:.3g} m below the floor and still moving down: "
                        "the step is too long for the bounce to catch it")
 
-    traj.verdict = kernel_verdict(traj, run, dt, below_floor)
-    return traj
+    return finish(scene, NAME, run, options, state, below_floor)
 
 
 class EulerCromer2D(Stepper):

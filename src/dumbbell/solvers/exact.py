@@ -26,7 +26,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
-from .verdicts import truth_verdict
+from .verdicts import conclude
 
 NAME = "exact"
 
@@ -244,13 +244,9 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
             for name, value in zip(cols, motion.state(seg, t[lo:hi] - seg.t0), strict=True):
                 cols[name][lo:hi] = value
     wall = time.perf_counter() - t0
-    traj = Trajectory(
-        scene=scene, solver=NAME, t=t, state=cols, events=events, dt=options.dt,
-        every=options.every, wall_time=wall,
-        info={"segments": len(segs), "root_xtol": ROOT_XTOL},
-    )
-    traj.verdict = truth_verdict(traj, verdict)
-    return traj
+    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
+                    wall_time=wall, info={"segments": len(segs), "root_xtol": ROOT_XTOL},
+                    truth=True)
 
 
 def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
@@ -266,13 +262,10 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
         t = t[t <= verdict.t]
     cols = sample(scene, segs, t)
     wall = time.perf_counter() - t0
-    traj = Trajectory(
-        scene=scene, solver=NAME, t=t, state=cols, events=events, dt=options.dt,
-        every=options.every, wall_time=wall,
-        info={"segments": len(segs), "root_xtol": RIGID_XTOL, "moment": rigid_moment(scene)},
-    )
-    traj.verdict = truth_verdict(traj, verdict)
-    return traj
+    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
+                    wall_time=wall, truth=True,
+                    info={"segments": len(segs), "root_xtol": RIGID_XTOL,
+                          "moment": rigid_moment(scene)})
 
 
 class Exact(Solver):

@@ -22,7 +22,7 @@ integration restarts. Samples come from the integrator's dense output at the sam
 
 The reference states its own error: unless told not to, it runs a second time at a ten times
 tighter tolerance (2D spring: half the step angle) and puts the largest position difference (over the first 2 s and over the
-whole run), the impact-time difference and its energy error into ``traj.info["estimated_error"]``.
+whole run), the impact-time difference and its energy error into ``info["estimated_error"]``.
 Over a long run of a chaotic scene the position difference grows like any other; over the
 window it is the honest error bar.
 
@@ -55,7 +55,7 @@ from ..model.energy import (
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
-from .verdicts import truth_verdict
+from .verdicts import head, judge
 
 NAME = "reference"
 
@@ -305,37 +305,44 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
         cols, impacts, verdict, nfev = integrate(scene, times, options.t_end, pb=pb)
     wall = time.perf_counter() - t0
     n = len(next(iter(cols.values())))
-    traj = Trajectory(scene=scene, solver=NAME, t=times[:n], state=cols, events=impacts,
-                      dt=options.dt, every=options.every, wall_time=wall,
-                      info={"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev})
+    t = times[:n]
     if scene.system.dimensions == 2 and scene.system.rigid is None:
         from .reference_2d import STEP_ANGLE
 
-        traj.info = {"method": "RK8 (DOP853 stages) on d = rA - rB, fixed step",
-                     "step_angle": STEP_ANGLE, "rk_steps": nfev}
+        info = {"method": "RK8 (DOP853 stages) on d = rA - rB, fixed step",
+                "step_angle": STEP_ANGLE, "rk_steps": nfev}
+    else:
+        info = {"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev}
     if scene.system.rigid is not None:
-        traj.info["moment"] = rigid_moment(scene)
-    traj.verdict = truth_verdict(traj, verdict)
-    if estimate_error and len(traj.t):
-        traj.info["estimated_error"] = _estimate_error(traj)
-    return traj
+        info["moment"] = rigid_moment(scene)
+    verdict, keep, energy = judge(scene, NAME, t, cols, impacts, verdict, options.dt,
+                                  truth=True)
+    t, cols = t[:keep], head(cols, keep)
+    if estimate_error and len(t):
+        info["estimated_error"] = _estimate_error(scene, t, cols, impacts, energy)
+    return Trajectory(scene=scene, solver=NAME, t=t, state=cols, events=impacts,
+                      verdict=verdict, dt=options.dt, every=options.every, wall_time=wall,
+                      info=info, energy=energy)
 
 
-def _estimate_error(traj: Trajectory) -> dict[str, float]:
-    """Differences from a run at 10x tighter tolerance, and the energy error."""
-    scene = traj.scene
-    cols, impacts, _, _ = integrate(scene, traj.t, float(traj.t[-1]), tight=True)
-    n = min(len(traj.t), len(next(iter(cols.values()))))
+def _estimate_error(
+    scene: Scene, t: np.ndarray, state: dict[str, np.ndarray], events: list[Impact],
+    energy: dict[str, np.ndarray],
+) -> dict[str, float]:
+    """Differences from a run at 10x tighter tolerance over the samples ``t`` (s) of
+    ``state`` with impacts ``events``, and the largest relative error of ``energy`` (J)."""
+    cols, impacts, _, _ = integrate(scene, t, float(t[-1]), tight=True)
+    n = min(len(t), len(next(iter(cols.values()))))
     pos = [c for c in state_columns(scene) if not c.startswith("v")]
-    diff = np.max([np.abs(traj.state[c][:n] - cols[c][:n]) for c in pos], axis=0)
-    window = traj.t[:n] <= ERROR_WINDOW + 1e-12
+    diff = np.max([np.abs(state[c][:n] - cols[c][:n]) for c in pos], axis=0)
+    window = t[:n] <= ERROR_WINDOW + 1e-12
     est = {
         "position_m_window": float(diff[window].max()),
-        "window_s": float(min(ERROR_WINDOW, traj.t[n - 1])),
+        "window_s": float(min(ERROR_WINDOW, t[n - 1])),
         "position_m_whole_run": float(diff.max()),
-        "energy_relative": float(relative_energy_error(traj).max()),
+        "energy_relative": float(relative_energy_error(energy).max()),
     }
-    early = [(a, b) for a, b in zip(impacts, traj.events, strict=False)
+    early = [(a, b) for a, b in zip(impacts, events, strict=False)
              if max(a.t, b.t) <= ERROR_WINDOW and a.body == b.body]
     if early:
         est["impact_time_s_window"] = float(max(abs(a.t - b.t) for a, b in early))

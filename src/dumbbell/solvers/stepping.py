@@ -2,8 +2,8 @@
 
 Each has a numba kernel (contract in :mod:`dumbbell.solvers.kernels`). It stops early on a bad
 status or when its impact buffer is nearly full; :func:`run_kernel` calls it chunk by chunk,
-which is also what moves the progress bar, and :func:`kernel_verdict` is the one mapping
-from the status it ended with to a verdict.
+which is also what moves the progress bar; :func:`kernel_verdict` names the status it ended
+with as a verdict, and :func:`finish` hands the samples to :func:`~.verdicts.conclude`.
 """
 
 from __future__ import annotations
@@ -14,11 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
 from .base import RunOptions, Solver
-from .kernels import BIG, BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B
-from .verdicts import energy_verdict, keep_samples, nonfinite_reason
+from .kernels import BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B
+from .verdicts import conclude, nonfinite_reason
 
 
 class Stepper(Solver):
@@ -67,38 +68,33 @@ def run_kernel(
     return KernelRun(i, status, events, time.perf_counter() - t0)
 
 
-def trim_blown_up(traj: Trajectory) -> None:
-    """Keep the samples before the first one whose state is non-finite or beyond :data:`BIG`."""
-    good = np.ones(len(traj.t), dtype=bool)
-    for col in traj.state.values():
-        good &= np.abs(col) < BIG
-    keep_samples(traj, int(np.argmin(good)) if not good.all() else len(good))
-
-
-def blowup_verdict(traj: Trajectory, t_overflow: float, dt: float) -> Verdict:
-    """The verdict of a run whose state overflowed at ``t_overflow`` (s): ``unstable`` from the
-    first sample whose energy error passed the scene's threshold, with the samples after it
-    dropped (they hold only the explosion, up to 1e300 J, which would swamp every plot and
-    bar scale), else from the overflow itself."""
-    trim_blown_up(traj)
-    verdict = energy_verdict(traj, dt)
-    if verdict.ok:
-        verdict = Verdict("unstable", t_overflow, nonfinite_reason(traj.scene, dt))
-    return verdict
-
-
 def kernel_verdict(
-    traj: Trajectory, run: KernelRun, dt: float,
+    scene: Scene, run: KernelRun, dt: float,
     below_floor: Callable[[str], Verdict],
     at_rest: Callable[[], Verdict] | None = None,
 ) -> Verdict:
-    """The verdict of a kernel run that ended with ``run.status``: blown up (:func:`blowup_verdict`),
-    a particle below the floor (``below_floor("A" or "B")``, the solver's own diagnosis),
-    at rest on the floor (``at_rest()``), else the energy check. ``dt`` is the step (s)."""
+    """The solver's own verdict on a kernel run that ended with ``run.status``: blown up
+    (``unstable`` at the overflow, :func:`~.verdicts.judge` then looks for an earlier energy
+    failure), a particle below the floor (``below_floor("A" or "B")``, the solver's own
+    diagnosis), at rest on the floor (``at_rest()``), else ok. ``dt`` is the step (s)."""
     if run.status == BLOWUP:
-        return blowup_verdict(traj, run.steps * dt, dt)
+        return Verdict("unstable", run.steps * dt, nonfinite_reason(scene, dt))
     if run.status in (TUNNEL_A, TUNNEL_B):
         return below_floor("A" if run.status == TUNNEL_A else "B")
     if run.status == REST and at_rest is not None:
         return at_rest()
-    return energy_verdict(traj, dt)
+    return Verdict()
+
+
+def finish(
+    scene: Scene, name: str, run: KernelRun, options: RunOptions, state: dict[str, np.ndarray],
+    below_floor: Callable[[str], Verdict], at_rest: Callable[[], Verdict] | None = None,
+) -> Trajectory:
+    """The Trajectory of a kernel run whose samples are ``state`` (every ``options.every``-th
+    step from the start): the verdict of :func:`kernel_verdict`, settled by
+    :func:`~.verdicts.conclude`."""
+    dt = options.dt
+    kept = len(next(iter(state.values())))
+    return conclude(scene, name, options.sample_times(kept), state, run.events,
+                    kernel_verdict(scene, run, dt, below_floor, at_rest), dt=dt,
+                    every=options.every, wall_time=run.wall, info={"steps": run.steps})

@@ -1,7 +1,10 @@
 """Verdicts shared by the solvers: how a run ended, and the likely cause in words.
 
-A solver that stops early keeps its samples up to the failure (:func:`keep_samples`) and sets
-``traj.verdict`` to one of these, whose ``str`` is the line ``dumbbell simulate`` prints:
+A solver hands its raw samples and its own verdict (from its status) to :func:`conclude`, the
+one path from a finished run to its frozen Trajectory: :func:`judge` settles the final verdict
+and how many samples the run keeps (those up to the failure), without changing any array, and
+the Trajectory is built once from them. The verdict's ``str`` is the line ``dumbbell
+simulate`` prints:
 
 - ``unstable``: the state stopped being finite or the energy grew past ``run.unstable_energy``
   ("unstable at t = 0.031 s: w*dt = 2.10 > 2 (w = sqrt(k/mu) = 1000 rad/s); use dt < 2e-3 s");
@@ -15,12 +18,15 @@ w = sqrt(k/mu)) is in docs/physics.md.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
-from ..model.energy import relative_energy_error
+from ..model.energy import partition, relative_energy_error
 from ..model.scene import Scene
-from ..model.trajectory import Trajectory, Verdict
+from ..model.trajectory import Impact, Trajectory, Verdict
+from .kernels import BIG
 
 #: The explicit spring step (Euler-Cromer, Verlet, pymunk) is stable iff w*dt < this.
 STEP_LIMIT = 2.0
@@ -93,18 +99,18 @@ def tunnel_reason(
 
 
 def below_floor_verdict(
-    traj: Trajectory, t: float, body: str, height: float, speed: float, dt: float,
-    push: float = 0.0, depth: float | None = None,
+    scene: Scene, t: float, body: str, height: float, speed: float, dt: float,
+    push: float = 0.0, depth: float | None = None, E: Sequence[float] | None = None,
 ) -> Verdict:
     """The verdict for ``body`` found ``height`` (m, < 0) below the floor at time ``t`` (s),
     moving down at ``speed`` (m/s) although the floor should have turned it back. ``push`` is
-    the spring's downward acceleration on it (m/s^2), ``depth`` as in :func:`tunnel_reason`.
+    the spring's downward acceleration on it (m/s^2), ``depth`` as in :func:`tunnel_reason`,
+    ``E`` the total energy (J) at the run's first and last samples, if known.
 
     Moving down no faster than a few steps of gravity plus the spring's push give, it is held
     on the floor (at rest, or pressed by the other particle), which a velocity-flip rule
     cannot do: ``failed``, saying how much energy was left. Otherwise it went through:
     ``tunnelled``."""
-    scene = traj.scene
     pressed = max(push, 0.0)
     if abs(speed) <= 3.0 * (scene.system.g + pressed) * dt:
         how = (f"pressed onto it by the spring at {pressed:.3g} m/s^2" if pressed > scene.system.g
@@ -112,8 +118,8 @@ def below_floor_verdict(
         reason = (f"{body} stays on the floor, {how} ({abs(height):.2g} m below it, moving at "
                   f"{abs(speed):.2g} m/s): a velocity-flip floor cannot hold a particle in "
                   "lasting contact")
-        if len(traj.t) and scene.system.floor is not None and scene.system.floor.elasticity >= 1.0:
-            E = traj["E"]
+        floor = scene.system.floor
+        if E is not None and len(E) and floor is not None and floor.elasticity >= 1.0:
             left = float(E[-1] / E[0]) if E[0] else math.nan
             if left < 0.5:
                 reason += (f"; the floor is elastic, so the step's impact errors drained the "
@@ -126,61 +132,53 @@ def below_floor_verdict(
     return Verdict("tunnelled", t, reason)
 
 
-def keep_samples(traj: Trajectory, count: int) -> None:
-    """Keep only the first ``count`` samples of ``traj`` (the ones before a failure)."""
-    count = max(0, min(count, len(traj.t)))
-    traj.t = traj.t[:count]
-    traj.state = {name: col[:count] for name, col in traj.state.items()}
-    traj._energy = None
-    traj._momentum = None
-
-
 #: A truth solver's samples may lie at most this far below the floor (m): more means it
 #: missed an impact, and its run must not end ``ok``.
 FLOOR_TOLERANCE = 1e-9
 
 
-def truth_verdict(traj: Trajectory, verdict: Verdict) -> Verdict:
-    """The verdict of a truth solver (exact, reference) that ended with ``verdict``: if any
-    sample has a particle more than FLOOR_TOLERANCE below the floor, ``failed`` at the first
-    such sample (the trajectory is cut after it: the truth missed an impact); else the
-    solver's own verdict, or when that is ok :func:`energy_verdict`."""
-    scene = traj.scene
-    if scene.system.floor is not None and len(traj.t):
-        key = "x" if scene.system.dimensions == 1 else "y"
-        heights = np.vstack([traj.state[f"{key}{body}"] for body in "AB"])
-        bad = np.flatnonzero(np.min(heights, axis=0) < -FLOOR_TOLERANCE)
-        if bad.size:
-            j = int(bad[0])
-            body = "AB"[int(np.argmin(heights[:, j]))]
-            depth = float(-heights[:, j].min())
-            t_fail = float(traj.t[j])
-            keep_samples(traj, j + 1)
-            return Verdict("failed", t_fail,
-                           f"{body} is {depth:.3g} m below the floor (more than "
-                           f"{FLOOR_TOLERANCE:g} m): {traj.solver} missed an impact, so this "
-                           "run is not a truth")
-    return verdict if not verdict.ok else energy_verdict(traj, None)
+def missed_impact(
+    scene: Scene, solver: str, t: np.ndarray, state: Mapping[str, np.ndarray],
+) -> tuple[Verdict, int] | None:
+    """For a truth solver (exact, reference) with samples at ``t`` (s) of ``state``: if a
+    particle is more than FLOOR_TOLERANCE below the floor at some sample, ``failed`` at the
+    first such sample and the number of samples up to it (the truth missed an impact); else
+    None."""
+    if scene.system.floor is None or not len(t):
+        return None
+    key = "x" if scene.system.dimensions == 1 else "y"
+    heights = np.vstack([state[f"{key}{body}"] for body in "AB"])
+    bad = np.flatnonzero(np.min(heights, axis=0) < -FLOOR_TOLERANCE)
+    if not bad.size:
+        return None
+    j = int(bad[0])
+    body = "AB"[int(np.argmin(heights[:, j]))]
+    depth = float(-heights[:, j].min())
+    return Verdict("failed", float(t[j]),
+                   f"{body} is {depth:.3g} m below the floor (more than {FLOOR_TOLERANCE:g} m): "
+                   f"{solver} missed an impact, so this run is not a truth"), j + 1
 
 
-def energy_verdict(traj: Trajectory, dt: float | None) -> Verdict:
-    """``unstable`` if the relative energy error passes the scene's ``run.unstable_energy``
-    (the trajectory is then cut after the first such sample), else ``ok``. ``dt`` is the step
-    (s; None for the exact solution).
+def energy_verdict(
+    scene: Scene, t: np.ndarray, energy: Mapping[str, np.ndarray], dt: float | None,
+) -> tuple[Verdict, int]:
+    """``unstable`` if the relative energy error of the energy columns ``energy`` (J, at the
+    sample times ``t`` in s) passes the scene's ``run.unstable_energy``, else ``ok``; and how
+    many samples to keep (up to the first bad one; all when ok). ``dt`` is the step (s; None
+    for a truth solver, whose dt only sets the sample times).
 
     Dissipative scenes lose energy by design; only a gain past the threshold counts there."""
-    scene = traj.scene
-    if len(traj.t) == 0:
-        return Verdict()
-    err = relative_energy_error(traj)
+    if len(t) == 0:
+        return Verdict(), 0
+    err = relative_energy_error(energy)
     if scene.system.dissipative:
-        E = traj["E"]
+        E = energy["E"]
         err = np.where(E > E[0], err, 0.0)
     bad = np.flatnonzero(~(err <= scene.run.unstable_energy))
     if bad.size == 0:
-        return Verdict()
+        return Verdict(), len(t)
     j = int(bad[0])
-    t_fail = float(traj.t[j])
+    t_fail = float(t[j])
     ratio = step_ratio(scene, dt)
     if ratio >= STEP_LIMIT:
         reason = nonfinite_reason(scene, dt)  # type: ignore[arg-type]
@@ -192,5 +190,73 @@ def energy_verdict(traj: Trajectory, dt: float | None) -> Verdict:
             reason += (f"; w*dt = {ratio_text(ratio)} < 2, where even a stable step swings the "
                        f"vibration energy by up to {stable_swing(ratio):.3g} times itself: "
                        "raise run.unstable_energy if that swing is expected, or lower dt")
-    keep_samples(traj, j + 1)
-    return Verdict("unstable", t_fail, reason)
+    return Verdict("unstable", t_fail, reason), j + 1
+
+
+def finite_samples(state: Mapping[str, np.ndarray]) -> int:
+    """How many samples come before the first whose state is non-finite or beyond :data:`BIG`."""
+    columns = list(state.values())
+    if not columns:
+        return 0
+    good = np.ones(len(columns[0]), dtype=bool)
+    for col in columns:
+        good &= np.abs(col) < BIG
+    return int(np.argmin(good)) if not good.all() else len(good)
+
+
+def head(columns: Mapping[str, np.ndarray], count: int) -> dict[str, np.ndarray]:
+    """The first ``count`` samples of every column (views, not copies)."""
+    return {name: col[:count] for name, col in columns.items()}
+
+
+def judge(
+    scene: Scene, solver: str, t: np.ndarray, state: Mapping[str, np.ndarray],
+    events: Iterable[Impact], verdict: Verdict, dt: float | None,
+    energy: Mapping[str, np.ndarray] | None = None, truth: bool = False,
+) -> tuple[Verdict, int, dict[str, np.ndarray]]:
+    """The one mapping from how a run ended to its verdict. ``verdict`` is the solver's own
+    (from its status), ``t`` (s), ``state`` and ``events`` its raw samples and impacts,
+    ``energy`` its energy columns (J) if it counted them itself, ``dt`` its step (s).
+
+    - a truth solver (``truth``) whose samples pass below the floor: ``failed`` there
+      (:func:`missed_impact`);
+    - ``unstable`` (the state blew up): the samples before the explosion, then the energy
+      verdict if it finds the failure earlier, else the solver's;
+    - ``tunnelled``, ``failed``: the solver's, all samples kept;
+    - ``ok``: :func:`energy_verdict` (a truth solver's with no step).
+
+    Returns the verdict, how many samples the run keeps, and the energy columns of those
+    samples (from :func:`dumbbell.model.energy.partition` unless given). Changes nothing."""
+    keep = len(t)
+    if truth:
+        missed = missed_impact(scene, solver, t, state)
+        if missed is not None:
+            verdict, keep = missed
+        dt = None
+    elif verdict.status == "unstable":
+        # The explosion's samples (up to 1e300 J) would swamp every plot and bar scale.
+        keep = finite_samples(state)
+    t, state = t[:keep], head(state, keep)
+    energy = (partition(scene, t, state, events) if energy is None
+              else head(energy, keep))
+    if verdict.ok or verdict.status == "unstable":
+        judged, keep = energy_verdict(scene, t, energy, dt)
+        if not (judged.ok and verdict.status == "unstable"):
+            verdict = judged
+    return verdict, keep, head(energy, keep)
+
+
+def conclude(
+    scene: Scene, solver: str, t: np.ndarray, state: Mapping[str, np.ndarray],
+    events: Iterable[Impact], verdict: Verdict, *, dt: float | None, every: int = 1,
+    wall_time: float = 0.0, info: Mapping[str, Any] | None = None,
+    energy: Mapping[str, np.ndarray] | None = None, truth: bool = False,
+) -> Trajectory:
+    """The finished run as its one frozen Trajectory: :func:`judge` decides the verdict and
+    where the run ends, then the Trajectory is built from the samples kept. Arguments as for
+    :func:`judge`; ``every``, ``wall_time`` (s) and ``info`` go to the Trajectory as they are."""
+    events = tuple(events)
+    verdict, keep, energy = judge(scene, solver, t, state, events, verdict, dt, energy, truth)
+    return Trajectory(scene=scene, solver=solver, t=t[:keep], state=head(state, keep),
+                      events=events, verdict=verdict, dt=dt, every=every, wall_time=wall_time,
+                      info=dict(info or {}), energy=energy)

@@ -31,7 +31,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params, point_particle_limits
 from .kernels import EVENT_BUFFER
-from .stepping import Stepper, kernel_verdict, run_kernel
+from .stepping import Stepper, finish, run_kernel
 from .verdicts import tunnel_reason
 
 NAME = "verlet"
@@ -82,14 +82,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     out[0] = st
     run = run_kernel(kernel, (mA, mB, k, b, g, e, floor), st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=False)
-    i, events, wall = run.steps, run.events, run.wall
+    i, events = run.steps, run.events
 
     kept = i // every + 1
-    traj = Trajectory(
-        scene=scene, solver=NAME, t=options.sample_times(kept),
-        state={name: out[:kept, c] for c, name in enumerate(columns)},
-        events=events, dt=dt, every=every, wall_time=wall, info={"steps": i},
-    )
+    state = {name: out[:kept, c] for c, name in enumerate(columns)}
 
     def below_floor(body: str) -> Verdict:
         y, vy = vertical[body]
@@ -105,8 +101,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
             "many impacts in finite time here",
         )
 
-    traj.verdict = kernel_verdict(traj, run, dt, below_floor, at_rest)
-    return traj
+    return finish(scene, NAME, run, options, state, below_floor, at_rest)
 
 
 class Verlet(Stepper):
