@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import UsageError
+from . import args
 from .scene import Scene
 
 if TYPE_CHECKING:
@@ -66,19 +68,31 @@ class Verdict:
         return f"{self.status} at t = {self.t:.6g} s: {self.reason}"
 
 
-def read_only(values: Any) -> np.ndarray:
+def read_only(values: np.ndarray) -> np.ndarray:
     """A read-only view of the array ``values``; the caller's own array stays writeable."""
-    view = np.asarray(values).view()
+    view = values.view()
     view.flags.writeable = False
     return view
 
 
-def _columns(columns: Mapping[str, Any], n: int, what: str) -> dict[str, np.ndarray]:
-    """Read-only views of ``columns``, each checked to hold ``n`` samples."""
-    out = {name: read_only(col) for name, col in columns.items()}
-    for name, col in out.items():
+def _samples(values: Any, name: str) -> np.ndarray:
+    """``values`` (a 1-d array of numbers) as a read-only view; UsageError naming ``name``."""
+    array = np.asarray(values) if isinstance(values, np.ndarray | list | tuple) else None
+    if array is None or array.ndim != 1 or array.dtype.kind not in "fiu":
+        raise UsageError(f"{name} = {args.show(values)}: must be a 1-d array of numbers",
+                         param=name)
+    return read_only(array)
+
+
+def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
+    """Read-only views of the columns by name ``columns``, each checked to hold ``n``
+    samples (as many as ``t``); UsageError naming ``name``."""
+    args.mapping(columns, name, "a dict of columns by name")
+    out = {key: _samples(col, f"{name}[{key!r}]") for key, col in columns.items()}
+    for key, col in out.items():
         if len(col) != n:
-            raise ValueError(f"{what} column {name!r} has {len(col)} samples, t has {n}")
+            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
+                             f"t ({n})", param=name)
     return out
 
 
@@ -107,14 +121,25 @@ class Trajectory:
     energy: Mapping[str, np.ndarray] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
-        # The one place a frozen Trajectory's fields are set: copies and read-only views, so
-        # neither the solver nor a user can change the result afterwards.
+        # The one place a frozen Trajectory's fields are set: checked, then copies and
+        # read-only views, so neither the solver nor a user can change the result afterwards.
         put = object.__setattr__
-        t = read_only(self.t)
+        args.instance(self.scene, "scene", Scene, "a Scene")
+        args.text(self.solver, "solver", "the solver's name (str)")
+        args.instance(self.verdict, "verdict", Verdict, "a Verdict")
+        if self.dt is not None:
+            args.real(self.dt, "dt", "s")
+        args.whole(self.every, "every", "steps")
+        args.real(self.wall_time, "wall_time", "s", lo=0.0)
+        t = _samples(self.t, "t")
         put(self, "t", t)
         put(self, "state", _columns(self.state, len(t), "state"))
-        put(self, "events", tuple(self.events))
-        put(self, "info", dict(self.info))
+        events = self.events
+        if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
+            raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
+                             param="events")
+        put(self, "events", tuple(events))
+        put(self, "info", dict(args.mapping(self.info, "info", "a dict")))
         energy = self.energy
         if energy is None:
             from .energy import partition
@@ -210,7 +235,6 @@ class Trajectory:
         """Write the columns with a header row; written to a temporary name, then renamed
         (a device or a FIFO is written directly)."""
         from ..io.files import atomic_output
-        from . import args
 
         args.path(path, "path")
         # One open of our own: given a name, numpy opens the file twice, and the first,
@@ -223,7 +247,6 @@ class Trajectory:
     def events_to_csv(self, path: str | Path) -> Path:
         """Write the impacts as ``t,body,v_before,v_after`` (s, -, m/s, m/s)."""
         from ..io.files import atomic_output
-        from . import args
 
         args.path(path, "path")
         with atomic_output(path) as tmp, open(tmp, "w") as fh:
@@ -234,7 +257,5 @@ class Trajectory:
     def first_impact(self, body: str | None = None) -> Impact | None:
         """The first impact (of ``body`` if given), or None."""
         if body is not None:
-            from . import args
-
             args.choice(body, "body", ("A", "B"))
         return next((e for e in self.events if body in (None, e.body)), None)
