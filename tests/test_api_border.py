@@ -13,6 +13,7 @@ import dataclasses
 import functools
 import importlib
 import inspect
+import math
 import pkgutil
 import sys
 import types
@@ -25,7 +26,7 @@ import pytest
 from dumbbell import DumbbellError
 
 #: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
-PACKAGES = ("dumbbell.spaces", "dumbbell.examples")
+PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
 TOP = ("dumbbell",)
 
@@ -123,6 +124,102 @@ class Fixtures:
 
         return dumbbell.simulate(self.scene, "exact", t_end=0.5, dt=1e-2)
 
+    @functools.cached_property
+    def scene_2d(self) -> Any:
+        from dumbbell import load_scene
+        from tests.conftest import SCENES
+
+        return load_scene(SCENES / "tilted-2d.toml").with_values({"run.t_end": 0.3})
+
+    @functools.cached_property
+    def rigid_2d(self) -> Any:
+        from dumbbell import load_scene
+        from tests.conftest import SCENES
+
+        return load_scene(SCENES / "rigid-2d.toml")
+
+    @functools.cached_property
+    def topple_scene(self) -> Any:
+        from dumbbell import load_scene
+        from tests.conftest import SCENES
+
+        return load_scene(SCENES / "topple-2d.toml")
+
+    @functools.cached_property
+    def traj_2d(self) -> Any:
+        """The rigid 2D dumbbell through its first impact (exact, 1 ms samples)."""
+        import dumbbell
+
+        return dumbbell.simulate(self.rigid_2d, "exact", t_end=0.6, dt=1e-3)
+
+    @functools.cached_property
+    def comparison(self) -> Any:
+        import dumbbell
+
+        return dumbbell.compare(self.scene, ["euler-cromer"], [1e-3], window=0.02, t_end=0.05)
+
+    @functools.cached_property
+    def bench_result(self) -> Any:
+        import dumbbell
+
+        return dumbbell.bench(self.scene, ["euler-cromer"], [1e-3, 5e-4, 2.5e-4], window=0.02,
+                              repeat=1, t_end=0.05)
+
+    @functools.cached_property
+    def sweep_result(self) -> Any:
+        import dumbbell
+
+        return dumbbell.sweep(self.scene, {"k": [100.0, 200.0], "dt": [1e-3, 5e-4]},
+                              t_end=0.02)
+
+    @functools.cached_property
+    def series(self) -> Any:
+        from dumbbell.analysis.rotation import series
+
+        return series(self.scene_2d, dt=1e-4, t_end=0.05)
+
+    @functools.cached_property
+    def restitution(self) -> Any:
+        from dumbbell.analysis.restitution import restitution
+
+        return restitution(self.rigid_2d, [10.0, 20.0], stiffnesses=(), dt=1e-3)
+
+    @functools.cached_property
+    def topple_cf(self) -> Any:
+        from dumbbell.analysis.topple import closed_form
+
+        return closed_form(self.topple_scene)
+
+    @functools.cached_property
+    def topple_measure(self) -> Any:
+        import dumbbell
+        from dumbbell.analysis.topple import measure
+
+        return measure(dumbbell.simulate(self.topple_scene, "pymunk", dt=1e-3, every=1))
+
+    @functools.cached_property
+    def contact(self) -> Any:
+        from dumbbell.analysis.contact import about_contact
+
+        return about_contact(self.traj_2d)
+
+    @functools.cached_property
+    def maps(self) -> dict[str, list[dict[str, Any]]]:
+        """Stability-map rows of one made-up solver: stable up to w*dt = 2."""
+        from dumbbell.analysis.stability import MAP_RATIOS, MAP_WDT
+
+        return {"made-up": [{"w_dt": h, "verdict": "ok" if h < 2 else "unstable",
+                             "max_rel_energy_error": h / 4 if h < 2 else math.nan,
+                             "t_fail": None if h < 2 else 0.1}
+                            for h in MAP_WDT for _ in MAP_RATIOS]}
+
+    def ax(self, count: int = 1) -> Any:
+        """A new figure's axes: one, or a list of ``count``."""
+        import matplotlib.pyplot as plt
+
+        axes = plt.subplots(count, 1)[1]
+        return axes if count == 1 else list(axes)
+
     # pymunk ---------------------------------------------------------------------------------
     def space(self) -> Any:
         """A ball above a floor, on a spring to a second ball."""
@@ -218,6 +315,32 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.api.stability": lambda f: {
         "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
         "quiet": True},
+    # dumbbell.plot
+    "dumbbell.plot.trajectory.positions": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
+    "dumbbell.plot.trajectory.kinetic": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
+    "dumbbell.plot.trajectory.potential": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
+    "dumbbell.plot.trajectory.energy": lambda f: {"traj": f.traj_2d, "ax": f.ax(),
+                                                  "window": 0.3},
+    "dumbbell.plot.trajectory.heights": lambda f: {"traj": f.traj},
+    "dumbbell.plot.trajectory.momentum_axis": lambda f: {
+        "ax": f.ax(), "traj": f.traj_2d, "window": 0.5, "loc": "upper left", "ncol": 2},
+    "dumbbell.plot.compare.compare": lambda f: {"result": f.comparison, "ax": f.ax()},
+    "dumbbell.plot.compare.compare_positions": lambda f: {"result": f.comparison, "ax": f.ax()},
+    "dumbbell.plot.compare.compare_energy": lambda f: {"result": f.comparison, "ax": f.ax()},
+    "dumbbell.plot.bench.work_precision": lambda f: {"result": f.bench_result, "ax": f.ax()},
+    "dumbbell.plot.bench.convergence": lambda f: {"result": f.bench_result, "ax": f.ax()},
+    "dumbbell.plot.maps.sweep_map": lambda f: {"result": f.sweep_result, "ax": f.ax()},
+    "dumbbell.plot.maps.stability_map": lambda f: {"maps": f.maps},
+    "dumbbell.plot.maps.axis_label": lambda f: {"key": "spring.stiffness"},
+    "dumbbell.plot.rotation.rotation": lambda f: {"s": f.series, "ax": f.ax()},
+    "dumbbell.plot.rotation_chapter.restitution": lambda f: {"result": f.restitution,
+                                                             "ax": f.ax(3)},
+    "dumbbell.plot.rotation_chapter.topple": lambda f: {
+        "cf": f.topple_cf, "measured": f.topple_measure, "ax": f.ax(3), "solver": "pymunk"},
+    "dumbbell.plot.rotation_chapter.contact_momentum": lambda f: {
+        "cm": f.contact, "ax": f.ax(), "solver": "exact"},
+    "dumbbell.plot.style.solver_style": lambda f: {"name": "verlet", "i": 0},
+    "dumbbell.plot.style.pyplot": lambda f: {},
     # dumbbell.spaces.accounting
     "dumbbell.spaces.accounting.energy": lambda f: {"space": f.space(), "about": (0.0, 0.0)},
     "dumbbell.spaces.accounting.inventory": lambda f: {"space": f.space()},

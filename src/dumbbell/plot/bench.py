@@ -10,13 +10,22 @@ from typing import Any
 import numpy as np
 
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
+from ..model import args
 from ..solvers import solver_class
 from .style import pyplot, solver_style
+
+__all__ = ["convergence", "work_precision"]
+
+
+def _checked(result: Any, ax: Any) -> tuple[BenchResult, Any]:
+    return (args.instance(result, "result", BenchResult, "a BenchResult (from dumbbell.bench)"),
+            args.axes(ax))
 
 
 def work_precision(result: BenchResult, ax: Any = None) -> Any:
     """Log-log error (m) against run time (s), one line per solver, dt beside each point,
     failed runs as crosses on the top edge."""
+    result, ax = _checked(result, ax)
     own = ax is None
     if own:
         fig, ax = pyplot().subplots(figsize=(7.2, 6.0), dpi=100)
@@ -106,6 +115,7 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
 
 def convergence(result: BenchResult, ax: Any = None) -> Any:
     """Log-log error (m) against dt (s), one line per solver, with the fitted order."""
+    result, ax = _checked(result, ax)
     own = ax is None
     if own:
         fig, ax = pyplot().subplots(figsize=(7.2, 5.0), dpi=100)

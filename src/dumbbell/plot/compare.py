@@ -10,7 +10,15 @@ import numpy as np
 
 from ..analysis.compare import DIVERGED, Comparison
 from ..analysis.metrics import energy_error
+from ..model import args
 from .style import ROW_COLOURS, ROW_DASHES, pyplot
+
+__all__ = ["compare", "compare_energy", "compare_positions"]
+
+
+def _checked(result: Any, ax: Any) -> tuple[Comparison, Any]:
+    return (args.instance(result, "result", Comparison, "a Comparison (from dumbbell.compare)"),
+            args.axes(ax))
 
 
 def _shown(result: Comparison) -> float:
@@ -40,6 +48,7 @@ def _heights_panel(ax: Any, result: Comparison, body: str) -> None:
 def compare_positions(result: Comparison, ax: Any = None) -> Any:
     """Heights (m) of each solver over the truth's, twice the error window long: on ``ax``
     particle B only; without, A above B. Returns the (last) axes."""
+    result, ax = _checked(result, ax)
     if ax is not None:
         _heights_panel(ax, result, "B")
         ax.set_xlabel("t [s]")
@@ -60,6 +69,7 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
 def compare(result: Comparison, ax: Any = None) -> Any:
     """Largest position error (m, log scale) of each solver against the truth over time, with
     the truth's impacts and the error window marked."""
+    result, ax = _checked(result, ax)
     own = ax is None
     if own:
         fig, ax = pyplot().subplots(figsize=(10, 4.6))
@@ -100,6 +110,7 @@ def _truth_label(truth: Any) -> str:
 
 def compare_energy(result: Comparison, ax: Any = None) -> Any:
     """E(t)/E(0) - 1 of each solver and of the truth."""
+    result, ax = _checked(result, ax)
     own = ax is None
     if own:
         fig, ax = pyplot().subplots(figsize=(10, 4.6))

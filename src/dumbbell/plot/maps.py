@@ -12,7 +12,10 @@ import numpy as np
 from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP_WDT
 from ..analysis.sweep import Axis, SweepResult
 from ..errors import UsageError
+from ..model import args
 from .style import FAIL_COLOURS, pyplot
+
+__all__ = ["axis_label", "stability_map", "sweep_map"]
 
 
 def _edges(values: np.ndarray, log: bool) -> np.ndarray:
@@ -40,12 +43,31 @@ AXIS_LABELS = {"spring.stiffness": "k, spring constant [N/m]", "run.dt": "dt, ti
 
 
 def axis_label(key: str) -> str:
-    return AXIS_LABELS.get(key, key)
+    """The axis label of a swept scene key (its unit in brackets), else the key itself."""
+    return AXIS_LABELS.get(args.text(key, "key", "a dotted scene key (str)"), key)
+
+
+#: What every row of a stability map holds (:func:`dumbbell.analysis.stability.map_rows`).
+MAP_ROW_KEYS = ("w_dt", "verdict", "max_rel_energy_error")
+
+
+def _check_maps(maps: Any) -> None:
+    """``maps``: solver name -> its rows, one per point of the map's grid, in grid order."""
+    points = len(MAP_WDT) * len(MAP_RATIOS)
+    allowed = (f"must map solver names to lists of {points} rows (dicts with "
+               f"{', '.join(MAP_ROW_KEYS)}) from dumbbell.analysis.stability.map_rows")
+    if (not isinstance(maps, dict) or not maps
+            or not all(isinstance(k, str) and isinstance(v, list | tuple) and len(v) == points
+                       and all(isinstance(r, dict) and all(k in r for k in MAP_ROW_KEYS)
+                               for r in v) for k, v in maps.items())):
+        raise UsageError(f"maps = {args.show(maps)}: {allowed}", param="maps")
 
 
 def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     """The sweep's map: log10 of the largest relative energy error over the grid (two axes),
     or along its one axis, failures painted by verdict, and the line w*dt = 2."""
+    result = args.instance(result, "result", SweepResult, "a SweepResult (from dumbbell.sweep)")
+    ax = args.axes(ax)
     own = ax is None
     if own:
         fig, ax = pyplot().subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
@@ -179,6 +201,7 @@ def stability_map(maps: dict[str, list[dict[str, Any]]]) -> list[Any]:
     """One panel per solver (rows of :func:`dumbbell.analysis.stability.map_rows`): log10 of
     the largest relative energy error over (w*dt, mass ratio), blow-ups marked, and the line
     w*dt = 2. Makes its own figure (the panels share one colour bar); returns the panels."""
+    _check_maps(maps)
     n = len(maps)
     fig, axes = pyplot().subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")

@@ -13,6 +13,8 @@ from ..analysis.rotation import Series, mean_after_first_cluster
 from .style import COLOURS, pyplot
 from .trajectory import momentum_axis
 
+__all__ = ["rotation"]
+
 
 def _overlay(ax: Any, s: Series) -> None:
     """Every run's K_rot on one axes, the rigid dumbbell's dashed."""
@@ -34,6 +36,10 @@ def rotation(s: Series, ax: Any = None) -> Any:
     On ``ax``: every spring dumbbell's K_rot over the rigid one's. Without: one panel per run,
     with the vibration energy and the mean K_rot after the first impacts; returns the top
     panel."""
+    from ..model import args
+
+    s = args.instance(s, "s", Series, "a Series (from dumbbell.analysis.rotation.series)")
+    ax = args.axes(ax)
     labels = list(s.runs)
     rigid = s.runs["rigid"]
     if ax is not None:

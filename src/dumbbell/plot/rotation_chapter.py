@@ -14,6 +14,8 @@ if TYPE_CHECKING:
     from ..analysis.restitution import RestitutionResult
     from ..analysis.topple import ToppleClosedForm, ToppleMeasure
 
+__all__ = ["contact_momentum", "restitution", "topple"]
+
 #: Colours of the spring dumbbells, softest to stiffest.
 SPRING_COLOURS = ("#9ecae1", "#4292c6", "#08519c")
 
@@ -31,7 +33,12 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     """e_eff against tilt (degrees), then the impacts in the first cluster and the share of
     kinetic energy that went into rotation. ``ax``: three axes, or None for a new figure.
     Returns the three axes."""
-    from ..analysis.restitution import e_eff_rigid, k_rot_share_rigid
+    from ..analysis.restitution import RestitutionResult, e_eff_rigid, k_rot_share_rigid
+    from ..model import args
+
+    args.instance(result, "result", RestitutionResult,
+                  "a RestitutionResult (from dumbbell.analysis.restitution.restitution)")
+    ax = args.axes(ax, count=3)
 
     top, mid, bottom = _axes(ax, 3, figsize=(8.5, 9.0), sharex=True,
                              gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
@@ -95,6 +102,15 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
            solver: str = "pymunk") -> Any:
     """The topple against its closed form: angle, the centre of mass's horizontal position and
     the top particle's speed, all against time (s). ``ax``: three axes, or None."""
+    from ..analysis.topple import ToppleClosedForm, ToppleMeasure
+    from ..model import args
+
+    args.instance(cf, "cf", ToppleClosedForm,
+                  "a ToppleClosedForm (from dumbbell.analysis.topple.closed_form)")
+    args.instance(measured, "measured", ToppleMeasure,
+                  "a ToppleMeasure (from dumbbell.analysis.topple.measure)")
+    ax = args.axes(ax, count=3)
+    solver = args.text(solver, "solver", "a str (the name in the legend)")
     a1, a2, a3 = _axes(ax, 3, figsize=(8.5, 8.0), sharex=True)
     t, theta = cf.angle_curve()
     step = max(1, len(measured.t) // 60)
@@ -141,6 +157,13 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
 def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> Any:
     """Angular momentum about the contact point through one impact: L_cm and the orbital part
     jump, their sum L_P does not. Time in ms from the impact. Returns the axes."""
+    from ..analysis.contact import ContactMomentum
+    from ..model import args
+
+    args.instance(cm, "cm", ContactMomentum,
+                  "a ContactMomentum (from dumbbell.analysis.contact.about_contact)")
+    ax = args.axes(ax)
+    solver = args.text(solver, "solver", "a str (the name in the title)")
     ax = _axes(ax, 1, figsize=(8.5, 4.6))
     t = (cm.t - cm.impact.t) * 1e3
     ax.axvline(0, color="0.6", lw=0.8, ls=":")

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 from typing import Any
 
+__all__ = ["COLOURS", "FAIL_COLOURS", "HEAT_COLOUR", "LABELS", "MOMENTUM_COLOUR", "ROW_COLOURS",
+           "ROW_DASHES", "SOLVER_STYLES", "pyplot", "solver_style"]
+
 #: Colour of each particle, the centre of mass and each energy term.
 COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",
            "K_rot": "#2ca02c", "K_vib": "#d62728", "K_spin": "#9467bd", "U_g": "#8c564b",
@@ -41,6 +44,10 @@ FAIL_COLOURS = {"unstable": "#bdbdbd", "tunnelled": "#f4a582", "failed": "#4d4d4
 
 def solver_style(name: str, i: int) -> tuple[str, str]:
     """Colour and marker of solver ``name``; the ``i``-th default for one without a style."""
+    from ..model import args
+
+    name = args.text(name, "name", "a solver name (str)")
+    i = args.whole(i, "i", "index", lo=0)
     return SOLVER_STYLES.get(name, (f"C{i % 10}", "D"))
 
 

@@ -17,11 +17,18 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import UsageError
+from ..model import args
 from ..model.trajectory import Trajectory
 from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, pyplot
 
+__all__ = ["WINDOW", "energy", "heights", "kinetic", "momentum_axis", "positions", "potential"]
+
 #: The textbook's time window (s).
 WINDOW = 2.0
+#: Where matplotlib can put a legend.
+LEGEND_LOCATIONS = ("best", "upper right", "upper left", "lower left", "lower right", "right",
+                    "center left", "center right", "lower center", "upper center", "center")
 
 
 def _window(traj: Trajectory, window: float) -> np.ndarray:
@@ -30,6 +37,7 @@ def _window(traj: Trajectory, window: float) -> np.ndarray:
 
 def heights(traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Vertical positions of A, B and the centre of mass (m), in 1D or 2D."""
+    args.trajectory(traj)
     scene = traj.scene
     key = "x" if scene.system.dimensions == 1 else "y"
     a, b = traj[f"{key}A"], traj[f"{key}B"]
@@ -91,6 +99,11 @@ def _frame(axes: list[Any], traj: Trajectory, window: float) -> None:
     _mark_first_impact(axes, traj, window, text=True)
 
 
+def _checked(traj: Any, ax: Any, window: Any) -> tuple[Trajectory, Any, float]:
+    """A figure's arguments at the border: a Trajectory, None or an Axes, a window > 0 (s)."""
+    return args.trajectory(traj), args.axes(ax), args.real(window, "window", "s")
+
+
 def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle: str) -> None:
     """Finish a figure this module made: shared frame, then the title naming the run."""
     _frame(axes, traj, window)
@@ -104,6 +117,7 @@ def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle:
 
 def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.13: heights of A, B and the centre of mass (m) over [0, window] s."""
+    traj, ax, window = _checked(traj, ax, window)
     if ax is not None:
         _positions_panel(ax, traj, window)
         _frame([ax], traj, window)
@@ -133,6 +147,7 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
 def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.14: the kinetic energy split into K_cm and K_int (in 2D K_rot, K_vib, K_spin),
     and E (J); without ``ax``, below the positions."""
+    traj, ax, window = _checked(traj, ax, window)
     names = ["K_cm", "K_int", "E"] if traj.scene.system.dimensions == 1 else [
         n for n in ("K_cm", "K_rot", "K_vib", "K_spin", "E") if n in traj.columns]
     return _two_panel(traj, ax, names, window,
@@ -142,6 +157,7 @@ def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 def potential(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.15: the external (U_g) and internal (U_spring) potential energy (J); without
     ``ax``, below the positions."""
+    traj, ax, window = _checked(traj, ax, window)
     names = [n for n in ("U_g", "U_spring") if n in traj.columns]
     return _two_panel(traj, ax, names, window,
                       "potential energy: external (gravity) against internal (spring)")
@@ -154,7 +170,9 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.plot(xA, yA, color=COLOURS["A"], lw=0.5, alpha=0.5)
     ax.plot(xB, yB, color=COLOURS["B"], lw=0.5, alpha=0.5)
     t = traj.t[m]
-    snaps = np.searchsorted(t, np.arange(0.0, t[-1] + 1e-9, 0.1)) if len(t) else []
+    # Clipped: a snapshot time may round past the last sample (0.1 * 3 > 0.3).
+    snaps = (np.minimum(np.searchsorted(t, np.arange(0.0, t[-1] + 1e-9, 0.1)), len(t) - 1)
+             if len(t) else [])
     for j, i in enumerate(snaps):
         grey = str(round(0.75 - 0.7 * j / max(1, len(snaps) - 1), 3))
         ax.plot([xA[i], xB[i]], [yA[i], yB[i]], color=grey, lw=1.0, zorder=2)
@@ -180,6 +198,12 @@ def momentum_axis(ax: Any, traj: Trajectory, window: float, loc: str = "upper ce
                   ncol: int = 3) -> None:
     """L_cm (kg m^2/s) on a right-hand axis of ``ax``: flat in flight, a step at each impact.
     The legend of ``ax`` moves to the right-hand axis (at ``loc``, in ``ncol`` columns)."""
+    traj, ax, window = _checked(traj, ax, window)
+    if ax is None:
+        raise UsageError("ax = None: must be a matplotlib Axes (the axes to add to)",
+                              param="ax")
+    loc = args.choice(loc, "loc", LEGEND_LOCATIONS)
+    ncol = args.whole(ncol, "ncol", "legend columns")
     m = _window(traj, window)
     right = ax.twinx()
     L = traj["L_cm"][m]
@@ -204,6 +228,7 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     positions (and, in 2D, the motion in the plane), then two panels, the centre of mass's
     terms (K_cm, U_g) with E and E_lost, and the internal ones (K_int, or K_rot, K_vib,
     U_spring and K_spin); returns the centre-of-mass panel."""
+    traj, ax, window = _checked(traj, ax, window)
     cols = traj.columns
     outer = [n for n in ("K_cm", "U_g", "E", "E_lost", "E_heat") if n in cols]
     inner = [n for n in ("K_int", "K_rot", "K_vib", "U_spring", "K_spin") if n in cols]
