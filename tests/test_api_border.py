@@ -21,12 +21,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from dumbbell import DumbbellError
 
 #: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
-PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot")
+PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
 TOP = ("dumbbell",)
 
@@ -122,7 +123,7 @@ class Fixtures:
     def traj(self) -> Any:
         import dumbbell
 
-        return dumbbell.simulate(self.scene, "exact", t_end=0.5, dt=1e-2)
+        return dumbbell.simulate(self.scene, "exact", t_end=0.5, dt=1e-2, every=1)
 
     @functools.cached_property
     def scene_2d(self) -> Any:
@@ -191,11 +192,16 @@ class Fixtures:
         return closed_form(self.topple_scene)
 
     @functools.cached_property
-    def topple_measure(self) -> Any:
+    def topple_traj(self) -> Any:
         import dumbbell
+
+        return dumbbell.simulate(self.topple_scene, "pymunk", dt=1e-3, every=1)
+
+    @functools.cached_property
+    def topple_measure(self) -> Any:
         from dumbbell.analysis.topple import measure
 
-        return measure(dumbbell.simulate(self.topple_scene, "pymunk", dt=1e-3, every=1))
+        return measure(self.topple_traj)
 
     @functools.cached_property
     def contact(self) -> Any:
@@ -212,6 +218,19 @@ class Fixtures:
                              "max_rel_energy_error": h / 4 if h < 2 else math.nan,
                              "t_fail": None if h < 2 else 0.1}
                             for h in MAP_WDT for _ in MAP_RATIOS]}
+
+    @functools.cached_property
+    def run(self) -> Any:
+        """Euler-Cromer sampled at :attr:`traj`'s times (every 10 ms)."""
+        import dumbbell
+
+        return dumbbell.simulate(self.scene, "euler-cromer", dt=1e-3, t_end=0.5, every=10)
+
+    @functools.cached_property
+    def stability_result(self) -> Any:
+        import dumbbell
+
+        return dumbbell.stability(self.scene_file.parent, ["euler-cromer"], workers=1)
 
     def ax(self, count: int = 1) -> Any:
         """A new figure's axes: one, or a list of ``count``."""
@@ -315,6 +334,121 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.api.stability": lambda f: {
         "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
         "quiet": True},
+    # dumbbell.analysis.bench
+    "dumbbell.analysis.bench.BenchResult": lambda f: fields(f.bench_result),
+    "dumbbell.analysis.bench.BenchResult.speedups": lambda f: {"target": 1e-3},
+    "dumbbell.analysis.bench.Fit": lambda f: {"solver": "verlet", "order": 2.0,
+                                              "log10_c": 1.0, "dts": [1e-3, 1e-4]},
+    "dumbbell.analysis.bench.Point": lambda f: fields(f.bench_result.points[0]),
+    "dumbbell.analysis.bench.default_solvers": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.bench.default_spacing": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.bench.dt_label": lambda f: {"dt": 3.2e-6},
+    "dumbbell.analysis.bench.fit_order": lambda f: {"points": f.bench_result.points},
+    "dumbbell.analysis.bench.run_bench": lambda f: {
+        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
+        "repeat": 1, "t_end": 0.02, "budget": 10.0, "spacing": None, "quiet": True},
+    "dumbbell.analysis.bench.time_for_error": lambda f: {
+        "line": [(0.1, 1e-3), (1.0, 1e-5)], "target": 1e-4},
+    # dumbbell.analysis.compare
+    "dumbbell.analysis.compare.Comparison": lambda f: fields(f.comparison),
+    "dumbbell.analysis.compare.Row": lambda f: fields(f.comparison.rows[0]),
+    "dumbbell.analysis.compare.compare": lambda f: {
+        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
+        "t_end": 0.02, "quiet": True},
+    "dumbbell.analysis.compare.default_solvers": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.compare.write": lambda f: {"result": f.comparison, "out": f.tmp / "cmp"},
+    # dumbbell.analysis.contact, extended, metrics
+    "dumbbell.analysis.contact.ContactMomentum": lambda f: fields(f.contact),
+    "dumbbell.analysis.contact.about_contact": lambda f: {"traj": f.traj_2d, "index": 0,
+                                                         "window": 0.01},
+    "dumbbell.analysis.extended.extended_precision_exact": lambda f: {"traj": f.traj,
+                                                                     "window": 0.3},
+    "dumbbell.analysis.extended.extended_precision_rigid": lambda f: {"traj": f.traj_2d,
+                                                                     "window": 0.3},
+    "dumbbell.analysis.metrics.coordinate_error": lambda f: {"run": f.run, "truth": f.traj},
+    "dumbbell.analysis.metrics.energy_error": lambda f: {"traj": f.run, "truth": f.traj},
+    "dumbbell.analysis.metrics.energy_spread": lambda f: {"traj": f.run},
+    "dumbbell.analysis.metrics.impact_time_error": lambda f: {"traj": f.run, "truth": f.traj,
+                                                             "window": 0.3},
+    "dumbbell.analysis.metrics.position_columns": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.metrics.position_error": lambda f: {"traj": f.run, "truth": f.traj,
+                                                          "window": 0.3},
+    # dumbbell.analysis.restitution
+    "dumbbell.analysis.restitution.Bounce": lambda f: {
+        "e_first": 0.9, "e_cluster": 0.8, "impacts": 2, "share_first": 0.1,
+        "share_cluster": 0.2},
+    "dumbbell.analysis.restitution.RestitutionResult": lambda f: fields(f.restitution),
+    "dumbbell.analysis.restitution.bounce": lambda f: {"traj": f.traj_2d, "gap": 0.05},
+    "dumbbell.analysis.restitution.drop_duration": lambda f: {"scene": f.rigid_2d},
+    "dumbbell.analysis.restitution.e_eff_rigid": lambda f: {"theta_deg": [0.0, 30.0],
+                                                           "e": 1.0, "q": 1.0},
+    "dumbbell.analysis.restitution.k_rot_share_rigid": lambda f: {"theta_deg": 30.0,
+                                                                 "e": 0.5, "q": 1.0},
+    "dumbbell.analysis.restitution.restitution": lambda f: {
+        "scene": f.rigid_2d, "thetas": [10.0], "stiffnesses": (), "dt": 1e-3,
+        "progress": lambda: None},
+    "dumbbell.analysis.restitution.rigid_q": lambda f: {"scene": f.scene_2d},
+    "dumbbell.analysis.restitution.sign_change_deg": lambda f: {"e": 0.5, "q": 1.0},
+    "dumbbell.analysis.restitution.tilted": lambda f: {"scene": f.rigid_2d, "theta_deg": 20.0,
+                                                      "stiffness": 500.0},
+    "dumbbell.analysis.restitution.truth_for": lambda f: {"scene": f.rigid_2d},
+    # dumbbell.analysis.rotation
+    "dumbbell.analysis.rotation.Series": lambda f: fields(f.series),
+    "dumbbell.analysis.rotation.mean_after_first_cluster": lambda f: {
+        "traj": f.traj_2d, "name": "K_rot", "gap": 0.1},
+    "dumbbell.analysis.rotation.preview": lambda f: {"traj": f.traj_2d, "window": 0.02},
+    "dumbbell.analysis.rotation.series": lambda f: {
+        "scene": f.scene_2d, "solver": "pymunk", "dt": 1e-4, "t_end": 0.02,
+        "stiffnesses": (200.0,)},
+    "dumbbell.analysis.rotation.variant": lambda f: {"scene": f.scene_2d, "stiffness": 500.0,
+                                                    "tilt": 10.0},
+    "dumbbell.analysis.rotation.variants": lambda f: {"scene": f.scene_2d,
+                                                     "stiffnesses": (100.0, 1e3)},
+    # dumbbell.analysis.stability
+    "dumbbell.analysis.stability.Prediction": lambda f: {"status": "ok", "why": "w*dt < 2"},
+    "dumbbell.analysis.stability.StabilityResult": lambda f: fields(f.stability_result),
+    "dumbbell.analysis.stability.csv_text": lambda f: {"rows": list(f.stability_result.rows)},
+    "dumbbell.analysis.stability.default_cases": lambda f: {},
+    "dumbbell.analysis.stability.default_solvers": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.stability.find_cases": lambda f: {"folder": f.scene_file.parent},
+    "dumbbell.analysis.stability.map_scene": lambda f: {},
+    "dumbbell.analysis.stability.map_solvers": lambda f: {"solvers": ["verlet", "exact"]},
+    "dumbbell.analysis.stability.markdown": lambda f: {
+        "rows": list(f.stability_result.rows), "skipped": ["x with y: why"],
+        "guard": ["- x: nothing to fix"]},
+    "dumbbell.analysis.stability.predict": lambda f: {
+        "scene": f.scene, "solver": "verlet", "dt": 1e-3, "t_end": 1.0},
+    "dumbbell.analysis.stability.rest_time": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.stability.run_stability": lambda f: {
+        "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
+        "quiet": True},
+    # dumbbell.analysis.sweep
+    "dumbbell.analysis.sweep.Axis": lambda f: fields(f.sweep_result.axes[0]),
+    "dumbbell.analysis.sweep.Point": lambda f: {"index": 0, "values": {"run.dt": 1e-3}},
+    "dumbbell.analysis.sweep.SweepResult": lambda f: fields(f.sweep_result),
+    "dumbbell.analysis.sweep.SweepResult.write_csv": lambda f: {"path": f.tmp / "sweep.csv"},
+    "dumbbell.analysis.sweep.check_axes": lambda f: {"axes": f.sweep_result.axes},
+    "dumbbell.analysis.sweep.evaluate": lambda f: {
+        "scene": f.scene, "values": {"spring.stiffness": 300.0}, "solver": "euler-cromer"},
+    "dumbbell.analysis.sweep.parse_axis": lambda f: {"text": "k=log:1e2:1e4:3"},
+    "dumbbell.analysis.sweep.plan": lambda f: {
+        "scene": f.scene, "axes": f.sweep_result.axes, "solver": "euler-cromer",
+        "t_end": 0.02},
+    "dumbbell.analysis.sweep.run_sweep": lambda f: {
+        "scene": f.scene, "axes": f.sweep_result.axes[:1], "solver": "euler-cromer",
+        "t_end": 0.02, "workers": 1, "scheduler": None, "quiet": True, "processes": False,
+        "points": None, "connect_timeout": 1.0},
+    "dumbbell.analysis.sweep.warm_up": lambda f: {"solver": "euler-cromer"},
+    # dumbbell.analysis.topple
+    "dumbbell.analysis.topple.ToppleClosedForm": lambda f: fields(f.topple_cf),
+    "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: {"theta": [0.1, 0.5]},
+    "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: {"n": 5},
+    "dumbbell.analysis.topple.ToppleClosedForm.cm_height": lambda f: {"theta": 0.3},
+    "dumbbell.analysis.topple.ToppleClosedForm.normal_force": lambda f: {"theta": 0.3},
+    "dumbbell.analysis.topple.ToppleClosedForm.omega": lambda f: {"theta": np.array([0.2])},
+    "dumbbell.analysis.topple.ToppleMeasure": lambda f: fields(f.topple_measure),
+    "dumbbell.analysis.topple.closed_form": lambda f: {"scene": f.topple_scene},
+    "dumbbell.analysis.topple.measure": lambda f: {"traj": f.topple_traj},
     # dumbbell.plot
     "dumbbell.plot.trajectory.positions": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
     "dumbbell.plot.trajectory.kinetic": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
@@ -414,6 +548,13 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
+    "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,
+    "dumbbell.analysis.sweep.SweepResult.write_csv": lambda f: f.sweep_result,
+    "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: f.topple_cf,
+    "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: f.topple_cf,
+    "dumbbell.analysis.topple.ToppleClosedForm.cm_height": lambda f: f.topple_cf,
+    "dumbbell.analysis.topple.ToppleClosedForm.normal_force": lambda f: f.topple_cf,
+    "dumbbell.analysis.topple.ToppleClosedForm.omega": lambda f: f.topple_cf,
 }
 
 

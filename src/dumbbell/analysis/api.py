@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 from ..errors import UsageError
 from ..model.scene import Scene
 
+__all__ = ["bench", "compare", "stability", "sweep"]
+
 if TYPE_CHECKING:
     from .bench import BenchResult
     from .compare import Comparison

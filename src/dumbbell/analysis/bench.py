@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import numbers
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -47,6 +48,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from ..solvers import RunOptions, Solver, make_options, solver_class, supported, truth_solver
@@ -57,6 +59,9 @@ if TYPE_CHECKING:
     import pandas
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
+__all__ = ["BenchResult", "Fit", "Point", "default_solvers", "default_spacing", "dt_label",
+           "fit_order", "run_bench", "time_for_error"]
+
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
 #: Default window of the position error (s): the textbook figures' 0-2 s.
 DEFAULT_WINDOW = 2.0
@@ -157,6 +162,7 @@ class BenchResult:
         """Run time each solver needs for the error ``target`` (m; default: Euler-Cromer's at
         the textbook's dt), read off its work-precision line by log-log interpolation, and the
         speed-up against Euler-Cromer (2D: euler-cromer-2d) there."""
+        target = None if target is None else args.real(target, "target", "m")
         base_name = self.baseline
         ref = next((p for p in self.points if p.solver == base_name and p.ok
                     and p.dt is not None and math.isclose(p.dt, TEXTBOOK_DT)), None)
@@ -197,6 +203,13 @@ class BenchResult:
 
 def time_for_error(line: list[tuple[float, float]], target: float) -> float | None:
     """The run time (s) at which a (seconds, error) line first reaches ``target`` (m)."""
+    target = args.real(target, "target", "m")
+    if not isinstance(line, list | tuple) or not all(
+            isinstance(p, tuple | list) and len(p) == 2 and isinstance(p[0], numbers.Real)
+            for p in line):
+        raise UsageError(f"line = {args.show(line)}: must be a list of (seconds, error) "
+                         "pairs of numbers (s, m), errors > 0", param="line")
+    line = [(float(t), args.real(e, "line", "m")) for t, e in line]
     for (t0, e0), (t1, e1) in itertools.pairwise(line):
         if e0 >= target >= e1 and e0 > e1:
             f = math.log(e0 / target) / math.log(e0 / e1)
@@ -208,6 +221,7 @@ def time_for_error(line: list[tuple[float, float]], target: float) -> float | No
 def default_spacing(scene: Scene) -> float:
     """Spacing of the compared samples (s): SAMPLE_SPACING, or 1/SAMPLES_PER_PERIOD of the
     spring's period when that is shorter."""
+    scene = args.scene(scene)
     if scene.system.omega > 0:
         return min(SAMPLE_SPACING, 2 * math.pi / scene.system.omega / SAMPLES_PER_PERIOD)
     return SAMPLE_SPACING
@@ -215,6 +229,7 @@ def default_spacing(scene: Scene) -> float:
 
 def default_solvers(scene: Scene) -> list[str]:
     """Every solver that can run ``scene``, except the truth."""
+    scene = args.scene(scene)
     truth = truth_solver(scene)
     return [n for n in supported(scene) if n != truth]
 
@@ -257,7 +272,6 @@ def run_bench(
     a step whose runs would take more than ``budget`` s in all is skipped. Samples are kept
     about every ``spacing`` s (default :func:`default_spacing`; the step-free solvers:
     exactly)."""
-    from ..model import args
     from ..progress import bar
     from ..solvers import available
 
@@ -440,6 +454,9 @@ def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: 
 def fit_order(points: list[Point]) -> Fit | None:
     """Least-squares slope of log10(error) against log10(dt) over the ok points with an error
     between FIT_MIN_ERROR and FIT_MAX_ERROR (m); None with fewer than 3 such points."""
+    if not isinstance(points, list | tuple) or not all(isinstance(p, Point) for p in points):
+        raise UsageError(f"points = {args.show(points)}: must be a list of bench Points "
+                         "(BenchResult.points)", param="points")
     use = [p for p in points if p.ok and p.dt is not None and math.isfinite(p.error)
            and FIT_MIN_ERROR < p.error < FIT_MAX_ERROR]
     if len(use) < 3:
@@ -455,6 +472,7 @@ def fit_order(points: list[Point]) -> Fit | None:
 
 def dt_label(dt: float) -> str:
     """'1e-5', '3.2e-6': a step size as written beside a point (s)."""
+    dt = args.real(dt, "dt", "s")
     mantissa, exponent = f"{dt:.1e}".split("e")
     mantissa = mantissa.rstrip("0").rstrip(".")
     return f"{mantissa}e{int(exponent)}"

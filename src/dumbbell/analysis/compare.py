@@ -40,6 +40,9 @@ if TYPE_CHECKING:
 
 #: Default window (s) for position errors.
 WINDOW = 2.0
+
+__all__ = ["Comparison", "Row", "compare", "default_solvers"]
+
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
 
@@ -178,6 +181,9 @@ class Comparison:
 
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
+    from ..model import args
+
+    scene = args.scene(scene)
     names = ["pymunk", "euler-cromer" if scene.system.dimensions == 1 else "euler-cromer-2d"]
     return [n for n in names if solver_class(n).supports(scene) is None]
 

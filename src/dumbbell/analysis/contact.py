@@ -15,8 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.energy import angular_momentum
 from ..model.trajectory import Impact, Trajectory
+
+__all__ = ["ContactMomentum", "about_contact"]
 
 
 @dataclass(frozen=True)
@@ -47,11 +50,15 @@ def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> Con
     """Angular momentum about the contact point of impact ``index`` (0: the first) of a 2D
     trajectory, over ``window`` s either side. Sample finely (every step or two) for a sharp
     before and after."""
+    traj = args.trajectory(traj)
+    index = args.whole(index, "index", "impacts", lo=0)
+    window = args.real(window, "window", "s")
     s = traj.scene
     if s.system.dimensions != 2:
         raise UsageError(f"{s.source}: angular momentum about a contact point needs a 2D scene")
     if not 0 <= index < len(traj.events):
-        raise UsageError(f"index = {index}: the run has {len(traj.events)} impacts")
+        raise UsageError(f"index = {index}: the run has {len(traj.events)} impacts",
+                         param="index")
     imp = traj.events[index]
     t = traj.t
     i = int(np.searchsorted(t, imp.t, side="left"))

@@ -9,10 +9,29 @@ as the truth's own point.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
+from ..errors import UsageError
+from ..model import args
 from ..model.trajectory import Trajectory
+
+__all__ = ["extended_precision_exact", "extended_precision_rigid"]
+
+
+def _checked(traj: Any, window: Any, rigid: bool) -> tuple[Trajectory, float]:
+    """A trajectory of the closed form's kind (1D, or the rigid 2D dumbbell) and a window
+    > 0 (s), else a UsageError naming the argument."""
+    traj = args.trajectory(traj)
+    system = traj.scene.system
+    fits = (system.dimensions == 2 and system.rigid is not None) if rigid else (
+        system.dimensions == 1)
+    if not fits:
+        kind = "the rigid 2D dumbbell" if rigid else "a 1D scene"
+        raise UsageError(f"traj: {traj.scene.source} is not {kind}; the closed form here is "
+                         f"that of {kind}", param="traj")
+    return traj, args.real(window, "window", "s")
 
 
 def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, float]:
@@ -21,6 +40,7 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
     with each impact time refined by Newton's method in that precision. It checks the
     rounding of the double-precision solution, given its sequence of impacts."""
+    traj, window = _checked(traj, window, rigid=False)
     L = np.longdouble
     scene = traj.scene
     mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
@@ -81,6 +101,7 @@ def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, fl
     """:func:`extended_precision_exact` for the rigid 2D dumbbell: the parabola-and-rotation
     closed form and the impulse law in numpy's extended precision, each impact time refined
     by Newton's method there; largest position error (m) and impact time error (s)."""
+    traj, window = _checked(traj, window, rigid=True)
     from ..model.energy import rigid_moment
 
     L = np.longdouble

@@ -17,22 +17,38 @@ run with other sample times is an error, not silently compared sample by sample.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
+from ..errors import UsageError
+from ..model import args
 from ..model.energy import BOOKKEEPING, energy_scale, relative_energy_error
 from ..model.trajectory import Trajectory
+
+__all__ = ["energy_error", "impact_time_error", "position_error", "position_error_series"]
+
+
+def _pair(run: Any, truth: Any, name: str = "run") -> tuple[Trajectory, Trajectory]:
+    """Two trajectories of scenes of the same dimensions (UsageError naming the argument)."""
+    run, truth = args.trajectory(run, name), args.trajectory(truth, "truth")
+    if run.scene.system.dimensions != truth.scene.system.dimensions:
+        raise UsageError(f"truth: a {truth.scene.system.dimensions}D run cannot be the truth of "
+                         f"a {run.scene.system.dimensions}D one", param="truth")
+    return run, truth
 
 
 def _check_shared_times(run: Trajectory, truth: Trajectory, n: int) -> None:
     # Sample times built as step * every * dt by different (dt, every) agree to rounding only.
     if not np.allclose(run.t[:n], truth.t[:n], rtol=1e-9, atol=0.0):
-        raise ValueError(f"{run.solver} and {truth.solver} do not share their sample times")
+        raise UsageError(f"truth: {run.solver} and {truth.solver} do not share their sample "
+                         "times; run both with the same dt * every", param="truth")
 
 
 def position_error_series(run: Trajectory, truth: Trajectory) -> np.ndarray:
     """The position error at each sample both runs have (m): the distance |r - r_truth| of
     either particle, the larger of A and B (in 1D the height difference)."""
+    run, truth = _pair(run, truth)
     n = min(len(run.t), len(truth.t))
     _check_shared_times(run, truth, n)
     per_body = []
@@ -46,6 +62,8 @@ def position_error_series(run: Trajectory, truth: Trajectory) -> np.ndarray:
 def position_error(run: Trajectory, truth: Trajectory, window: float) -> float:
     """The largest :func:`position_error_series` over the samples in [0, window] (m); inf if
     the run stopped before the window ended. Both must share their sample times."""
+    run, truth = _pair(run, truth)
+    window = args.real(window, "window", "s")
     n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
     if len(run.t) < n:
         return math.inf
@@ -58,6 +76,8 @@ def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
 
     Impacts are paired in order; inf if the solver's sequence misses one or names another
     body before the window ends."""
+    traj, truth = _pair(traj, truth, "traj")
+    window = args.real(window, "window", "s")
     wanted = [e for e in truth.events if e.t <= window]
     worst, compared = 0.0, 0
     for mine, true in zip(traj.events, wanted):
@@ -73,6 +93,9 @@ def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
 def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     """Largest relative energy error over the whole run: drift from E(0), or for a
     dissipative scene the distance from the truth's E at the same times (dimensionless)."""
+    traj = args.trajectory(traj)
+    if truth is not None:
+        traj, truth = _pair(traj, truth, "traj")
     if len(traj.t) == 0:
         return math.nan
     if not traj.scene.system.dissipative:

@@ -18,14 +18,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.energy import rigid_moment
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .rotation import variant
+
+__all__ = ["Bounce", "RestitutionResult", "bounce", "drop_duration", "e_eff_rigid",
+           "k_rot_share_rigid", "restitution", "rigid_q", "sign_change_deg", "tilted",
+           "truth_for"]
 
 #: Impacts closer together than this (s) belong to one cluster.
 CLUSTER_GAP = 0.1
@@ -33,27 +39,38 @@ CLUSTER_GAP = 0.1
 STIFFNESSES = (200.0, 2e3, 2e4)
 
 
+def _formula_args(theta_deg: Any, e: Any, q: Any) -> tuple[np.ndarray, float, float]:
+    """The formulas' arguments at the border: tilts (degrees), 0 <= e <= 1, q > 0."""
+    return (args.array(theta_deg, "theta_deg", "degrees"),
+            args.real(e, "e", "floor restitution", lo=0.0, hi=1.0),
+            args.real(q, "q", "M a_B^2 / I"))
+
+
 def e_eff_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -> np.ndarray:
     """The rigid dumbbell's apparent restitution (dimensionless) at tilt ``theta_deg``
     (degrees from vertical), floor restitution ``e`` and q = M a_B^2 / I."""
-    s2 = np.sin(np.radians(np.asarray(theta_deg, dtype=float))) ** 2
+    theta_deg, e, q = _formula_args(theta_deg, e, q)
+    s2 = np.sin(np.radians(theta_deg)) ** 2
     return (e - q * s2) / (1.0 + q * s2)
 
 
 def sign_change_deg(e: float, q: float = 1.0) -> float:
     """The tilt (degrees) past which e_eff turns negative: sin^2 theta = e/q; nan if never."""
+    _, e, q = _formula_args(0.0, e, q)
     return math.degrees(math.asin(math.sqrt(e / q))) if e <= q else math.nan
 
 
 def k_rot_share_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -> np.ndarray:
     """Share of the kinetic energy before the impact that the rigid dumbbell has as K_rot
     right after it (dimensionless): (1 + e)^2 q sin^2 theta / (1 + q sin^2 theta)^2."""
-    s2 = np.sin(np.radians(np.asarray(theta_deg, dtype=float))) ** 2
+    theta_deg, e, q = _formula_args(theta_deg, e, q)
+    s2 = np.sin(np.radians(theta_deg)) ** 2
     return (1.0 + e) ** 2 * q * s2 / (1.0 + q * s2) ** 2
 
 
 def rigid_q(scene: Scene) -> float:
     """q = M a_B^2 / I of the scene's dumbbell made rigid (dimensionless): a_B = mA L / M."""
+    scene = args.scene(scene)
     s = scene if scene.system.rigid is not None else variant(scene, None)
     a_B = s.system.A.mass * s.system.rigid.length / s.system.M
     return s.system.M * a_B**2 / rigid_moment(s)
@@ -84,6 +101,8 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     """Measure the first impact cluster of a tilted drop. Velocities are read at the samples
     on either side and carried to the impact's time with the free fall's -g, so sampling does
     not bias them; the run must continue ``gap`` s past the cluster."""
+    traj = args.trajectory(traj)
+    gap = args.real(gap, "gap", "s")
     s = traj.scene
     times = [e.t for e in traj.events]
     if not times:
@@ -131,6 +150,7 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
 def tilted(scene: Scene, theta_deg: float, stiffness: float | None = None) -> Scene:
     """``scene``'s dumbbell tilted ``theta_deg`` (degrees from vertical), rigid when
     ``stiffness`` is None, else a spring of that stiffness (N/m) at the same length."""
+    theta_deg = args.real(theta_deg, "theta_deg", "degrees", positive=False)
     return variant(scene, stiffness, theta_deg)
 
 
@@ -150,6 +170,7 @@ def _check_scene(scene: Scene) -> None:
 
 def drop_duration(scene: Scene) -> float:
     """Run time (s) that covers the fall, the first cluster of impacts and the gap after it."""
+    scene = args.scene(scene)
     g, h, v = scene.system.g, scene.system.B.height, -scene.system.B.vy
     t_fall = (-v + math.sqrt(v * v + 2 * g * h)) / g if g > 0 else h / max(v, 1e-9)
     return t_fall + 0.4
@@ -157,6 +178,7 @@ def drop_duration(scene: Scene) -> float:
 
 def truth_for(scene: Scene) -> str:
     """The name of the most exact solver that runs ``scene`` (rigid or spring, 2D)."""
+    scene = args.scene(scene)
     from ..solvers import METHODS
 
     for name, cls in METHODS.items():
@@ -219,8 +241,13 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
     pymunk. ``progress``, if given, is called once per run."""
     from ..solvers import simulate
 
+    scene = args.scene(scene)
+    thetas = np.asarray(args.reals(thetas, "thetas", "degrees", positive=False))
+    stiffnesses = tuple(args.reals(stiffnesses, "stiffnesses", "N/m", empty=True))
+    dt = args.real(dt, "dt", "s")
+    if progress is not None:
+        args.function(progress, "progress", "a function called once per run, or None")
     _check_scene(scene)
-    thetas = np.asarray(thetas, dtype=float)
     t_end = drop_duration(scene)
     e = scene.system.floor.elasticity
     q = rigid_q(scene)

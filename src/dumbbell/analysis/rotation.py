@@ -28,8 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Trajectory
+
+__all__ = ["Series", "mean_after_first_cluster", "preview", "series", "variant", "variants"]
 
 #: Spring constants of the preview (N/m).
 STIFFNESSES = (200.0, 2e3, 2e4)
@@ -52,6 +55,9 @@ def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) ->
     """``scene``'s dumbbell with a spring of ``stiffness`` (N/m), or rigid when it is None, at
     the same rest (or rod) length; tilted ``tilt`` degrees from vertical when given.
     Everything else is kept."""
+    scene = args.scene(scene)
+    stiffness = None if stiffness is None else args.real(stiffness, "stiffness", "N/m")
+    tilt = None if tilt is None else args.real(tilt, "tilt", "degrees", positive=False)
     length = _length(scene)
     doc = scene.to_dict()
     doc.pop("spring", None)
@@ -70,6 +76,8 @@ def variant(scene: Scene, stiffness: float | None, tilt: float | None = None) ->
 def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict[str, Scene]:
     """Spring dumbbells at ``stiffnesses`` (N/m) and the rigid one, built from ``scene``:
     label -> scene. The rest length (or rod length) and everything else are kept."""
+    scene = args.scene(scene)
+    stiffnesses = args.reals(stiffnesses, "stiffnesses", "N/m", empty=True)
     if scene.system.dimensions != 2:
         raise UsageError(f"{scene.source}: the rotation preview needs a 2D scene "
                          "(dimensions = 2)")
@@ -93,8 +101,13 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
            stiffnesses: tuple[float, ...] = STIFFNESSES) -> Series:
     """Run every variant of ``scene`` with ``solver`` at step ``dt`` (s) up to ``t_end`` (s).
     The step is cut where needed to keep w*dt <= 0.05 for the stiffest spring."""
-    from ..solvers import simulate, solver_class
+    from ..solvers import available, simulate, solver_class
 
+    scene = args.scene(scene)
+    solver = args.choice(solver, "solver", available())
+    dt = args.real(dt, "dt", "s")
+    t_end = args.real(t_end, "t_end", "s")
+    stiffnesses = args.reals(stiffnesses, "stiffnesses", "N/m", empty=True)
     scenes = variants(scene, stiffnesses)
     w_max = max(s.system.omega for s in scenes.values())
     dt = min(dt, 0.05 / w_max) if w_max > 0 else dt
@@ -114,6 +127,10 @@ def mean_after_first_cluster(traj: Trajectory, name: str, gap: float = CLUSTER_G
     to the next impact or the end of the run. Returns (mean, start s, end s); nan without
     impacts. Averaging only up to the second impact would, for a stiff spring, cover just
     the short time before the other particle lands."""
+    traj = args.trajectory(traj)
+    name = args.text(name, "name", "a column name (str)")
+    gap = args.real(gap, "gap", "s")
+    traj[name]  # an unknown column is named before anything is computed
     times = [e.t for e in traj.events]
     if not times:
         return math.nan, math.nan, math.nan
@@ -128,5 +145,7 @@ def mean_after_first_cluster(traj: Trajectory, name: str, gap: float = CLUSTER_G
 def preview(traj: Trajectory, window: float = 2.0) -> Series:
     """The runs of the rotation preview for ``traj``'s scene (2D): its solver, its step (the
     scene's without one) and ``window`` s."""
+    traj = args.trajectory(traj)
+    window = args.real(window, "window", "s")
     dt = traj.dt if traj.dt else traj.scene.run.dt
     return series(traj.scene, solver=traj.solver, dt=dt, t_end=window)

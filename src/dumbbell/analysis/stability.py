@@ -31,11 +31,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import DumbbellError, UsageError
+from ..model import args
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 from ..parallel import ordered_map
 
 if TYPE_CHECKING:
     import pandas
+
+__all__ = ["COLUMNS", "Prediction", "StabilityResult", "default_cases", "default_solvers",
+           "find_cases", "map_scene", "map_solvers", "predict", "rest_time", "run_stability"]
 
 #: Report columns, in CSV order.
 COLUMNS = ("case", "title", "solver", "dt", "w_dt", "verdict", "t_fail",
@@ -93,7 +97,7 @@ def default_cases() -> Path:
 
 def find_cases(folder: str | Path) -> list[Path]:
     """The scene files in ``folder``, sorted by name (UsageError if there are none)."""
-    folder = Path(folder)
+    folder = args.path(folder, "folder")
     if not folder.is_dir():
         raise UsageError(f"cases {folder}: no such folder", param="cases")
     paths = sorted(folder.glob("*.toml"))
@@ -105,6 +109,7 @@ def find_cases(folder: str | Path) -> list[Path]:
 def default_solvers(scene: Scene) -> list[str]:
     """Solvers run on a case by default: all that can run it, but of the truth solvers only
     the scene's own (the exact solution in 1D, not the slow reference)."""
+    scene = args.scene(scene)
     from ..solvers import METHODS, supported, truth_solver
 
     truth = truth_solver(scene)
@@ -121,6 +126,7 @@ def _impact_speed(scene: Scene) -> float:
 def rest_time(scene: Scene) -> float:
     """When a point mass dropped like the lower particle comes to rest on an inelastic floor:
     t1 + 2 e v1 / (g (1 - e)) (s); inf on an elastic floor or without gravity."""
+    scene = args.scene(scene)
     if scene.system.floor is None or scene.system.g <= 0 or scene.system.floor.elasticity >= 1.0:
         return math.inf
     low = min((scene.system.A, scene.system.B), key=lambda p: p.height)
@@ -133,6 +139,12 @@ def rest_time(scene: Scene) -> float:
 def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     """The verdict theory expects for ``scene`` run by ``solver`` at step ``dt`` up to
     ``t_end`` (s); see the module docstring."""
+    from ..solvers import available
+
+    scene = args.scene(scene)
+    args.choice(solver, "solver", available())
+    dt = args.real(dt, "dt", "s")
+    t_end = args.real(t_end, "t_end", "s")
     from ..solvers import solver_class
 
     cls = solver_class(solver)
@@ -280,6 +292,11 @@ def map_points(scene: Scene) -> list[Any]:
 def map_rows(solver: str, workers: int | None = None, quiet: bool = True
              ) -> list[dict[str, Any]]:
     """The map's rows for one solver, in grid order."""
+    from ..solvers import available
+
+    args.choice(solver, "solver", available())
+    workers = None if workers is None else args.whole(workers, "workers", "processes")
+    quiet = args.flag(quiet, "quiet")
     from .sweep import evaluate, warm_up
 
     scene = map_scene()
@@ -292,6 +309,9 @@ def map_rows(solver: str, workers: int | None = None, quiet: bool = True
 def map_solvers(solvers: list[str] | None) -> list[str]:
     """The time-stepping solvers a map is drawn for: those asked for (all by default) that
     can run the 1D map scene."""
+    from ..solvers import available
+
+    solvers = None if solvers is None else args.names(solvers, "solvers", available())
     from ..solvers import available, solver_class
 
     names = available() if solvers is None else solvers
@@ -305,6 +325,12 @@ def run_stability(cases: str | Path | None = None, solvers: list[str] | None = N
     """Run every case in the folder ``cases`` (default: the shipped catalogue) with
     ``solvers`` (default: every solver that can run each case) and put each verdict beside
     the theory's. Everything is validated before anything runs; nothing is written."""
+    from ..solvers import available
+
+    cases = None if cases is None else args.path(cases, "cases")
+    solvers = None if solvers is None else args.names(solvers, "solvers", available())
+    workers = None if workers is None else args.whole(workers, "workers", "processes")
+    quiet = args.flag(quiet, "quiet")
     runs, skipped = plan_runs(cases, solvers)
     return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                            tuple(guard_lines(runs)))

@@ -35,6 +35,9 @@ from ..parallel import ordered_map
 if TYPE_CHECKING:
     import pandas
 
+__all__ = ["Axis", "Point", "SweepResult", "check_axes", "evaluate", "parse_axis", "plan",
+           "run_sweep", "warm_up"]
+
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}
 #: Largest number of time steps one grid point may take (about 2.5 s of Euler-Cromer).
@@ -97,6 +100,10 @@ def parse_axis(text: str) -> Axis:
     """Parse one grid axis (the command's ``--grid`` item), ``NAME=log:A:B:N``, ``NAME=lin:A:B:N`` or ``NAME=v1,v2,...``
     (UsageError naming the item and what is allowed)."""
     form = "NAME=log:A:B:N, NAME=lin:A:B:N or NAME=V1,V2,..."
+    if not isinstance(text, str):
+        from ..model import args
+
+        raise UsageError(f"text = {args.show(text)}: must be a grid axis, {form}", param="text")
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     if not sep or not name or not spec:
@@ -138,8 +145,17 @@ def parse_axis(text: str) -> Axis:
     return Axis(key, text, values, "list")
 
 
+def _check_axis_list(axes: Any) -> None:
+    from ..model import args
+
+    if not isinstance(axes, list | tuple) or not all(isinstance(a, Axis) for a in axes):
+        raise UsageError(f"axes = {args.show(axes)}: must be a list of Axis (parse_axis)",
+                         param="axes")
+
+
 def check_axes(axes: Sequence[Axis]) -> None:
     """One or two axes on different keys (UsageError otherwise)."""
+    _check_axis_list(axes)
     if not 1 <= len(axes) <= 2:
         raise UsageError(f"grid: give one or two axes (got {len(axes)}), e.g. "
                          "k=log:1e2:1e7:50 dt=log:1e-6:1e-2:50", param="grid")
@@ -164,6 +180,13 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
     """Every grid point, validated as a scene and as a bounded run before anything runs.
 
     ``t_end`` (s) overrides the scene's ``run.t_end``. Raises UsageError naming the axis."""
+    from ..model import args
+    from ..solvers import available
+
+    scene = args.scene(scene)
+    _check_axis_list(axes)
+    args.choice(solver, "solver", available())
+    t_end = None if t_end is None else args.real(t_end, "t_end", "s")
     from ..solvers import make_options, solver_class
 
     check_axes(axes)
@@ -201,6 +224,13 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
 def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any]:
     """Run one grid point and summarise it: w_dt, verdict, t_fail (s or None),
     max_rel_energy_error and reason. A solver error becomes the verdict ``failed``."""
+    from ..model import args
+    from ..model.scene import Scene
+    from ..solvers import available
+
+    args.instance(scene, "scene", Scene, "a Scene")
+    args.mapping(values, "values", "a dict of dotted scene keys to values")
+    args.choice(solver, "solver", available())
     from ..model.energy import relative_energy_error
     from ..solvers import make_options, simulate
 
@@ -224,6 +254,10 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
 
 def warm_up(solver: str) -> None:
     """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
+    from ..model import args
+    from ..solvers import available
+
+    args.choice(solver, "solver", available())
     from ..solvers import solver_class
 
     solver_class(solver).warm_up()
@@ -311,11 +345,21 @@ def run_sweep(
     from ..solvers import available
 
     scene = args.scene(scene)
-    if not isinstance(axes, list | tuple) or not all(isinstance(a, Axis) for a in axes):
-        raise UsageError(f"axes = {args.show(axes)}: must be a list of Axis (parse_axis)",
-                         param="axes")
+    _check_axis_list(axes)
     args.choice(solver, "solver", available())
+    t_end = None if t_end is None else args.real(t_end, "t_end", "s")
+    if workers is not None:
+        workers = args.whole(workers, "workers", "processes")
+    if scheduler is not None:
+        args.text(scheduler, "scheduler", "a Dask scheduler address ('tcp://HOST:PORT', or "
+                  "'local') or None")
+    quiet = args.flag(quiet, "quiet")
+    processes = args.flag(processes, "processes")
     connect_timeout = args.real(connect_timeout, "connect_timeout", "s")
+    if points is not None and (not isinstance(points, list | tuple)
+                               or not all(isinstance(p, Point) for p in points)):
+        raise UsageError(f"points = {args.show(points)}: must be a list of Point (from plan) "
+                         "or None", param="points")
     points = plan(scene, axes, solver, t_end) if points is None else points
     workers, _ = cap_workers(workers, len(points))
     if scheduler is not None:

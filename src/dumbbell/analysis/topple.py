@@ -22,9 +22,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.energy import rigid_moment
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
+
+__all__ = ["ToppleClosedForm", "ToppleMeasure", "closed_form", "measure"]
+
+#: Most points :meth:`ToppleClosedForm.angle_curve` computes (one quadrature each).
+MAX_CURVE_POINTS = 100_000
 
 
 @dataclass(frozen=True)
@@ -51,7 +57,7 @@ class ToppleClosedForm:
 
     def omega(self, theta: np.ndarray | float) -> np.ndarray:
         """Angular speed |theta'| (rad/s) at angle ``theta`` (rad), from energy conservation."""
-        return self._omega_past(np.asarray(theta, dtype=float) - self.theta0)
+        return self._omega_past(args.array(theta, "theta", "rad") - self.theta0)
 
     def _omega_past(self, delta: np.ndarray | float) -> np.ndarray:
         # Angular speed ``delta`` rad past the release. cos(theta0) - cos(theta) is written as
@@ -65,7 +71,7 @@ class ToppleClosedForm:
     def alpha(self, theta: np.ndarray | float) -> np.ndarray:
         """Angular acceleration theta'' (rad/s^2) at ``theta`` (rad): half the derivative of
         omega^2 with respect to theta."""
-        th = np.asarray(theta, dtype=float)
+        th = args.array(theta, "theta", "rad")
         M, a, g = self.M, self.a, self.g
         s, c = np.sin(th), np.cos(th)
         den = M * a * a * s * s + self.I
@@ -74,12 +80,12 @@ class ToppleClosedForm:
 
     def cm_height(self, theta: np.ndarray | float) -> np.ndarray:
         """Height of the centre of mass (m) at ``theta`` (rad), B on the floor."""
-        return self.a * np.cos(np.asarray(theta, dtype=float))
+        return self.a * np.cos(args.array(theta, "theta", "rad"))
 
     def normal_force(self, theta: np.ndarray | float) -> np.ndarray:
         """The floor's push on B (N) at ``theta`` (rad): M (g + Y''). It must stay >= 0 for B
         to keep touching the floor; :meth:`check` says where it does not."""
-        th = np.asarray(theta, dtype=float)
+        th = args.array(theta, "theta", "rad")
         w, al = self.omega(th), self.alpha(th)
         y_dd = -self.a * (np.cos(th) * w * w + np.sin(th) * al)
         return self.M * (self.g + y_dd)
@@ -114,6 +120,7 @@ class ToppleClosedForm:
     def angle_curve(self, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
         """(t in s, theta in rad) from the release to the landing, ``n`` points, each time by
         its own quadrature from the release."""
+        n = args.whole(n, "n", "points", lo=2, hi=MAX_CURVE_POINTS)
         from scipy.integrate import quad
 
         u = np.linspace(0.0, 1.0, n)
@@ -138,6 +145,7 @@ def closed_form(scene: Scene) -> ToppleClosedForm:
     """The closed form for a topple scene: a rigid dumbbell, B at rest on a frictionless floor
     at height 0, A above it, tilted by a small nonzero angle. Raises UsageError naming what
     does not fit."""
+    scene = args.scene(scene)
     where = scene.source
     if scene.system.dimensions != 2 or scene.system.rigid is None:
         raise UsageError(f"{where}: the topple needs a rigid 2D dumbbell ([rigid], dimensions = 2)")
@@ -182,6 +190,10 @@ def measure(traj: Trajectory) -> ToppleMeasure:
     """Measure the topple in ``traj`` (2D, B on the floor): the landing is where A's height
     first reaches 0, found by linear interpolation between samples; the speeds are taken at
     the last sample before it (sample finely: ``every`` of 1 ms or less)."""
+    traj = args.trajectory(traj)
+    if traj.scene.system.dimensions != 2:
+        raise UsageError(f"traj: {traj.scene.source} is 1D; the topple is measured in 2D",
+                         param="traj")
     s = traj.scene
     yA = traj["yA"]
     hit = np.flatnonzero(yA <= 0.0)

@@ -142,6 +142,24 @@ def scene(value: Any, name: str = "scene") -> Any:
                      param=name)
 
 
+def array(value: Any, name: str, unit: str) -> Any:
+    """``value`` (a number, or a list, tuple or numpy array of numbers) as a float numpy
+    array (0-d for a number) of finite values, in ``unit``."""
+    import numpy as np
+
+    allowed = f"must be a finite number or an array of finite numbers ({unit})"
+    if isinstance(value, bool | str) or not isinstance(
+            value, numbers.Real | list | tuple | np.ndarray):
+        raise UsageError(f"{name} = {show(value)}: {allowed}", param=name)
+    try:
+        out = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise UsageError(f"{name} = {show(value)}: {allowed}", param=name) from None
+    if out.ndim > 1 or not np.all(np.isfinite(out)):
+        raise UsageError(f"{name} = {show(value)}: {allowed}", param=name)
+    return out
+
+
 def text(value: Any, name: str, what: str = "a str") -> str:
     """``value`` as a str (``what`` says what it is for in the message)."""
     if not isinstance(value, str):
