@@ -454,7 +454,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.plot.trajectory.kinetic": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
     "dumbbell.plot.trajectory.potential": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
     "dumbbell.plot.trajectory.energy": lambda f: {"traj": f.traj_2d, "ax": f.ax(),
-                                                  "window": 0.3},
+                                                  "window": 0.6},
     "dumbbell.plot.trajectory.heights": lambda f: {"traj": f.traj},
     "dumbbell.plot.trajectory.momentum_axis": lambda f: {
         "ax": f.ax(), "traj": f.traj_2d, "window": 0.5, "loc": "upper left", "ncol": 2},
