@@ -18,11 +18,20 @@ from ..analysis.bench import (
     BenchResult,
     dt_label,
 )
+from ..model import args
 from .tables import csv_text, write_text
+
+__all__ = ["markdown", "to_json", "write_all", "write_csv", "write_json", "write_markdown"]
+
+
+def _checked(result: Any) -> BenchResult:
+    return args.instance(result, "result", BenchResult, "a BenchResult (from dumbbell.bench)")
 
 
 def write_csv(result: BenchResult, path: Path) -> Path:
     """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
+    result = _checked(result)
+    path = args.path(path, "path")
     rows = ([row[c] for c in CSV_COLUMNS] for row in map(asdict, result.points))
     return write_text(path, csv_text(CSV_COLUMNS, rows))
 
@@ -39,6 +48,7 @@ def _json_value(value: Any) -> Any:
 
 def to_json(result: BenchResult) -> dict[str, Any]:
     """The result as plain JSON data (inf as the string "inf", nan as null)."""
+    result = _checked(result)
     data = {
         "scene": result.scene, "source": result.source, "truth": result.truth,
         "window_s": result.window, "t_end_s": result.t_end, "repeat": result.repeat,
@@ -54,6 +64,8 @@ def to_json(result: BenchResult) -> dict[str, Any]:
 
 def write_json(result: BenchResult, path: Path) -> Path:
     """:func:`to_json` as indented JSON."""
+    result = _checked(result)
+    path = args.path(path, "path")
     return write_text(path, json.dumps(to_json(result), indent=1) + "\n")
 
 
@@ -67,6 +79,7 @@ def _sci(x: float | None, digits: int = 2) -> str:
 
 def markdown(result: BenchResult) -> str:
     """The table, fitted orders and matched-error speed-ups as markdown."""
+    result = _checked(result)
     lines = [
         (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
         f"truth: `{result.truth}`; position error over [0, {result.window:g}] s; time: min "
@@ -132,6 +145,8 @@ def _ms(seconds: float) -> str:
 
 def write_markdown(result: BenchResult, path: Path) -> Path:
     """:func:`markdown` as a file."""
+    result = _checked(result)
+    path = args.path(path, "path")
     return write_text(path, markdown(result))
 
 
@@ -139,6 +154,8 @@ def write_all(result: BenchResult, out: Path) -> list[Path]:
     """CSV, JSON and markdown into ``out``, named bench-SCENE*. (The figures are
     :mod:`dumbbell.plot`'s: :func:`~dumbbell.plot.work_precision` and
     :func:`~dumbbell.plot.convergence`; the command saves them.)"""
+    result = _checked(result)
+    out = args.path(out, "out")
     stem = f"bench-{result.scene}"
     return [
         write_csv(result, out / f"{stem}.csv"),

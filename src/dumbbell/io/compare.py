@@ -5,12 +5,21 @@ summary, the impact times side by side and the position-error series. The figure
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..analysis.compare import Comparison
+from ..model import args
 from .files import atomic_output
 from .tables import csv_text, write_text
+
+__all__ = ["SUMMARY_COLUMNS", "impacts_csv", "summary_csv", "write", "write_errors"]
+
+
+def _checked(result: Any) -> Comparison:
+    return args.instance(result, "result", Comparison, "a Comparison (from dumbbell.compare)")
+
 
 #: Columns of SCENE-compare.csv (times in s, position errors in m, the energy error
 #: dimensionless; the measures of :mod:`dumbbell.analysis.metrics`).
@@ -20,6 +29,7 @@ SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m"
 
 def summary_csv(result: Comparison) -> str:
     """One line per run, the truth first, with :data:`SUMMARY_COLUMNS`."""
+    result = _checked(result)
     rows = []
     for row, rec in zip([None, *result.rows], result.summary(), strict=True):
         r = result.truth if row is None else row.traj
@@ -34,6 +44,7 @@ def summary_csv(result: Comparison) -> str:
 def impacts_csv(result: Comparison) -> str:
     """:meth:`Comparison.impacts` as CSV: number, body, the truth's time, then each run's
     time and its difference from the truth (s)."""
+    result = _checked(result)
     keys = ["n", "body", "truth_t"] + [k for row in result.rows
                                        for k in (f"{row.label}_t", f"{row.label}_diff")]
     return csv_text(keys, ([rec[k] for k in keys] for rec in result.impacts()))
@@ -41,6 +52,8 @@ def impacts_csv(result: Comparison) -> str:
 
 def write_errors(result: Comparison, path: Path) -> Path:
     """The position-error series (m) of every run at the samples all runs have, beside t (s)."""
+    result = _checked(result)
+    path = args.path(path, "path")
     n = min(len(row.error) for row in result.rows) if result.rows else 0
     table = np.column_stack([result.truth.t[:n], *[row.error[:n] for row in result.rows]])
     with atomic_output(path) as tmp:
@@ -53,6 +66,8 @@ def write_errors(result: Comparison, path: Path) -> Path:
 def write(result: Comparison, out: Path) -> list[Path]:
     """SCENE-compare.csv, -compare-impacts.csv and -compare-errors.csv into ``out``; returns
     the paths."""
+    result = _checked(result)
+    out = args.path(out, "out")
     stem = out / f"{result.scene.name}-compare"
     return [write_text(f"{stem}.csv", summary_csv(result)),
             write_text(f"{stem}-impacts.csv", impacts_csv(result)),

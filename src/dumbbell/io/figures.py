@@ -5,7 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..errors import UsageError
+from ..model import args
 from .files import atomic_output
+
+__all__ = ["DPI", "save_figure"]
 
 #: Resolution of saved figures (dots per inch).
 DPI = 110
@@ -16,7 +20,17 @@ def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
     "figure" for the figure's own) and close it; returns the path."""
     import matplotlib.pyplot as plt
 
-    path = Path(path)
+    fig = args.figure(fig)
+    path = args.path(path, "path")
+    formats = fig.canvas.get_supported_filetypes()
+    if path.suffix[1:].lower() not in formats:
+        raise UsageError(f"path = {args.show(str(path))}: must end in a figure format: "
+                         f"{', '.join('.' + f for f in sorted(formats))}", param="path")
+    if dpi != "figure":
+        if isinstance(dpi, str):
+            raise UsageError(f"dpi = {args.show(dpi)}: must be a number > 0 (dots per inch) or "
+                             "'figure'", param="dpi")
+        args.real(dpi, "dpi", "dots per inch")
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=dpi)
     plt.close(fig)

@@ -22,6 +22,23 @@ from pathlib import Path
 
 from ..errors import UsageError
 
+__all__ = ["OutputTransaction", "atomic_output", "check_writable", "is_special",
+           "output_transaction"]
+
+
+def _inputs(inputs: object) -> list[tuple[str | Path, str]]:
+    """``inputs`` as (path, how the user named it) pairs, else a UsageError."""
+    from ..model import args
+
+    allowed = "must be (path, name) pairs, e.g. [('x.toml', 'the scene x.toml')]"
+    if isinstance(inputs, str | bytes) or not isinstance(inputs, Iterable):
+        raise UsageError(f"inputs = {args.show(inputs)}: {allowed}", param="inputs")
+    pairs = list(inputs)
+    if not all(isinstance(p, tuple | list) and len(p) == 2 and isinstance(p[0], str | os.PathLike)
+               and str(p[0]) and isinstance(p[1], str) for p in pairs):
+        raise UsageError(f"inputs = {args.show(inputs)}: {allowed}", param="inputs")
+    return [(p[0], p[1]) for p in pairs]
+
 
 def _key(path: Path) -> str:
     """One spelling per file: symlinks, '..' and '.' resolved."""
@@ -31,6 +48,9 @@ def _key(path: Path) -> str:
 def is_special(path: str | Path) -> bool:
     """True when ``path`` exists and is neither a regular file nor a folder (a device, a FIFO,
     a socket): such an output is written directly, never replaced."""
+    from ..model import args
+
+    path = args.path(path, "path")
     try:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):
@@ -53,7 +73,7 @@ class OutputTransaction:
 
     def __init__(self, inputs: Iterable[tuple[str | Path, str]] = ()):
         #: real path -> how the user named it ("the scene x.toml", "-o x.csv").
-        self.inputs = {_key(Path(p)): what for p, what in inputs}
+        self.inputs = {_key(Path(p)): what for p, what in _inputs(inputs)}
         self.claimed: dict[str, str] = {}
         self.pending: list[tuple[Path, Path]] = []
         self.created: list[Path] = []
@@ -74,7 +94,12 @@ class OutputTransaction:
     def claim(self, path: str | Path, what: str | None = None) -> None:
         """Check that the output ``path`` is no input; with ``what`` (how the user named it,
         e.g. '-o x.csv') also reserve it, refusing a second output on the same file."""
-        key = _key(Path(path))
+        from ..model import args
+
+        path = args.path(path, "path")
+        if what is not None:
+            args.text(what, "what", "how the user named the output (str) or None")
+        key = _key(path)
         label = what or str(path)
         clash = self._same(key, self.inputs) or (what and self._same(key, self.claimed))
         if clash:
@@ -112,7 +137,7 @@ def output_transaction(inputs: Iterable[tuple[str | Path, str]] = ()
     """Defer every :func:`atomic_output` rename inside the block to its successful end; on
     any exception (a KeyboardInterrupt or a signal too) remove the outputs instead.
     ``inputs``: (path, how to name it) pairs that no output may replace."""
-    transaction = OutputTransaction(inputs)
+    transaction = OutputTransaction(_inputs(inputs))
     token = _active.set(transaction)
     try:
         yield transaction
@@ -194,6 +219,13 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
 def check_writable(path: str | Path, flag: str, folder: bool = False) -> None:
     """Raise UsageError naming ``flag`` unless ``path`` (a folder if ``folder``, else a file)
     could be created or replaced: called before any work, so nothing is half written."""
+    from ..model import args
+
+    args.text(flag, "flag", "the flag or argument that names the path (str)")
+    if not isinstance(path, str | os.PathLike):
+        raise UsageError(f"{flag} = {args.show(path)}: must be a path (str or pathlib.Path)",
+                         param="path")
+    folder = args.flag(folder, "folder")
     text = str(path)
     if "\0" in text:
         raise UsageError(f"{flag} {text!r}: a path cannot hold a NUL character")

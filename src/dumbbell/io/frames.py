@@ -5,7 +5,9 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from ..errors import MissingExtraError
+from ..errors import MissingExtraError, UsageError
+
+__all__ = ["data_frame", "pandas_module"]
 
 if TYPE_CHECKING:
     import pandas
@@ -13,6 +15,9 @@ if TYPE_CHECKING:
 
 def pandas_module(what: str = "to_pandas()") -> Any:
     """The pandas module, or a MissingExtraError naming the extra that installs it."""
+    from ..model import args
+
+    args.text(what, "what", "what needs pandas, for the message (str)")
     try:
         import pandas
     except ImportError:
@@ -24,6 +29,14 @@ def data_frame(columns: Mapping[str, Sequence[Any]], index: str | None = None,
                units: Mapping[str, str] | None = None) -> pandas.DataFrame:
     """A DataFrame of ``columns`` in their order, ``index`` (a column name) as its index, and
     the unit of every column (index included) in ``df.attrs["units"]``."""
+    from ..model import args
+
+    args.mapping(columns, "columns", "a dict of column name to values")
+    if index is not None and (not isinstance(index, str) or index not in columns):
+        raise UsageError(f"index = {args.show(index)}: must be one of the columns or None",
+                         param="index")
+    if units is not None:
+        args.mapping(units, "units", "a dict of column name to unit, or None")
     pd = pandas_module()
     df = pd.DataFrame({name: columns[name] for name in columns})
     if index is not None:

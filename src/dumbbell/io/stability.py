@@ -12,6 +12,15 @@ from ..analysis.stability import COLUMNS, StabilityResult
 from .tables import csv_text as _csv_text
 from .tables import write_text
 
+__all__ = ["csv_text", "markdown", "write"]
+
+
+def _checked(result: Any) -> StabilityResult:
+    from ..model import args
+
+    return args.instance(result, "result", StabilityResult,
+                         "a StabilityResult (from dumbbell.stability)")
+
 
 def _fmt(value: Any, kind: str = "") -> str:
     """A table cell: "-" when missing, 2 significant digits for an error (kind "err"), 4 for
@@ -31,6 +40,7 @@ def markdown(result: StabilityResult) -> str:
     """The report as a markdown table, then the verdict lines of the runs that did not end ok
     or disagree with the theory, the step-size guard on the pymunk runs and the runs not
     made."""
+    result = _checked(result)
     rows, skipped, guard = result.rows, result.skipped, result.guard
     out = [("| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | "
             "t_fail [s] | largest rel. energy error | theory expects | agreement |"),
@@ -72,10 +82,15 @@ def markdown(result: StabilityResult) -> str:
 
 def csv_text(result: StabilityResult) -> str:
     """The report as CSV with :data:`~dumbbell.analysis.stability.COLUMNS`."""
+    result = _checked(result)
     return _csv_text(COLUMNS, ([r[c] for c in COLUMNS] for r in result.rows))
 
 
 def write(result: StabilityResult, out: Path) -> list[Path]:
     """OUT/stability.md and OUT/stability.csv; returns the paths."""
+    from ..model import args
+
+    result = _checked(result)
+    out = args.path(out, "out")
     return [write_text(out / "stability.md", markdown(result)),
             write_text(out / "stability.csv", csv_text(result))]

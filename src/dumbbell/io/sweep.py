@@ -11,6 +11,14 @@ from ..analysis.sweep import SweepResult
 from .tables import csv_text as _csv_text
 from .tables import write_text
 
+__all__ = ["csv_text", "write_csv"]
+
+
+def _checked(result: Any) -> SweepResult:
+    from ..model import args
+
+    return args.instance(result, "result", SweepResult, "a SweepResult (from dumbbell.sweep)")
+
 
 def _value(value: Any) -> Any:
     # A swept switch is written as TOML spells it, so the cell reads back as a scene value.
@@ -21,10 +29,12 @@ def _value(value: Any) -> Any:
 
 def csv_text(result: SweepResult) -> str:
     """The CSV as text: the same bytes whichever backend produced the rows."""
+    result = _checked(result)
     return _csv_text(result.columns, ([_value(row[c]) for c in result.columns]
                                       for row in result.rows))
 
 
 def write_csv(result: SweepResult, path: str | Path) -> Path:
     """Write :func:`csv_text` to ``path`` atomically; returns the path."""
+    result = _checked(result)
     return write_text(path, csv_text(result))

@@ -12,7 +12,11 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..errors import UsageError
+from ..model import args
 from .files import atomic_output
+
+__all__ = ["cell", "csv_text", "write_text"]
 
 
 def cell(value: Any) -> str:
@@ -26,6 +30,17 @@ def cell(value: Any) -> str:
 
 def csv_text(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
     """A CSV with ``header``, then one line per row of cells (see :func:`cell`), "\\n" ends."""
+    if isinstance(header, str) or not isinstance(header, Sequence) or not all(
+            isinstance(h, str) for h in header):
+        raise UsageError(f"header = {args.show(header)}: must be a list of column names (str)",
+                         param="header")
+    if isinstance(rows, str | bytes) or not isinstance(rows, Iterable):
+        raise UsageError(f"rows = {args.show(rows)}: must be rows (lists of cells)",
+                         param="rows")
+    rows = list(rows)
+    if not all(isinstance(r, Sequence) and not isinstance(r, str) for r in rows):
+        raise UsageError(f"rows = {args.show(rows)}: must be rows (lists of cells)",
+                         param="rows")
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(header)
@@ -35,7 +50,8 @@ def csv_text(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
 
 def write_text(path: str | Path, text: str) -> Path:
     """Write ``text`` to ``path`` atomically (whole or not at all); returns the path."""
-    path = Path(path)
+    path = args.path(path, "path")
+    text = args.text(text, "text", "the text to write (str)")
     with atomic_output(path) as tmp:
         tmp.write_text(text)
     return path

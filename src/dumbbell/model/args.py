@@ -230,6 +230,13 @@ def axes(value: Any, name: str = "ax", count: int = 1) -> Any:
     return value
 
 
+def figure(value: Any, name: str = "fig") -> Any:
+    """``value`` as a matplotlib Figure (matplotlib is not imported here)."""
+    module = sys.modules.get("matplotlib.figure")
+    return instance(value, name, module.Figure if module is not None else (),
+                    "a matplotlib Figure (ax.figure)")
+
+
 def _pymunk(name: str) -> Any:
     """The pymunk class ``name`` if pymunk is loaded, else an empty tuple: without pymunk
     loaded no pymunk object can exist, so nothing passes an isinstance check against it."""
