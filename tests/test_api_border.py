@@ -28,7 +28,7 @@ from dumbbell import DumbbellError
 
 #: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
 PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis",
-            "dumbbell.io")
+            "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
 TOP = ("dumbbell",)
 
@@ -446,6 +446,15 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.topple.ToppleMeasure": lambda f: fields(f.topple_measure),
     "dumbbell.analysis.topple.closed_form": lambda f: {"scene": f.topple_scene},
     "dumbbell.analysis.topple.measure": lambda f: {"traj": f.topple_traj},
+    # dumbbell.animation
+    "dumbbell.animation.render.check_fps": lambda f: {"fps": 25, "where": "fps"},
+    "dumbbell.animation.render.check_size": lambda f: {"size": (64, 64), "where": "size"},
+    "dumbbell.animation.render.check_frames": lambda f: {"t_end": 1.0, "fps": 25,
+                                                        "max_frames": 100, "where": "t_end"},
+    "dumbbell.animation.render.delays_cs": lambda f: {"n": 4, "fps": 30},
+    "dumbbell.animation.render.frame_count": lambda f: {"t_end": 1.0, "fps": 25},
+    "dumbbell.animation.render.frames_of": lambda f: {"traj": f.traj, "fps": 10, "t_end": 0.3},
+    "dumbbell.animation.render.sample_every": lambda f: {"dt": 1e-4, "fps": 25, "t_end": 1.0},
     # dumbbell.io
     "dumbbell.io.bench.markdown": lambda f: {"result": f.bench_result},
     "dumbbell.io.bench.to_json": lambda f: {"result": f.bench_result},
@@ -647,3 +656,42 @@ def test_hostile_arguments_are_refused_naming_them(key, tmp_path, monkeypatch):
             finally:
                 _close_figures()
     assert not failures, f"{key}:\n" + "\n".join(failures)
+
+
+# --- numpy scalars are numbers ---------------------------------------------------------------
+
+
+def _numpy(value: Any) -> Any:
+    """``value`` with every float as np.float32 and every int as np.int64 (bools kept), in
+    lists and tuples too."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, float):
+        return np.float32(value)
+    if isinstance(value, int):
+        return np.int64(value)
+    if isinstance(value, list | tuple) and not hasattr(value, "_fields"):
+        return type(value)(_numpy(v) for v in value)
+    return value
+
+
+def test_numpy_scalars_are_taken_wherever_numbers_are(tmp_path, monkeypatch):
+    """Every row of VALID whose arguments hold numbers, called with np.float32 and np.int64
+    in their place (in lists and tuples too): it must succeed."""
+    monkeypatch.chdir(tmp_path)
+    f = Fixtures(tmp_path)
+    checked, failures = [], []
+    for key in sorted(VALID):
+        kwargs = VALID[key](f)
+        numpy_kwargs = {name: _numpy(value) for name, value in kwargs.items()}
+        if all(numpy_kwargs[n] is kwargs[n] for n in kwargs):
+            continue  # no number among the arguments
+        checked.append(key)
+        try:
+            _target(key, f)(**numpy_kwargs)
+        except Exception as exc:  # noqa: BLE001 - any refusal of a number is the failure
+            failures.append(f"{key}: {type(exc).__name__}: {exc}")
+        finally:
+            _close_figures()
+    assert not failures, "\n".join(failures)
+    assert len(checked) >= 90, checked

@@ -33,6 +33,9 @@ from PIL import Image, ImageDraw, ImageFont
 
 from ..model.energy import BOOKKEEPING, energy_columns
 from ..model.scene import Scene
+
+#: No public names: this is the painter behind :func:`dumbbell.animation.render.render_gif`.
+__all__: list[str] = []
 from ..plot.style import COLOURS
 
 #: Supersampling factor of everything drawn with smooth edges.

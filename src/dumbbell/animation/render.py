@@ -39,6 +39,9 @@ from ..model.trajectory import Trajectory
 if TYPE_CHECKING:
     from .drawing import Frames
 
+__all__ = ["MAX_FPS", "MAX_FRAMES", "Gif", "check_fps", "check_frames", "check_size",
+           "delays_cs", "frame_count", "frames_of", "render_gif", "sample_every"]
+
 #: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
 MAX_FPS = 50
 #: Most frames an animation may have unless told otherwise (``max_frames``, ``--max-frames``):
@@ -58,7 +61,7 @@ def check_fps(fps: Any, where: str = "fps") -> int:
         raise UsageError(
             f"{where} = {fps}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
             "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)",
-            param=where.lstrip("-"))
+            param=where.lstrip("-") if isinstance(where, str) else None)
     return int(fps)
 
 
@@ -71,17 +74,30 @@ def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, i
     try:
         return parse_size(size)
     except ValueError as exc:
-        raise UsageError(f"{where}: {exc}", param=where.lstrip("-")) from None
+        raise UsageError(f"{where}: {exc}",
+                         param=where.lstrip("-") if isinstance(where, str) else None) from None
 
 
 def frame_count(t_end: float, fps: int) -> int:
     """Frames of an animation of ``t_end`` s at ``fps``: times 0, 1/fps, ... below t_end."""
+    from ..model import args
+
+    t_end = args.real(t_end, "t_end", "s")
+    fps = check_fps(fps)
+    if not t_end * fps <= 1e15:
+        raise UsageError(f"t_end = {t_end:g} s at {fps} fps: more than 1e15 frames", param="t_end")
     return max(1, math.ceil(t_end * fps - 1e-9))
 
 
 def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") -> int:
     """The frame count of ``t_end`` s at ``fps``, or a UsageError when it passes
     ``max_frames``; compared before multiplying, so a huge ``t_end`` cannot overflow."""
+    from ..model import args
+
+    where = args.text(where, "where", "the argument's name for the message (str)")
+    t_end = args.real(t_end, "t_end", "s")
+    fps = check_fps(fps)
+    max_frames = args.whole(max_frames, "max_frames", "frames")
     if t_end * fps <= max_frames + 1:
         n = frame_count(t_end, fps)
         if n <= max_frames:
@@ -98,6 +114,10 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
 def delays_cs(n: int, fps: int) -> list[int]:
     """Delay of each of ``n`` frames in GIF units (10 ms): frame k starts at
     round(k * 100 / fps) units, so the animation keeps real time."""
+    from ..model import args
+
+    n = args.whole(n, "n", "frames", lo=0, hi=10**7)
+    fps = check_fps(fps)
     starts = [math.floor(k * 100 / fps + 0.5) for k in range(n + 1)]
     return [b - a for a, b in itertools.pairwise(starts)]
 
@@ -106,6 +126,14 @@ def sample_every(dt: float, fps: int, t_end: float) -> int:
     """Steps between kept samples so that samples fall on frame times when 1/fps is a whole
     number of steps ``dt`` (s), about :data:`STRIP_RATE` samples per second for the strip and
     at most about :data:`STRIP_SAMPLES` over ``t_end`` (s)."""
+    from ..model import args
+
+    dt = args.real(dt, "dt", "s")
+    fps = check_fps(fps)
+    t_end = args.real(t_end, "t_end", "s")
+    if not 1.0 / (fps * dt) <= 1e15:
+        raise UsageError(f"dt = {dt:g}: more than 1e15 steps per frame at {fps} fps",
+                         param="dt")
     per_frame = max(1, round(1.0 / (fps * dt)))
     target = max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES)
     divisors = [d for d in range(1, math.isqrt(per_frame) + 1) if per_frame % d == 0]
@@ -116,6 +144,11 @@ def sample_every(dt: float, fps: int, t_end: float) -> int:
 
 def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
+    from ..model import args
+
+    traj = args.trajectory(traj)
+    fps = check_fps(fps)
+    t_end = args.real(t_end, "t_end", "s")
     from .drawing import Frames
 
     t = traj.t

@@ -13,11 +13,17 @@ if TYPE_CHECKING:
     import pandas
 
 
+def _show(value: Any) -> str:
+    # This module is below the model (it may not import dumbbell.model.args): a short repr.
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def pandas_module(what: str = "to_pandas()") -> Any:
     """The pandas module, or a MissingExtraError naming the extra that installs it."""
-    from ..model import args
-
-    args.text(what, "what", "what needs pandas, for the message (str)")
+    if not isinstance(what, str):
+        raise UsageError(f"what = {_show(what)}: must be a str (what needs pandas)",
+                         param="what")
     try:
         import pandas
     except ImportError:
@@ -29,14 +35,15 @@ def data_frame(columns: Mapping[str, Sequence[Any]], index: str | None = None,
                units: Mapping[str, str] | None = None) -> pandas.DataFrame:
     """A DataFrame of ``columns`` in their order, ``index`` (a column name) as its index, and
     the unit of every column (index included) in ``df.attrs["units"]``."""
-    from ..model import args
-
-    args.mapping(columns, "columns", "a dict of column name to values")
+    if not isinstance(columns, Mapping):
+        raise UsageError(f"columns = {_show(columns)}: must be a dict of column name to "
+                         "values", param="columns")
     if index is not None and (not isinstance(index, str) or index not in columns):
-        raise UsageError(f"index = {args.show(index)}: must be one of the columns or None",
+        raise UsageError(f"index = {_show(index)}: must be one of the columns or None",
                          param="index")
-    if units is not None:
-        args.mapping(units, "units", "a dict of column name to unit, or None")
+    if units is not None and not isinstance(units, Mapping):
+        raise UsageError(f"units = {_show(units)}: must be a dict of column name to unit, or "
+                         "None", param="units")
     pd = pandas_module()
     df = pd.DataFrame({name: columns[name] for name in columns})
     if index is not None:
