@@ -364,13 +364,12 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                                      "window": 0.3},
     "dumbbell.analysis.extended.extended_precision_rigid": lambda f: {"traj": f.traj_2d,
                                                                      "window": 0.3},
-    "dumbbell.analysis.metrics.coordinate_error": lambda f: {"run": f.run, "truth": f.traj},
+    "dumbbell.analysis.metrics.position_error_series": lambda f: {"run": f.run,
+                                                                 "truth": f.traj},
     "dumbbell.analysis.metrics.energy_error": lambda f: {"traj": f.run, "truth": f.traj},
-    "dumbbell.analysis.metrics.energy_spread": lambda f: {"traj": f.run},
     "dumbbell.analysis.metrics.impact_time_error": lambda f: {"traj": f.run, "truth": f.traj,
                                                              "window": 0.3},
-    "dumbbell.analysis.metrics.position_columns": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.metrics.position_error": lambda f: {"traj": f.run, "truth": f.traj,
+    "dumbbell.analysis.metrics.position_error": lambda f: {"run": f.run, "truth": f.traj,
                                                           "window": 0.3},
     # dumbbell.analysis.restitution
     "dumbbell.analysis.restitution.Bounce": lambda f: {
