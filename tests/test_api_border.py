@@ -30,7 +30,7 @@ from dumbbell import DumbbellError
 PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis",
             "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
-TOP = ("dumbbell",)
+TOP = ("dumbbell", "dumbbell.solvers")
 
 #: Values that are wrong for nearly every argument.
 HOSTILE = (None, "text", [1, 2], float("nan"), -1, object())
@@ -309,6 +309,18 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "scene": f.scene, "solver": "exact", "dt": 1e-2, "t_end": 0.05, "every": 1,
         "quiet": True, "max_samples": 1000},
     "dumbbell.solvers.available": lambda f: {},
+    "dumbbell.solvers.base.make_options": lambda f: {
+        "scene": f.scene, "dt": 1e-3, "t_end": 0.5, "every": 10, "quiet": True,
+        "max_samples": 10_000},
+    "dumbbell.solvers.no_truth_reason": lambda f: {"scene": f.scene_2d},
+    "dumbbell.solvers.scene_solver": lambda f: {"scene": f.scene},
+    "dumbbell.solvers.solver_class": lambda f: {"solver": "verlet"},
+    "dumbbell.solvers.supported": lambda f: {"scene": f.scene_2d},
+    "dumbbell.solvers.truth_solver": lambda f: {"scene": f.rigid_2d},
+    "dumbbell.solvers.base.RunOptions": lambda f: {"dt": 1e-3, "t_end": 1.0, "every": 1,
+                                                  "quiet": True},
+    "dumbbell.solvers.base.Solver": lambda f: {},
+    "dumbbell.solvers.base.RunOptions.sample_times": lambda f: {"count": 3},
     "dumbbell.model.trajectory.Trajectory": lambda f: fields(f.traj),
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: {"path": f.tmp / "t.csv"},
     "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: {"path": f.tmp / "e.csv"},
@@ -582,6 +594,8 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.spaces.guard.Driver.step": lambda f: __import__("dumbbell").spaces.Driver(
         f.space(), 1e-2, 1),
     "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
+    "dumbbell.solvers.base.RunOptions.sample_times":
+        lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
     "dumbbell.io.files.OutputTransaction.claim":
         lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":

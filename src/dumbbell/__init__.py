@@ -9,15 +9,15 @@ its internal motion, from the bouncing dumbbell of textbook section 13.5.1.
 
 from .analysis.api import bench, compare, stability, sweep
 from .animation.render import Gif, render_gif
-from .errors import DumbbellError, MissingExtraError, SceneError, UsageError
+from .errors import ColumnError, DumbbellError, MissingExtraError, SceneError, UsageError
 from .model.scene import Scene, load_scene
 from .model.trajectory import Impact, Trajectory, Verdict
 from .solvers import available as solvers
 from .solvers import simulate
 
 __all__ = [
-    "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError", "Trajectory",
-    "UsageError", "Verdict", "bench", "compare", "load_scene", "render_gif", "simulate",
-    "solvers", "stability", "sweep",
+    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError",
+    "Trajectory", "UsageError", "Verdict", "bench", "compare", "load_scene", "render_gif",
+    "simulate", "solvers", "stability", "sweep",
 ]
 __version__ = "0.1.0"

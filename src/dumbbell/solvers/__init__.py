@@ -50,19 +50,21 @@ __all__ = [
 ]
 
 
-def solver_class(name: str) -> type[Solver]:
-    """The class of solver ``name``; UsageError naming the choices when there is none."""
-    if not isinstance(name, str):
-        raise UsageError(f"solver = {args.show(name)}: must be a solver name, one of "
+def solver_class(solver: str) -> type[Solver]:
+    """The class of the solver named ``solver``; UsageError naming the choices when there is
+    none."""
+    if not isinstance(solver, str):
+        raise UsageError(f"solver = {args.show(solver)}: must be a solver name, one of "
                          f"{', '.join(available())}", param="solver")
-    if name not in METHODS:
-        raise UsageError(f"solver {name!r}: must be one of {', '.join(available())}")
-    return METHODS[name]
+    if solver not in METHODS:
+        raise UsageError(f"solver {solver!r}: must be one of {', '.join(available())}")
+    return METHODS[solver]
 
 
 def scene_solver(scene: Scene) -> type[Solver]:
     """The class of the solver the scene's ``run.solver`` names; SceneError naming the file
     and key when no solver has that name."""
+    scene = args.scene(scene)
     name = scene.run.solver
     if name not in METHODS:
         raise SceneError(f"{scene.source}: run.solver = {name!r}: must be one of "
@@ -77,6 +79,7 @@ def available() -> list[str]:
 
 def supported(scene: Scene) -> list[str]:
     """Names of the solvers that can run ``scene``."""
+    scene = args.scene(scene)
     return [n for n, cls in METHODS.items() if cls.supports(scene) is None]
 
 
@@ -89,12 +92,14 @@ def _truth_class(scene: Scene) -> type[Solver] | None:
 def truth_solver(scene: Scene) -> str | None:
     """The solver analysis takes as truth for ``scene`` (``exact`` in 1D and for the rigid 2D
     dumbbell, ``reference`` for a 2D spring); None when it cannot run the scene."""
+    scene = args.scene(scene)
     cls = _truth_class(scene)
     return cls.name if cls is not None and cls.supports(scene) is None else None
 
 
 def no_truth_reason(scene: Scene) -> str | None:
     """Why there is no truth for ``scene`` (its truth solver's reason), or None if there is."""
+    scene = args.scene(scene)
     cls = _truth_class(scene)
     if cls is None:
         return "no solver is the truth for this kind of scene"

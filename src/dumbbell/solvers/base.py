@@ -49,6 +49,10 @@ class RunOptions:
     def sample_times(self, count: int | None = None) -> np.ndarray:
         """Times of the first ``count`` samples (s; all by default): step * dt, with the step
         index j * every kept whole so every solver and every ``every`` share the same floats."""
+        if count is not None:
+            from ..model import args
+
+            count = args.whole(count, "count", "samples", lo=0)
         steps = np.arange(self.n_samples if count is None else count, dtype=np.int64)
         return (steps * self.every) * self.dt
 
@@ -148,6 +152,7 @@ def make_options(
     exact integers before anything is allocated."""
     from ..model import args
 
+    scene = args.scene(scene)
     dt = args.real(scene.run.dt if dt is None else dt, "dt", "s")
     t_end = args.real(scene.run.t_end if t_end is None else t_end, "t_end", "s")
     if dt > t_end:
