@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+import re
 import signal
 import socket
 import stat
@@ -106,6 +107,80 @@ def test_compare_refuses_past_the_sample_budget_in_its_own_flags(work):
     status, _, err = cli("compare", scene, "--t-end", "1e5", "--out", out)
     line = refused(status, err, out)
     assert "--t-end" in line and "samples" in line and "--every" not in line
+
+
+def _help_flags(command: str) -> set[str]:
+    status, out, _ = cli(command, "--help")
+    assert status == 0
+    return set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", out))
+
+
+#: A budget per command that keeps samples or frames: (command, its arguments past SCENE;
+#: SCENE is the short 1D scene, or "2D" for a shipped 2D one), and the way out it must name
+#: (a flag, or a scene key where the command has no flag for it).
+BUDGETS = [
+    ("simulate", ["--t-end", "1e4", "--dt", "1e-5", "--every", "1"], ["--every", "--max-samples"]),
+    ("run", ["@long-run"], ["run.every", "--max-samples"]),
+    ("run", ["@long-gif"], ["outputs.gif.t_end", "outputs.gif.fps", "--max-frames"]),
+    ("render", ["--t-end", "1e4"], ["--t-end", "--fps", "--max-frames"]),
+    ("compare", ["--t-end", "1e5"], ["--t-end"]),
+    ("bench", ["--t-end", "1e4", "--dts", "1e-3", "--window", "1e-3", "--sample-spacing",
+               "1e-4"], ["--sample-spacing", "--t-end"]),
+    ("restitution", ["2D", "--dt", "1e-9"], ["--dt"]),
+    ("sweep", ["--grid", "k=lin:100:200:200", "--t-end", "9000"], ["--grid", "--t-end"]),
+]
+
+
+@pytest.mark.parametrize("command,flags,fixes", BUDGETS,
+                         ids=[f"{c}-{i}" for i, (c, _, _) in enumerate(BUDGETS)])
+def test_a_budget_refusal_names_flags_the_command_has(work, command, flags, fixes):
+    scene, out = work
+    extra = {"@long-run": SHORT_SCENE.replace("t_end = 0.05", "t_end = 1e4"),
+             "@long-gif": SHORT_SCENE + "[outputs]\ncsv = true\ngif = { fps = 25, t_end = 1e4 }\n"}
+    if flags and flags[0] in extra:
+        (scene.parent / "budget.toml").write_text(extra[flags.pop(0)], encoding="utf-8")
+        scene = scene.parent / "budget.toml"
+    elif flags and flags[0] == "2D":
+        flags, scene = flags[1:], SCENES / "tilted-2d.toml"
+    where = ["-o", out / "x.gif"] if command == "render" else (
+        ["-o", out / "x.csv"] if command == "simulate" else ["--out", out])
+    status, _, err = cli(command, scene, *flags, *where)
+    line = refused(status, err, out)
+    assert "budget" in line or "at most" in line, line
+    named = set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", line.split("budget", 1)[-1]))
+    assert named <= _help_flags(command), (line, named - _help_flags(command))
+    assert all(f in line for f in fixes), line
+
+
+def test_render_keeps_a_bounded_number_of_samples_whatever_fps_and_dt():
+    """The samples a render keeps, t_end / dt / every + 1, stay under 2 * STRIP_SAMPLES + 1 for
+    any frame rate and step; and they fall on frame times whenever a divisor of the frame
+    interval (in steps) is within a factor 2 of the strip's target."""
+    from dumbbell.animation.render import STRIP_RATE, STRIP_SAMPLES, sample_every
+
+    for fps in range(1, 51):
+        for dt in (1e-6, 7e-6, 1e-5, 3e-5, 1e-4, 1e-3, 0.013, 0.05):
+            for t_end in (1.0, 37.0, 600.0):
+                every = sample_every(dt, fps, t_end)
+                samples = round(t_end / dt) // every + 1
+                assert 1 <= every and samples <= 2 * STRIP_SAMPLES + 1, (fps, dt, t_end, every)
+                per_frame = max(1, round(1 / (fps * dt)))
+                target = max(1.0, 1 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES)
+                near = [d for d in range(1, per_frame + 1)
+                        if per_frame % d == 0 and target / 2 <= d <= target]
+                if near:
+                    assert every == max(near), (fps, dt, t_end, every)
+
+
+def test_render_of_a_tiny_step_neither_hangs_nor_overflows(work, tmp_path):
+    # dt = 1e-200 s: the frame interval is 4e198 steps, whose divisors cannot be searched.
+    scene, out = work
+    tiny = scene.parent / "tiny.toml"
+    tiny.write_text(SHORT_SCENE.replace("t_end = 0.05", "t_end = 1e-195")
+                    .replace("dt = 1e-4", "dt = 1e-200"), encoding="utf-8")
+    status, _, err = cli("render", tiny, "-o", out / "x.gif", "-q")
+    assert status == 0 and "Traceback" not in err, err
+    assert files_in(out) == ["x.gif"]
 
 
 def test_sweep_caps_workers_and_says_so_once(work):

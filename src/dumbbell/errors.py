@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import string
+from collections.abc import Callable, Mapping, Sequence
+
 
 class DumbbellError(Exception):
     """Base class of the errors that are the user's to fix (exit status 2)."""
@@ -20,11 +23,46 @@ class UsageError(DumbbellError, ValueError):
 
     Library code names the parameter and starts the message with it, e.g.
     ``UsageError("window = -1: must be a finite number > 0 (s)", param="window")``; the
-    command line shows the flag instead (``--window = -1: ...``)."""
+    command line shows the flag instead (``--window = -1: ...``).
 
-    def __init__(self, message: str, param: str | None = None):
-        super().__init__(message)
+    ``fixes`` are the ways out, each a phrase naming the parameters to change in braces:
+    ``fixes=("keep fewer with a larger {every}", "raise the budget {max_samples}")`` ends the
+    message with ``: keep fewer with a larger every or raise the budget max_samples``. The
+    command line names its own flags there instead (:meth:`text`), and leaves out a way that
+    needs a parameter the command cannot set."""
+
+    def __init__(self, message: str, param: str | None = None, fixes: Sequence[str] = ()):
+        self.reason = message
         self.param = param
+        self.fixes = tuple(fixes)
+        super().__init__(self.text())
+
+    def text(self, name: Callable[[str], str | None] = str) -> str:
+        """The message with every parameter of :attr:`fixes` spelt ``name(parameter)``; a fix
+        with a parameter whose name is None is left out."""
+        ways = []
+        for fix in self.fixes:
+            params = [p for _, p, _, _ in string.Formatter().parse(fix) if p]
+            names = {p: name(p) for p in params}
+            if all(n is not None for n in names.values()):
+                ways.append(fix.format_map(names))
+        if not ways:
+            return self.reason
+        last = ways.pop()
+        return f"{self.reason}: {', '.join(ways) + ' or ' if ways else ''}{last}"
+
+    def named(self, names: Mapping[str, str]) -> UsageError:
+        """The same error with the parameters in ``names`` spelt as given there, for good:
+        a caller that knows where a value came from (a scene key) says so."""
+        fixes = [fix.format_map(_Keep(names)) for fix in self.fixes]
+        return UsageError(self.reason, self.param, fixes)
+
+
+class _Keep(dict):
+    """format_map's mapping that leaves a placeholder it has no name for as it was."""
+
+    def __missing__(self, key: str) -> str:
+        return "{" + key + "}"
 
 
 class ColumnError(UsageError, KeyError):

@@ -51,7 +51,15 @@ from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from ..solvers import RunOptions, Solver, make_options, solver_class, supported, truth_solver
+from ..solvers import (
+    MAX_SAMPLES,
+    RunOptions,
+    Solver,
+    make_options,
+    solver_class,
+    supported,
+    truth_solver,
+)
 from .extended import extended_precision_exact, extended_precision_rigid
 from .metrics import energy_error, impact_time_error, position_error
 
@@ -247,12 +255,23 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
         try:
             make_options(scene, dt=dt, t_end=t_end)
         except UsageError as exc:
-            raise UsageError(f"dts: {exc}", param="dts") from None
+            raise UsageError(f"dts: {exc.reason}", param="dts", fixes=exc.fixes) from None
     if window > t_end:
         raise UsageError(f"window {window:g}: must be <= the run's t_end = {t_end:g} (s)", param="window")
     if not 0 < spacing <= window:
         raise UsageError(f"sample_spacing {spacing:g}: must be > 0 and <= the window "
                          f"{window:g} (s)", param="sample_spacing")
+    # The samples one run keeps, before anything runs: a stepping solver keeps every
+    # round(spacing / dt)-th step, a solver without a step one sample per spacing.
+    ratio = t_end / spacing  # a float: inf when the quotient passes the largest float
+    counts = [make_options(scene, dt=dt, t_end=t_end, every=_every(dt, spacing)).n_samples
+              for dt in dts]
+    if not (ratio + 1 <= MAX_SAMPLES and max(counts, default=0) <= MAX_SAMPLES):
+        most = max([*counts, round(ratio) + 1]) if math.isfinite(ratio) else None
+        count = f"{most:,} samples" if most is not None else "more than 1e308 samples"
+        raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: a run would "
+                         f"keep {count}, past the budget of {MAX_SAMPLES:,}",
+                         fixes=("keep fewer with a larger {spacing}", "a shorter {t_end}"))
 
 
 def run_bench(

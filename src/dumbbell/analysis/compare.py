@@ -226,8 +226,8 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     samples = round(t_end / spacing) + 1  # finite: t_end / dt passed the step cap above
     if samples > MAX_SAMPLES:
         raise UsageError(f"t_end = {t_end:g}: each run keeps a sample every {spacing:g} s, "
-                         f"{samples:,} samples, past the budget of {MAX_SAMPLES:,}: lower "
-                         "t_end", param="t_end")
+                         f"{samples:,} samples, past the budget of {MAX_SAMPLES:,}",
+                         param="t_end", fixes=("lower {t_end}",))
     truth_name = truth_solver(scene)
     notes = []
     if truth_name is None:

@@ -233,6 +233,22 @@ class RestitutionResult:
         return "\n".join([head, rule, *rows])
 
 
+def _check_samples(rigid: Scene, dt: float, t_end: float) -> None:
+    """UsageError before anything runs when a rigid run of the drop, which keeps every step
+    (pymunk at ``dt``, the truth at the scene's run.dt; s), would keep more samples than
+    :data:`~dumbbell.solvers.MAX_SAMPLES`."""
+    from ..solvers import MAX_SAMPLES, make_options
+
+    for step, what, fix in ((dt, "dt", "use a larger {dt}"),
+                            (rigid.run.dt, "run.dt", "use a larger run.dt in the scene")):
+        samples = make_options(rigid, dt=step, t_end=t_end).n_samples
+        if samples > MAX_SAMPLES:
+            raise UsageError(f"{what} = {step:g} s over the drop's {t_end:g} s: a rigid run "
+                             f"would keep {samples:,} samples, past the budget of "
+                             f"{MAX_SAMPLES:,}", param="dt" if what == "dt" else None,
+                             fixes=(fix,))
+
+
 def restitution(scene: Scene, thetas: np.ndarray | list[float],
                 stiffnesses: tuple[float, ...] = STIFFNESSES, dt: float = 1e-5,
                 progress=None) -> RestitutionResult:
@@ -255,6 +271,7 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
     springs: dict[float, dict[str, list[float]]] = {
         k: {"e_eff": [], "impacts": [], "K_rot_share": []} for k in stiffnesses}
     truth_name = truth_for(tilted(scene, float(thetas[0])))
+    _check_samples(tilted(scene, float(thetas[0])), dt, t_end)
     for th in thetas:
         rigid = tilted(scene, float(th))
         tr = simulate(rigid, truth_name, t_end=t_end, every=1)

@@ -200,7 +200,9 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
         try:
             make_options(scene)  # the step cap, before any case runs
         except DumbbellError as exc:
-            raise UsageError(f"{path}: {exc}") from None
+            fixes = exc.fixes if isinstance(exc, UsageError) else ()
+            raise UsageError(f"{path}: {getattr(exc, 'reason', exc)}", fixes=fixes).named(
+                {"dt": "run.dt", "t_end": "run.t_end"}) from None
         names = default_solvers(scene) if solvers is None else solvers
         for name in names:
             reason = solver_class(name).supports(scene)

@@ -216,8 +216,8 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
         points.append(Point(index, values))
     if total > MAX_STEPS_TOTAL:
         raise UsageError(f"grid: the sweep would take {total:.3g} steps in all; at most "
-                         f"{MAX_STEPS_TOTAL:.0e}: use fewer points, a larger dt or a smaller "
-                         "t_end", param="grid")
+                         f"{MAX_STEPS_TOTAL:.0e}", param="grid",
+                         fixes=("use fewer points ({grid})", "a larger dt", "a smaller {t_end}"))
     return points
 
 

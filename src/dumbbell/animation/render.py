@@ -107,8 +107,8 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
         count = (f"{math.ceil(t_end * fps):,} frames" if math.isfinite(t_end * fps)
                  else "more than 1e308 frames")
     raise UsageError(f"{where} = {t_end:g} s at {fps} fps is {count}, past the budget of "
-                     f"{max_frames:,}: shorten the animation (--t-end), lower --fps or raise "
-                     "the budget (--max-frames)")
+                     f"{max_frames:,}", fixes=("shorten the animation ({t_end})", "lower {fps}",
+                                               "raise the budget ({max_frames})"))
 
 
 def delays_cs(n: int, fps: int) -> list[int]:
@@ -122,24 +122,38 @@ def delays_cs(n: int, fps: int) -> list[int]:
     return [b - a for a, b in itertools.pairwise(starts)]
 
 
+#: Longest frame interval, in steps, whose divisors :func:`sample_every` searches (dt down to
+#: 2 ns at 50 fps); past it a search would take too long and the samples are too dense anyway.
+MAX_DIVISOR_SEARCH = 10**7
+
+
 def sample_every(dt: float, fps: int, t_end: float) -> int:
     """Steps between kept samples so that samples fall on frame times when 1/fps is a whole
     number of steps ``dt`` (s), about :data:`STRIP_RATE` samples per second for the strip and
-    at most about :data:`STRIP_SAMPLES` over ``t_end`` (s)."""
+    at most about :data:`STRIP_SAMPLES` over ``t_end`` (s). Never fewer than half the steps
+    that target asks for, so a render keeps at most 2 * STRIP_SAMPLES + 1 samples."""
     from ..model import args
 
     dt = args.real(dt, "dt", "s")
     fps = check_fps(fps)
     t_end = args.real(t_end, "t_end", "s")
-    if not 1.0 / (fps * dt) <= 1e15:
-        raise UsageError(f"dt = {dt:g}: more than 1e15 steps per frame at {fps} fps",
-                         param="dt")
-    per_frame = max(1, round(1.0 / (fps * dt)))
-    target = max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES)
+    steps = max(1.0, t_end / dt)  # inf only past the step cap, which a run checks first
+    # At most the run's steps, so that a subnormal dt cannot make it overflow.
+    target = min(steps, max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES))
+    frame_steps = 1.0 / (fps * dt)
+    if not (frame_steps <= MAX_DIVISOR_SEARCH and math.isfinite(target)):
+        return math.floor(target) if math.isfinite(target) else 1
+    per_frame = max(1, round(frame_steps))
     divisors = [d for d in range(1, math.isqrt(per_frame) + 1) if per_frame % d == 0]
     divisors += [per_frame // d for d in divisors]
-    fitting = [d for d in divisors if d <= target]
-    return max(fitting) if fitting else 1
+    best = max(d for d in divisors if d <= target)  # 1 always fits
+    if 2 * best < target:
+        # No divisor of the frame interval comes near the target (23 fps at dt = 1e-5 s:
+        # 4348 steps, best divisor 4 of a target of 200): keeping every 4th step would keep
+        # 50 times the samples needed. Frames then take the nearest sample instead, at most
+        # half a sample spacing (1 ms; t_end / STRIP_SAMPLES / 2 for long runs) away.
+        return math.floor(target)
+    return best
 
 
 def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:

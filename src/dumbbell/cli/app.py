@@ -18,7 +18,7 @@ import sys
 import threading
 from collections.abc import Iterator, Sequence
 
-from ..errors import DumbbellError
+from ..errors import DumbbellError, UsageError
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep",
@@ -178,10 +178,27 @@ def _check_paths(args: argparse.Namespace, transaction) -> None:
             transaction.claim(value, f"{flag} {value}")
 
 
-def as_flags(exc: DumbbellError) -> str:
+def flag_for(param: str, args: argparse.Namespace | None) -> str | None:
+    """How command ``args`` sets the library parameter ``param``: the name the command
+    declares for it (``set_defaults(names={...})``: a flag of another name, a scene key),
+    else ``--param`` when the command has that option, else None (it cannot)."""
+    if args is None:
+        return None
+    names = getattr(args, "names", {})
+    if param in names:
+        return names[param]
+    if param not in ("func", "command", "names") and hasattr(args, param):
+        return "--" + param.replace("_", "-")
+    return None
+
+
+def as_flags(exc: DumbbellError, args: argparse.Namespace | None = None) -> str:
     """The error's message as the command line says it: a library error that starts with
-    the parameter's name (``UsageError.param``) starts with its flag instead."""
-    text = str(exc)
+    the parameter's name (``UsageError.param``) starts with its flag instead, and the ways
+    out it names (``UsageError.fixes``) name the flags of this command (``args``), leaving
+    out those it has no flag for."""
+    text = (exc.text(lambda p: flag_for(p, args)) if isinstance(exc, UsageError) and args
+            is not None else str(exc))
     param = getattr(exc, "param", None)
     if param and text.startswith(param):
         return "--" + param.replace("_", "-") + text[len(param):]
@@ -216,7 +233,7 @@ def _run(args: argparse.Namespace, command: str) -> int:
             _check_paths(args, transaction)
             return int(args.func(args) or 0)
     except DumbbellError as exc:
-        sys.stderr.write(one_line(f"{command}: error: {as_flags(exc)}") + "\n")
+        sys.stderr.write(one_line(f"{command}: error: {as_flags(exc, args)}") + "\n")
         return EXIT_USAGE
     except BrokenPipeError:
         # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep

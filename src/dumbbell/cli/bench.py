@@ -60,7 +60,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         f"output, or 1/{SAMPLES_PER_PERIOD} of the spring's period if shorter); "
                         "the exact and reference solvers are timed for exactly these samples")
     add_quiet(p)
-    p.set_defaults(func=run)
+    # The library's dt (one of dts) and spacing are --dts and --sample-spacing here.
+    p.set_defaults(func=run, names={"dt": "--dts", "spacing": "--sample-spacing"})
 
 
 def run(args: argparse.Namespace) -> int:

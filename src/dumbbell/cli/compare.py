@@ -36,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "default: pymunk and euler-cromer in 1D, pymunk and euler-cromer-2d "
                         "in 2D)")
     add_quiet(p)
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, names={"dts": "--dt"})
 
 
 def run(args: argparse.Namespace) -> int:

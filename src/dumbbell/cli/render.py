@@ -42,7 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-strip", dest="strip", action="store_false", default=None,
                    help="leave out the strip of the energy time series")
     add_quiet(p)
-    p.set_defaults(func=run)
+    # The step comes from the scene: a run past the step cap names its key.
+    p.set_defaults(func=run, names={"dt": "run.dt"})
 
 
 def _whole(text: str) -> int:

@@ -7,7 +7,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .app import add_quiet
+from ..animation.render import MAX_FRAMES
+from ..solvers import MAX_SAMPLES
+from .app import add_quiet, positive_int
 
 #: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
 SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d", "topple-2d")
@@ -26,8 +28,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="folder for the outputs (default: renders)")
     p.add_argument("--all", action="store_true",
                    help="run every showcase scene (" + ", ".join(SHOWCASE) + ")")
+    p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
+                   default=MAX_SAMPLES,
+                   help=f"refuse, before anything runs, a scene whose run would keep more than "
+                        f"N samples (run.t_end / run.dt / run.every + 1; default "
+                        f"{MAX_SAMPLES:,})")
+    p.add_argument("--max-frames", type=positive_int("frames"), metavar="N",
+                   default=MAX_FRAMES,
+                   help=f"refuse, before anything runs, a GIF of more than N frames "
+                        f"(outputs.gif t_end x fps; default {MAX_FRAMES:,})")
     add_quiet(p)
-    p.set_defaults(func=run)
+    # The run's settings come from the scene: a refusal names its keys.
+    p.set_defaults(func=run, names={"every": "run.every", "dt": "run.dt",
+                                    "t_end": "run.t_end"})
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,27 +51,50 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError("give either SCENE or --all, not both")
     paths = ([packaged_scene(n) for n in SHOWCASE] if args.all
              else [Path(args.scene) if args.scene else packaged_scene()])
-    # Validate every scene before any output is written.
+    # Validate every scene, and its budgets, before any output is written.
     scenes = [load_scene(p) for p in paths]
     for scene in scenes:
-        if scene.outputs.gif is not None:
-            from ..animation.render import MAX_FRAMES, check_frames
-
-            gif = scene.outputs.gif
-            check_frames(gif.t_end, gif.fps, MAX_FRAMES,
-                         f"{scene.source}: outputs.gif.t_end")
+        _check_budgets(scene, args.max_samples, args.max_frames)
     status = 0
     for scene in scenes:
-        status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet))
+        status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet,
+                                       max_samples=args.max_samples,
+                                       max_frames=args.max_frames))
     return status
 
 
-def run_scene(scene, out: Path, quiet: bool = False) -> int:
-    """Make every output ``scene`` asks for in ``out``; returns the exit status (0 or 3)."""
+def _check_budgets(scene, max_samples: int, max_frames: int) -> None:
+    """UsageError naming the scene and its keys when its run would keep more than
+    ``max_samples`` samples or its GIF have more than ``max_frames`` frames."""
+    from ..animation.render import check_frames
+    from ..errors import UsageError
+    from ..solvers import make_options
+
+    def in_scene(exc: UsageError, keys: dict[str, str]) -> UsageError:
+        return UsageError(f"{scene.source}: {exc.reason}", fixes=exc.fixes).named(keys)
+
+    try:
+        make_options(scene, max_samples=max_samples)
+    except UsageError as exc:
+        raise in_scene(exc, {}) from None
+    if scene.outputs.gif is not None:
+        gif = scene.outputs.gif
+        try:
+            check_frames(gif.t_end, gif.fps, max_frames, "outputs.gif.t_end")
+        except UsageError as exc:
+            raise in_scene(exc, {"t_end": "outputs.gif.t_end",
+                                 "fps": "outputs.gif.fps"}) from None
+
+
+def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMPLES,
+              max_frames: int = MAX_FRAMES) -> int:
+    """Make every output ``scene`` asks for in ``out``, refusing a run that would keep more
+    than ``max_samples`` samples or a GIF of more than ``max_frames`` frames; returns the
+    exit status (0 or 3)."""
     from ..solvers import simulate
     from .app import EXIT_VERDICT
 
-    traj = simulate(scene, quiet=quiet)
+    traj = simulate(scene, quiet=quiet, max_samples=max_samples)
     written: list[Path] = []
     if scene.outputs.figures:
         from ..io.figures import save_figure
@@ -75,7 +111,8 @@ def run_scene(scene, out: Path, quiet: bool = False) -> int:
 
         gif = scene.outputs.gif
         written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
-                                  size=gif.size, strip=gif.strip, t_end=gif.t_end))
+                                  size=gif.size, strip=gif.strip, t_end=gif.t_end,
+                                  max_frames=max_frames))
     if not quiet:
         for path in written:
             sys.stderr.write(f"wrote {path}\n")

@@ -164,7 +164,7 @@ def make_options(
     if not ratio <= MAX_STEPS:
         count = f"{round(ratio):,} steps" if math.isfinite(ratio) else "more than 1e308 steps"
         raise UsageError(f"t_end / dt = {t_end:g} s / {dt:g} s = {count}: a run may take at "
-                         f"most {MAX_STEPS:,} steps; raise dt or lower t_end")
+                         f"most {MAX_STEPS:,} steps", fixes=("raise {dt}", "lower {t_end}"))
     options = RunOptions(dt, t_end, every, quiet)
     if max_samples is not None:
         check_samples(scene, options, args.whole(max_samples, "max_samples", "samples"))
@@ -184,8 +184,8 @@ def check_samples(scene: Scene, options: RunOptions, max_samples: int) -> None:
     raise UsageError(
         f"{options.n_steps:,} steps with every = {options.every:,} would keep "
         f"{samples:,} samples (about {_bytes(size)} in memory), past the budget of "
-        f"{max_samples:,}: keep fewer with a larger every (--every) or raise the budget "
-        "max_samples (--max-samples)")
+        f"{max_samples:,}",
+        fixes=("keep fewer with a larger {every}", "raise the budget {max_samples}"))
 
 
 def _bytes(size: int) -> str:
