@@ -194,15 +194,16 @@ def flag_for(param: str, args: argparse.Namespace | None) -> str | None:
 
 def as_flags(exc: DumbbellError, args: argparse.Namespace | None = None) -> str:
     """The error's message as the command line says it: a library error that starts with
-    the parameter's name (``UsageError.param``) starts with its flag instead, and the ways
-    out it names (``UsageError.fixes``) name the flags of this command (``args``), leaving
-    out those it has no flag for."""
-    text = (exc.text(lambda p: flag_for(p, args)) if isinstance(exc, UsageError) and args
-            is not None else str(exc))
+    the parameter's name (``UsageError.param``) starts with how command ``args`` sets it
+    (:func:`flag_for`; unchanged when it cannot), and the ways out it names
+    (``UsageError.fixes``) name this command's flags, leaving out those it has none for."""
+    def spell(param: str) -> str | None:
+        return "--" + param.replace("_", "-") if args is None else flag_for(param, args)
+
+    text = exc.text(spell) if isinstance(exc, UsageError) and args is not None else str(exc)
     param = getattr(exc, "param", None)
-    if param and text.startswith(param):
-        return "--" + param.replace("_", "-") + text[len(param):]
-    return text
+    flag = spell(param) if param and text.startswith(param) else None
+    return flag + text[len(param):] if flag else text
 
 
 def main(argv: Sequence[str] | None = None) -> int:
