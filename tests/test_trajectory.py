@@ -93,3 +93,17 @@ def test_judge_changes_nothing_and_says_where_to_cut():
     # A solver's own failure (not an energy one) keeps every sample.
     verdict, keep, _ = judge(scene, "test", t, state, (), Verdict("tunnelled", 1.0, "x"), 1e-4)
     assert verdict.status == "tunnelled" and keep == len(t)
+
+
+@pytest.mark.parametrize("solver", ["euler-cromer", "verlet", "pymunk"])
+def test_an_energy_cut_drops_the_impacts_after_it(solver):
+    # The spring starts at its rest length; w*dt = 2.001 lets the vibration the first impact
+    # starts grow until the energy check cuts the run just after that impact, while the
+    # uncut run bounces on (and on).
+    base = {"spring.stiffness": 5e4, "bodies.A.height": 1.2, "run.t_end": 3.0}
+    cut = simulate(make_scene({**base, "run.unstable_energy": 0.5}), solver, dt=2.001e-3)
+    uncut = simulate(make_scene({**base, "run.unstable_energy": 1e70}), solver, dt=2.001e-3)
+    assert cut.verdict.status == "unstable" and len(cut.t) < len(uncut.t)
+    end = cut.t[-1]
+    assert any(e.t > end for e in uncut.events)          # there was something to drop
+    assert cut.events == tuple(e for e in uncut.events if e.t <= end) != ()

@@ -253,10 +253,16 @@ def conclude(
     energy: Mapping[str, np.ndarray] | None = None, truth: bool = False,
 ) -> Trajectory:
     """The finished run as its one frozen Trajectory: :func:`judge` decides the verdict and
-    where the run ends, then the Trajectory is built from the samples kept. Arguments as for
+    where the run ends, then the Trajectory is built from the samples kept, and the impacts up
+    to the last of them. Arguments as for
     :func:`judge`; ``every``, ``wall_time`` (s) and ``info`` go to the Trajectory as they are."""
     events = tuple(events)
     verdict, keep, energy = judge(scene, solver, t, state, events, verdict, dt, energy, truth)
+    if keep < len(t):
+        # The verdict cut the run: impacts after its last sample belong to the part cut off
+        # (an energy blow-up may bounce on for a while before the solver's end).
+        end = float(t[keep - 1]) if keep else -math.inf
+        events = tuple(e for e in events if e.t <= end)
     return Trajectory(scene=scene, solver=solver, t=t[:keep], state=head(state, keep),
                       events=events, verdict=verdict, dt=dt, every=every, wall_time=wall_time,
                       info=dict(info or {}), energy=energy)
