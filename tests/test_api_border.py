@@ -231,8 +231,9 @@ class Fixtures:
 
         return dumbbell.stability(self.scene_file.parent, ["euler-cromer"], workers=1)
 
-    def ax(self, count: int = 1) -> Any:
-        """A new figure's axes: one, or a list of ``count``."""
+    @functools.cache  # noqa: B019 - one figure per count for the whole test: hostile calls
+    def ax(self, count: int = 1) -> Any:  # stop before drawing, valid ones draw over it
+        """A figure's axes: one, or a list of ``count``."""
         import matplotlib.pyplot as plt
 
         axes = plt.subplots(count, 1)[1]
@@ -708,3 +709,25 @@ def test_numpy_scalars_are_taken_wherever_numbers_are(tmp_path, monkeypatch):
             _close_figures()
     assert not failures, "\n".join(failures)
     assert len(checked) >= 90, checked
+
+
+def test_numpy_scalars_give_what_the_equal_python_numbers_give(tmp_path):
+    from dumbbell import spaces
+    from dumbbell.analysis.restitution import e_eff_rigid, sign_change_deg
+    from dumbbell.animation.render import delays_cs, sample_every
+
+    f = Fixtures(tmp_path)
+    dt = np.float32(1 / 60)
+    assert spaces.suggest_dt(f.space(), dt) == spaces.suggest_dt(f.space(), float(dt))
+    a, b = f.space(), f.space()
+    spaces.step(a, dt, np.int64(3))
+    spaces.step(b, float(dt), 3)
+    assert [tuple(x.position) for x in a.bodies] == [tuple(x.position) for x in b.bodies]
+    assert spaces.energy(a, about=np.array([0.5, 1.0])) == spaces.energy(b, about=(0.5, 1.0))
+    e = np.float32(0.5)
+    assert e_eff_rigid(np.float64(30.0), e, np.int64(1)) == e_eff_rigid(30.0, float(e), 1)
+    assert sign_change_deg(e, np.int64(1)) == sign_change_deg(float(e), 1)
+    assert f.topple_cf.omega(np.float32(0.3)) == f.topple_cf.omega(float(np.float32(0.3)))
+    assert delays_cs(np.int64(7), np.int64(30)) == delays_cs(7, 30)
+    assert sample_every(np.float32(1e-4), np.int64(25), np.float64(2.0)) == sample_every(
+        float(np.float32(1e-4)), 25, 2.0)

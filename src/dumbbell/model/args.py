@@ -131,13 +131,19 @@ def path(value: Any, name: str) -> Path:
 
 
 def scene(value: Any, name: str = "scene") -> Any:
-    """``value`` as a Scene: a Scene, or the path of a scene file, which is loaded."""
+    """``value`` as a Scene: a Scene, or the path of a scene file, which is loaded (a file
+    that cannot be read or is not a valid scene is a SceneError that names the argument, then
+    the file: ``scene: x.toml: no such scene file``)."""
+    from ..errors import SceneError
     from .scene import Scene, load_scene
 
     if isinstance(value, Scene):
         return value
     if isinstance(value, str | os.PathLike):
-        return load_scene(value)
+        try:
+            return load_scene(value)
+        except SceneError as exc:
+            raise SceneError(f"{name}: {exc}") from None
     raise UsageError(f"{name} = {show(value)}: must be a Scene or the path of a scene file",
                      param=name)
 
