@@ -592,7 +592,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
 
 #: Method case -> f -> the object whose method it is (fresh at each call).
 OWNER: dict[str, Callable[[Fixtures], Any]] = {
-    "dumbbell.spaces.guard.Driver.step": lambda f: __import__("dumbbell").spaces.Driver(
+    "dumbbell.spaces.guard.Driver.step": lambda f: importlib.import_module("dumbbell.spaces").Driver(
         f.space(), 1e-2, 1),
     "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
     "dumbbell.solvers.base.RunOptions.sample_times":
@@ -600,9 +600,9 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.io.files.OutputTransaction.claim":
         lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
-        lambda f: __import__("dumbbell").spaces.draw_options(),
+        lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
-        lambda f: __import__("dumbbell").spaces.draw_options(),
+        lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
@@ -731,3 +731,75 @@ def test_numpy_scalars_give_what_the_equal_python_numbers_give(tmp_path):
     assert delays_cs(np.int64(7), np.int64(30)) == delays_cs(7, 30)
     assert sample_every(np.float32(1e-4), np.int64(25), np.float64(2.0)) == sample_every(
         float(np.float32(1e-4)), 25, 2.0)
+
+
+# --- wrong kinds beyond the hostile values -------------------------------------------------
+
+
+def _pymunk() -> Any:
+    import pymunk
+
+    return pymunk
+
+
+WRONG_KINDS: dict[str, tuple[Callable[[Fixtures], Any], str]] = {
+    "a Body for a space": (lambda f: importlib.import_module("dumbbell.spaces").energy(
+        _pymunk().Body(1, 1)), "space"),
+    "a Body for the heat counter's space": (lambda f: importlib.import_module("dumbbell.spaces").HeatCounter(
+        _pymunk().Body(1, 1)), "space"),
+    "a Space for a heat counter": (lambda f: importlib.import_module("dumbbell.spaces").Recorder(
+        f.space(), f.tmp / "r.gif", heat=f.space()), "heat"),
+    "a PinJoint for a spring": (lambda f: importlib.import_module("dumbbell.spaces.guard").spring_omega(
+        _pymunk().PinJoint(_pymunk().Body(1, 1), _pymunk().Body(1, 1))), "spring"),
+    "a Body for a shape": (lambda f: importlib.import_module("dumbbell.spaces").shape_size(
+        _pymunk().Body(1, 1)), "shape"),
+    "endless frames": (lambda f: importlib.import_module("dumbbell.spaces").Driver(
+        f.space(), 1e-3, 1).step(10**12), "frames"),
+    "a step needing endless sub-steps": (lambda f: importlib.import_module("dumbbell.spaces").substeps(
+        f.space(), 1e308), "dt"),
+    "a Figure for an Axes": (lambda f: importlib.import_module("dumbbell.plot").kinetic(
+        f.traj, ax=f.ax().figure), "ax"),
+    "one Axes for three": (lambda f: importlib.import_module("dumbbell.plot").restitution(
+        f.restitution, ax=f.ax()), "ax"),
+    "two Axes for three": (lambda f: importlib.import_module("dumbbell.plot").topple(
+        f.topple_cf, f.topple_measure, ax=f.ax(3)[:2]), "ax"),
+    "an Axes for a figure": (lambda f: importlib.import_module("dumbbell.io.figures")
+                             .save_figure(f.ax(), f.tmp / "x.png"), "fig"),
+    "a figure file without a format": (lambda f: importlib.import_module("dumbbell.io.figures")
+                                       .save_figure(f.ax().figure, f.tmp / "x.part"), "path"),
+    "a huge dpi": (lambda f: importlib.import_module("dumbbell.io.figures").save_figure(
+        f.ax().figure, f.tmp / "x.png", dpi=1e6), "dpi"),
+    "a 1D run for the topple": (lambda f: importlib.import_module("dumbbell.analysis.topple")
+                                .measure(f.traj), "traj"),
+    "a 1D run for a tilted drop": (lambda f: importlib.import_module(
+        "dumbbell.analysis.restitution").bounce(f.traj), "traj"),
+    "a 1D run for the rigid closed form": (lambda f: importlib.import_module(
+        "dumbbell.analysis.extended").extended_precision_rigid(f.traj, 0.1), "traj"),
+    "a 2D run for the 1D closed form": (lambda f: importlib.import_module(
+        "dumbbell.analysis.extended").extended_precision_exact(f.traj_2d, 0.1), "traj"),
+    "a 1D truth for a 2D run": (lambda f: importlib.import_module("dumbbell.analysis.metrics")
+                                .position_error(f.traj_2d, f.traj, 0.1), "truth"),
+    "a Body for an example's space": (lambda f: importlib.import_module(
+        "dumbbell.examples.pendulum").measure(1e-3, 0.04, space=_pymunk().Body(1, 1)),
+        "space"),
+    "endless seconds": (lambda f: importlib.import_module("dumbbell.examples.newtons_cradle")
+                        .measure(1e-3, 1e300), "seconds"),
+    "a scene file that is not there": (lambda f: __import__("dumbbell").simulate(
+        f.tmp / "none.toml"), "scene"),
+    "frames past the floats": (lambda f: importlib.import_module("dumbbell.animation.render")
+                               .frame_count(1e300, 25), "t_end"),
+    "a column that is not there": (lambda f: f.traj["K_rot"], "name"),
+    "a body that is not there": (lambda f: f.traj.first_impact("C"), "body"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(WRONG_KINDS))
+def test_wrong_kinds_are_refused_naming_the_argument(case, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    call, argument = WRONG_KINDS[case]
+    try:
+        with pytest.raises(DumbbellError) as info:
+            call(Fixtures(tmp_path))
+    finally:
+        _close_figures()
+    assert argument in str(info.value) and "\n" not in str(info.value)

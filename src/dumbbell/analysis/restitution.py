@@ -103,6 +103,9 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     not bias them; the run must continue ``gap`` s past the cluster."""
     traj = args.trajectory(traj)
     gap = args.real(gap, "gap", "s")
+    if traj.scene.system.dimensions != 2:
+        raise UsageError(f"traj: {traj.scene.source} is 1D; a tilted drop is measured in 2D",
+                         param="traj")
     s = traj.scene
     times = [e.t for e in traj.events]
     if not times:
@@ -115,7 +118,8 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     t_last = times[n - 1]
     if float(traj.t[-1]) < t_last + gap:
         raise UsageError(f"{s.source}: the run ends before the first impact cluster is over "
-                         f"(last impact at {t_last:g} s); run longer")
+                         f"(last impact at {t_last:g} s, then gap = {gap:g} s without one); "
+                         "run longer")
     vy = _cm_vy(traj)
     g = s.system.g
     i_before = int(np.searchsorted(traj.t, t0, side="left")) - 1

@@ -9,10 +9,12 @@ from ..errors import UsageError
 from ..model import args
 from .files import atomic_output
 
-__all__ = ["DPI", "save_figure"]
+__all__ = ["DPI", "MAX_DPI", "save_figure"]
 
-#: Resolution of saved figures (dots per inch).
+#: Resolution of saved figures (dots per inch), and the most allowed (past it the image of a
+#: figure of a few inches runs into the renderer's size limit).
 DPI = 110
+MAX_DPI = 2000
 
 
 def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
@@ -30,7 +32,7 @@ def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
         if isinstance(dpi, str):
             raise UsageError(f"dpi = {args.show(dpi)}: must be a number > 0 (dots per inch) or "
                              "'figure'", param="dpi")
-        args.real(dpi, "dpi", "dots per inch")
+        args.real(dpi, "dpi", "dots per inch", lo=1, hi=MAX_DPI)
     with atomic_output(path) as tmp:
         fig.savefig(tmp, dpi=dpi)
     plt.close(fig)

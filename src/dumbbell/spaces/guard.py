@@ -33,6 +33,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from ..errors import UsageError
 from ..model import args
 from .accounting import body_label, constraint_label, energy
 
@@ -43,6 +44,9 @@ __all__ = ["Driver", "Finding", "check", "report", "shape_size", "spring_omega",
 SPRING_LIMIT = 2.0
 #: Largest slop, as a fraction of the smallest shape's size.
 SLOP_FRACTION = 0.1
+#: Most sub-steps of one step, and most steps one call of :func:`step` or
+#: :meth:`Driver.step` takes: past it a loop would run for hours, so it is refused at once.
+MAX_STEPS = 10**9
 #: Slop suggested, as a fraction of the smallest shape's size.
 SLOP_SUGGESTED = 0.01
 
@@ -323,7 +327,11 @@ def substeps(space: Any, dt: float, speeds: str = "both") -> int:
     limits = [f.dt_max for f in check(space, dt, speeds) if f.dt_max is not None]
     if not limits:
         return 1
-    return math.floor(dt / min(limits)) + 1
+    ratio = dt / min(limits)
+    if not ratio < MAX_STEPS:
+        raise UsageError(f"dt = {dt:g}: clearing the guard's findings would take more than "
+                         f"{MAX_STEPS:,} sub-steps of it; take a smaller dt", param="dt")
+    return math.floor(ratio) + 1
 
 
 def suggest_dt(space: Any, dt: float, speeds: str = "both") -> float:
@@ -355,7 +363,7 @@ def report(space: Any, dt: float, speeds: str = "both") -> str:
 def step(space: Any, dt: float, substeps: int = 1) -> None:
     """Advance ``space`` by ``dt`` (s) in ``substeps`` equal steps."""
     args.space(space)
-    substeps = args.whole(substeps, "substeps", "sub-steps")
+    substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
     h = args.real(dt, "dt", "s") / substeps
     for _ in range(substeps):
         space.step(h)
@@ -371,7 +379,7 @@ class Driver:
         self.space, self.dt, speeds = _check(space, dt, speeds)
         if substeps is None:
             substeps = globals()["substeps"](space, self.dt, speeds)
-        self.substeps = args.whole(substeps, "substeps", "sub-steps")
+        self.substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
         self.h = self.dt / substeps
         self.frames = 0
 
@@ -382,7 +390,7 @@ class Driver:
 
     def step(self, frames: int = 1) -> None:
         """Advance ``frames`` frames."""
-        frames = args.whole(frames, "frames", "frames", lo=0)
+        frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)
         step_ = self.space.step
         h = self.h
         for _ in range(frames * self.substeps):
