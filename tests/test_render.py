@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-from dumbbell.animation.drawing import TERM_RGB, Painter
+from dumbbell.animation.drawing import Painter
+from dumbbell.animation.palette import INK, TERM_RGB
 from dumbbell.animation.render import delays_cs, render_gif, sample_every
 from dumbbell.cli import main
 from dumbbell.model.scene import scene_from_dict
@@ -216,7 +217,7 @@ def test_range_since_previous_frame_matches_brute_force():
 def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     """Index 255 marks 'unchanged' (transparent) in the GIF: a drawn pixel with it would show
     the previous frame's colour instead."""
-    from dumbbell.animation.drawing import palette
+    from dumbbell.animation.palette import palette
     from dumbbell.animation.render import frames_of
 
     frames = frames_of(short, 25, 1.0)
@@ -226,18 +227,19 @@ def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
 
 
 def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook):
-    """Over 2 s the strip shows a window of drawing.WINDOW s: the cursor walks in, then stays
+    """Over 2 s the strip shows a window of strip.WINDOW s: the cursor walks in, then stays
     put while the curves scroll under it, and in every frame the U_g curve just left of the
     cursor is drawn at U_g of that column's time (so the window's time axis is right)."""
-    from dumbbell.animation import drawing
     from dumbbell.animation.render import frames_of
+    from dumbbell.animation.strip import AHEAD, WINDOW
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
     frames = frames_of(traj, 25, 2.0)
     painter = Painter(textbook, frames, (640, 360), True)
-    assert painter.window == drawing.WINDOW < 2.0
-    sx0, sy0, sx1, sy1 = painter.L.strip_box
-    ink, brown = np.array(drawing.INK), np.array(TERM_RGB["U_g"])
+    strip = painter.strip
+    assert strip.window == WINDOW < 2.0
+    sx0, sy0, sx1, sy1 = strip.box
+    ink, brown = np.array(INK), np.array(TERM_RGB["U_g"])
     cursors = []
     for k in range(0, len(frames.t), 3):
         rgb = np.asarray(painter.frame(k).convert("RGB"))
@@ -248,15 +250,15 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
         cursors.append((float(frames.t[k]), cursor))
         # The column 6 px left of the cursor shows the time 6 px earlier.
         x = cursor - 6
-        t = float(frames.t[k]) - (cursor - x) / painter.px_per_s
+        t = float(frames.t[k]) - (cursor - x) / strip.px_per_s
         if t < 0.05:
             continue
         rows = np.flatnonzero(np.all(rgb[sy0 + 1:sy1, x] == brown, axis=1)) + sy0 + 1
         assert len(rows) > 0
-        expected = painter.strip_y(float(np.interp(t, traj.t, traj["U_g"])))
+        expected = strip.y(float(np.interp(t, traj.t, traj["U_g"])))
         assert abs(rows.mean() + 0.5 - expected) < 2.0, (t, rows, expected)
     walk = [(t, c) for t, c in cursors if t <= 0.7]
-    still = {c for t, c in cursors if t >= 0.8 and t <= 2.0 - drawing.AHEAD - 0.05}
+    still = {c for t, c in cursors if t >= 0.8 and t <= 2.0 - AHEAD - 0.05}
     slope = np.polyfit(*zip(*walk), 1)[0]
-    assert abs(slope - painter.px_per_s) < 0.02 * painter.px_per_s   # walks at the strip's scale
+    assert abs(slope - strip.px_per_s) < 0.02 * strip.px_per_s   # walks at the strip's scale
     assert len(still) == 1                                             # then stays put

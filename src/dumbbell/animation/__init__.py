@@ -1,4 +1,6 @@
 """Layer 4, animation: frames of a trajectory painted with Pillow and written as a GIF."""
 
-#: :mod:`.render` holds the API (``render_gif``); :mod:`.drawing` the painter behind it.
+#: :mod:`.render` holds the API (``render_gif``); :mod:`.drawing` the painter behind it, put
+#: together from :mod:`.layout`, :mod:`.world`, :mod:`.bars`, :mod:`.strip`, :mod:`.palette`,
+#: :mod:`.glyphs`, :mod:`.backdrop` and :mod:`.frames` (no public names of their own).
 __all__ = ["drawing", "render"]

@@ -37,7 +37,7 @@ from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
 
 if TYPE_CHECKING:
-    from .drawing import Frames
+    from .frames import Frames
 
 __all__ = ["MAX_FPS", "MAX_FRAMES", "Gif", "check_fps", "check_frames", "check_size",
            "delays_cs", "frame_count", "frames_of", "render_gif", "sample_every"]
@@ -163,7 +163,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     traj = args.trajectory(traj)
     fps = check_fps(fps)
     t_end = args.real(t_end, "t_end", "s")
-    from .drawing import Frames
+    from .frames import Frames
 
     t = traj.t
     if len(t) == 0:
@@ -275,7 +275,8 @@ def render_gif(
     seconds spent drawing and encoding."""
     from .. import progress
     from ..model import args
-    from .drawing import Painter, palette
+    from .drawing import Painter
+    from .palette import palette
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",

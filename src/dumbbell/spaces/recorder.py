@@ -32,26 +32,25 @@ from typing import Any, Self
 import numpy as np
 from PIL import Image, ImageDraw
 
-from ..animation.drawing import (
+from ..animation.backdrop import SS, Backdrop
+from ..animation.bars import EnergyScale, bar_rows, draw_legend, draw_values
+from ..animation.glyphs import Stamps, fmt_tick, font, nice_step
+from ..animation.layout import unit
+from ..animation.palette import (
     GREY,
     INK,
     LIGHT,
     SPRING,
-    SS,
     TERM_RGB,
     WHITE,
-    Backdrop,
-    Stamps,
-    _blend,
-    _fmt_tick,
-    _ink_index,
-    _nice_step,
-    _zigzag,
-    font,
+    blend,
+    ink_index,
     palette,
     to_palette,
 )
 from ..animation.render import _delta, _encode_frame, _header, check_fps, check_size, delays_cs
+from ..animation.strip import GRID
+from ..animation.world import zigzag
 from ..errors import DumbbellError, UsageError
 from ..io.files import atomic_output
 
@@ -62,6 +61,8 @@ TERMS = {"K_trans": TERM_RGB["K_cm"], "K_rot": TERM_RGB["K_rot"], "U_g": TERM_RG
          "U_spring": TERM_RGB["U_spring"], "E": TERM_RGB["E"]}
 HEAT_RGB = TERM_RGB["E_lost"]
 STATIC_FILL = (232, 232, 232)
+#: Height of an energy bar's row at most (px at 640x360): fewer terms than the animation's.
+ROW_MAX = 26
 
 __all__ = ["PaletteDrawOptions", "Recorder", "draw_options"]  # noqa: F822 - see __getattr__
 
@@ -350,15 +351,15 @@ class _Painter(Backdrop):
         self.rec = rec
         self.W, self.H = rec.W, rec.H
         self.n = len(rec.items)
-        self.u = u = min(self.W / 640, self.H / 360)
+        self.u = u = unit(self.W, self.H)
         self.t = np.arange(self.n) / rec.fps
         self.st_time = Stamps(font(max(9, round(14 * u)), bold=True))
         self.st_text = Stamps(font(max(8, round(12 * u))))
         self.st_note = Stamps(font(max(8, round(11 * u))))
-        self.inks = [_ink_index(c) for c in BODY_INKS]
-        self.idx = {name: _ink_index(rgb) for name, rgb in TERMS.items()}
-        self.idx["heat"] = _ink_index(_blend(HEAT_RGB, 0.6))
-        self.idx["ink"] = _ink_index(INK)
+        self.inks = [ink_index(c) for c in BODY_INKS]
+        self.idx = {name: ink_index(rgb) for name, rgb in TERMS.items()}
+        self.idx["heat"] = ink_index(blend(HEAT_RGB, 0.6))
+        self.idx["ink"] = ink_index(INK)
         self.heat = rec.heat is not None and rec.energy
         self.names = [*TERMS, "heat"] if self.heat else list(TERMS)
         self.e = {k: np.asarray(v, dtype=float) for k, v in rec.terms.items()}
@@ -402,22 +403,17 @@ class _Painter(Backdrop):
         vals = [self.e[n] for n in TERMS]
         if self.heat:
             vals += [self.e["heat"], self.e["E"] + self.e["heat"]]
-        allv = np.concatenate([v[np.isfinite(v)] for v in vals] + [np.zeros(1)])
-        self.e_lo = min(0.0, float(allv.min()))
-        self.e_hi = max(float(allv.max()), self.e_lo + 1e-12)
-        span = self.e_hi - self.e_lo
-        self.decimals = max(0, min(6, 2 - math.floor(math.log10(span))))
-        bx0, by0, bx1, by1 = self.bars_box
+        self.scale = scale = EnergyScale.of(vals)
+        self.e_lo, self.e_hi, self.decimals = scale.lo, scale.hi, scale.decimals
+        span = scale.span
+        bx0, _, bx1, _ = self.bars_box
         self.value_w = round(self.st_text.width(f"-{max(abs(self.e_lo), self.e_hi):.{self.decimals}f}")
                              + 8 * self.u)
         self.bar_left = bx0 + round(70 * self.u)
         self.bar_right = bx1 - self.value_w
         self.bar_scale = (self.bar_right - self.bar_left) / span
         self.bar_zero = self.bar_left - self.e_lo * self.bar_scale
-        head = round(22 * self.u)
-        row = min((by1 - by0 - head) / len(self.names), 26 * self.u)
-        self.rows = [(name, round(by0 + head + (i + 0.2) * row), round(by0 + head + (i + 0.8) * row))
-                     for i, name in enumerate(self.names)]
+        self.rows = bar_rows(self.names, self.bars_box, self.u, row_max=ROW_MAX)
 
     def bar_px(self, v: float) -> float:
         return self.bar_zero + v * self.bar_scale
@@ -447,7 +443,7 @@ class _Painter(Backdrop):
             if ink < 0:
                 return GREY, STATIC_FILL
             rgb = BODY_INKS[ink]
-            return rgb, _blend(rgb, 0.33)
+            return rgb, blend(rgb, 0.33)
 
         for it in items:
             kind = it[0]
@@ -474,7 +470,7 @@ class _Painter(Backdrop):
             elif kind == "spring":
                 _, ax, ay, bx, by = it
                 pa, pb = P(ax, ay), P(bx, by)
-                d.line(_zigzag(pa, pb, 5 * u * S, 9), fill=SPRING, width=line, joint="curve")
+                d.line(zigzag(pa, pb, 5 * u * S, 9), fill=SPRING, width=line, joint="curve")
             elif kind == "line":
                 _, ax, ay, bx, by = it
                 d.line([P(ax, ay), P(bx, by)], fill=SPRING, width=line)
@@ -505,44 +501,27 @@ class _Painter(Backdrop):
         if self.rec.energy:
             d.line([(self.scene_w * S, 8 * u * S), (self.scene_w * S, (H - 8 * u) * S)],
                    fill=LIGHT, width=S)
-            self._bars_static(d, S)
+            draw_legend(d, S, u, self.bars_box, self.rows,
+                        lambda name: HEAT_RGB if name == "heat" else TERMS[name], self.bar_zero)
             if self.rec.strip:
                 self._strip_static(d, S)
         return to_palette(img.reduce(S))
-
-    def _bars_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
-        u = self.u
-        bx0, by0, _, _ = self.bars_box
-        d.text((bx0 * S, by0 * S), "Energy (J)", font=font(round(13 * u) * S, True), fill=INK,
-               anchor="lt")
-        ft = font(round(12 * u) * S)
-        for name, top, bot in self.rows:
-            mid = (top + bot) / 2
-            sw = round(9 * u)
-            rgb = HEAT_RGB if name == "heat" else TERMS[name]
-            d.rectangle([bx0 * S, (mid - sw / 2) * S, (bx0 + sw) * S, (mid + sw / 2) * S],
-                        fill=rgb)
-            d.text(((bx0 + sw + 5 * u) * S, mid * S), name, font=ft, fill=INK, anchor="lm")
-        zx = self.bar_zero * S
-        d.line([(zx, (self.rows[0][1] - 3) * S), (zx, (self.rows[-1][2] + 3) * S)], fill=GREY,
-               width=S)
 
     def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
         u = self.u
         sx0, sy0, sx1, sy1 = self.strip_box
         fs = font(round(10 * u) * S)
         d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
-        step = _nice_step((self.e_hi - self.e_lo) / 2)
-        for k in range(math.ceil(self.e_lo / step - 1e-9), math.floor(self.e_hi / step + 1e-9) + 1):
-            y = self.strip_y(k * step) * S
-            d.line([((sx0 + 1) * S, y), ((sx1 - 1) * S, y)], fill=(238, 238, 238), width=S)
-            d.text(((sx0 - 4 * u) * S, y), _fmt_tick(k * step), font=fs, fill=GREY, anchor="rm")
+        for v in self.scale.ticks():
+            y = self.strip_y(v) * S
+            d.line([((sx0 + 1) * S, y), ((sx1 - 1) * S, y)], fill=GRID, width=S)
+            d.text(((sx0 - 4 * u) * S, y), fmt_tick(v), font=fs, fill=GREY, anchor="rm")
         end = float(self.t[-1])
-        tstep = _nice_step(end / 4) if end > 0 else 1.0
+        tstep = nice_step(end / 4) if end > 0 else 1.0
         for k in range(math.floor(end / tstep + 1e-9) + 1):
             x = self.strip_x(k * tstep) * S
             d.line([(x, sy1 * S), (x, (sy1 + 3 * u) * S)], fill=GREY, width=S)
-            d.text((x, (sy1 + 5 * u) * S), _fmt_tick(k * tstep), font=fs, fill=GREY, anchor="mt")
+            d.text((x, (sy1 + 5 * u) * S), fmt_tick(k * tstep), font=fs, fill=GREY, anchor="mt")
         d.text(((sx0 - 4 * u) * S, (sy1 + 5 * u) * S), "t (s)", font=fs, fill=GREY, anchor="rt")
         xs = self.strip_x(self.t) * S
         width = max(1, round(1.5 * u * S))
@@ -556,16 +535,11 @@ class _Painter(Backdrop):
             ok = np.isfinite(ys)
             if ok.sum() < 2:
                 continue
-            rgb = {"heat": HEAT_RGB, "E + heat": _blend(HEAT_RGB, 0.6)}.get(name) or TERMS[name]
+            rgb = {"heat": HEAT_RGB, "E + heat": blend(HEAT_RGB, 0.6)}.get(name) or TERMS[name]
             d.line(list(zip(xs[ok].tolist(), ys[ok].tolist(), strict=True)), fill=rgb,
                    width=width, joint="curve")
 
     # --- one frame --------------------------------------------------------------------------
-
-    def _fpatch(self, img: Image.Image, box: tuple[float, float, float, float], ss: int):
-        """:meth:`Backdrop._patch` of the whole pixels that cover ``box`` (px)."""
-        return self._patch(img, (math.floor(box[0]), math.floor(box[1]), math.ceil(box[2]),
-                                 math.ceil(box[3])), ss)
 
     def frame(self, k: int) -> Image.Image:
         """Frame ``k`` as a palette image."""
@@ -579,11 +553,11 @@ class _Painter(Backdrop):
                 box = (max(px0 - m, 0), max(py0 - m, 0), min(px1 + m, self.scene_w - 1),
                        min(py1 + m, self.H))
                 if box[2] > box[0] and box[3] > box[1]:
-                    crop, (cx, cy), done = self._fpatch(img, box, SS)
+                    crop, (cx, cy), done = self.patch(img, box, SS)
                     self._draw_items(ImageDraw.Draw(crop), items, SS, cx, cy)
                     done()
         u = self.u
-        crop, (cx, cy), done = self._fpatch(img, (4 * u, 2 * u, 130 * u, 24 * u), 1)
+        crop, (cx, cy), done = self.patch(img, (4 * u, 2 * u, 130 * u, 24 * u), 1)
         self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), f"t = {self.t[k]:.2f} s", INK, "lt")
         done()
         if self.rec.energy:
@@ -612,9 +586,5 @@ class _Painter(Backdrop):
                 d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
         bx1 = self.bars_box[2]
         box = (self.bar_right + 2, self.rows[0][1] - 3, bx1, self.rows[-1][2] + 3)
-        crop, (cx, cy), done = self._fpatch(img, box, 1)
-        for name, top, bot in self.rows:
-            v = values[name]
-            text = f"{v:.{self.decimals}f}" if math.isfinite(v) else "n/a"
-            self.st_text.draw(crop, (bx1 - cx, (top + bot) / 2 - cy), text, INK, "rm")
-        done()
+        draw_values(self.patch(img, box, 1), self.rows,
+                    lambda name: self.scale.text(values[name]), bx1, self.st_text)

@@ -1,0 +1,219 @@
+"""The strip of the energy time series: a window of :data:`WINDOW` s that scrolls with a
+cursor (time ticks and labels move with it; faint lines mark the impacts), on the energy
+panel's fixed scale.
+
+The curves of the whole animation are drawn once on a long 'tape'; a frame pastes the window
+it shows, its time labels and the cursor.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from .backdrop import Patch
+from .bars import EnergyScale
+from .frames import Frames
+from .glyphs import Stamps, fmt_tick, nice_step
+from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, term_inks, to_palette
+
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+__all__: list[str] = []
+
+#: Seconds of the energy time series the strip shows at once. The textbook spring's energy
+#: terms oscillate at 20 Hz: over 1 s and ~390 px each oscillation is ~20 px wide and reads
+#: as a line (over 2 s they merge into a hatched band; over the whole run, a pale band).
+WINDOW = 1.0
+#: Fraction of the strip's window after the cursor (what comes next).
+AHEAD = 0.25
+#: Width (px) of the pieces the strip's tape is drawn in.
+TAPE_CHUNK = 1024
+#: Time ticks per window (about).
+TIME_TICKS = 5
+#: A term whose range within one pixel column is mostly wider than this (px) changes faster
+#: than a column can show: it is drawn as a pale band of that range, not as a line.
+BAND_PX = 3
+#: Opacity of such a band.
+BAND_ALPHA = 0.45
+GRID = (238, 238, 238)     # the energy grid lines
+IMPACT = (216, 216, 216)   # the impacts' faint lines
+#: The strip, in units of u (px on the 640 x 360 reference frame).
+PAD = 4          # between the strip's frame and the highest and lowest energy
+TICK = 3         # length of a time tick under the strip (at least 2 px)
+LABEL_GAP = 4    # between the strip and its tick labels
+IMPACT_TICK = 4  # an impact's tick at the foot of the strip
+LINE = 2         # width of the curves (at least 1 px)
+CURSOR = 1.5     # width of the cursor (at least 1 px)
+LABEL_OVERHANG = 3  # time labels may start this far left of the strip's frame
+LABEL_EDGE = 2   # and end this far from the frame's right edge
+
+
+@dataclass(frozen=True)
+class Strip:
+    """The strip's geometry for one animation: its ``box`` (px), the unit ``u``, the energy
+    ``scale``; inside its frame it starts at ``inner_x`` and is ``inner_w`` wide (px); the
+    tape is ``tape_w`` x ``tape_h`` px, pasted at ``tape_y``; it shows ``window`` s at
+    ``px_per_s``, the cursor stops at ``cursor_px`` from the left, time ticks every
+    ``t_step`` s, ``tick_len`` px long."""
+
+    box: tuple[int, int, int, int]
+    u: float
+    scale: EnergyScale
+    inner_x: int
+    inner_w: int
+    tick_len: int
+    tape_y: int
+    tape_h: int
+    window: float
+    px_per_s: float
+    tape_w: int
+    cursor_px: int
+    t_step: float
+
+    @classmethod
+    def build(cls, box: tuple[int, int, int, int], u: float, scale: EnergyScale,
+              t_end: float) -> Strip:
+        """The strip in ``box`` for an animation ``t_end`` s long: it shows :data:`WINDOW` s
+        (the whole animation when shorter), :data:`AHEAD` of it after the cursor."""
+        sx0, sy0, sx1, sy1 = box
+        inner_x, inner_w = sx0 + 1, sx1 - sx0 - 1    # inside the frame (px)
+        tick_len = max(2, round(TICK * u))
+        window = min(WINDOW, t_end)
+        px_per_s = (inner_w - 1) / window
+        return cls(box, u, scale, inner_x, inner_w, tick_len, sy0 + 1,
+                   sy1 + tick_len - sy0, window, px_per_s,
+                   max(inner_w, math.ceil(t_end * px_per_s) + 1),
+                   round((1 - AHEAD) * (inner_w - 1)) if window < t_end else 0,
+                   nice_step(window / TIME_TICKS))
+
+    def y(self, value):
+        """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
+        _, sy0, _, sy1 = self.box
+        pad = PAD * self.u
+        lo, hi = self.scale.lo, self.scale.hi
+        return sy1 - pad - (sy1 - sy0 - 2 * pad) * (value - lo) / (hi - lo)
+
+    def offset(self, t: float) -> tuple[int, int]:
+        """For a frame at ``t`` (s): the tape column at the strip's left edge and the cursor's
+        column in the tape (px). The cursor walks in until it reaches its place, then the tape
+        scrolls under it, and at the end the cursor walks out to the right edge."""
+        x = round(t * self.px_per_s)
+        return min(max(0, x - self.cursor_px), self.tape_w - self.inner_w), x
+
+    def draw_static(self, d: ImageDraw.ImageDraw, S: int, fs) -> None:
+        """The parts of the strip that do not scroll, on a background ``S`` times the size:
+        the frame (one crisp pixel on each side), the energy ticks and the axis names."""
+        u = self.u
+        sx0, sy0, sx1, sy1 = self.box
+        d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
+        for v in self.scale.ticks():
+            y = self.y(v)
+            d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(v), font=fs, fill=GREY,
+                   anchor="rm")
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), "J", font=fs, fill=GREY,
+               anchor="rs")
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), "t (s)", font=fs,
+               fill=GREY, anchor="rt")
+
+    def tape(self, frames: Frames, names: Sequence[str]) -> Image.Image:
+        """The energy time series ``names`` of the whole animation on one long palette image
+        at the strip's time scale (grid, bottom edge, time and impact ticks included); each
+        frame pastes the window it shows. Drawn in pieces so long runs need little memory.
+
+        Drawn without supersampling, unlike the rest: the strip scrolls, so its every line
+        pixel is encoded again in every frame, and smooth edges make those pixels cost ~60 %
+        more bytes (the textbook GIF would exceed 2 MB)."""
+        fr, u, S = frames, self.u, 1
+        p, h = self.px_per_s, self.tape_h
+        tape = Image.new("P", (self.tape_w, h))
+        y_of = [(self.y(v) - self.tape_y) * S for v in self.scale.ticks()]
+        edge = (self.box[3] - self.tape_y) * S
+        ticks = [k * self.t_step for k in range(math.floor(fr.t_end / self.t_step + 1e-9) + 1)]
+        impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
+        # Fast terms as pale bands, the others as lines; E on top.
+        order = [n for n in names if n != "E"] + ["E"]
+        t = fr.series_t
+        cols_all = np.floor(t * p * S).astype(np.int64)
+        series, band = {}, {}
+        for name in order:
+            ys = (self.y(fr.series[name]) - self.tape_y) * S
+            ok = np.isfinite(ys)
+            if ok.sum() < 2:
+                continue
+            c, y = cols_all[ok], ys[ok]
+            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+            series[name] = (t[ok], c, y)
+            band[name] = bool(np.median(np.maximum.reduceat(y, starts)
+                                        - np.minimum.reduceat(y, starts)) > BAND_PX * S)
+        width = max(1, round(LINE * u))
+        for c0 in range(0, self.tape_w, TAPE_CHUNK):
+            c1 = min(self.tape_w, c0 + TAPE_CHUNK)
+            img = Image.new("RGB", ((c1 - c0) * S, h * S), WHITE)
+            d = ImageDraw.Draw(img)
+            for y in y_of:
+                d.line([(0, y), ((c1 - c0) * S, y)], fill=GRID, width=S)
+            d.rectangle([0, edge, (c1 - c0) * S, edge + S - 1], fill=LIGHT)
+            for ti in ticks:
+                x = (ti * p - c0) * S
+                if -S <= x <= (c1 - c0 + 1) * S:
+                    d.line([(x, edge), (x, edge + (self.tick_len + 1) * S)], fill=GREY, width=S)
+            for ti in impacts:  # a faint line through the strip, a tick at its foot
+                x = (ti * p - c0) * S
+                if -S <= x <= (c1 - c0 + 1) * S:
+                    d.line([(x, 0), (x, edge)], fill=IMPACT, width=S)
+                    d.line([(x, edge - IMPACT_TICK * u * S), (x, edge)], fill=GREY, width=S)
+            lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
+            lines = []
+            for name, (ts, c, y) in series.items():
+                i0 = max(0, int(np.searchsorted(ts, lo_t)) - 1)
+                i1 = min(len(ts), int(np.searchsorted(ts, hi_t, side="right")) + 1)
+                if i1 - i0 < 2:
+                    continue
+                cc, yy = c[i0:i1] - c0 * S, y[i0:i1]
+                if band[name]:
+                    starts = np.flatnonzero(np.r_[True, cc[1:] != cc[:-1]])
+                    top = np.minimum.reduceat(yy, starts)
+                    bot = np.maximum.reduceat(yy, starts)
+                    mask = Image.new("L", img.size, 0)
+                    dm = ImageDraw.Draw(mask)
+                    for x, a, b in zip(cc[starts].tolist(), top.tolist(), bot.tolist(),
+                                       strict=True):
+                        dm.line([(x, a), (x, b)], fill=255, width=1)
+                    img.paste(blend(TERM_RGB.get(name, GREY), BAND_ALPHA), (0, 0), mask)
+                else:
+                    xs = (ts[i0:i1] * p - c0) * S
+                    lines.append((name, list(zip(xs.tolist(), yy.tolist(), strict=True))))
+            for name, pts in lines:
+                d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
+            tape.paste(to_palette(img), (c0, 0))
+        return tape
+
+    def draw(self, img: Image.Image, t: float, tape: Image.Image,
+             patch: Callable[[tuple[int, int, int, int]], Patch], stamps: Stamps) -> None:
+        """The window of ``tape`` a frame at ``t`` (s) shows, its time labels (on a crop from
+        ``patch``, reaching to the frame's right edge) and the cursor."""
+        left, x = self.offset(t)
+        img.paste(tape.crop((left, 0, left + self.inner_w, self.tape_h)),
+                  (self.inner_x, self.tape_y))
+        sx0, _, _, sy1 = self.box
+        u, W = self.u, img.width
+        y = sy1 + self.tick_len + 1
+        # Labels may reach past the frame's left edge, short of the axis name 't (s)'.
+        x_min = sx0 - round(LABEL_OVERHANG * u)
+        crop, (cx, cy), done = patch((x_min, y, W, img.height))
+        first = math.ceil(left / self.px_per_s / self.t_step - 1e-9)
+        last = math.floor((left + self.inner_w - 1) / self.px_per_s / self.t_step + 1e-9)
+        for j in range(first, last + 1):
+            xt = self.inner_x + j * self.t_step * self.px_per_s - left
+            text = fmt_tick(j * self.t_step)
+            half = stamps.width(text) / 2
+            if xt - half >= x_min and xt + half <= W - LABEL_EDGE * u:
+                stamps.draw(crop, (xt + 0.5 - cx, sy1 + LABEL_GAP * u - cy), text, GREY, "mt")
+        done()
+        xc = self.inner_x + x - left
+        ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=term_inks()["ink"],
+                                 width=max(1, round(CURSOR * u)))

@@ -1,0 +1,237 @@
+"""The scene panel: the floor and the height ruler (drawn once), and per frame the dumbbell
+(particles at their true radius, the spring as a zig-zag with a constant number of coils or a
+rigid rod, the centre of mass, in 2D its axis and angle), the time and, in 2D, the axis angle
+from vertical."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from PIL import ImageDraw
+
+from ..model.scene import System
+from .backdrop import SS, Patch
+from .frames import Frames
+from .glyphs import Stamps, fmt_tick, nice_step
+from .layout import Layout
+from .palette import BLACK, FLOOR, GREY, INK, LIGHT, SPRING, TERM_RGB, WHITE
+
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+__all__: list[str] = []
+
+#: Coils of the drawn spring; constant, so the spacing of the zig-zag shows the stretch.
+COILS = 9
+#: Straight leads at each end of the drawn spring, a share of its length.
+LEAD = 0.12
+#: Smallest drawn particle radius (px); smaller particles are drawn as markers of this size.
+MIN_RADIUS_PX = 3.5
+#: Radius of the centre-of-mass symbol (px at 640x360); the spring's zig-zag is wider.
+CM_RADIUS = 3.0
+#: Least distance (px at 640x360) of the 2D particle labels from the centre of mass: beyond
+#: the angle's arc (:data:`ARC`) and vertical line (1.25 times as long) with room for the letter.
+LABEL_CLEAR = 32.0
+#: The scene panel, in units of u (px on the 640 x 360 reference frame).
+FLOOR_LINE = 2        # width of the floor's edge
+RULER_TICK = 4        # a ruler tick's length ...
+RULER_LABEL = 6       # ... and its label's distance from the ruler
+RULER_TITLE = (4, 5)  # the ruler's title: from the left edge, from the bottom edge
+ZIGZAG_SHARE = 0.06   # the zig-zag's half-width: this share of the rest length ...
+ZIGZAG_MAX = 8        # ... at most this, and at least CM_RADIUS + 1.5
+ZIGZAG_LINE = 1.5     # the zig-zag's line width (at least 2 px at twice the size)
+ROD_LINE = 3          # the rigid rod's width
+OUTLINE = 0.8         # the particles' and centre of mass's outline (at least 1 px)
+CROP_1D, CROP_2D = 8, 18  # a frame redraws this far around the particles beyond their size,
+LABELS_2D = 34        # in 2D this much more for the letters beyond the particles,
+LABELS_RIGHT = 16     # and this much more on the right for the 1D letters
+IMPACT_CROP = 30      # an impact's mark and word: this far left and right of the particle,
+IMPACT_WORD = 20      # this far under the floor,
+IMPACT_MARK = 14      # the mark's half-length and
+IMPACT_LINE = 3       # width,
+IMPACT_GAP = 4        # the word under it
+LETTER_GAP = 7        # a particle's letter beyond its edge (2D: also above the floor)
+LETTER_GAP_1D = 4     # a particle's letter right of its edge (1D)
+AXIS_REACH = 12       # the axis line reaches this far beyond half the length ...
+AXIS_MIN = 24         # ... and at least this far from the centre of mass
+ARC = 20              # radius of the angle's arc; its vertical line is 1.25 times as long
+ARC_LINE = 1.3        # the arc's width (at least 1 px)
+TIME_BOX = (4, 2)     # the time label's crop: from the left and top edges ...
+TIME_BOTTOM_1D, TIME_BOTTOM_2D = 22, 34  # ... down to here (2D: the angle's line too)
+TIME_AT = 6           # the time label, this far from the left and top edges
+ANGLE_AT = 24         # the angle's line, this far from the top edge
+
+
+def axis_angle(pa: tuple[float, float], pb: tuple[float, float]) -> float:
+    """Angle of the axis from B to A from vertical (degrees, positive towards +x, like the
+    scene's ``tilt``), from pixel positions (pixel y points down)."""
+    return math.degrees(math.atan2(pa[0] - pb[0], pb[1] - pa[1]))
+
+
+def zigzag(p0: tuple[float, float], p1: tuple[float, float], amp: float, coils: int
+           ) -> list[tuple[float, float]]:
+    """Points of a spring from ``p0`` to ``p1`` (px): straight leads of :data:`LEAD` at each
+    end and ``coils`` zig-zags of half-width ``amp`` (px) between them: the spacing follows the
+    length."""
+    ax, ay = p1[0] - p0[0], p1[1] - p0[1]
+    length = math.hypot(ax, ay)
+    if length == 0:
+        return [p0, p1]
+    nx, ny = -ay / length * amp, ax / length * amp
+    lead = LEAD
+    pts = [p0, (p0[0] + ax * lead, p0[1] + ay * lead)]
+    for i in range(2 * coils):
+        f = lead + (1 - 2 * lead) * (i + 0.5) / (2 * coils)
+        s = 1 if i % 2 == 0 else -1
+        pts.append((p0[0] + ax * f + s * nx, p0[1] + ay * f + s * ny))
+    pts += [(p0[0] + ax * (1 - lead), p0[1] + ay * (1 - lead)), p1]
+    return pts
+
+
+@dataclass(frozen=True)
+class World:
+    """The scene panel of one animation: the dumbbell ``system`` on the ``layout``."""
+
+    system: System
+    layout: Layout
+
+    def draw_static(self, d: ImageDraw.ImageDraw, S: int, fs) -> None:
+        """The floor and the height ruler on a background ``S`` times the size."""
+        L, u, H = self.layout, self.layout.u, self.layout.H
+        if self.system.floor is not None:
+            _, fy = L.px(0.0, 0.0)
+            d.rectangle([0, fy * S, L.scene_w * S, H * S], fill=FLOOR)
+            d.line([(0, fy * S), (L.scene_w * S, fy * S)], fill=GREY,
+                   width=round(FLOOR_LINE * u * S))
+        _, _, y0, y1 = L.world
+        step = nice_step((y1 - y0) / 5)
+        rx = L.ruler_x * S
+        lo, hi = math.ceil(y0 / step - 1e-9), math.floor(y1 / step + 1e-9)
+        ya, yb = L.px(0, lo * step)[1], L.px(0, hi * step)[1]
+        d.line([(rx, ya * S), (rx, yb * S)], fill=GREY, width=S)
+        for k in range(lo, hi + 1):
+            y = L.px(0, k * step)[1] * S
+            d.line([(rx - RULER_TICK * u * S, y), (rx, y)], fill=GREY, width=S)
+            d.text((rx - RULER_LABEL * u * S, y), fmt_tick(k * step), font=fs, fill=GREY,
+                   anchor="rm")
+        d.text((RULER_TITLE[0] * u * S, (H - RULER_TITLE[1] * u) * S), "height (m)", font=fs,
+               fill=GREY, anchor="ls")
+
+    def draw_dumbbell(self, frames: Frames, k: int, impact: bool,
+                      patch: Callable[[tuple[float, float, float, float]], Patch],
+                      letters: Stamps, small: Stamps) -> None:
+        """Frame ``k``'s dumbbell (``impact``: with the mark of an impact since the previous
+        frame) on a crop from ``patch`` at :data:`SS` times the size; ``letters`` and
+        ``small`` are fonts at that size."""
+        sc, L, u, S = self.system, self.layout, self.layout.u, SS
+        (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
+        if not all(math.isfinite(v) for v in (ax, ay, bx, by)):
+            return
+        pa, pb = L.px(ax, ay), L.px(bx, by)
+        ra = max(sc.A.radius * L.s, MIN_RADIUS_PX * u)
+        rb = max(sc.B.radius * L.s, MIN_RADIUS_PX * u)
+        rest = sc.spring.rest_length if sc.spring else sc.rigid.length if sc.rigid else 0.0
+        amp = max((CM_RADIUS + 1.5) * u, min(ZIGZAG_SHARE * rest * L.s, ZIGZAG_MAX * u))
+        two_d = sc.dimensions == 2
+        m = max(ra, rb, amp) + (CROP_2D if two_d else CROP_1D) * u
+        impact = impact and sc.floor is not None
+        mx = m + (LABELS_2D * u if two_d else 0)
+        x0, x1 = min(pa[0], pb[0]) - mx, max(pa[0], pb[0]) + mx + LABELS_RIGHT * u
+        y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + (mx if two_d else m)
+        if impact:  # the mark on the floor and the word under it
+            fy = L.px(0.0, 0.0)[1]
+            low = pa if pa[1] > pb[1] else pb
+            x0, x1 = min(x0, low[0] - IMPACT_CROP * u), max(x1, low[0] + IMPACT_CROP * u)
+            y1 = max(y1, fy + IMPACT_WORD * u)
+        crop, (cx, cy), done = patch((x0, y0, x1, y1))
+        d = ImageDraw.Draw(crop)
+
+        def P(p: tuple[float, float]) -> tuple[float, float]:
+            return ((p[0] - cx) * S, (p[1] - cy) * S)
+
+        w = sc.A.mass / sc.M
+        pc = (w * pa[0] + (1 - w) * pb[0], w * pa[1] + (1 - w) * pb[1])
+        if two_d:
+            self._angle(d, P, pa, pb, pc)
+        if impact:
+            fy = L.px(0.0, 0.0)[1]
+            low = pa if pa[1] > pb[1] else pb
+            x, y = P((low[0], fy))
+            d.line([(x - IMPACT_MARK * u * S, y), (x + IMPACT_MARK * u * S, y)], fill=BLACK,
+                   width=round(IMPACT_LINE * u * S))
+            small.draw(crop, (x, y + IMPACT_GAP * u * S), "impact", INK, "mt")
+        if sc.rigid is not None:
+            d.line([P(pa), P(pb)], fill=SPRING, width=round(ROD_LINE * u * S))
+        elif sc.spring is not None:
+            d.line([P(p) for p in zigzag(pb, pa, amp, COILS)], fill=SPRING,
+                   width=max(2, round(ZIGZAG_LINE * u * S)), joint="curve")
+        else:
+            d.line([P(pa), P(pb)], fill=LIGHT, width=S)
+        # Labels sit beyond each particle along the axis, clear of the spring; in 2D at least
+        # LABEL_CLEAR from the centre of mass (clear of the angle's arc and vertical line when
+        # the spring is compressed) and above the floor; in 1D (and when the particles
+        # touch) to the right.
+        dx, dy = pa[0] - pb[0], pa[1] - pb[1]
+        dist = math.hypot(dx, dy)
+        ex, ey = (dx / dist, dy / dist) if two_d and dist > 0 else (0.0, 0.0)
+        floor_y = L.px(0.0, 0.0)[1] if sc.floor is not None else math.inf
+        outline = max(1, round(OUTLINE * u * S))
+        for p, r, name, sign in ((pa, ra, "A", 1), (pb, rb, "B", -1)):
+            x, y = P(p)
+            d.ellipse([x - r * S, y - r * S, x + r * S, y + r * S], fill=TERM_RGB[name],
+                      outline=INK, width=outline)
+            if ex or ey:
+                reach = max(math.hypot(p[0] - pc[0], p[1] - pc[1]) + r + LETTER_GAP * u,
+                            LABEL_CLEAR * u)
+                lx, ly = pc[0] + sign * ex * reach, min(pc[1] + sign * ey * reach,
+                                                        floor_y - LETTER_GAP * u)
+                letters.draw(crop, P((lx, ly)), name, INK, "mm")
+            else:
+                letters.draw(crop, (x + (r + LETTER_GAP_1D * u) * S, y), name, INK, "lm")
+        # Centre of mass: the quartered-disc symbol, narrower than the spring's zig-zag so
+        # the coils still show beside it when the spring is fully compressed.
+        (x, y), rc = P(pc), CM_RADIUS * u * S
+        bb = [x - rc, y - rc, x + rc, y + rc]
+        d.ellipse(bb, fill=WHITE, outline=BLACK, width=outline)
+        d.pieslice(bb, 180, 270, fill=BLACK)
+        d.pieslice(bb, 0, 90, fill=BLACK)
+        done()
+
+    def _angle(self, d: ImageDraw.ImageDraw, P, pa, pb, pc) -> None:
+        """The axis through B and A, a vertical reference at the centre of mass and the arc
+        between them (the angle's value is printed under the time)."""
+        u, S = self.layout.u, SS
+        dx, dy = pa[0] - pb[0], pa[1] - pb[1]
+        length = math.hypot(dx, dy)
+        if length == 0:
+            return
+        theta = axis_angle(pa, pb)
+        ex, ey = dx / length, dy / length
+        reach = max(length / 2 + AXIS_REACH * u, AXIS_MIN * u)
+        d.line([P((pc[0] - ex * reach, pc[1] - ey * reach)),
+                P((pc[0] + ex * reach, pc[1] + ey * reach))], fill=LIGHT, width=S)
+        rv = ARC * u
+        x, y = P(pc)
+        d.line([(x, y), (x, y - rv * 1.25 * S)], fill=GREY, width=S)
+        start, end = sorted((-90.0, -90.0 + theta))
+        d.arc([x - rv * S, y - rv * S, x + rv * S, y + rv * S], start, end, fill=GREY,
+              width=max(1, round(ARC_LINE * u * S)))
+
+    def draw_time(self, frames: Frames, k: int,
+                  patch: Callable[[tuple[float, float, float, float]], Patch],
+                  time: Stamps, note: Stamps) -> None:
+        """Frame ``k``'s time and, in 2D, its axis angle from vertical, top left."""
+        L, u = self.layout, self.layout.u
+        two_d = self.system.dimensions == 2
+        box = (round(TIME_BOX[0] * u), round(TIME_BOX[1] * u), L.scene_w - round(TIME_BOX[0] * u),
+               round((TIME_BOTTOM_2D if two_d else TIME_BOTTOM_1D) * u))
+        crop, (cx, cy), done = patch(box)
+        time.draw(crop, (TIME_AT * u - cx, TIME_AT * u - cy), f"t = {frames.t[k]:.2f} s", INK,
+                  "lt")
+        if two_d:
+            (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
+            if all(math.isfinite(v) for v in (ax, ay, bx, by)) and (ax, ay) != (bx, by):
+                theta = axis_angle(L.px(ax, ay), L.px(bx, by))
+                note.draw(crop, (TIME_AT * u - cx, ANGLE_AT * u - cy),
+                          f"axis {theta:+.0f}° from vertical", GREY, "lt")
+        done()
