@@ -166,3 +166,30 @@ def test_with_values_revalidates(textbook):
     assert textbook.system.spring.stiffness == 200.0  # the original is untouched
     with pytest.raises(SceneError, match="spring.stiffness"):
         textbook.with_values({"spring.stiffness": -5.0})
+
+
+def test_spinning_discs_are_physics_on_the_system_not_an_engine_setting():
+    from dumbbell.model.energy import energy_columns
+    from dumbbell.solvers import simulate
+
+    flat = load_scene(SCENES / "tilted-2d.toml")
+    discs = flat.with_values({"pymunk.spin": True})
+    assert not flat.system.discs and discs.system.discs
+    assert not hasattr(discs.pymunk, "spin")              # the engine settings do not hold it
+    assert "K_spin" in energy_columns(discs) and "K_spin" not in energy_columns(flat)
+    assert scene_from_dict(discs.to_dict(), discs.source) == discs
+    # A 1D line has nothing to spin: the key is accepted and changes nothing.
+    line = load_scene(SCENES / "textbook-1d.toml")
+    assert line.with_values({"pymunk.spin": True}) == line
+    # The solvers follow the system: pymunk gives each disc its moment 1/2 m r^2 and its own
+    # spin, so K_spin starts at sum 1/4 m r^2 w^2 (J).
+    spun = discs.with_values({"bodies.A.spin": 4.0, "bodies.B.spin": -2.0})
+    run = simulate(spun, "pymunk", t_end=0.01, dt=1e-3)
+    A, B = spun.system.A, spun.system.B
+    expected = 0.25 * (A.mass * A.radius**2 * 4.0**2 + B.mass * B.radius**2 * 2.0**2)
+    assert run["K_spin"][0] == pytest.approx(expected, rel=1e-12)
+    # A solver of point particles declines discs, by the system's word.
+    from dumbbell.solvers import METHODS
+
+    assert "point particles" in (METHODS["euler-cromer-2d"].supports(spun) or "")
+    assert METHODS["euler-cromer-2d"].supports(spun.with_values({"pymunk.spin": False})) is None

@@ -64,8 +64,9 @@ def column_unit(name: str) -> str:
 
 
 def spins(scene: Scene) -> bool:
-    """True when the particles may spin about their own centres (2D pymunk with spin on)."""
-    return scene.system.dimensions == 2 and bool(scene.pymunk.spin)
+    """True when the particles are spinning discs (:attr:`System.discs
+    <dumbbell.model.scene.System.discs>`, 2D only)."""
+    return scene.system.discs
 
 
 def energy_columns(scene: Scene) -> list[str]:

@@ -103,7 +103,6 @@ class PymunkSettings:
     collision_slop: float | None
     collision_bias: float | None
     iterations: int | None
-    spin: bool | None
 
     #: Overlap tolerated before the position correction acts (m); pymunk's 0.1 is pixels.
     DEFAULT_SLOP: ClassVar[float] = 1e-4
@@ -112,8 +111,6 @@ class PymunkSettings:
     DEFAULT_BIAS: ClassVar[float] = 1.0
     #: Contact-impulse iterations per step (pymunk's default).
     DEFAULT_ITERATIONS: ClassVar[int] = 10
-    #: Circles as spinning discs (True) or point particles of infinite moment (False).
-    DEFAULT_SPIN: ClassVar[bool] = False
 
     def resolved(self) -> dict[str, Any]:
         """The settings used: the scene's values, else the defaults."""
@@ -123,7 +120,6 @@ class PymunkSettings:
             "collision_bias": (self.DEFAULT_BIAS if self.collision_bias is None
                                else self.collision_bias),
             "iterations": self.DEFAULT_ITERATIONS if self.iterations is None else self.iterations,
-            "spin": self.DEFAULT_SPIN if self.spin is None else self.spin,
         }
 
 
@@ -166,6 +162,11 @@ class System:
     #: The axis's angle from vertical (degrees) that placed A from B, or None when the scene
     #: gives A's position. Kept so that changing the length moves A, as in the file.
     tilt: float | None = None
+    #: The particles are discs that spin (moment 1/2 m r^2, a ``K_spin`` energy term, 2D
+    #: only) rather than points of infinite moment (the textbook's particles). Physics, not
+    #: an engine option: every solver and the energy terms follow it. A file sets it with the
+    #: ``[pymunk]`` key ``spin``, where it was first introduced.
+    discs: bool = False
 
     @property
     def M(self) -> float:
@@ -266,8 +267,10 @@ class Scene:
                 gif["t_end"] = out.gif.t_end
             doc["outputs"]["gif"] = gif
         pymunk = {key: getattr(self.pymunk, key) for key in
-                  ("collision_slop", "collision_bias", "iterations", "spin")}
+                  ("collision_slop", "collision_bias", "iterations")}
         pymunk = {key: value for key, value in pymunk.items() if value is not None}
+        if s.discs:
+            pymunk["spin"] = True
         if pymunk:
             doc["pymunk"] = pymunk
         return doc
@@ -532,10 +535,10 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
     g = _gravity(top)
     run = _run(top, source)
     outputs = _outputs(top, dims, floor is not None, rigid is not None, run.t_end)
-    pm = _pymunk(top)
+    pm, discs = _pymunk(top)
     top.done()
     system = System(dimensions=dims, A=A, B=B, spring=spring, rigid=rigid, floor=floor, g=g,
-                    tilt=tilt)
+                    tilt=tilt, discs=discs and dims == 2)
     return Scene(title=title, system=system, run=run, outputs=outputs, pymunk=pm, source=source)
 
 
@@ -702,19 +705,20 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
     return OutputSettings(figures, csv, gif)
 
 
-def _pymunk(top: _Checker) -> PymunkSettings:
-    """[pymunk]: engine settings; None where the scene leaves the engine's default."""
+def _pymunk(top: _Checker) -> tuple[PymunkSettings, bool]:
+    """[pymunk]: engine settings (None where the scene leaves the engine's default), and its
+    ``spin`` key, which says whether the particles are spinning discs (:attr:`System.discs`)."""
     cp = top.sub("pymunk")
     if cp is None:
-        return PymunkSettings(None, None, None, None)
+        return PymunkSettings(None, None, None), False
     pm = PymunkSettings(
         cp.number("collision_slop", lo=0.0, unit="m") if cp.has("collision_slop") else None,
         cp.number("collision_bias", lo=0.0, hi=1.0) if cp.has("collision_bias") else None,
         cp.integer("iterations", 10, lo=1, hi=10000) if cp.has("iterations") else None,
-        cp.boolean("spin", None),
     )
+    discs = bool(cp.boolean("spin", False))
     cp.done()
-    return pm
+    return pm, discs
 
 
 def _parse_size(text: Any) -> tuple[int, int] | None:

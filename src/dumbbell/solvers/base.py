@@ -137,7 +137,7 @@ def point_particle_limits(scene: Scene, name: str) -> str | None:
         return f"{name} handles two particles and a spring, not a rigid body"
     if scene.system.floor is not None and scene.system.floor.friction > 0:
         return f"{name} has a frictionless floor only; use pymunk for friction"
-    if scene.pymunk.spin:
+    if scene.system.discs:
         return f"{name} has point particles (no spin); use pymunk for spinning particles"
     return None
 

@@ -121,7 +121,7 @@ def build(scene: Scene) -> World:
         M = scene.system.M
         R = ((A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M)
         moment = scene.system.mu * scene.system.rigid.length**2
-        if cfg["spin"]:
+        if scene.system.discs:
             moment += disc_inertia(A.mass, A.radius) + disc_inertia(B.mass, B.radius)
         body = pymunk.Body(M, moment)
         body.position = R
@@ -136,11 +136,11 @@ def build(scene: Scene) -> World:
         world.rigid_body = body
     else:
         for p in (A, B):
-            moment = disc_inertia(p.mass, p.radius) if cfg["spin"] else math.inf
+            moment = disc_inertia(p.mass, p.radius) if scene.system.discs else math.inf
             body = pymunk.Body(p.mass, moment)
             body.position = (p.x, p.height)
             body.velocity = (p.vx, p.vy)
-            if cfg["spin"]:
+            if scene.system.discs:
                 body.angular_velocity = p.spin
             space.add(body, circle(body, p, (0.0, 0.0)))
         if scene.system.spring is not None:
