@@ -47,6 +47,11 @@ def cap_note(flag: str, requested: int | None, jobs: int, what: str = "runs") ->
     return f"{flag} {requested}: starting {n} processes, as {why}"
 
 
+#: The signals that stop a run (the CLI turns them into a clean exit).
+_STOP_NUMBERS = {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                 if hasattr(signal, name)}
+
+
 def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -> None:
     """Run first in each pool worker. The parent's stop handlers (inherited through fork)
     would turn the pool's own SIGTERM into an exception inside the worker instead of ending
@@ -56,6 +61,8 @@ def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -
     if hasattr(signal, "SIGHUP"):
         signal.signal(signal.SIGHUP, signal.SIG_DFL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # The parent forked us with these signals blocked (see _on_pool); now they are safe.
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_NUMBERS)
     if initializer is not None:
         initializer(*initargs)
 
@@ -138,9 +145,19 @@ def _on_pool(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: t
     import multiprocessing
 
     items = [(func, lead, [indexed[i] for i in b]) for b in batches(len(indexed), workers)]
-    pool = multiprocessing.get_context().Pool(workers, initializer=worker_init,
-                                              initargs=(initializer, *initargs))
+    # A signal that lands between a worker's fork and its worker_init would run the parent's
+    # stop handler inside the worker and print a traceback. So the stop signals stay blocked
+    # while the pool forks (its helper threads, which fork replacements, inherit the mask);
+    # a signal sent meanwhile waits, and is raised once the pool can be terminated.
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_NUMBERS)
     try:
+        pool = multiprocessing.get_context().Pool(workers, initializer=worker_init,
+                                                  initargs=(initializer, *initargs))
+    except BaseException:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+        raise
+    try:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
         for part in pool.imap_unordered(_run_pool_batch, items):
             for i, value in part:
                 results[i] = value
