@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model.scene import Scene, System
 from ..model.trajectory import Trajectory
+from .kernels import Params
 
 #: Largest number of steps one run may take, so that no run can hang.
 MAX_STEPS = 10**10
@@ -123,11 +124,14 @@ class Solver:
         return math.nan
 
 
-def kernel_params(system: System) -> tuple[float, float, float, float, float, float, bool]:
-    """The scalars the compiled time-steppers take: mA, mB (kg), k (N/m), b (m), g (m/s^2),
-    the floor's elasticity, and whether there is a floor."""
-    return (system.A.mass, system.B.mass, system.k, system.b, system.g, system.elasticity,
-            system.floor is not None)
+def kernel_params(system: System, dt: float) -> Params:
+    """The record of scalars a compiled time-stepper reads: the step ``dt`` (s) and the
+    system's masses (kg), spring (N/m, m), gravity (m/s^2), elasticity, floor and radii (m),
+    as floats, so a scene's integers do not compile a second kernel."""
+    A, B = system.A, system.B
+    return Params(float(dt), float(A.mass), float(B.mass), float(system.k), float(system.b),
+                  float(system.g), float(system.elasticity), system.floor is not None,
+                  float(A.radius), float(B.radius))
 
 
 def point_particle_limits(scene: Scene, name: str) -> str | None:

@@ -24,7 +24,7 @@ from ..model.energy import partition_1d
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params
-from .kernels import EVENT_BUFFER
+from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 from .verdicts import below_floor_verdict
 
@@ -50,7 +50,7 @@ def warm_up() -> float:
     st = np.array([1.2, 0.0, 1.0, 0.0])
     out = np.empty((4, 2))
     ev = np.empty((EVENT_BUFFER, 4))
-    advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, out, ev)
+    advance(st, 0, 1, Params(1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02), 1, out, ev)
     partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *out)
     return time.perf_counter() - t0
 
@@ -59,14 +59,15 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Integrate ``scene`` with the textbook's Euler-Cromer method. See the module docstring."""
     from .kernels.euler_cromer import advance
 
-    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
+    params = kernel_params(scene.system, options.dt)
+    mA, mB, k, b, g = params.mA, params.mB, params.k, params.b, params.g
     dt, every = options.dt, options.every
     # One contiguous row per column, so the Trajectory's columns are views, not copies.
     out = np.empty((4, options.n_samples))
     A, B = scene.system.A, scene.system.B
     st = np.array([A.height, A.vy, B.height, B.vy], dtype=np.float64)
     out[:, 0] = st
-    run = run_kernel(advance, (mA, mB, k, b, g, e, floor), st, out, options,
+    run = run_kernel(advance, params, st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
     i = run.steps
 

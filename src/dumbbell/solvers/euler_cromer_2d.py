@@ -27,7 +27,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params, point_particle_limits
-from .kernels import EVENT_BUFFER
+from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 
 NAME = "euler-cromer-2d"
@@ -49,8 +49,8 @@ def warm_up() -> float:
 
     t0 = time.perf_counter()
     st = np.array([0.1, 1.17, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
-    advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02, 1,
-             np.empty((2, 8)), np.empty((EVENT_BUFFER, 4)))
+    advance(st, 0, 1, Params(1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02), 1,
+            np.empty((2, 8)), np.empty((EVENT_BUFFER, 4)))
     return time.perf_counter() - t0
 
 
@@ -59,14 +59,13 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     from .kernels.euler_cromer_2d import advance
 
     A, B = scene.system.A, scene.system.B
-    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
     dt, every = options.dt, options.every
     out = np.empty((options.n_samples, 8))
     st = np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)
     out[0] = st
     warm_up()  # compiling is not part of the run time
-    run = run_kernel(advance, (mA, mB, k, b, g, e, floor, A.radius, B.radius), st, out,
-                     options, f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
+    run = run_kernel(advance, kernel_params(scene.system, dt), st, out, options,
+                     f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=True)
     i = run.steps
 
     kept = i // every + 1

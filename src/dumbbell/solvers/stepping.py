@@ -18,7 +18,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
 from .base import RunOptions, Solver
-from .kernels import BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B
+from .kernels import BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B, Params
 from .verdicts import conclude, nonfinite_reason
 
 
@@ -46,7 +46,7 @@ class KernelRun:
 
 
 def run_kernel(
-    kernel: Callable, params: tuple, st: np.ndarray, out: np.ndarray, options: RunOptions,
+    kernel: Callable, params: Params, st: np.ndarray, out: np.ndarray, options: RunOptions,
     desc: str, chunk: int, event_time_in_steps: bool,
 ) -> KernelRun:
     """Run ``kernel`` over ``options.n_steps`` steps in chunks of ``chunk`` steps, with a
@@ -60,7 +60,7 @@ def run_kernel(
     t0 = time.perf_counter()
     with bar(n, desc, "step", quiet=options.quiet or n < 5 * chunk) as pb:
         while i < n and status == OK:
-            i_new, status, n_ev = kernel(st, i, min(n, i + chunk), dt, *params, every, out, ev)
+            i_new, status, n_ev = kernel(st, i, min(n, i + chunk), params, every, out, ev)
             events.extend(Impact(float(r[0]) * scale, "AB"[int(r[1])], float(r[2]), float(r[3]))
                           for r in ev[:n_ev])
             pb.update(i_new - i)

@@ -30,7 +30,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory, Verdict
 from .base import RunOptions, kernel_params, point_particle_limits
-from .kernels import EVENT_BUFFER
+from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 from .verdicts import tunnel_reason
 
@@ -53,9 +53,10 @@ def warm_up() -> float:
     st = np.array([1.2, 0.0, 1.0, 0.0])
     out = np.empty((2, 4))
     ev = np.empty((EVENT_BUFFER, 4))
-    advance(st, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, out, ev)
+    p = Params(1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02)
+    advance(st, 0, 1, p, 1, out, ev)
     st2 = np.array([0.1, 1.17, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
-    advance_2d(st2, 0, 1, 1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 1, np.empty((2, 8)), ev)
+    advance_2d(st2, 0, 1, p, 1, np.empty((2, 8)), ev)
     return time.perf_counter() - t0
 
 
@@ -66,7 +67,6 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     verdict or the energy."""
     from .kernels.verlet import advance, advance_2d
 
-    mA, mB, k, b, g, e, floor = kernel_params(scene.system)
     dt, every = options.dt, options.every
     A, B = scene.system.A, scene.system.B
     if scene.system.dimensions == 1:
@@ -80,7 +80,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                                                                          "B": (5, 7)}
     out = np.empty((options.n_samples, len(columns)))
     out[0] = st
-    run = run_kernel(kernel, (mA, mB, k, b, g, e, floor), st, out, options,
+    run = run_kernel(kernel, kernel_params(scene.system, dt), st, out, options,
                      f"{NAME} {scene.name}", _CHUNK, event_time_in_steps=False)
     i, events = run.steps, run.events
 

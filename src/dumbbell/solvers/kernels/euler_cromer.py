@@ -13,7 +13,8 @@ from . import BIG, BLOWUP, OK, TUNNEL_A, TUNNEL_B
 
 
 @njit(cache=True, nogil=True)
-def advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # pragma: no cover
+def advance(st, i, i_stop, p, every, out, ev):  # pragma: no cover
+    dt, mA, mB, k, b, g, e, floor, _, _ = p
     xA = st[0]
     vA = st[1]
     xB = st[2]

@@ -15,8 +15,8 @@ from . import BIG, BLOWUP, OK, TUNNEL_A, TUNNEL_B
 
 
 @njit(cache=True, nogil=True)
-def advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, rA, rB, every, out, ev
-             ):  # pragma: no cover
+def advance(st, i, i_stop, p, every, out, ev):  # pragma: no cover
+    dt, mA, mB, k, b, g, e, floor, rA, rB = p
     xA, yA, vxA, vyA, xB, yB, vxB, vyB = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
     invA = 1.0 / mA
     invB = 1.0 / mB

@@ -64,7 +64,8 @@ def _first_root(c, b, a, h):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # pragma: no cover
+def advance(st, i, i_stop, p, every, out, ev):  # pragma: no cover
+    dt, mA, mB, k, b, g, e, floor, _, _ = p
     xA = st[0]
     vA = st[1]
     xB = st[2]
@@ -151,8 +152,10 @@ def advance(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev):  # pr
 
 
 @njit(cache=True, nogil=True)
-def _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g):  # pragma: no cover
-    """Accelerations (m/s^2) of A and B from the spring along their axis and gravity."""
+def _accel_2d(xA, yA, xB, yB, p):  # pragma: no cover
+    """Accelerations (m/s^2) of A and B from the spring along their axis and gravity, with
+    the masses, spring and gravity of the record ``p``."""
+    mA, mB, k, b, g = p.mA, p.mB, p.k, p.b, p.g
     dx = xA - xB
     dy = yA - yB
     L = math.sqrt(dx * dx + dy * dy)
@@ -166,10 +169,10 @@ def _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
-                ):  # pragma: no cover
+def advance_2d(st, i, i_stop, p, every, out, ev):  # pragma: no cover
+    dt, e, floor = p.dt, p.e, p.floor
     xA, yA, vxA, vyA, xB, yB, vxB, vyB = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
-    axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g)
+    axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, p)
     n_ev = 0
     status = OK
     while i < i_stop:
@@ -192,7 +195,7 @@ def advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
             yA = yA + h * (vyA + 0.5 * ayA * h)
             xB = xB + h * (vxB + 0.5 * axB * h)
             yB = yB + h * (vyB + 0.5 * ayB * h)
-            nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g)
+            nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, p)
             vxA = vxA + 0.5 * (axA + nxA) * h
             vyA = vyA + 0.5 * (ayA + nyA) * h
             vxB = vxB + 0.5 * (axB + nxB) * h
@@ -216,7 +219,7 @@ def advance_2d(st, i, i_stop, dt, mA, mB, k, b, g, e, floor, every, out, ev
             else:
                 yB = 0.0
                 vyB = v_out
-            axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, mA, mB, k, b, g)
+            axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, p)
             if abs(v_in) < REST_SPEED or hits > MAX_HITS:
                 status = REST
                 break
