@@ -5,10 +5,10 @@ Between impacts the centre of mass R follows its parabola in closed form (gravit
 the spring is internal). Only d = rA - rB has no closed form: ``mu d'' = -k (|d| - b) d/|d|``,
 a central force, with gravity gone. It is integrated by the 8th-order Runge-Kutta formula of
 Dormand and Prince (the 12 stages of DOP853, coefficients from scipy) at a fixed step, compiled
-with numba. The step is ``STEP_ANGLE / rate``, where rate bounds how fast the state turns: the
-spring's w = sqrt(k/mu) and the axis' fastest rotation |d x d'| / r_min^2 (r_min the shortest
-length the segment's relative energy allows); every sample time is a step end, so samples need
-no interpolation.
+with numba (:mod:`.kernels.reference_2d`). The step is ``STEP_ANGLE / rate``, where rate
+bounds how fast the state turns: the spring's w = sqrt(k/mu) and the axis' fastest rotation
+|d x d'| / r_min^2 (r_min the shortest length the segment's relative energy allows); every
+sample time is a step end, so samples need no interpolation.
 
 The guarantee against a missed impact is a bound, not a heuristic: between impacts each
 particle's height ``y = R_y + c d_y`` (c = mB/M for A, -mA/M for B) has
@@ -22,7 +22,6 @@ particle that just bounced at speed v cannot return before ``v / C`` (``y >= v t
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -41,94 +40,14 @@ REST_SPEED = 1e-9
 MAX_IMPACTS = 100_000
 
 
-@functools.cache
-def _kernels():
-    """The compiled RK8 step and the stepping loop (compiled on first use)."""
-    from numba import njit
-    from scipy.integrate._ivp import dop853_coefficients as dop
-
-    n = dop.N_STAGES
-    A = np.ascontiguousarray(dop.A[:n, :n])
-    B = np.ascontiguousarray(dop.B)
-
-    @njit(cache=True, nogil=True)
-    def rhs(s, w2, b, out):  # pragma: no cover
-        dx, dy = s[0], s[1]
-        r = math.sqrt(dx * dx + dy * dy)
-        f = -w2 * (r - b) / r if r > 0 else -w2
-        out[0] = s[2]
-        out[1] = s[3]
-        out[2] = f * dx
-        out[3] = f * dy
-
-    @njit(cache=True, nogil=True)
-    def step(s, h, w2, b, out):  # pragma: no cover
-        K = np.empty((n, 4))
-        tmp = np.empty(4)
-        for i in range(n):
-            for c in range(4):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, c]
-                tmp[c] = s[c] + h * acc
-            rhs(tmp, w2, b, K[i])
-        for c in range(4):
-            acc = 0.0
-            for i in range(n):
-                acc += B[i] * K[i, c]
-            out[c] = s[c] + h * acc
-
-    @njit(cache=True, nogil=True)
-    def run(s, t, times, k, hmax, seg, g, cA, cB, CA, CB, quietA, quietB, w2, b, out, nxt):
-        """Step from (t, s) through the sample times ``times[k:]``, writing samples into
-        ``out``; stop before a step whose ends do not clear the curvature margin of a particle
-        (returns 1, with the step's end state and time in ``nxt``) or after the last sample
-        (returns 0); also the time reached, the next sample index and the steps taken."""
-        t0, Y0, VY0 = seg[0], seg[1], seg[2]
-        new = np.empty(4)
-        count = 0
-        while k < times.size:
-            target = times[k]
-            if target > t:
-                m = math.ceil((target - t) / hmax)
-                h = (target - t) / m
-                for j in range(m):
-                    t1 = target if j == m - 1 else t + h
-                    step(s, t1 - t, w2, b, new)
-                    count += 1
-                    ta, tb = t - t0, t1 - t0
-                    ya = Y0 + VY0 * ta - 0.5 * g * ta * ta
-                    yb = Y0 + VY0 * tb - 0.5 * g * tb * tb
-                    hh = t1 - t
-                    suspect = False
-                    margin = hh * hh / 8.0
-                    if t1 > quietA and min(ya + cA * s[1], yb + cA * new[1]) <= CA * margin:
-                        suspect = True
-                    if t1 > quietB and min(ya - cB * s[1], yb - cB * new[1]) <= CB * margin:
-                        suspect = True
-                    if suspect:
-                        for c in range(4):
-                            nxt[c] = new[c]
-                        nxt[4] = t1
-                        return 1, t, k, count
-                    for c in range(4):
-                        s[c] = new[c]
-                    t = t1
-            for c in range(4):
-                out[k, c] = s[c]
-            k += 1
-        return 0, t, k, count
-
-    return step, run
-
-
 def warm_up() -> None:
     """Compile the kernels (or load them from numba's cache)."""
-    run = _kernels()[1]
+    from .kernels.reference_2d import Span, run
+
     s = np.array([0.2, 0.0, 0.0, 0.0])
     out = np.empty((1, 4))
-    run(s, 0.0, np.array([1e-3]), 0, 1e-3, np.array([0.0, 1.0, 0.0]), 9.8, 0.5, 0.5, 1.0, 1.0,
-        -1.0, -1.0, 4000.0, 0.2, out, np.empty(5))
+    span = Span(0.0, 1.0, 0.0, 1e-3, 9.8, 0.5, 0.5, 1.0, 1.0, -1.0, -1.0, 4000.0, 0.2)
+    run(s, 0.0, np.array([1e-3]), 0, span, out, np.empty(5))
 
 
 def integrate(scene: Scene, times: np.ndarray, t_end: float, step_angle: float = STEP_ANGLE,
@@ -136,32 +55,73 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, step_angle: float =
               ) -> tuple[dict[str, np.ndarray], list[Impact], Verdict, int]:
     """The 2D spring dumbbell sampled at ``times`` (s, sorted): state columns of the samples
     reached, impacts, verdict, and the number of Runge-Kutta steps taken."""
-    step, run = _kernels()
-    A, B = scene.system.A, scene.system.B
-    M, g = scene.system.M, scene.system.g
-    cA, cB = B.mass / M, A.mass / M
-    w2 = scene.system.omega**2
-    b = scene.system.b
-    e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
-    floor = scene.system.floor is not None
-    times = np.ascontiguousarray(times, dtype=np.float64)
-    out = np.empty((len(times), 4))
-    # Centre-of-mass segments: (t0, X0, Y0, VX, VY0); relative state s = (d, d').
-    X0 = (A.mass * A.x + B.mass * B.x) / M
-    Y0 = (A.mass * A.height + B.mass * B.height) / M
-    VX = (A.mass * A.vx + B.mass * B.vx) / M
-    VY0 = (A.mass * A.vy + B.mass * B.vy) / M
-    s = np.array([A.x - B.x, A.height - B.height, A.vx - B.vx, A.vy - B.vy], dtype=np.float64)
-    segs = [(0.0, X0, Y0, VX, VY0)]
-    t, k = 0.0, 0
-    quiet = {"A": -1.0, "B": -1.0}
-    impacts: list[Impact] = []
-    verdict = Verdict()
-    steps = 0
-    nxt = np.empty(5)
+    return _Integration(scene, times, step_angle).run(pb)
 
-    def bounds(s: np.ndarray) -> tuple[float, float, float]:
+
+class _Integration:
+    """One integration in progress: the centre-of-mass segments ``(t0, X0, Y0, VX, VY0)``,
+    the relative state ``s = (d, d')`` at time ``t``, the samples reached (``k``), the
+    current segment's step and curvature bounds, and when each particle is ``quiet`` (cannot
+    reach the floor) after its last impact."""
+
+    def __init__(self, scene: Scene, times: np.ndarray, step_angle: float) -> None:
+        from .kernels import reference_2d as kernels
+
+        self.kernels = kernels
+        self.scene = scene
+        self.step_angle = step_angle
+        A, B = scene.system.A, scene.system.B
+        self.M, self.g = scene.system.M, scene.system.g
+        M = self.M
+        self.cA, self.cB = B.mass / M, A.mass / M
+        self.w2 = scene.system.omega**2
+        self.b = scene.system.b
+        self.e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
+        self.floor = scene.system.floor is not None
+        self.times = np.ascontiguousarray(times, dtype=np.float64)
+        self.out = np.empty((len(self.times), 4))
+        X0 = (A.mass * A.x + B.mass * B.x) / M
+        Y0 = (A.mass * A.height + B.mass * B.height) / M
+        VX = (A.mass * A.vx + B.mass * B.vx) / M
+        VY0 = (A.mass * A.vy + B.mass * B.vy) / M
+        self.s = np.array([A.x - B.x, A.height - B.height, A.vx - B.vx, A.vy - B.vy],
+                          dtype=np.float64)
+        self.segs = [(0.0, X0, Y0, VX, VY0)]
+        self.t, self.k = 0.0, 0
+        self.quiet = {"A": -1.0, "B": -1.0}
+        self.impacts: list[Impact] = []
+        self.verdict = Verdict()
+        self.steps = 0
+        self.nxt = np.empty(5)
+        self.hmax, self.CA, self.CB = self.bounds(self.s)
+
+    def run(self, pb: object | None) -> tuple[dict[str, np.ndarray], list[Impact], Verdict,
+                                               int]:
+        """Step to the last sample, stopping at every impact; the results of
+        :func:`integrate`."""
+        while self.k < len(self.times):
+            if self.advance(pb) == 0:
+                break
+            # A suspect step [t, t1]: search each particle's first contact in it.
+            t1 = float(self.nxt[4])
+            s0 = self.s.copy()
+            roots = self.contacts(s0, t1)
+            hit_t = min(roots.values(), default=math.inf)
+            if not math.isfinite(hit_t):
+                # Cleared on closer look: take the step.
+                self.s[:] = self.nxt[:4]
+                self.t = t1
+                continue
+            hit = [body for body, r in roots.items() if r - hit_t <= 10 * ROOT_XTOL]
+            if not self.bounce(s0, hit_t, hit):
+                break
+        k = self.k
+        cols = _columns(self.scene, self.segs, self.times[:k], self.out[:k])
+        return cols, self.impacts, self.verdict, self.steps
+
+    def bounds(self, s: np.ndarray) -> tuple[float, float, float]:
         """Step length (s) and the curvature bounds C_A, C_B (m/s^2) of this segment."""
+        w2, b = self.w2, self.b
         r = math.hypot(s[0], s[1])
         v2 = s[2] ** 2 + s[3] ** 2
         energy = 0.5 * v2 + 0.5 * w2 * (r - b) ** 2  # per unit reduced mass
@@ -174,52 +134,59 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, step_angle: float =
             r_min = max(b - S, 0.05 * max(b, r))
             spin = abs(s[0] * s[3] - s[1] * s[2]) / r_min**2
         rate = max(math.sqrt(w2), spin, 1e-300)
-        return step_angle / rate, g + cA * w2 * S, g + cB * w2 * S
+        return self.step_angle / rate, self.g + self.cA * w2 * S, self.g + self.cB * w2 * S
 
-    hmax, CA, CB = bounds(s)
-    while k < len(times):
-        t0, Xs, Ys, VXs, VYs = segs[-1]
-        seg = np.array([t0, Ys, VYs])
-        qa, qb = (quiet["A"], quiet["B"]) if floor else (math.inf, math.inf)
-        status, t, k2, count = run(s, t, times, k, hmax, seg, g, cA, cB, CA, CB, qa, qb, w2, b,
-                                   out, nxt)
-        steps += count
+    def advance(self, pb: object | None) -> int:
+        """Run the compiled loop from ``t`` until a suspect step (returns 1, its end in
+        ``nxt``) or past the last sample (returns 0), moving the progress bar."""
+        t0, _, Ys, _, VYs = self.segs[-1]
+        qa, qb = (self.quiet["A"], self.quiet["B"]) if self.floor else (math.inf, math.inf)
+        span = self.kernels.Span(t0, Ys, VYs, self.hmax, self.g, self.cA, self.cB, self.CA,
+                                 self.CB, qa, qb, self.w2, self.b)
+        k = self.k
+        status, self.t, self.k, count = self.kernels.run(self.s, self.t, self.times, k, span,
+                                                         self.out, self.nxt)
+        self.steps += count
         if pb is not None:
-            pb.update(t - (times[k - 1] if k else 0.0))  # type: ignore[attr-defined]
-        k = k2
-        if status == 0:
-            break
-        # A suspect step [t, t1]: search each particle's first contact in it.
-        t1 = float(nxt[4])
-        s0 = s.copy()
+            pb.update(self.t - (self.times[k - 1] if k else 0.0))  # type: ignore[attr-defined]
+        return status
 
-        def state(tau: float, s0: np.ndarray = s0, t=t) -> np.ndarray:
-            if tau == t:
-                return s0.copy()
-            res = np.empty(4)
-            step(s0, tau - t, w2, b, res)
-            return res
+    def relative(self, s0: np.ndarray, tau: float) -> np.ndarray:
+        """The relative state at ``tau`` (s) inside the step that starts at ``t`` from ``s0``:
+        a single Runge-Kutta step."""
+        if tau == self.t:
+            return s0.copy()
+        res = np.empty(4)
+        self.kernels.step(s0, tau - self.t, self.w2, self.b, res)
+        return res
 
-        def height(body: str, tau: float, t0=t0, Ys=Ys, VYs=VYs) -> tuple[float, float]:
-            x = state(tau)
-            c = cA if body == "A" else -cB
-            ta = tau - t0
-            return (float(Ys + VYs * ta - 0.5 * g * ta * ta + c * x[1]),
-                    float(VYs - g * ta + c * x[3]))
+    def height(self, s0: np.ndarray, body: str, tau: float) -> tuple[float, float]:
+        """Height (m) and vertical velocity (m/s) of ``body`` at ``tau`` (s) in the step."""
+        t0, _, Ys, _, VYs = self.segs[-1]
+        x = self.relative(s0, tau)
+        c = self.cA if body == "A" else -self.cB
+        ta = tau - t0
+        g = self.g
+        return (float(Ys + VYs * ta - 0.5 * g * ta * ta + c * x[1]),
+                float(VYs - g * ta + c * x[3]))
 
+    def contacts(self, s0: np.ndarray, t1: float) -> dict[str, float]:
+        """Each particle's first contact time (s, inf if none) in the step [t, t1]."""
         roots = {}
-        for body, C in (("A", CA), ("B", CB)):
-            lo = max(t, quiet[body])
+        for body, C in (("A", self.CA), ("B", self.CB)):
+            lo = max(self.t, self.quiet[body])
             if lo < t1:
-                roots[body] = _first_root(lambda tau, body=body: height(body, tau), C, lo, t1)
-        hit_t = min(roots.values(), default=math.inf)
-        if not math.isfinite(hit_t):
-            # Cleared on closer look: take the step.
-            s[:] = nxt[:4]
-            t = t1
-            continue
-        hit = [body for body, r in roots.items() if r - hit_t <= 10 * ROOT_XTOL]
-        x = state(hit_t)
+                roots[body] = _first_root(lambda tau, body=body: self.height(s0, body, tau),
+                                          C, lo, t1)
+        return roots
+
+    def bounce(self, s0: np.ndarray, hit_t: float, hit: list[str]) -> bool:
+        """Reflect the particles in ``hit`` at ``hit_t`` (s) and start a new segment there;
+        False when the run ends (a particle at rest, too many impacts)."""
+        A, B = self.scene.system.A, self.scene.system.B
+        M, g, cA, cB = self.M, self.g, self.cA, self.cB
+        t0, Xs, Ys, VXs, VYs = self.segs[-1]
+        x = self.relative(s0, hit_t)
         ta = hit_t - t0
         R = (Xs + VXs * ta, Ys + VYs * ta - 0.5 * g * ta * ta)
         V = [VXs, VYs - g * ta]
@@ -229,27 +196,25 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, step_angle: float =
         for body in hit:
             v_before = float(vel[body][1])
             if abs(v_before) < REST_SPEED:
-                verdict = Verdict("failed", hit_t, f"{body} came to rest on the floor (impact "
-                                  f"speed {abs(v_before):.1e} m/s): infinitely many impacts "
-                                  "ahead")
-                break
-            vel[body][1] = -e * v_before
-            impacts.append(Impact(hit_t, body, v_before, vel[body][1]))
-        if not verdict.ok:
-            t = hit_t
-            break
+                self.verdict = Verdict("failed", hit_t, f"{body} came to rest on the floor "
+                                       f"(impact speed {abs(v_before):.1e} m/s): infinitely "
+                                       "many impacts ahead")
+                self.t = hit_t
+                return False
+            vel[body][1] = -self.e * v_before
+            self.impacts.append(Impact(hit_t, body, v_before, vel[body][1]))
         V = [(A.mass * vA[0] + B.mass * vB[0]) / M, (A.mass * vA[1] + B.mass * vB[1]) / M]
-        s = np.array([x[0], x[1], vA[0] - vB[0], vA[1] - vB[1]], dtype=np.float64)
-        segs.append((hit_t, R[0], R[1], V[0], V[1]))
-        t = hit_t
-        hmax, CA, CB = bounds(s)
+        self.s = np.array([x[0], x[1], vA[0] - vB[0], vA[1] - vB[1]], dtype=np.float64)
+        self.segs.append((hit_t, R[0], R[1], V[0], V[1]))
+        self.t = hit_t
+        self.hmax, self.CA, self.CB = self.bounds(self.s)
         for body in hit:
-            C = CA if body == "A" else CB
-            quiet[body] = hit_t + (vel[body][1] / C if C > 0 else math.inf)
-        if len(impacts) >= MAX_IMPACTS:
-            verdict = Verdict("failed", t, f"more than {MAX_IMPACTS} impacts")
-            break
-    return _columns(scene, segs, times[:k], out[:k], cA, cB), impacts, verdict, steps
+            C = self.CA if body == "A" else self.CB
+            self.quiet[body] = hit_t + (vel[body][1] / C if C > 0 else math.inf)
+        if len(self.impacts) >= MAX_IMPACTS:
+            self.verdict = Verdict("failed", self.t, f"more than {MAX_IMPACTS} impacts")
+            return False
+        return True
 
 
 def _first_root(f, C: float, lo: float, hi: float) -> float:
@@ -278,10 +243,11 @@ def _first_root(f, C: float, lo: float, hi: float) -> float:
 
 
 def _columns(scene: Scene, segs: list[tuple[float, float, float, float, float]],
-             t: np.ndarray, rel: np.ndarray, cA: float, cB: float) -> dict[str, np.ndarray]:
+             t: np.ndarray, rel: np.ndarray) -> dict[str, np.ndarray]:
     """Particle positions (m) and velocities (m/s) at the samples from the centre-of-mass
     segments (closed form) and the relative state."""
-    g = scene.system.g
+    g, M = scene.system.g, scene.system.M
+    cA, cB = scene.system.B.mass / M, scene.system.A.mass / M
     R = np.empty((len(t), 4))
     bounds = np.searchsorted(t, [s[0] for s in segs[1:]], side="left")
     for (t0, X0, Y0, VX, VY0), lo, hi in zip(segs, [0, *bounds], [*bounds, len(t)],

@@ -1,4 +1,5 @@
-"""Compiled (numba) time-step kernels, one module per stepping solver, and their contract.
+"""Compiled (numba) time-step kernels, one module per stepping solver, and their contract
+(plus :mod:`.reference_2d`, the reference's Runge-Kutta loop, with a contract of its own).
 
 A kernel ``advance(st, i, i_stop, p, every, out, ev)`` advances the state ``st`` in place
 from step ``i`` towards ``i_stop`` with the scalars of the record ``p`` (:class:`Params`),
