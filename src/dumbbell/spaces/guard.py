@@ -236,9 +236,16 @@ def _networks(space: Any, dt: float) -> list[tuple[Finding, bool]]:
 def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, bool]]:
     """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
     ``speeds``: 'state' (the present speeds), 'energy' or 'both' (the larger)."""
+    space, dt, speeds = _check(space, dt, speeds)
+    apart = _apart(space)
+    return (_springs(space, dt) + _networks(space, dt) + _tunnelling(space, dt, speeds, apart)
+            + _contact_settings(space, apart))
+
+
+def _springs(space: Any, dt: float) -> list[tuple[Finding, bool]]:
+    """Each spring's w*dt (linear and rotary) against the explicit step's limit."""
     import pymunk
 
-    space, dt, speeds = _check(space, dt, speeds)
     rows: list[tuple[Finding, bool]] = []
     for c in space.constraints:
         if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
@@ -251,40 +258,67 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
         rows.append((Finding(kind, constraint_label(space, c), w * dt, SPRING_LIMIT,
                              f"w = {w:.4g} rad/s: dt < {dt_max:.4g} s", dt_max),
                      w * dt < SPRING_LIMIT))
-    rows += _networks(space, dt)
+    return rows
 
-    shapes = list(space.shapes)
-    apart = _apart(space)
-    sizes = [shape_size(s) for s in shapes]
+
+def _potential(space: Any, apart: set[tuple[int, int]]) -> float:
+    """The energy (J) a body could turn into speed: the springs' energy plus each dynamic
+    body's fall to the lowest level it can reach."""
+    import pymunk
+
     e = energy(space)
     g = math.hypot(*space.gravity)
     down = (space.gravity[0] / g, space.gravity[1] / g) if g > 0 else (0.0, -1.0)
     level = _level(space, down, apart) if g > 0 else None
     potential = e.U_spring
-    dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
     if level is not None:
-        for b in dyn:
+        for b in space.bodies:
+            if b.body_type != pymunk.Body.DYNAMIC:
+                continue
             r = b.local_to_world(b.center_of_gravity)
             potential += b.mass * g * max(0.0, level - (r[0] * down[0] + r[1] * down[1]))
-    for b in dyn:
-        own = [i for i, s in enumerate(shapes) if s.body is b]
-        if not own:
+    return potential
+
+
+def _closing_speeds(body: Any, own: list[Any], targets: list[Any],
+                    potential: float) -> tuple[float, float]:
+    """How fast (m/s) ``body``'s shapes ``own`` may close on the shapes ``targets``: from the
+    present motion, and from all the energy ``potential`` (J) turned into its speed. The
+    obstacles may move too (their present speed; a kinematic one keeps its speed whatever
+    the energy)."""
+    import pymunk
+
+    reach = max(_reach(body, s) for s in own)
+    moving = [_speed(s) for s in targets]
+    driven = [_speed(s) for s in targets if s.body.body_type == pymunk.Body.KINEMATIC]
+    v_state = body.velocity.length + abs(body.angular_velocity) * reach + max(moving)
+    v_energy = (math.sqrt(body.velocity.length**2 + 2.0 * potential / body.mass)
+                + max(driven, default=0.0))
+    return v_state, v_energy
+
+
+def _tunnelling(space: Any, dt: float, speeds: str,
+                apart: set[tuple[int, int]]) -> list[tuple[Finding, bool]]:
+    """Each dynamic body that can hit something: how far it may move in one step against
+    half the thinnest shape it can hit plus half its own smallest one."""
+    import pymunk
+
+    shapes = list(space.shapes)
+    sizes = [shape_size(s) for s in shapes]
+    potential = _potential(space, apart)
+    rows: list[tuple[Finding, bool]] = []
+    for b in space.bodies:
+        if b.body_type != pymunk.Body.DYNAMIC:
             continue
+        own = [i for i, s in enumerate(shapes) if s.body is b]
         targets = [j for j, o in enumerate(shapes)
                    if any(_can_hit(shapes[i], o, apart) for i in own)]
         if not targets:
             continue
         thinnest = min(sizes[j] for j in targets)
         limit = 0.5 * thinnest + 0.5 * min(sizes[i] for i in own)
-        reach = max(_reach(b, shapes[i]) for i in own)
-        # Closing speed: the obstacles may move too (their present speed; a kinematic one
-        # keeps its speed whatever the energy).
-        moving = [_speed(shapes[j]) for j in targets]
-        driven = [_speed(shapes[j]) for j in targets
-                  if shapes[j].body.body_type == pymunk.Body.KINEMATIC]
-        v_state = b.velocity.length + abs(b.angular_velocity) * reach + max(moving)
-        v_energy = (math.sqrt(b.velocity.length**2 + 2.0 * potential / b.mass)
-                    + max(driven, default=0.0))
+        v_state, v_energy = _closing_speeds(b, [shapes[i] for i in own],
+                                            [shapes[j] for j in targets], potential)
         v = {"state": v_state, "energy": v_energy, "both": max(v_state, v_energy)}[speeds]
         if v == 0.0 or limit == 0.0:
             continue
@@ -294,25 +328,32 @@ def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, b
         rows.append((Finding("tunnelling", body_label(space, b), v * dt, limit,
                              f"{v:.4g} m/s ({source}) moves {v * dt:.3g} m per step; "
                              f"dt < {dt_max:.4g} s", dt_max), v * dt < limit))
+    return rows
 
-    # Slop and bias act only where shapes can touch.
+
+def _contact_settings(space: Any, apart: set[tuple[int, int]]) -> list[tuple[Finding, bool]]:
+    """The collision slop against the smallest shape, and the collision bias where elastic
+    shapes can touch. Slop and bias act only where shapes can touch."""
+    shapes = list(space.shapes)
     contacts = any(_can_hit(a, b, apart) for i, a in enumerate(shapes) for b in shapes[i + 1:])
-    if shapes and contacts:
-        smallest = min(sizes)
-        if smallest > 0:
-            slop_limit = SLOP_FRACTION * smallest
-            rows.append((Finding("slop", "space.collision_slop", space.collision_slop,
-                                 slop_limit, f"smallest shape {smallest:.3g}: set "
-                                 f"space.collision_slop = {SLOP_SUGGESTED * smallest:.3g}"),
-                         space.collision_slop <= slop_limit))
-        elastic = any(s.elasticity > 0 and o.elasticity > 0 for s in shapes for o in shapes
-                      if _can_hit(s, o, apart))
-        if elastic:
-            bias = space.collision_bias
-            rows.append((Finding("bias", "space.collision_bias", bias, 1.0,
-                                 "elastic contacts: set space.collision_bias = 1.0 (no "
-                                 "position correction, which adds energy) if energy matters"),
-                         bias >= 1.0))
+    if not (shapes and contacts):
+        return []
+    rows: list[tuple[Finding, bool]] = []
+    smallest = min(shape_size(s) for s in shapes)
+    if smallest > 0:
+        slop_limit = SLOP_FRACTION * smallest
+        rows.append((Finding("slop", "space.collision_slop", space.collision_slop,
+                             slop_limit, f"smallest shape {smallest:.3g}: set "
+                             f"space.collision_slop = {SLOP_SUGGESTED * smallest:.3g}"),
+                     space.collision_slop <= slop_limit))
+    elastic = any(s.elasticity > 0 and o.elasticity > 0 for s in shapes for o in shapes
+                  if _can_hit(s, o, apart))
+    if elastic:
+        bias = space.collision_bias
+        rows.append((Finding("bias", "space.collision_bias", bias, 1.0,
+                             "elastic contacts: set space.collision_bias = 1.0 (no "
+                             "position correction, which adds energy) if energy matters"),
+                     bias >= 1.0))
     return rows
 
 
