@@ -46,13 +46,14 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
-from ..model.scene import Scene
+from ..model.scene import Particle, Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
 from .verdicts import conclude, nonfinite_reason, tunnel_reason
@@ -105,70 +106,96 @@ def build(scene: Scene) -> World:
     space.collision_slop = cfg["collision_slop"]
     space.collision_bias = cfg["collision_bias"]
     space.iterations = cfg["iterations"]
-    A, B = scene.system.A, scene.system.B
-    points: dict[str, tuple[Any, Any, tuple[float, float]]] = {}
-    world = World(space, points)
-
-    def circle(body: Any, p: Any, offset: tuple[float, float]) -> Any:
-        shape = pymunk.Circle(body, p.radius, offset)
-        shape.elasticity = 1.0
-        shape.friction = 1.0
-        shape.collision_type = _PARTICLE_TYPE[p.name]
-        points[p.name] = (body, shape, offset)
-        return shape
-
+    world = World(space, {})
     if scene.system.rigid is not None:
-        M = scene.system.M
-        R = ((A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M)
-        moment = scene.system.mu * scene.system.rigid.length**2
-        if scene.system.discs:
-            moment += disc_inertia(A.mass, A.radius) + disc_inertia(B.mass, B.radius)
-        body = pymunk.Body(M, moment)
-        body.position = R
-        # One body: its velocity and spin follow from the particles' (consistent) velocities.
-        V = ((A.mass * A.vx + B.mass * B.vx) / M, (A.mass * A.vy + B.mass * B.vy) / M)
-        d = (A.x - B.x, A.height - B.height)
-        w = (A.vx - B.vx, A.vy - B.vy)
-        body.velocity = V
-        body.angular_velocity = (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)
-        shapes = [circle(body, p, (p.x - R[0], p.height - R[1])) for p in (A, B)]
-        space.add(body, *shapes)
-        world.rigid_body = body
+        _add_rigid(scene, world)
     else:
-        for p in (A, B):
-            moment = disc_inertia(p.mass, p.radius) if scene.system.discs else math.inf
-            body = pymunk.Body(p.mass, moment)
-            body.position = (p.x, p.height)
-            body.velocity = (p.vx, p.vy)
-            if scene.system.discs:
-                body.angular_velocity = p.spin
-            space.add(body, circle(body, p, (0.0, 0.0)))
-        if scene.system.spring is not None:
-            bA, bB = points["A"][0], points["B"][0]
-            rest, stiffness = scene.system.spring.rest_length, scene.system.spring.stiffness
-            spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0), rest, stiffness, 0.0)
-            spring.collide_bodies = False
-            space.add(spring)
-            world.spring = spring
-
+        _add_particles(scene, world)
     if scene.system.floor is not None:
-        radii = sorted({A.radius, B.radius})
-        for bit, r in enumerate(radii):
-            W, T = _FLOOR_HALF_WIDTH, FLOOR_THICKNESS
-            box = pymunk.Poly(space.static_body, [(-W, -r - T), (W, -r - T), (W, -r), (-W, -r)])
-            box.elasticity = scene.system.floor.elasticity
-            box.friction = scene.system.floor.friction
-            box.collision_type = _FLOOR_TYPE
-            if len(radii) > 1:
-                # Each particle meets only the box placed for its own radius.
-                box.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
-                for p in (A, B):
-                    if p.radius == r:
-                        shape = points[p.name][1]
-                        shape.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
-            space.add(box)
-            world.floors.append(box)
+        _add_floors(scene, world)
     return world
+
+
+def _circle(world: World, body: Any, p: Particle, offset: tuple[float, float]) -> Any:
+    """The circle of particle ``p`` on ``body`` at ``offset`` (m), recorded in the world."""
+    import pymunk
+
+    shape = pymunk.Circle(body, p.radius, offset)
+    shape.elasticity = 1.0
+    shape.friction = 1.0
+    shape.collision_type = _PARTICLE_TYPE[p.name]
+    world.points[p.name] = (body, shape, offset)
+    return shape
+
+
+def _add_rigid(scene: Scene, world: World) -> None:
+    """The rigid dumbbell: one body at the centre of mass carrying both circles."""
+    import pymunk
+
+    A, B = scene.system.A, scene.system.B
+    M = scene.system.M
+    R = ((A.mass * A.x + B.mass * B.x) / M, (A.mass * A.height + B.mass * B.height) / M)
+    moment = scene.system.mu * scene.system.rigid.length**2
+    if scene.system.discs:
+        moment += disc_inertia(A.mass, A.radius) + disc_inertia(B.mass, B.radius)
+    body = pymunk.Body(M, moment)
+    body.position = R
+    # One body: its velocity and spin follow from the particles' (consistent) velocities.
+    V = ((A.mass * A.vx + B.mass * B.vx) / M, (A.mass * A.vy + B.mass * B.vy) / M)
+    d = (A.x - B.x, A.height - B.height)
+    w = (A.vx - B.vx, A.vy - B.vy)
+    body.velocity = V
+    body.angular_velocity = (d[0] * w[1] - d[1] * w[0]) / (d[0] ** 2 + d[1] ** 2)
+    shapes = [_circle(world, body, p, (p.x - R[0], p.height - R[1])) for p in (A, B)]
+    world.space.add(body, *shapes)
+    world.rigid_body = body
+
+
+def _add_particles(scene: Scene, world: World) -> None:
+    """Two bodies, one circle each, joined by the spring if there is one."""
+    import pymunk
+
+    space = world.space
+    for p in (scene.system.A, scene.system.B):
+        moment = disc_inertia(p.mass, p.radius) if scene.system.discs else math.inf
+        body = pymunk.Body(p.mass, moment)
+        body.position = (p.x, p.height)
+        body.velocity = (p.vx, p.vy)
+        if scene.system.discs:
+            body.angular_velocity = p.spin
+        space.add(body, _circle(world, body, p, (0.0, 0.0)))
+    if scene.system.spring is not None:
+        bA, bB = world.points["A"][0], world.points["B"][0]
+        rest, stiffness = scene.system.spring.rest_length, scene.system.spring.stiffness
+        spring = pymunk.DampedSpring(bA, bB, (0.0, 0.0), (0.0, 0.0), rest, stiffness, 0.0)
+        spring.collide_bodies = False
+        space.add(spring)
+        world.spring = spring
+
+
+def _add_floors(scene: Scene, world: World) -> None:
+    """One static floor box per distinct circle radius, its top where such a circle's
+    centre is at height 0."""
+    import pymunk
+
+    A, B = scene.system.A, scene.system.B
+    radii = sorted({A.radius, B.radius})
+    for bit, r in enumerate(radii):
+        W, T = _FLOOR_HALF_WIDTH, FLOOR_THICKNESS
+        box = pymunk.Poly(world.space.static_body,
+                          [(-W, -r - T), (W, -r - T), (W, -r), (-W, -r)])
+        box.elasticity = scene.system.floor.elasticity
+        box.friction = scene.system.floor.friction
+        box.collision_type = _FLOOR_TYPE
+        if len(radii) > 1:
+            # Each particle meets only the box placed for its own radius.
+            box.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
+            for p in (A, B):
+                if p.radius == r:
+                    shape = world.points[p.name][1]
+                    shape.filter = pymunk.ShapeFilter(categories=1 << bit, mask=1 << bit)
+        world.space.add(box)
+        world.floors.append(box)
 
 
 def _reader(scene: Scene, world: World) -> Any:
@@ -245,6 +272,78 @@ def _energy(
     return partition_from_terms(scene, t, state, events, evaluate(inv, st))
 
 
+def _impact_log(world: World, dt: float, step: Callable[[], int]) -> list[Impact]:
+    """The list into which the circles' floor contacts are recorded as they happen: each an
+    :class:`Impact` at the end of the step ``step()`` (index, step ``dt`` in s) in which it
+    began, with the vertical velocity (m/s) before and after the contact's impulses."""
+    events: list[Impact] = []
+    pending: dict[str, list[float]] = {}
+
+    def begin(arbiter: Any, _space: Any, _data: Any) -> None:
+        shape = arbiter.shapes[0]
+        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
+        pending[name] = [(step() + 1) * dt, _vertical_velocity(shape.body, shape)]
+
+    def post_solve(arbiter: Any, _space: Any, _data: Any) -> None:
+        shape = arbiter.shapes[0]
+        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
+        hit = pending.pop(name, None)
+        if hit is not None:
+            events.append(Impact(hit[0], name, hit[1], _vertical_velocity(shape.body, shape)))
+
+    for name in "AB":
+        world.space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=begin,
+                                 post_solve=post_solve)
+    return events
+
+
+@dataclass(frozen=True)
+class _Watch:
+    """What ends a pymunk run at a sample: a state beyond :data:`_BIG` (``unstable``), or a
+    circle more than its radius below the floor and moving down (``tunnelled``).
+    ``columns`` maps each particle to its (height, vertical velocity) columns of a row."""
+
+    scene: Scene
+    floors: bool
+    columns: dict[str, tuple[int, int]]
+    radius: dict[str, float]
+
+    @classmethod
+    def of(cls, scene: Scene, world: World, names: list[str]) -> _Watch:
+        """The watch of ``world``, whose rows have the columns ``names``."""
+        one = scene.system.dimensions == 1
+        columns = {name: (names.index(f"{'x' if one else 'y'}{name}"),
+                          names.index(f"{'v' if one else 'vy'}{name}")) for name in "AB"}
+        radius = {"A": scene.system.A.radius, "B": scene.system.B.radius}
+        return cls(scene, bool(world.floors), columns, radius)
+
+    def verdict(self, row: tuple[float, ...], t: float, dt: float) -> Verdict | None:
+        """The verdict of the sample ``row`` at ``t`` (s) of a run at step ``dt`` (s), or
+        None when the run goes on."""
+        if not all(abs(v) < _BIG for v in row):
+            return Verdict("unstable", t, nonfinite_reason(self.scene, dt))
+        if not self.floors:
+            return None
+        for name in "AB":
+            y, vy = row[self.columns[name][0]], row[self.columns[name][1]]
+            if y < -self.radius[name] and vy < 0:
+                return Verdict("tunnelled", t, tunnel_reason(
+                    self.scene, name, y, vy, dt,
+                    depth=self.radius[name] + FLOOR_THICKNESS / 2))
+        return None
+
+
+def _state(scene: Scene, world: World, names: list[str], out: np.ndarray,
+           heat: np.ndarray) -> dict[str, np.ndarray]:
+    """The state columns of the samples kept (rows of ``out``, columns ``names``), the
+    contacts' heat (J), and for a spinning rigid body each circle's spin (the body's)."""
+    state = {name: out[:, c].copy() for c, name in enumerate(names[: out.shape[1]])}
+    state["heat"] = heat
+    if world.rigid_body is not None and spins(scene):
+        state["omegaA"] = state["omegaB"] = state["omega"]
+    return state
+
+
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Run ``scene`` in pymunk at step ``options.dt`` (s). See the module docstring."""
     from ..progress import bar
@@ -256,40 +355,15 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     names = state_columns(scene) + _extra_columns(scene, world)
     out = np.empty((options.n_samples, len(names)))
     out[0] = read()
-    if world.rigid_body is not None and spins(scene):
-        names += ["omegaA", "omegaB"]
 
     # Heat of the contacts, from their impulses step by step (friction included).
     from ..spaces.heat import HeatCounter
 
     counter = HeatCounter(space)
     heat = np.zeros(options.n_samples)
-    events: list[Impact] = []
-    pending: dict[str, list[float]] = {}
-    i = 0  # step index; the callbacks read it (a closure cell), so the loop pays nothing
-
-    def begin(arbiter: Any, _space: Any, _data: Any) -> None:
-        shape = arbiter.shapes[0]
-        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
-        pending[name] = [(i + 1) * dt, _vertical_velocity(shape.body, shape)]
-
-    def post_solve(arbiter: Any, _space: Any, _data: Any) -> None:
-        shape = arbiter.shapes[0]
-        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
-        hit = pending.pop(name, None)
-        if hit is not None:
-            events.append(Impact(hit[0], name, hit[1], _vertical_velocity(shape.body, shape)))
-
-    if world.floors:
-        for name in "AB":
-            space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=begin,
-                               post_solve=post_solve)
-
-    radius = {"A": scene.system.A.radius, "B": scene.system.B.radius}
-    y_col = {name: names.index(f"{'x' if scene.system.dimensions == 1 else 'y'}{name}")
-             for name in "AB"}
-    vy_col = {name: names.index(f"{'v' if scene.system.dimensions == 1 else 'vy'}{name}")
-              for name in "AB"}
+    i = 0  # step index; the impact log reads it (a closure cell), so the loop pays nothing
+    events = _impact_log(world, dt, lambda: i) if world.floors else []
+    watch = _Watch.of(scene, world, names)
     step = space.step
     verdict: Verdict | None = None
     j = 0
@@ -305,19 +379,11 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                 row = read()
                 out[j] = row
                 heat[j] = counter.total
-                if not all(abs(v) < _BIG for v in row):
-                    verdict = Verdict("unstable", j * every * dt, nonfinite_reason(scene, dt))
-                    j -= 1  # keep only finite samples
+                verdict = watch.verdict(row, j * every * dt, dt)
+                if verdict is not None:
+                    if verdict.status == "unstable":
+                        j -= 1  # keep only finite samples
                     break
-                if world.floors:
-                    for name in "AB":
-                        if row[y_col[name]] < -radius[name] and row[vy_col[name]] < 0:
-                            verdict = Verdict("tunnelled", j * every * dt, tunnel_reason(
-                                scene, name, row[y_col[name]], row[vy_col[name]], dt,
-                                depth=radius[name] + FLOOR_THICKNESS / 2))
-                            break
-                    if verdict is not None:
-                        break
             pb.update(min(j * every, n) - pb.n)
         if verdict is None:
             for i in range(j * every, n):
@@ -325,10 +391,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     wall = time.perf_counter() - t0
 
     kept = j + 1
-    state = {name: out[:kept, c].copy() for c, name in enumerate(names[: out.shape[1]])}
-    state["heat"] = heat[:kept]
-    if world.rigid_body is not None and spins(scene):
-        state["omegaA"] = state["omegaB"] = state["omega"]
+    state = _state(scene, world, names, out[:kept], heat[:kept])
     cfg = settings(scene)
     info = {"steps": min(n, kept * every) if verdict else n, **cfg}
     if world.rigid_body is not None:
