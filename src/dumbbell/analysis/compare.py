@@ -195,7 +195,7 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
     from ..model import args
-    from ..solvers import MAX_SAMPLES, available, make_options, simulate
+    from ..solvers import available, simulate
 
     scene = args.scene(scene)
     solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
@@ -210,7 +210,32 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
             raise UsageError(f"solvers: {name!r} cannot run {scene.source}: {reason}", param="solvers")
     if not (window > 0 and math.isfinite(window)):
         raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
-    # One sample spacing for every run, so that they compare point by point.
+    spacing = _spacing(scene, dts, t_end)
+    truth, truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
+    rows = []
+    for name in solvers:
+        for dt in dts:
+            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
+                           quiet=quiet)
+            err = position_error_series(run, truth)
+            over = np.flatnonzero(err > DIVERGED)
+            label = name if len(dts) == 1 else f"{name} dt={dt:g}"
+            rows.append(Row(label, run, err, position_error(run, truth, window),
+                            float(run.t[over[0]]) if over.size else None,
+                            energy_error(run, truth)))
+    notes = []
+    if t_end < window:
+        notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
+    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
+
+
+
+def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
+    """The one sample spacing (s) of every run, so that they compare point by point: the
+    largest dt or the scene's dt * every, which each dt must divide. UsageError before
+    anything runs if a dt does not fit or the samples would pass the budget."""
+    from ..solvers import MAX_SAMPLES, make_options
+
     spacing = max(max(dts), scene.run.dt * scene.run.every)
     for dt in dts:
         try:
@@ -228,40 +253,34 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
         raise UsageError(f"t_end = {t_end:g}: each run keeps a sample every {spacing:g} s, "
                          f"{samples:,} samples, past the budget of {MAX_SAMPLES:,}",
                          param="t_end", fixes=("lower {t_end}",))
+    return spacing
+
+
+def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
+           quiet: bool) -> tuple[Trajectory, str]:
+    """The run every solver is measured against, sampled every ``spacing`` (s), and a note
+    saying what it is: the scene's truth solver, or pymunk at a tenth of the smallest step
+    ``dt_min`` (s) where there is none."""
+    from ..solvers import simulate
+
     truth_name = truth_solver(scene)
-    notes = []
     if truth_name is None:
-        truth_dt = min(dts) / 10
+        truth_dt = dt_min / 10
         truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
                          every=round(spacing / truth_dt), quiet=quiet)
         why = no_truth_reason(scene)
-        truth_note = (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: {why}; "
-                      "so errors are against a ten times smaller step)")
-    else:
-        truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
-        truth_note = truth_name
-        est = truth.info.get("estimated_error")
-        if est:
-            method = ("RK8 on d = rA - rB, no impact missed" if truth.info.get("rk_steps")
-                      is not None else "DOP853, rtol 1e-12")
-            truth_note += (f" ({method}; its own estimated error: "
-                           f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
-                           f"energy {est['energy_relative']:.1e})")
-        elif truth_name == "exact":
-            truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
-                           "chaotic map amplifies about 10x per impact)")
-    rows = []
-    for name in solvers:
-        for dt in dts:
-            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
-                           quiet=quiet)
-            err = position_error_series(run, truth)
-            over = np.flatnonzero(err > DIVERGED)
-            label = name if len(dts) == 1 else f"{name} dt={dt:g}"
-            rows.append(Row(label, run, err, position_error(run, truth, window),
-                            float(run.t[over[0]]) if over.size else None,
-                            energy_error(run, truth)))
-    if t_end < window:
-        notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
-    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
-
+        return truth, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
+                       f"{why}; so errors are against a ten times smaller step)")
+    truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
+    truth_note = truth_name
+    est = truth.info.get("estimated_error")
+    if est:
+        method = ("RK8 on d = rA - rB, no impact missed" if truth.info.get("rk_steps")
+                  is not None else "DOP853, rtol 1e-12")
+        truth_note += (f" ({method}; its own estimated error: "
+                       f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
+                       f"energy {est['energy_relative']:.1e})")
+    elif truth_name == "exact":
+        truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
+                       "chaotic map amplifies about 10x per impact)")
+    return truth, truth_note
