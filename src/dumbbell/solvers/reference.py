@@ -42,6 +42,7 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -211,29 +212,22 @@ def integrate(scene: Scene, times: np.ndarray, t_end: float, tight: bool = False
         from .reference_2d import integrate as integrate_2d
 
         return integrate_2d(scene, times, t_end, STEP_ANGLE / 2 if tight else STEP_ANGLE, pb)
-    return _integrate_dop853(scene, times, t_end, RTOL / 10 if tight else RTOL,
-                             ATOL / 10 if tight else ATOL, pb)
+    return _integrate_dop853(scene, times, t_end, tight, pb)
 
 
-def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, rtol: float, atol: float,
+def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, tight: bool,
                       pb: object | None = None
                       ) -> tuple[dict[str, np.ndarray], list[Impact], Verdict, int]:
-    """scipy's DOP853 with impacts as terminal events (1D, and the rigid dumbbell)."""
+    """scipy's DOP853 with impacts as terminal events (1D, and the rigid dumbbell), at
+    tolerances :data:`RTOL` and :data:`ATOL`, 10x tighter if ``tight``."""
     from scipy.integrate import solve_ivp
 
+    rtol, atol = (RTOL / 10, ATOL / 10) if tight else (RTOL, ATOL)
     model = _model(scene)
     if len(times):
         t_end = max(t_end, float(times[-1]))  # j * every * dt can round past t_end
-    e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
     bodies = list(model.height) if scene.system.floor is not None else []
-    events = []
-    for body in bodies:
-        def event(_t: float, y: np.ndarray, body: str = body) -> float:
-            return model.height[body](y)
-        event.terminal = True  # type: ignore[attr-defined]
-        event.direction = -1  # type: ignore[attr-defined]
-        events.append(event)
-
+    events = _floor_events(model, bodies)
     y = np.asarray(model.y0, dtype=float)
     t = 0.0
     out = np.empty((len(times), len(y)))
@@ -259,28 +253,50 @@ def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, rtol: float
             pb.update(t_stop - t)  # type: ignore[attr-defined]
         if sol.status != 1:
             break
-        hits = [(float(te[0]), body) for te, body in zip(sol.t_events, bodies, strict=True)
-                if len(te)]
-        t_hit, body = min(hits)
-        y = np.asarray(sol.y_events[bodies.index(body)][0], dtype=float)
-        v_before = float(model.vertical_velocity(y, body))
-        if abs(v_before) < REST_SPEED:
-            verdict = Verdict("failed", t_hit, f"{body} came to rest on the floor (impact speed "
-                              f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
+        y, impact = _bounce(scene, model, sol, bodies)
+        if isinstance(impact, Verdict):
+            verdict = impact
             break
-        mass = (model.effective_mass(y, body) if model.effective_mass is not None
-                else (scene.system.A.mass if body == "A" else scene.system.B.mass))
-        y = model.jump(y, body, e)
-        v_after = float(model.vertical_velocity(y, body))
-        impacts.append(Impact(t_hit, body, v_before, v_after,
-                              impact_heat(mass, v_before, v_after)))
-        t = t_hit
+        impacts.append(impact)
+        t = impact.t
         if len(impacts) >= MAX_IMPACTS:
             verdict = Verdict("failed", t, f"more than {MAX_IMPACTS} impacts")
             break
         if t >= t_end:
             break
     return model.columns(out[:k]), impacts, verdict, nfev
+
+
+def _floor_events(model: _Model, bodies: list[str]) -> list[Callable[..., float]]:
+    """solve_ivp's terminal events: each body's height reaching 0 going down."""
+    events = []
+    for body in bodies:
+        def event(_t: float, y: np.ndarray, body: str = body) -> float:
+            return model.height[body](y)
+        event.terminal = True  # type: ignore[attr-defined]
+        event.direction = -1  # type: ignore[attr-defined]
+        events.append(event)
+    return events
+
+
+def _bounce(scene: Scene, model: _Model, sol: Any, bodies: list[str]
+            ) -> tuple[np.ndarray, Impact | Verdict]:
+    """The state just after the first impact that stopped ``sol`` and the impact, or a
+    ``failed`` verdict when the body hit at rest (an inelastic floor's endless bounces)."""
+    e = scene.system.floor.elasticity if scene.system.floor is not None else 1.0
+    hits = [(float(te[0]), body) for te, body in zip(sol.t_events, bodies, strict=True)
+            if len(te)]
+    t_hit, body = min(hits)
+    y = np.asarray(sol.y_events[bodies.index(body)][0], dtype=float)
+    v_before = float(model.vertical_velocity(y, body))
+    if abs(v_before) < REST_SPEED:
+        return y, Verdict("failed", t_hit, f"{body} came to rest on the floor (impact speed "
+                          f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
+    mass = (model.effective_mass(y, body) if model.effective_mass is not None
+            else (scene.system.A.mass if body == "A" else scene.system.B.mass))
+    y = model.jump(y, body, e)
+    v_after = float(model.vertical_velocity(y, body))
+    return y, Impact(t_hit, body, v_before, v_after, impact_heat(mass, v_before, v_after))
 
 
 def warm_up() -> float:
