@@ -114,26 +114,35 @@ def parse_axis(text: str) -> Axis:
                          "spring.stiffness, bodies.A.mass or run.dt (k and dt are short names)", param="grid")
     kind = spec.split(":", 1)[0]
     if kind in ("log", "lin"):
-        parts = spec.split(":")
-        if len(parts) != 4:
-            raise UsageError(f"grid {text!r}: must be {name}={kind}:A:B:N", param="grid")
-        a, b = _number(parts[1], text), _number(parts[2], text)
-        try:
-            n = int(parts[3])
-        except ValueError:
-            n = 0
-        if not 2 <= n <= MAX_AXIS_VALUES:
-            raise UsageError(f"grid {text!r}: N = {parts[3]!r} must be a whole number from 2 "
-                             f"to {MAX_AXIS_VALUES}", param="grid")
-        if a == b:
-            raise UsageError(f"grid {text!r}: A and B must differ", param="grid")
-        if kind == "log":
-            if a <= 0 or b <= 0:
-                raise UsageError(f"grid {text!r}: log spacing needs A > 0 and B > 0", param="grid")
-            values = tuple(float(v) for v in np.geomspace(a, b, n))
-        else:
-            values = tuple(float(v) for v in np.linspace(a, b, n))
-        return Axis(key, text, values, kind)
+        return Axis(key, text, _spaced_values(text, name, kind, spec), kind)
+    return Axis(key, text, _listed_values(text, spec, form), "list")
+
+
+def _spaced_values(text: str, name: str, kind: str, spec: str) -> tuple[float, ...]:
+    """The N values of ``spec`` = ``log:A:B:N`` (geometric) or ``lin:A:B:N`` (even) of the
+    grid item ``text`` for the key ``name``."""
+    parts = spec.split(":")
+    if len(parts) != 4:
+        raise UsageError(f"grid {text!r}: must be {name}={kind}:A:B:N", param="grid")
+    a, b = _number(parts[1], text), _number(parts[2], text)
+    try:
+        n = int(parts[3])
+    except ValueError:
+        n = 0
+    if not 2 <= n <= MAX_AXIS_VALUES:
+        raise UsageError(f"grid {text!r}: N = {parts[3]!r} must be a whole number from 2 "
+                         f"to {MAX_AXIS_VALUES}", param="grid")
+    if a == b:
+        raise UsageError(f"grid {text!r}: A and B must differ", param="grid")
+    if kind == "log":
+        if a <= 0 or b <= 0:
+            raise UsageError(f"grid {text!r}: log spacing needs A > 0 and B > 0", param="grid")
+        return tuple(float(v) for v in np.geomspace(a, b, n))
+    return tuple(float(v) for v in np.linspace(a, b, n))
+
+
+def _listed_values(text: str, spec: str, form: str) -> tuple[Any, ...]:
+    """The values of ``spec`` = ``V1,V2,...`` of the grid item ``text``, each once."""
     items = [s for s in spec.split(",")]
     if any(not s.strip() for s in items):
         raise UsageError(f"grid {text!r}: an empty value in the list; must be {form}", param="grid")
@@ -142,7 +151,7 @@ def parse_axis(text: str) -> Axis:
     values = tuple(_list_value(s) for s in items)
     if len(set(map(repr, values))) != len(values):
         raise UsageError(f"grid {text!r}: a value is listed twice", param="grid")
-    return Axis(key, text, values, "list")
+    return values
 
 
 def _check_axis_list(axes: Any) -> None:
