@@ -25,6 +25,7 @@ solver, which evaluates it over all its samples at once.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -128,19 +129,7 @@ def inventory(space: Any) -> Inventory:
     dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
     tracked = list(dyn)
     labels = [body_label(space, b) for b in dyn]
-    skipped: list[Skipped] = []
-    unknown: list[Skipped] = []
-    notes: list[str] = []
-    for b in space.bodies:
-        if b.body_type == pymunk.Body.STATIC:
-            skipped.append(Skipped(body_label(space, b), "static: holds no energy"))
-        elif b.body_type == pymunk.Body.KINEMATIC:
-            skipped.append(Skipped(body_label(space, b),
-                                   "kinematic: moved by the user, its energy is not counted"))
-    for b, label in zip(dyn, labels, strict=True):
-        if math.isinf(b.moment) and b.angular_velocity != 0.0:
-            skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
-                                          "rad/s: rotational energy left out"))
+    skipped = _skipped_bodies(space, dyn, labels)
 
     def index(body: Any) -> int:
         for i, other in enumerate(tracked):
@@ -150,39 +139,7 @@ def inventory(space: Any) -> Inventory:
         labels.append(body_label(space, body))
         return len(tracked) - 1
 
-    springs: list[Spring] = []
-    for c in space.constraints:
-        name = type(c).__name__
-        label = constraint_label(space, c)
-        if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
-            rotary = isinstance(c, pymunk.DampedRotarySpring)
-            custom = c._torque_func if rotary else c._force_func
-            if custom is not None and custom not in (pymunk.DampedSpring.spring_force,
-                                                     pymunk.DampedRotarySpring.spring_torque):
-                unknown.append(Skipped(label, "custom force function: its energy is unknown"))
-                continue
-            a, b = c.a, c.b
-            ia, ib = index(a), index(b)
-            if rotary:
-                anchors = ((0.0, 0.0), (0.0, 0.0))
-                rest = c.rest_angle
-            else:
-                anchors = tuple((float(p[0] - cg[0]), float(p[1] - cg[1])) for p, cg in
-                                ((c.anchor_a, a.center_of_gravity),
-                                 (c.anchor_b, b.center_of_gravity)))
-                rest = c.rest_length
-            if c.damping != 0.0:
-                notes.append(f"{label} has damping {c.damping:g}: it turns energy into heat "
-                             "that the heat counter does not see")
-            springs.append(Spring(label, "DampedRotarySpring" if rotary else "DampedSpring",
-                                  ia, ib, anchors[0], anchors[1], float(c.stiffness),
-                                  float(rest), float(c.damping), c))
-        elif name in _WORKLESS and type(c).__module__.startswith("pymunk"):
-            continue
-        elif isinstance(c, pymunk.SimpleMotor):
-            unknown.append(Skipped(label, "motor: puts energy in (its work is not counted)"))
-        else:
-            unknown.append(Skipped(label, f"{name}: constraint not known to the accounting"))
+    springs, unknown, notes = _constraints(space, index)
     if space.damping != 1.0:
         notes.append(f"space.damping = {space.damping:g}: bodies lose energy every step that "
                      "no term here counts")
@@ -194,6 +151,80 @@ def inventory(space: Any) -> Inventory:
         springs=tuple(springs), skipped=tuple(skipped), unknown=tuple(unknown),
         notes=tuple(notes),
     )
+
+
+def _constraints(space: Any, index: Callable[[Any], int]
+                 ) -> tuple[list[Spring], list[Skipped], list[str]]:
+    """The springs of ``space`` between the tracked bodies ``index(body)``, the constraints
+    whose energy is unknown, and notes on energy that nothing counts (spring damping)."""
+    import pymunk
+
+    unknown: list[Skipped] = []
+    notes: list[str] = []
+    springs: list[Spring] = []
+    for c in space.constraints:
+        name = type(c).__name__
+        label = constraint_label(space, c)
+        if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
+            spring = _spring(c, label, index)
+            if isinstance(spring, Skipped):
+                unknown.append(spring)
+                continue
+            if c.damping != 0.0:
+                notes.append(f"{label} has damping {c.damping:g}: it turns energy into heat "
+                             "that the heat counter does not see")
+            springs.append(spring)
+        elif name in _WORKLESS and type(c).__module__.startswith("pymunk"):
+            continue
+        elif isinstance(c, pymunk.SimpleMotor):
+            unknown.append(Skipped(label, "motor: puts energy in (its work is not counted)"))
+        else:
+            unknown.append(Skipped(label, f"{name}: constraint not known to the accounting"))
+    return springs, unknown, notes
+
+
+def _skipped_bodies(space: Any, dyn: list[Any], labels: list[str]) -> list[Skipped]:
+    """The bodies (or parts of their motion) whose energy is not counted: static and
+    kinematic bodies, and the spin of a dynamic body of infinite moment."""
+    import pymunk
+
+    skipped: list[Skipped] = []
+    for b in space.bodies:
+        if b.body_type == pymunk.Body.STATIC:
+            skipped.append(Skipped(body_label(space, b), "static: holds no energy"))
+        elif b.body_type == pymunk.Body.KINEMATIC:
+            skipped.append(Skipped(body_label(space, b),
+                                   "kinematic: moved by the user, its energy is not counted"))
+    for b, label in zip(dyn, labels, strict=True):
+        if math.isinf(b.moment) and b.angular_velocity != 0.0:
+            skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
+                                          "rad/s: rotational energy left out"))
+    return skipped
+
+
+def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped:
+    """The linear or rotary spring ``c`` as a :class:`Spring` between the tracked bodies
+    ``index(body)``, or Skipped when a custom force function makes its energy unknown."""
+    import pymunk
+
+    rotary = isinstance(c, pymunk.DampedRotarySpring)
+    custom = c._torque_func if rotary else c._force_func
+    if custom is not None and custom not in (pymunk.DampedSpring.spring_force,
+                                             pymunk.DampedRotarySpring.spring_torque):
+        return Skipped(label, "custom force function: its energy is unknown")
+    a, b = c.a, c.b
+    ia, ib = index(a), index(b)
+    if rotary:
+        anchors = ((0.0, 0.0), (0.0, 0.0))
+        rest = c.rest_angle
+    else:
+        anchors = tuple((float(p[0] - cg[0]), float(p[1] - cg[1])) for p, cg in
+                        ((c.anchor_a, a.center_of_gravity),
+                         (c.anchor_b, b.center_of_gravity)))
+        rest = c.rest_length
+    return Spring(label, "DampedRotarySpring" if rotary else "DampedSpring",
+                  ia, ib, anchors[0], anchors[1], float(c.stiffness),
+                  float(rest), float(c.damping), c)
 
 
 @dataclass(frozen=True)
