@@ -106,25 +106,25 @@ def _options_class() -> type:
             self._shape_ink = self.ink_of(shape.body)
             return SpaceDebugColor(0, 0, 0, 255)
 
+        def _emit(self, item: tuple) -> None:
+            """Keep a shape's primitive, unless it is a static shape already kept."""
+            if not self._skip:
+                self._sink.append(item)
+
         def draw_circle(self, pos: Any, angle: float, radius: float, outline_color: Any,
                         fill_color: Any) -> None:
-            if not self._skip:
-                self._sink.append(("circle", self._shape_ink, pos.x, pos.y, radius, angle))
+            self._emit(("circle", self._shape_ink, pos.x, pos.y, radius, angle))
 
         def draw_segment(self, a: Any, b: Any, color: Any) -> None:
-            if not self._skip:
-                self._sink.append(("seg", self._shape_ink, a.x, a.y, b.x, b.y, 0.0))
+            self._emit(("seg", self._shape_ink, a.x, a.y, b.x, b.y, 0.0))
 
         def draw_fat_segment(self, a: Any, b: Any, radius: float, outline_color: Any,
                              fill_color: Any) -> None:
-            if not self._skip:
-                self._sink.append(("seg", self._shape_ink, a.x, a.y, b.x, b.y, radius))
+            self._emit(("seg", self._shape_ink, a.x, a.y, b.x, b.y, radius))
 
         def draw_polygon(self, verts: Any, radius: float, outline_color: Any,
                          fill_color: Any) -> None:
-            if not self._skip:
-                self._sink.append(("poly", self._shape_ink, tuple((v.x, v.y) for v in verts),
-                                   radius))
+            self._emit(("poly", self._shape_ink, tuple((v.x, v.y) for v in verts), radius))
 
         def draw_dot(self, size: float, pos: Any, color: Any) -> None:
             pass  # collision points are not drawn
@@ -140,36 +140,43 @@ def _options_class() -> type:
             space.debug_draw(self)
             if first:
                 self.static = self._static_sink
-            self._constraints(space)
+            self.items += _constraint_items(space)
             return self.items
 
-        def _constraints(self, space: Any) -> None:
-            for c in space.constraints:
-                a, b = c.a, c.b
-                if isinstance(c, pymunk.DampedSpring):
-                    pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
-                    self.items.append(("spring", pa.x, pa.y, pb.x, pb.y))
-                elif isinstance(c, pymunk.DampedRotarySpring):
-                    # At the pivot the two bodies share, if any; else at the moving body.
-                    pins = [j for j in space.constraints if isinstance(j, pymunk.PivotJoint)
-                            and {id(j.a), id(j.b)} == {id(a), id(b)}]
-                    if pins:
-                        p = pins[0].a.local_to_world(pins[0].anchor_a)
-                    else:
-                        body = b if b.body_type == pymunk.Body.DYNAMIC else a
-                        p = body.local_to_world(body.center_of_gravity)
-                    self.items.append(("rotary", p.x, p.y, a.angle - b.angle - c.rest_angle))
-                elif isinstance(c, pymunk.PinJoint | pymunk.SlideJoint):
-                    pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
-                    self.items.append(("line", pa.x, pa.y, pb.x, pb.y))
-                elif isinstance(c, pymunk.PivotJoint):
-                    p = a.local_to_world(c.anchor_a)
-                    self.items.append(("dot", p.x, p.y))
-                elif isinstance(c, pymunk.GrooveJoint):
-                    ga, gb = a.local_to_world(c.groove_a), a.local_to_world(c.groove_b)
-                    self.items.append(("line", ga.x, ga.y, gb.x, gb.y))
-
     return PaletteDrawOptions
+
+
+def _constraint_items(space: Any) -> list[tuple]:
+    """The primitives of the constraints of ``space`` that have a picture: springs (linear
+    and rotary), pin and slide joints and grooves as lines, pivots as dots."""
+    import pymunk
+
+    items: list[tuple] = []
+    for c in space.constraints:
+        a, b = c.a, c.b
+        if isinstance(c, pymunk.DampedSpring):
+            pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
+            items.append(("spring", pa.x, pa.y, pb.x, pb.y))
+        elif isinstance(c, pymunk.DampedRotarySpring):
+            # At the pivot the two bodies share, if any; else at the moving body.
+            pins = [j for j in space.constraints if isinstance(j, pymunk.PivotJoint)
+                    and {id(j.a), id(j.b)} == {id(a), id(b)}]
+            if pins:
+                p = pins[0].a.local_to_world(pins[0].anchor_a)
+            else:
+                body = b if b.body_type == pymunk.Body.DYNAMIC else a
+                p = body.local_to_world(body.center_of_gravity)
+            items.append(("rotary", p.x, p.y, a.angle - b.angle - c.rest_angle))
+        elif isinstance(c, pymunk.PinJoint | pymunk.SlideJoint):
+            pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
+            items.append(("line", pa.x, pa.y, pb.x, pb.y))
+        elif isinstance(c, pymunk.PivotJoint):
+            p = a.local_to_world(c.anchor_a)
+            items.append(("dot", p.x, p.y))
+        elif isinstance(c, pymunk.GrooveJoint):
+            ga, gb = a.local_to_world(c.groove_a), a.local_to_world(c.groove_b)
+            items.append(("line", ga.x, ga.y, gb.x, gb.y))
+    return items
 
 
 def draw_options() -> Any:
