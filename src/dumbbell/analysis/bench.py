@@ -326,19 +326,17 @@ def run_bench(
     steppers = [n for n in solvers if solver_class(n).has_step]
     single = [n for n in solvers if not solver_class(n).has_step and n != truth]
     total = len(steppers) * len(dts) + len(single) + (truth is not None)
-    limits = _Limits(window, t_end, repeat, budget, spacing)
+    plan = _Plan(dts, window, t_end, repeat, budget, spacing, truth)
     with bar(total, f"bench {scene.name}", "point", quiet=quiet) as pb:
         for name in steppers:
-            points += _stepper_points(scene, name, dts, limits, truth, truth_at, pb)
+            points += _stepper_points(scene, name, plan, truth_at, pb)
         for name in single:
             pb.set_postfix_str(name)
-            points.append(_single_point(scene, name, t_end, window, repeat, truth, truth_at,
-                                        spacing))
+            points.append(_single_point(scene, name, plan, truth_at))
             pb.update(1)
         if truth is not None:
             pb.set_postfix_str(f"{truth} (truth)")
-            points.append(_single_point(scene, truth, t_end, window, repeat, truth, None,
-                                        spacing))
+            points.append(_single_point(scene, truth, plan, None))
             pb.update(1)
     fits = {}
     for name in steppers:
@@ -350,41 +348,44 @@ def run_bench(
 
 
 @dataclass(frozen=True)
-class _Limits:
-    """What every point of one benchmark shares: the error window and run length (s), the
-    timed runs per point, the time budget per point (s) and the sample spacing (s)."""
+class _Plan:
+    """What every point of one benchmark shares: the steps of the stepping solvers (s,
+    largest first), the error window and run length (s), the timed runs per point, the time
+    budget per point (s), the sample spacing (s) and the truth solver (None: none)."""
 
+    dts: list[float]
     window: float
     t_end: float
     repeat: int
     budget: float
     spacing: float
+    truth: str | None
 
 
-def _stepper_points(scene: Scene, name: str, dts: list[float], limits: _Limits,
-                    truth: str | None, truth_at: Any, pb: Any) -> list[Point]:
-    """One point per step in ``dts`` (largest first) for the stepping solver ``name``. A step
-    whose runs the cost per step measured so far says would pass the budget is skipped."""
+def _stepper_points(scene: Scene, name: str, plan: _Plan, truth_at: Any,
+                    pb: Any) -> list[Point]:
+    """One point per step in ``plan.dts`` for the stepping solver ``name``. A step whose runs
+    the cost per step measured so far says would pass the budget is skipped."""
     cls = solver_class(name)
     compile_s = cls.warm_up()
     cost_per_step = None
     points = []
-    for dt in dts:
+    for dt in plan.dts:
         pb.set_postfix_str(f"{name} dt={dt:g}")
-        options = make_options(scene, dt=dt, t_end=limits.t_end,
-                               every=_every(dt, limits.spacing))
-        base = Point(name, dt, window=limits.window, t_end=limits.t_end, truth=truth or "",
+        options = make_options(scene, dt=dt, t_end=plan.t_end,
+                               every=_every(dt, plan.spacing))
+        base = Point(name, dt, window=plan.window, t_end=plan.t_end, truth=plan.truth or "",
                      steps=options.n_steps, every=options.every, compile_seconds=compile_s)
         estimate = None if cost_per_step is None else cost_per_step * options.n_steps
-        if estimate is not None and estimate * (limits.repeat + 1) > limits.budget:
+        if estimate is not None and estimate * (plan.repeat + 1) > plan.budget:
             base.verdict, base.seconds = "skipped", estimate
-            base.reason = (f"estimated {estimate:.3g} s per run x {limits.repeat + 1} runs > "
-                           f"budget {limits.budget:g} s")
+            base.reason = (f"estimated {estimate:.3g} s per run x {plan.repeat + 1} runs > "
+                           f"budget {plan.budget:g} s")
             points.append(base)
             pb.update(1)
             continue
-        traj, point = _measure(cls, scene, options, limits.repeat, base)
-        _score(point, traj, truth_at(options), limits.window)
+        traj, point = _measure(cls, scene, options, plan.repeat, base)
+        _score(point, traj, truth_at(options), plan.window)
         points.append(point)
         if point.ok and point.steps:
             cost_per_step = point.seconds_call / point.steps
@@ -437,11 +438,12 @@ def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: flo
             impact_time_error(traj, truth, window))
 
 
-def _single_point(scene: Scene, name: str, t_end: float, window: float, repeat: int,
-                  truth: str | None, truth_at, spacing: float) -> Point:
+def _single_point(scene: Scene, name: str, plan: _Plan, truth_at: Any) -> Point:
     """A solver without a step as one point: its cost for the bench's samples
-    (every ``spacing`` s over t_end) and its error; for the truth itself, against a tighter
-    evaluation (exact: extended precision) or its own estimate (reference)."""
+    (every ``plan.spacing`` s over t_end) and its error; for the truth itself, against a
+    tighter evaluation (exact: extended precision) or its own estimate (reference)."""
+    t_end, window, repeat, truth = plan.t_end, plan.window, plan.repeat, plan.truth
+    spacing = plan.spacing
     cls = solver_class(name)
     options = make_options(scene, dt=spacing, t_end=t_end, every=1)
     is_truth = name == truth
