@@ -35,6 +35,9 @@ ROOT_XTOL = 1e-14
 #: Intervals shorter than this (s) are not split further: a dip below the floor inside one
 #: would be shallower than C * MIN_SPLIT^2 / 8, about 1e-25 m.
 MIN_SPLIT = 1e-13
+#: A point of a particle's height curve, as the root searches pass it: time (s), height (m)
+#: and vertical velocity (m/s).
+HeightPoint = tuple[float, float, float]
 #: An impact slower than this (m/s) means the particle has come to rest on the floor.
 REST_SPEED = 1e-9
 #: Impacts allowed in one run, so that no run can hang.
@@ -140,8 +143,9 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
     def f(tau: float) -> tuple[float, float]:
         return motion.height_at(seg, body, tau)
 
-    def search(lo: float, flo: float, dlo: float, hi: float, fhi: float, dhi: float) -> float:
+    def search(low: HeightPoint, high: HeightPoint) -> float:
         # Curvature bound: below the chord by at most C h^2 / 8; the slope changes by <= C h.
+        (lo, flo, dlo), (hi, fhi, dhi) = low, high
         width = hi - lo
         if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
             return math.inf
@@ -151,11 +155,11 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
         if width < MIN_SPLIT:
             return hi if fhi <= 0 else math.inf
         mid = 0.5 * (lo + hi)
-        fm, dm = f(mid)
-        left = search(lo, flo, dlo, mid, fm, dm)
+        middle = (mid, *f(mid))
+        left = search(low, middle)
         if left < math.inf:
             return left
-        return search(mid, fm, dm, hi, fhi, dhi)
+        return search(middle, high)
 
     while a < stop:
         taus = np.minimum(a + h * np.arange(block + 1), stop)
@@ -164,8 +168,8 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
         lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
         suspect = np.flatnonzero((lower <= 0) & (width > 0))
         for j in suspect:
-            root = search(*(float(v) for v in (taus[j], fs[j], ds[j],
-                                                taus[j + 1], fs[j + 1], ds[j + 1])))
+            root = search((float(taus[j]), float(fs[j]), float(ds[j])),
+                          (float(taus[j + 1]), float(fs[j + 1]), float(ds[j + 1])))
             if root < math.inf:
                 return root
         a = taus[-1]

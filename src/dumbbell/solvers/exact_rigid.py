@@ -43,6 +43,7 @@ from scipy.optimize import brentq
 from ..model.energy import impact_heat, rigid_moment, spins, state_columns
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
+from .exact import HeightPoint
 
 #: Root tolerance for impact times (s).
 ROOT_XTOL = 1e-14
@@ -205,8 +206,8 @@ class RigidBody:
         def fd(tau: float) -> float:
             return self.height(s, body, tau)[1]
 
-        def search(lo: float, flo: float, dlo: float, hi: float, fhi: float, dhi: float
-                   ) -> float:
+        def search(low: HeightPoint, high: HeightPoint) -> float:
+            (lo, flo, dlo), (hi, fhi, dhi) = low, high
             width = hi - lo
             if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
                 return math.inf
@@ -221,11 +222,11 @@ class RigidBody:
             if width < MIN_SPLIT:
                 return hi if flo > 0 and fhi <= 0 else math.inf
             mid = 0.5 * (lo + hi)
-            fm, dm = self.height(s, body, mid)
-            left = search(lo, flo, dlo, mid, fm, dm)
+            middle = (mid, *self.height(s, body, mid))
+            left = search(low, middle)
             if left < math.inf:
                 return left
-            return search(mid, fm, dm, hi, fhi, dhi)
+            return search(middle, high)
 
         block = 64
         while lo < stop:
@@ -234,8 +235,8 @@ class RigidBody:
             width = np.diff(taus)
             lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
             for j in np.flatnonzero((lower <= 0) & (width > 0)):
-                root = search(*(float(v) for v in (taus[j], fs[j], ds[j],
-                                                    taus[j + 1], fs[j + 1], ds[j + 1])))
+                root = search((float(taus[j]), float(fs[j]), float(ds[j])),
+                              (float(taus[j + 1]), float(fs[j + 1]), float(ds[j + 1])))
                 if root < math.inf:
                     return root
             lo = float(taus[-1])

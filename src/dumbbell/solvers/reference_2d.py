@@ -30,6 +30,7 @@ from scipy.optimize import brentq
 from ..model.energy import spins
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Verdict
+from .exact import HeightPoint
 
 #: The fixed step turns the state by at most this angle (rad): RK8's local error is then
 #: about STEP_ANGLE^9, 5e-16 of the motion's scale.
@@ -224,7 +225,8 @@ def _first_root(f, C: float, lo: float, hi: float) -> float:
     def y(tau: float) -> float:
         return f(tau)[0]
 
-    def search(lo, flo, dlo, hi, fhi, dhi) -> float:
+    def search(low: HeightPoint, high: HeightPoint) -> float:
+        (lo, flo, dlo), (hi, fhi, dhi) = low, high
         width = hi - lo
         if flo <= 0 and dlo < 0:
             return lo  # on (or, by rounding, just below) the floor and moving down
@@ -235,11 +237,11 @@ def _first_root(f, C: float, lo: float, hi: float) -> float:
         if width < MIN_SPLIT:
             return hi if flo > 0 and fhi <= 0 else math.inf
         mid = 0.5 * (lo + hi)
-        fm, dm = f(mid)
-        left = search(lo, flo, dlo, mid, fm, dm)
-        return left if left < math.inf else search(mid, fm, dm, hi, fhi, dhi)
+        middle = (mid, *f(mid))
+        left = search(low, middle)
+        return left if left < math.inf else search(middle, high)
 
-    return search(lo, *f(lo), hi, *f(hi))
+    return search((lo, *f(lo)), (hi, *f(hi)))
 
 
 def _columns(scene: Scene, segs: list[tuple[float, float, float, float, float]],
