@@ -262,3 +262,17 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
     slope = np.polyfit(*zip(*walk), 1)[0]
     assert abs(slope - strip.px_per_s) < 0.02 * strip.px_per_s   # walks at the strip's scale
     assert len(still) == 1                                             # then stays put
+
+
+def test_printed_values_that_round_to_zero_have_no_minus_sign():
+    from dumbbell.animation.bars import fixed
+
+    assert fixed(-1e-17, 3) == "0.000" and fixed(-4e-4, 3) == "0.000"
+    assert fixed(-1e-17, 4, "+") == "+0.0000" and fixed(-6e-5, 4, "+") == "-0.0001"
+    # Everywhere else the text is Python's own fixed-point rounding of the value.
+    rng = np.random.default_rng(7)
+    for value in rng.normal(0.0, 1.0, 2000) * 10.0 ** rng.integers(-6, 3, 2000):
+        for d in (0, 2, 3, 4):
+            want = f"{value:.{d}f}".replace("-", "") if float(f"{value:.{d}f}") == 0 \
+                else f"{value:.{d}f}"
+            assert fixed(value, d) == want

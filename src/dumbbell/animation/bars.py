@@ -72,7 +72,13 @@ class EnergyScale:
 
     def text(self, value: float) -> str:
         """``value`` (J) as printed beside its bar."""
-        return f"{value:.{self.decimals}f}" if math.isfinite(value) else "n/a"
+        return fixed(value, self.decimals) if math.isfinite(value) else "n/a"
+
+
+def fixed(value: float, decimals: int, sign: str = "") -> str:
+    """``value`` with ``decimals`` decimals; a value that rounds to zero prints as 0, never as
+    "-0.000" (a residue of -1e-17 J after a landing is no negative energy)."""
+    return f"{round(value, decimals) + 0.0:{sign}.{decimals}f}"
 
 
 Row = tuple[str, int, int]
@@ -232,9 +238,9 @@ class Bars:
         y = (below + limit) / 2
         box = (self.box[0], round(y - MOMENTUM_HALF * u), self.box[2],
                round(y + MOMENTUM_HALF * u))
-        text = f"L_cm = {value:+.4f} kg m²/s (about the centre of mass)"
+        text = f"L_cm = {fixed(value, 4, '+')} kg m²/s (about the centre of mass)"
         if stamps.width(text) > box[2] - box[0]:
-            text = f"L_cm = {value:+.4f} kg m²/s"
+            text = f"L_cm = {fixed(value, 4, '+')} kg m²/s"
         crop, (cx, cy), done = patch(box)
         stamps.draw(crop, (box[2] - cx, y - cy), text, INK, "rm")
         done()
