@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import importlib
 import os
 import re
 import signal
@@ -218,6 +219,112 @@ def test_the_worker_cap():
     assert cap_workers(None, 3)[0] == min(cpus, 3)
     assert cap_workers(1, 3) == (1, False)
     assert cap_workers(5, 0) == (1, True)
+
+
+# The exact solvers' work: impacts and the impact search, bounded before and during a run.
+
+
+def _bouncer(dimensions: int, drop: float, elasticity: float = 1.0, k: float = 200.0,
+             t_end: float = 2.0, spin: float = 0.0):
+    """A dumbbell (1D spring, or 2D rigid rod, vertical) with B ``drop`` m above the floor;
+    in 2D A moves sideways at ``spin`` m/s, which sets the rod turning."""
+    data = {"title": "bouncer", "dimensions": dimensions,
+            "bodies": {"A": {"mass": 0.1, "height": drop + 0.2},
+                       "B": {"mass": 0.1, "height": drop}},
+            "floor": {"elasticity": elasticity}, "gravity": {"g": 9.8},
+            "run": {"t_end": t_end, "dt": 1e-3, "solver": "exact"}}
+    if dimensions == 1:
+        data["spring"] = {"stiffness": k, "rest_length": 0.2}
+    else:
+        data["tilt"] = 0.0
+        data["bodies"]["A"] = {"mass": 0.1, "velocity": [spin, 0.0]}
+        data["rigid"] = {"length": 0.2}
+    return scene_from_dict(data, source="bouncer.toml")
+
+
+@pytest.mark.parametrize("scene", [
+    "textbook-1d", "rigid-2d", "1D 1 mm", "1D 10 um", "2D 1 mm", "1D stiff", "2D spinning"])
+def test_the_impact_estimate_is_a_lower_bound(scene):
+    """The estimate that refuses a run is a bound the run itself never beats: the impacts
+    located are at least min_impacts (and the bound is not empty)."""
+    from dumbbell.solvers.base import min_impacts
+    from dumbbell.solvers.exact import vertical_energy
+
+    made = {"1D 1 mm": lambda: _bouncer(1, 1e-3), "1D 10 um": lambda: _bouncer(1, 1e-5),
+            "2D 1 mm": lambda: _bouncer(2, 1e-3), "1D stiff": lambda: _bouncer(1, 0.05, k=1e6),
+            "2D spinning": lambda: _bouncer(2, 0.05, spin=3.0)}
+    loaded = made[scene]() if scene in made else load_scene(SCENES / f"{scene}.toml")
+    bound, _ = min_impacts(loaded, loaded.run.t_end, vertical_energy(loaded))
+    traj = dumbbell.simulate(loaded, "exact", dt=1e-2)
+    assert traj.verdict.ok and 1 <= bound <= len(traj.events), (bound, len(traj.events))
+
+
+@pytest.mark.parametrize("command,scene,flags,fix", [
+    ("simulate", "textbook-1d", ["--solver", "exact", "--t-end", "1e6", "--dt", "1", "-o",
+                                 "OUT/x.csv"], "--t-end"),
+    ("simulate", "rigid-2d", ["--solver", "exact", "--t-end", "1e6", "--dt", "1", "-o",
+                              "OUT/x.csv"], "--t-end"),
+    ("run", "@exact", ["--out", "OUT"], "run.t_end"),
+    ("bench", "textbook-1d", ["--t-end", "2e5", "--dts", "1", "--window", "1",
+                              "--sample-spacing", "1", "--out", "OUT"], "--t-end"),
+    ("compare", "textbook-1d", ["--t-end", "2e5", "--dt", "1", "--out", "OUT"], "--t-end"),
+])
+def test_exact_refuses_a_run_past_its_impact_budget_before_any_work(work, monkeypatch,
+                                                                     command, scene, flags,
+                                                                     fix):
+    def no_work(*args, **kwargs):
+        raise AssertionError("the impact search started")
+
+    for module, name in (("exact", "_segments"), ("exact_rigid", "_flight")):
+        monkeypatch.setattr(importlib.import_module(f"dumbbell.solvers.{module}"), name,
+                            no_work)
+    _, out = work
+    if scene == "@exact":
+        path = out.parent / "exact.toml"
+        path.write_text((SCENES / "textbook-1d.toml").read_text().replace(
+            "t_end = 10.0", "t_end = 1e6").replace("dt = 1e-5", "dt = 1.0").replace(
+            'solver = "euler-cromer"', 'solver = "exact"').split("[outputs]")[0]
+            + "[outputs]\ncsv = true\n", encoding="utf-8")
+    else:
+        path = SCENES / f"{scene}.toml"
+    status, _, err = cli(command, path, *[f.replace("OUT", str(out)) for f in flags])
+    line = refused(status, err, out)
+    assert "impacts" in line and "budget of 100,000" in line and fix in line, line
+    named = set(re.findall(r"(?<![\w-])--[a-z][a-z-]*", line))
+    assert named <= _help_flags(command), line
+
+
+@pytest.mark.parametrize("dimensions", [1, 2])
+def test_exact_stops_at_the_impact_budget_with_a_failed_verdict(work, monkeypatch,
+                                                                dimensions):
+    # Bouncing 10 um high on an elastic floor: hundreds of impacts a second, far more than
+    # the energy's lower bound (which lets the run start), so the loop's budget must end it.
+    monkeypatch.setattr(importlib.import_module("dumbbell.solvers.base"), "MAX_IMPACTS", 300)
+    scene = _bouncer(dimensions, 1e-5)
+    traj = dumbbell.simulate(scene, "exact", dt=1e-3)
+    assert traj.verdict.status == "failed" and "impact budget" in traj.verdict.reason
+    assert 300 <= len(traj.events) <= 302 and traj.t[-1] <= traj.verdict.t
+    assert traj.verdict.t == pytest.approx(traj.events[-1].t)
+    # The command line: exit 3, the samples up to there, one line saying why.
+    _, out = work
+    path = out.parent / "bouncer.toml"
+    path.write_text(SHORT_SCENE.replace("height = 1.2", f"height = {0.2 + 1e-5}").replace(
+        "height = 1.0", "height = 1e-5").replace('solver = "euler-cromer"', 'solver = "exact"')
+        .replace("t_end = 0.05", "t_end = 2.0"), encoding="utf-8")
+    status, _, err = cli("simulate", path, "-q")
+    assert status == 3 and "impact budget" in err and len(err.strip().splitlines()) == 1, err
+
+
+@pytest.mark.parametrize("scene", ["1D stiff", "2D spinning"])
+def test_exact_stops_at_the_search_budget_with_a_failed_verdict(monkeypatch, scene):
+    # A stiff spring (w = 1e5 rad/s) or a fast spin makes the search's intervals short.
+    monkeypatch.setattr(importlib.import_module("dumbbell.solvers.base"), "MAX_SEARCH_WORK",
+                        300)
+    loaded = (_bouncer(1, 0.05, k=1e9, t_end=1.0) if scene == "1D stiff"
+              else _bouncer(2, 0.05, spin=300.0, t_end=1.0))
+    traj = dumbbell.simulate(loaded, "exact", dt=1e-3)
+    assert traj.verdict.status == "failed" and "search's budget" in traj.verdict.reason
+    assert traj.t[-1] <= traj.verdict.t
 
 
 # --- 2. arithmetic overflow -----------------------------------------------------------------

@@ -272,6 +272,10 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
         raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: a run would "
                          f"keep {count}, past the budget of {MAX_SAMPLES:,}",
                          fixes=("keep fewer with a larger {spacing}", "a shorter {t_end}"))
+    # Every solver's own work budget (the exact solver's impacts), before the first run.
+    truth = truth_solver(scene)
+    for name in [*solvers, *([truth] if truth else [])]:
+        solver_class(name).check_work(scene, make_options(scene, dt=spacing, t_end=t_end))
 
 
 def run_bench(

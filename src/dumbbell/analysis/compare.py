@@ -211,6 +211,12 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     if not (window > 0 and math.isfinite(window)):
         raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
     spacing = _spacing(scene, dts, t_end)
+    # Every run's own work budget (the exact truth's impacts), before the first run.
+    from ..solvers import make_options
+
+    truth_name = truth_solver(scene)
+    for name in [*solvers, *([truth_name] if truth_name else [])]:
+        solver_class(name).check_work(scene, make_options(scene, spacing, t_end))
     truth, truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
     rows = []
     for name in solvers:
@@ -241,7 +247,7 @@ def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
         try:
             make_options(scene, dt, t_end)  # validates dt against t_end
         except UsageError as exc:
-            raise UsageError(f"dts: {exc}", param="dts") from None
+            raise UsageError(f"dts: {exc.reason}", param="dts", fixes=exc.fixes) from None
         ratio = spacing / dt
         if abs(ratio - round(ratio)) > 1e-6 * ratio:
             raise UsageError(f"dts: dt {dt:g}: must divide the sample spacing {spacing:g} s "

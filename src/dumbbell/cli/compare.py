@@ -60,7 +60,8 @@ def run(args: argparse.Namespace) -> int:
         if exc.param != "dts":
             raise
         # The library's dts is this command's --dt: "dts: dt = ..." reads "--dt = ...".
-        raise UsageError(str(exc).removeprefix("dts: "), param="dt") from None
+        raise UsageError(exc.reason.removeprefix("dts: "), param="dt",
+                         fixes=exc.fixes) from None
     paths = write(result, Path(args.out))
     from .. import plot
     from ..io.figures import save_figure

@@ -22,6 +22,14 @@ from .kernels import Params
 
 #: Largest number of steps one run may take, so that no run can hang.
 MAX_STEPS = 10**10
+#: Impacts the root-searching (exact) solvers may locate in one run: each costs about
+#: 0.2-0.8 ms here, so a run that reaches the budget ends (``failed``) within a minute or so.
+MAX_IMPACTS = 100_000
+#: Work their impact search may do in one run, in units of one interval split (a few us here);
+#: a block of 64 intervals scanned at once counts :data:`BLOCK_WORK` (about 70 us). A stiff
+#: spring or a fast spin makes the intervals short; a graze makes the splits deep.
+MAX_SEARCH_WORK = 10_000_000
+BLOCK_WORK = 10
 #: Samples :func:`~dumbbell.solvers.simulate` keeps unless told otherwise (``max_samples``,
 #: ``--max-samples``): 5e6 rows of about ten float64 columns are about 400 MB.
 MAX_SAMPLES = 5_000_000
@@ -105,6 +113,12 @@ class Solver:
         raise NotImplementedError
 
     @classmethod
+    def check_work(cls, scene: Scene, options: RunOptions) -> None:
+        """UsageError, before any work, when the run is known to exceed this solver's work
+        budget (the default: no such estimate). :meth:`solve` calls it first; callers that
+        plan several runs call it for each before the first."""
+
+    @classmethod
     def truth_for(cls, scene: Scene) -> bool:
         """Whether this (``is_truth``) solver is the truth for scenes of ``scene``'s kind,
         whether or not it can run this one (False for every other solver)."""
@@ -122,6 +136,66 @@ class Solver:
         """Compile or load what the first run would; returns the seconds it took, NaN when
         there is nothing to compile (the default)."""
         return math.nan
+
+
+class OverBudget(Exception):
+    """A run reached its work budget (:class:`SearchBudget`); the solver turns it into the
+    verdict ``failed`` with this message as the reason."""
+
+
+class SearchBudget:
+    """Counts the work of one run's impact search (blocks scanned, intervals split) and
+    raises :class:`OverBudget` past ``limit`` units (default :data:`MAX_SEARCH_WORK`), so
+    that no search can hang."""
+
+    def __init__(self, limit: int | None = None):
+        self.limit = MAX_SEARCH_WORK if limit is None else limit
+        self.work = 0
+
+    def spend(self, units: int = 1) -> None:
+        self.work += units
+        if self.work > self.limit:
+            raise OverBudget(
+                f"the impact search's budget was reached: {self.limit:,} units of work (a "
+                f"split interval is 1, a block of 64 scanned intervals {BLOCK_WORK}; a stiff "
+                "spring or a fast spin makes intervals short); a shorter t_end fits")
+
+
+def impact_budget_reason(count: int) -> str:
+    """The reason of a run stopped at :data:`MAX_IMPACTS`-like ``count`` impacts."""
+    return (f"the impact budget was reached: {count:,} impacts located, the most one run may "
+            "locate; a shorter t_end fits")
+
+
+def min_impacts(scene: Scene, t_end: float, vertical_energy: float) -> tuple[float, float]:
+    """(a lower bound on the impacts of ``scene`` in [0, ``t_end``] (s), the longest gap
+    between two (s)); (0, inf) where no bound holds. With an elastic floor (e = 1) and
+    gravity g the vertical energy E (J; ``vertical_energy``: vertical kinetic, potential
+    above the floor, internal) is conserved, so (1/2) V^2 + g Y <= E / M for the centre of
+    mass, which falls freely between impacts; an end is at or below the floor by the time Y
+    reaches it, so no gap between impacts lasts longer than 2 sqrt(2 E / M) / g. No bound is
+    claimed for e < 1: a run can end early, at rest."""
+    system = scene.system
+    if system.floor is None or system.floor.elasticity < 1 or not system.g > 0:
+        return 0.0, math.inf
+    gap = 2.0 * math.sqrt(2.0 * max(vertical_energy, 0.0) / system.M) / system.g
+    return (math.floor(t_end / gap) if gap > 0 and math.isfinite(t_end / gap) else math.inf,
+            gap)
+
+
+def check_impacts(scene: Scene, options: RunOptions, vertical_energy: float,
+                  limit: int) -> None:
+    """UsageError when a run of ``scene`` over ``options.t_end`` (s) must locate more than
+    ``limit`` impacts by :func:`min_impacts`."""
+    count, gap = min_impacts(scene, options.t_end, vertical_energy)
+    if count <= limit:
+        return
+    shown = f"{count:,}" if math.isfinite(count) else "more than 1e308"
+    raise UsageError(
+        f"t_end = {options.t_end:g} s: the exact solution would locate at least {shown} "
+        f"impacts (on this elastic floor the centre of mass stays at most {gap:.3g} s in the "
+        f"air between two), past the budget of {limit:,} per run", param="t_end",
+        fixes=("lower {t_end}",))
 
 
 def kernel_params(system: System, dt: float) -> Params:

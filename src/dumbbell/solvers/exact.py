@@ -25,7 +25,8 @@ import numpy as np
 
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from .base import RunOptions, Solver
+from . import base
+from .base import OverBudget, RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import conclude
 
 NAME = "exact"
@@ -40,8 +41,6 @@ MIN_SPLIT = 1e-13
 HeightPoint = tuple[float, float, float]
 #: An impact slower than this (m/s) means the particle has come to rest on the floor.
 REST_SPEED = 1e-9
-#: Impacts allowed in one run, so that no run can hang.
-MAX_IMPACTS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -128,8 +127,11 @@ def _earliest_possible(motion: _Motion, seg: Segment, body: str) -> float:
     return gap / -V0 if V0 < 0 else math.inf
 
 
-def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: float) -> float:
-    """First time in (start, stop] at which ``body`` crosses the floor going down, or inf."""
+def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: float,
+                budget: SearchBudget | None = None) -> float:
+    """First time in (start, stop] at which ``body`` crosses the floor going down, or inf;
+    each block scanned and
+    interval split counts against ``budget``."""
     from scipy.optimize import brentq  # scipy loads only when the exact solver runs
 
     S = motion.amplitude(seg)
@@ -154,6 +156,8 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
             return brentq(lambda x: f(x)[0], lo, hi, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
         if width < MIN_SPLIT:
             return hi if fhi <= 0 else math.inf
+        if budget is not None:
+            budget.spend()
         mid = 0.5 * (lo + hi)
         middle = (mid, *f(mid))
         left = search(low, middle)
@@ -162,6 +166,8 @@ def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: fl
         return search(middle, high)
 
     while a < stop:
+        if budget is not None:
+            budget.spend(base.BLOCK_WORK)
         taus = np.minimum(a + h * np.arange(block + 1), stop)
         fs, ds = motion.height(seg, body, taus)
         width = np.diff(taus)
@@ -189,19 +195,36 @@ def supports(scene: Scene) -> str | None:
 
 
 def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], Verdict]:
-    """The free-flight segments up to ``t_end`` (s), the impacts between them, and a verdict."""
+    """The free-flight segments up to ``t_end`` (s), the impacts between them, and a verdict:
+    ``failed`` when a particle comes to rest or the run reaches its work budget
+    (:data:`~dumbbell.solvers.base.MAX_IMPACTS` impacts, :data:`~.base.MAX_SEARCH_WORK`
+    units of impact search)."""
+    segs: list[Segment] = []
+    events: list[Impact] = []
+    try:
+        return _segments(scene, t_end, segs, events)
+    except OverBudget as exc:
+        return segs, events, Verdict("failed", segs[-1].t0, str(exc))
+
+
+def _segments(scene: Scene, t_end: float, segs: list[Segment], events: list[Impact]
+              ) -> tuple[list[Segment], list[Impact], Verdict]:
+    """:func:`segments`, filling ``segs`` and ``events`` as it goes."""
     motion = _Motion(scene)
+    budget = SearchBudget(base.MAX_SEARCH_WORK)
     A, B = scene.system.A, scene.system.B
     seg = motion.segment_at(0.0, A.height, A.vy, B.height, B.vy)
-    segs, events = [seg], []
+    segs.append(seg)
     if scene.system.floor is None:
         return segs, events, Verdict()
     e = scene.system.floor.elasticity
     # After an impact the particle is on the floor moving up: no new root before this time.
     start = {"A": 0.0, "B": 0.0}
-    while len(events) < MAX_IMPACTS:
+    limit = base.MAX_IMPACTS
+    while len(events) < limit:
         horizon = t_end - seg.t0
-        roots = {body: _first_root(motion, seg, body, start[body], horizon) for body in "AB"}
+        roots = {body: _first_root(motion, seg, body, start[body], horizon, budget)
+                 for body in "AB"}
         tau = min(roots.values())
         if not tau <= horizon:
             return segs, events, Verdict()
@@ -227,11 +250,35 @@ def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], V
             start[body] = (v_up / C if body in hit and C > 0 else 0.0)
             if body in hit and C == 0:
                 start[body] = horizon  # straight line up, never to return
-    return segs, events, Verdict("failed", seg.t0, f"more than {MAX_IMPACTS} impacts")
+    return segs, events, Verdict("failed", seg.t0, impact_budget_reason(limit))
+
+
+def vertical_energy(scene: Scene) -> float:
+    """The scene's energy at t = 0 that can move the centre of mass vertically (J): every
+    term but the horizontal motion (none in 1D; constant on a frictionless floor in 2D)."""
+    from ..model.energy import gravity_potential, spring_potential, translational_ke
+
+    system = scene.system
+    if system.rigid is not None:
+        from .exact_rigid import vertical_energy as rigid_energy
+
+        return rigid_energy(scene)
+    A, B, g = system.A, system.B, system.g
+    return float(translational_ke(A.mass, 0.0, A.vy) + translational_ke(B.mass, 0.0, B.vy)
+                 + gravity_potential(A.mass, 0.0, -g, 0.0, A.height)
+                 + gravity_potential(B.mass, 0.0, -g, 0.0, B.height)
+                 + spring_potential(system.k, A.height - B.height, system.b))
+
+
+def check_work(scene: Scene, options: RunOptions) -> None:
+    """UsageError before any work when the run must locate more impacts than
+    :data:`~dumbbell.solvers.base.MAX_IMPACTS` (:func:`~.base.check_impacts`)."""
+    check_impacts(scene, options, vertical_energy(scene), base.MAX_IMPACTS)
 
 
 def solve(scene: Scene, options: RunOptions) -> Trajectory:
     """Evaluate the exact solution at the sample times ``i * every * dt`` (s)."""
+    check_work(scene, options)
     if scene.system.rigid is not None:
         return _solve_rigid(scene, options)
     t0 = time.perf_counter()
@@ -286,6 +333,7 @@ class Exact(Solver):
     estimates_error = False
     supports = staticmethod(supports)
     solve = staticmethod(solve)
+    check_work = staticmethod(check_work)
 
     @staticmethod
     def truth_for(scene: Scene) -> bool:

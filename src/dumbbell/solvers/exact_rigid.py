@@ -40,9 +40,19 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
-from ..model.energy import impact_heat, rigid_moment, spins, state_columns
+from ..model.energy import (
+    gravity_potential,
+    impact_heat,
+    rigid_moment,
+    rotational_ke,
+    spins,
+    state_columns,
+    translational_ke,
+)
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
+from . import base
+from .base import OverBudget, SearchBudget, impact_budget_reason
 from .exact import HeightPoint
 
 #: Root tolerance for impact times (s).
@@ -51,8 +61,6 @@ ROOT_XTOL = 1e-14
 MIN_SPLIT = 1e-13
 #: An impact slower than this (m/s) means the end has come to rest on the floor.
 REST_SPEED = 1e-9
-#: Impacts allowed in one run, so that no run can hang.
-MAX_IMPACTS = 2_000_000
 #: Rounds of impulses for ends that hit together.
 MAX_ROUNDS = 100
 
@@ -189,9 +197,11 @@ class RigidBody:
                 break
         return s, events, Verdict()
 
-    def first_contact(self, s: RigidState, body: str, start: float, stop: float) -> float:
+    def first_contact(self, s: RigidState, body: str, start: float, stop: float,
+                      budget: SearchBudget | None = None) -> float:
         """First time in [start, stop] (s after ``s``) at which ``body`` reaches the floor
-        moving down, or inf. See the module docstring for why no root can be missed."""
+        moving down, or inf; each block scanned and interval split counts against
+        ``budget``. See the module docstring for why no root can be missed."""
         a, w = self.arm[body], s.omega
         C = self.curvature(s, body)
         D = abs(a) * abs(w) ** 3  # bound on |y'''|
@@ -208,6 +218,12 @@ class RigidBody:
 
         def search(low: HeightPoint, high: HeightPoint) -> float:
             (lo, flo, dlo), (hi, fhi, dhi) = low, high
+            if flo <= 0 and dlo < 0:
+                # Already at the floor moving down: the search began on the root, as when
+                # _earliest is the contact time itself (an end straight below the centre of
+                # mass) and rounding puts it a hair past. Every split of this interval would
+                # start at or below the floor and none could clear it.
+                return lo
             width = hi - lo
             if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
                 return math.inf
@@ -221,6 +237,8 @@ class RigidBody:
                 return brentq(f, lo, t_min, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
             if width < MIN_SPLIT:
                 return hi if flo > 0 and fhi <= 0 else math.inf
+            if budget is not None:
+                budget.spend()
             mid = 0.5 * (lo + hi)
             middle = (mid, *self.height(s, body, mid))
             left = search(low, middle)
@@ -230,6 +248,8 @@ class RigidBody:
 
         block = 64
         while lo < stop:
+            if budget is not None:
+                budget.spend(base.BLOCK_WORK)
             taus = np.minimum(lo + h * np.arange(block + 1), stop)
             fs, ds = self.heights(s, body, taus)
             width = np.diff(taus)
@@ -266,19 +286,44 @@ def supports(scene: Scene) -> str | None:
     return None
 
 
+def vertical_energy(scene: Scene) -> float:
+    """The rigid dumbbell's energy at t = 0 that can move its centre of mass vertically (J):
+    vertical kinetic, rotational, and potential above the floor (the horizontal motion is
+    constant on a frictionless floor)."""
+    body = RigidBody(scene)
+    s = body.initial(scene)
+    return float(translational_ke(body.M, 0.0, s.VY) + rotational_ke(body.moment, s.omega)
+                 + gravity_potential(body.M, 0.0, -body.g, 0.0, s.Y))
+
+
 def flight(scene: Scene, t_end: float) -> tuple[list[RigidState], list[Impact], Verdict]:
     """The free-flight segments up to ``t_end`` (s; each starts just after an impact), the
-    impacts between them, and a verdict (``failed`` when an end comes to rest)."""
+    impacts between them, and a verdict: ``failed`` when an end comes to rest or the run
+    reaches its work budget (:data:`~dumbbell.solvers.base.MAX_IMPACTS` impacts,
+    :data:`~.base.MAX_SEARCH_WORK` units of impact search)."""
+    segs: list[RigidState] = []
+    events: list[Impact] = []
+    try:
+        return _flight(scene, t_end, segs, events)
+    except OverBudget as exc:
+        return segs, events, Verdict("failed", segs[-1].t, str(exc))
+
+
+def _flight(scene: Scene, t_end: float, segs: list[RigidState], events: list[Impact]
+            ) -> tuple[list[RigidState], list[Impact], Verdict]:
+    """:func:`flight`, filling ``segs`` and ``events`` as it goes."""
     body = RigidBody(scene)
+    budget = SearchBudget(base.MAX_SEARCH_WORK)
     seg = body.initial(scene)
-    segs, events = [seg], []
+    segs.append(seg)
     if scene.system.floor is None:
         return segs, events, Verdict()
     e = scene.system.floor.elasticity
     start = {"A": 0.0, "B": 0.0}
-    while len(events) < MAX_IMPACTS:
+    limit = base.MAX_IMPACTS
+    while len(events) < limit:
         horizon = t_end - seg.t
-        roots = {b: body.first_contact(seg, b, start[b], horizon) for b in "AB"}
+        roots = {b: body.first_contact(seg, b, start[b], horizon, budget) for b in "AB"}
         tau = min(roots.values())
         if not tau <= horizon:
             return segs, events, Verdict()
@@ -295,7 +340,7 @@ def flight(scene: Scene, t_end: float) -> tuple[list[RigidState], list[Impact], 
             v_up = body.vertical_velocity(new, b)
             C = body.curvature(new, b)
             start[b] = (v_up / C if C > 0 else horizon) if b in hit and v_up > 0 else 0.0
-    return segs, events, Verdict("failed", seg.t, f"more than {MAX_IMPACTS} impacts")
+    return segs, events, Verdict("failed", seg.t, impact_budget_reason(limit))
 
 
 def sample(scene: Scene, segs: list[RigidState], t: np.ndarray) -> dict[str, np.ndarray]:
