@@ -13,6 +13,7 @@ import dataclasses
 import functools
 import importlib
 import inspect
+import io
 import math
 import pkgutil
 import sys
@@ -323,8 +324,6 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.solvers.base.Solver": lambda f: {},
     "dumbbell.solvers.base.RunOptions.sample_times": lambda f: {"count": 3},
     "dumbbell.model.trajectory.Trajectory": lambda f: fields(f.traj),
-    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: {"path": f.tmp / "t.csv"},
-    "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: {"path": f.tmp / "e.csv"},
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: {"body": "B"},
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: {"name": "E"},
     "dumbbell.model.trajectory.Impact": lambda f: fields(f.traj.events[0]),
@@ -505,6 +504,10 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.io.tables.cell": lambda f: {"value": 1.5},
     "dumbbell.io.tables.csv_text": lambda f: {"header": ["a", "b"], "rows": [[1, 2.5]]},
     "dumbbell.io.tables.write_text": lambda f: {"path": f.tmp / "t.txt", "text": "x\n"},
+    "dumbbell.io.trajectory.dump_csv": lambda f: {"traj": f.traj, "stream": io.StringIO()},
+    "dumbbell.io.trajectory.events_csv": lambda f: {"traj": f.traj},
+    "dumbbell.io.trajectory.write_csv": lambda f: {"traj": f.traj, "path": f.tmp / "t.csv"},
+    "dumbbell.io.trajectory.write_events": lambda f: {"traj": f.traj, "path": f.tmp / "e.csv"},
     # dumbbell.plot
     "dumbbell.plot.trajectory.positions": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
     "dumbbell.plot.trajectory.kinetic": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
@@ -603,8 +606,6 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
-    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
-    "dumbbell.model.trajectory.Trajectory.events_to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),

@@ -562,15 +562,15 @@ def test_dash_writes_to_stdout(work):
 
 def test_a_failed_second_output_leaves_the_first_out_too(work, monkeypatch):
     scene, out = work
-    from dumbbell.model.trajectory import Trajectory
+    import dumbbell.io.trajectory
 
-    def fail(self, path):
+    def fail(traj, path):
         from dumbbell.io.files import atomic_output
 
         with atomic_output(path) as tmp:
             raise PermissionError(13, "Permission denied", str(tmp))
 
-    monkeypatch.setattr(Trajectory, "events_to_csv", fail)
+    monkeypatch.setattr(dumbbell.io.trajectory, "write_events", fail)
     status, _, err = cli("simulate", scene, "-o", out / "x.csv", "--events", out / "e.csv")
     line = refused(status, err, out)
     assert str(out / "e.csv") in line and ".part" not in line
@@ -762,11 +762,13 @@ def test_analysis_functions_check_their_arguments():
 def test_trajectory_outputs_check_their_path(tmp_path):
     scene = load_scene(SCENES / "textbook-1d.toml")
     traj = dumbbell.simulate(scene, t_end=0.01)
+    from dumbbell.io.trajectory import write_csv, write_events
+
     with pytest.raises(DumbbellError, match="path"):
-        traj.to_csv(None)
+        write_csv(traj, None)
     with pytest.raises(DumbbellError, match="path"):
-        traj.events_to_csv(3)
-    assert traj.to_csv(str(tmp_path / "x.csv")).is_file()
+        write_events(traj, 3)
+    assert write_csv(traj, str(tmp_path / "x.csv")).is_file()
 
 
 def test_a_step_count_past_the_floats_is_said_in_words():

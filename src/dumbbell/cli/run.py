@@ -103,9 +103,11 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
             ax = _figure(name, traj)
             written.append(save_figure(ax.figure, out / f"{scene.name}-{name}.png"))
     if scene.outputs.csv:
-        written.append(traj.to_csv(out / f"{scene.name}.csv"))
+        from ..io.trajectory import write_csv, write_events
+
+        written.append(write_csv(traj, out / f"{scene.name}.csv"))
         if scene.system.floor is not None:
-            written.append(traj.events_to_csv(out / f"{scene.name}-impacts.csv"))
+            written.append(write_events(traj, out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
 

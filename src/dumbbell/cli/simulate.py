@@ -43,6 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.trajectory import dump_csv, write_csv, write_events
     from ..model.scene import load_scene
     from ..solvers import simulate
 
@@ -50,14 +51,11 @@ def run(args: argparse.Namespace) -> int:
     traj = simulate(scene, args.solver, dt=args.dt, t_end=args.t_end, every=args.every,
                     quiet=args.quiet, max_samples=args.max_samples)
     if args.output and args.output != "-":
-        traj.to_csv(args.output)
+        write_csv(traj, args.output)
     else:
-        import numpy as np
-
-        np.savetxt(sys.stdout, traj.table(), delimiter=",", header=",".join(traj.columns),
-                   comments="", fmt="%.17g")
+        dump_csv(traj, sys.stdout)
     if args.events:
-        traj.events_to_csv(Path(args.events))
+        write_events(traj, Path(args.events))
     if not traj.verdict.ok:
         sys.stderr.write(f"dumbbell simulate: {traj.solver}: {traj.verdict}\n")
         return EXIT_VERDICT

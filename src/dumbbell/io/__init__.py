@@ -2,4 +2,4 @@
 
 #: The writers, one module per result, and what they share.
 __all__ = ["bench", "compare", "figures", "files", "frames", "restitution", "stability", "sweep",
-           "tables"]
+           "tables", "trajectory"]

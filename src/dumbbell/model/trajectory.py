@@ -17,7 +17,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -230,29 +229,6 @@ class Trajectory:
     def table(self) -> np.ndarray:
         """All CSV columns as one (samples, columns) float array."""
         return np.column_stack([self[c] for c in self.columns])
-
-    def to_csv(self, path: str | Path) -> Path:
-        """Write the columns with a header row; written to a temporary name, then renamed
-        (a device or a FIFO is written directly)."""
-        from ..io.files import atomic_output
-
-        args.path(path, "path")
-        # One open of our own: given a name, numpy opens the file twice, and the first,
-        # empty open would end a FIFO's reader.
-        with atomic_output(path) as tmp, open(tmp, "w") as fh:
-            np.savetxt(fh, self.table(), delimiter=",", header=",".join(self.columns),
-                       comments="", fmt="%.17g")
-        return Path(path)
-
-    def events_to_csv(self, path: str | Path) -> Path:
-        """Write the impacts as ``t,body,v_before,v_after`` (s, -, m/s, m/s)."""
-        from ..io.files import atomic_output
-
-        args.path(path, "path")
-        with atomic_output(path) as tmp, open(tmp, "w") as fh:
-            fh.write("t,body,v_before,v_after\n")
-            fh.writelines(f"{e.t!r},{e.body},{e.v_before!r},{e.v_after!r}\n" for e in self.events)
-        return Path(path)
 
     def first_impact(self, body: str | None = None) -> Impact | None:
         """The first impact (of ``body`` if given), or None."""
