@@ -17,7 +17,7 @@ report says so). Each other run is measured against it:
 The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` reports.
 
 >>> result = compare(load_scene("scenes/textbook-1d.toml"))       # doctest: +SKIP
->>> print(result.table())                                          # doctest: +SKIP
+>>> print(dumbbell.io.compare.text(result))                         # doctest: +SKIP
 """
 
 from __future__ import annotations
@@ -101,30 +101,6 @@ class Comparison:
                 "verdict": r.verdict})
         return out
 
-    def table(self) -> str:
-        """The summary as a fixed-width text table."""
-        head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'steps/s':>10}"
-                f"{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}{'impacts':>9}"
-                "  verdict")
-        lines = [f"{self.scene.title}  ({self.scene.source})",
-                 f"truth: {self.truth_note}",
-                 (f"position error: largest distance of either particle from its true place over "
-                  f"[0, {self.window:g}] s "
-                 "(chaotic motion: later errors do not measure the method)"),
-                 "", head, "-" * len(head)]
-        for i, rec in enumerate(self.summary()):
-            rate = "-" if rec["steps_per_s"] is None else f"{rec['steps_per_s']:.3g}"
-            dt = "-" if rec["dt"] is None else f"{rec['dt']:g}"
-            err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
-            div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
-            energy = "-" if math.isnan(rec["energy_error"]) else f"{rec['energy_error']:.2e}"
-            lines.append(
-                f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}"
-                f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
-                f"{rec['impacts']:>9}  {rec['verdict']}")
-        lines += ["", *self.impact_lines(), *self.notes]
-        return "\n".join(lines)
-
     def to_pandas(self) -> pandas.DataFrame:
         """:meth:`summary` as a DataFrame indexed by label, the verdict as text, units in
         ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
@@ -158,25 +134,6 @@ class Comparison:
                 rec[f"{row.label}_diff"] = other.t - ev.t if same else math.nan
             out.append(rec)
         return out
-
-    def impact_lines(self) -> list[str]:
-        """The impacts inside the window as text (differences in ms; '?' where the bodies
-        no longer match: the runs have parted)."""
-        head = f"{'impact':>6} {'body':>4} {'truth t [s]':>12}" + "".join(
-            f"{row.label[:22]:>24}" for row in self.rows)
-        lines = [f"impacts in [0, {self.window:g}] s: time, and difference from the truth",
-                 head]
-        for rec in self.impacts():
-            if rec["truth_t"] > self.window:  # type: ignore[operator]
-                break
-            cells = ""
-            for row in self.rows:
-                t, d = rec[f"{row.label}_t"], rec[f"{row.label}_diff"]
-                text = ("-" if math.isnan(t) else (f"{t:.5f} ({d * 1e3:+.3f} ms)"  # type: ignore
-                        if not math.isnan(d) else f"{t:.5f} (?)"))  # type: ignore[arg-type]
-                cells += f"{text:>24}"
-            lines.append(f"{rec['n']:>6} {rec['body']:>4} {rec['truth_t']:>12.6f}{cells}")
-        return lines
 
 
 def default_solvers(scene: Scene) -> list[str]:

@@ -227,15 +227,6 @@ class RestitutionResult:
                 out[f"k{k:g}_{name}"] = col
         return out
 
-    def table(self) -> str:
-        """A Markdown table of the columns, 6 significant digits."""
-        cols = self.columns()
-        head = "| " + " | ".join(cols) + " |"
-        rule = "|" + "---|" * len(cols)
-        rows = ["| " + " | ".join(f"{cols[c][i]:.6g}" for c in cols) + " |"
-                for i in range(len(self.theta))]
-        return "\n".join([head, rule, *rows])
-
 
 def _check_samples(rigid: Scene, dt: float, t_end: float) -> None:
     """UsageError before anything runs when a rigid run of the drop, which keeps every step

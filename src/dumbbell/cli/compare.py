@@ -42,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.compare import compare
     from ..errors import UsageError
-    from ..io.compare import write
+    from ..io.compare import text, write
     from ..model.scene import load_scene
     from ..solvers import available
 
@@ -70,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     for name, draw in (("positions", plot.compare_positions), ("error", plot.compare),
                        ("energy", plot.compare_energy)):
         paths.append(save_figure(draw(result).figure, f"{stem}-{name}.png"))
-    print(result.table())
+    print(text(result))
     if not args.quiet:
         for path in paths:
             sys.stderr.write(f"wrote {path}\n")

@@ -89,7 +89,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.restitution import restitution
     from ..io.figures import save_figure
-    from ..io.restitution import write_csv
+    from ..io.restitution import markdown, write_csv
     from ..model.scene import load_scene
     from ..plot.rotation_chapter import restitution as draw
     from ..progress import bar
@@ -107,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
     fig = draw(result)[0].figure
     fig.tight_layout()
     save_figure(fig, png)
-    print(result.table())
+    print(markdown(result))
     if not args.quiet:
         for path in (csv, png):
             sys.stderr.write(f"wrote {path}\n")

@@ -1,9 +1,10 @@
-"""The comparison's files (:class:`dumbbell.analysis.compare.Comparison` in, CSVs out): the
-summary, the impact times side by side and the position-error series. The figures are
-:mod:`dumbbell.plot`'s; the command saves them."""
+"""The comparison's outputs (:class:`dumbbell.analysis.compare.Comparison` in): the CSVs of
+the summary, the impact times side by side and the position-error series, and the text table
+``dumbbell compare`` prints. The figures are :mod:`dumbbell.plot`'s; the command saves them."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -14,7 +15,7 @@ from ..model import args
 from .files import atomic_output
 from .tables import csv_text, write_text
 
-__all__ = ["SUMMARY_COLUMNS", "impacts_csv", "summary_csv", "write", "write_errors"]
+__all__ = ["SUMMARY_COLUMNS", "impacts_csv", "summary_csv", "text", "write", "write_errors"]
 
 
 def _checked(result: Any) -> Comparison:
@@ -72,3 +73,50 @@ def write(result: Comparison, out: Path) -> list[Path]:
     return [write_text(f"{stem}.csv", summary_csv(result)),
             write_text(f"{stem}-impacts.csv", impacts_csv(result)),
             write_errors(result, Path(f"{stem}-errors.csv"))]
+
+
+def text(result: Comparison) -> str:
+    """The summary as a fixed-width text table (times in s, position errors in m, steps/s),
+    then the impacts inside the window and the notes: what ``dumbbell compare`` prints."""
+    result = _checked(result)
+    head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'steps/s':>10}"
+            f"{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}{'impacts':>9}"
+            "  verdict")
+    lines = [f"{result.scene.title}  ({result.scene.source})",
+             f"truth: {result.truth_note}",
+             (f"position error: largest distance of either particle from its true place over "
+              f"[0, {result.window:g}] s "
+              "(chaotic motion: later errors do not measure the method)"),
+             "", head, "-" * len(head)]
+    for i, rec in enumerate(result.summary()):
+        rate = "-" if rec["steps_per_s"] is None else f"{rec['steps_per_s']:.3g}"
+        dt = "-" if rec["dt"] is None else f"{rec['dt']:g}"
+        err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
+        div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
+        energy = "-" if math.isnan(rec["energy_error"]) else f"{rec['energy_error']:.2e}"
+        lines.append(
+            f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}"
+            f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
+            f"{rec['impacts']:>9}  {rec['verdict']}")
+    lines += ["", *_impact_lines(result), *result.notes]
+    return "\n".join(lines)
+
+
+def _impact_lines(result: Comparison) -> list[str]:
+    """The impacts inside the window as text (differences in ms; '?' where the bodies
+    no longer match: the runs have parted)."""
+    head = f"{'impact':>6} {'body':>4} {'truth t [s]':>12}" + "".join(
+        f"{row.label[:22]:>24}" for row in result.rows)
+    lines = [f"impacts in [0, {result.window:g}] s: time, and difference from the truth",
+             head]
+    for rec in result.impacts():
+        if rec["truth_t"] > result.window:  # type: ignore[operator]
+            break
+        cells = ""
+        for row in result.rows:
+            t, d = rec[f"{row.label}_t"], rec[f"{row.label}_diff"]
+            cell = ("-" if math.isnan(t) else (f"{t:.5f} ({d * 1e3:+.3f} ms)"  # type: ignore
+                    if not math.isnan(d) else f"{t:.5f} (?)"))  # type: ignore[arg-type]
+            cells += f"{cell:>24}"
+        lines.append(f"{rec['n']:>6} {rec['body']:>4} {rec['truth_t']:>12.6f}{cells}")
+    return lines
