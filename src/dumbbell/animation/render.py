@@ -13,10 +13,10 @@ whole units alternate so that frame k still starts at round(k*100/fps) units: th
 keeps real time to within 5 ms (30 fps: 30, 40, 30, 30, 40, ... ms). fps above 50 is refused
 (browsers show delays of 10 ms or less as 100 ms). The GIF loops forever.
 
-The file is written by this module, not by Pillow's multi-frame writer: one global palette,
-and each frame after the first holds only the rectangle that changed, with unchanged pixels
-in it marked transparent (disposal 'leave in place'); Pillow's C encoder compresses each
-rectangle (LZW). Drawing and encoding take about the same time per frame.
+The file is written by :mod:`dumbbell.animation.gif`, not by Pillow's multi-frame writer: one
+global palette, and each frame after the first holds only the rectangle that changed, with
+unchanged pixels in it marked transparent (disposal 'leave in place'); Pillow's C encoder
+compresses each rectangle (LZW). Drawing and encoding take about the same time per frame.
 """
 
 from __future__ import annotations
@@ -276,7 +276,7 @@ def render_gif(
     from .. import progress
     from ..model import args
     from .drawing import Painter
-    from .palette import palette
+    from .gif import write_frames
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
@@ -295,7 +295,6 @@ def render_gif(
     t0 = time.perf_counter()
     frames = frames_of(traj, fps, t_end)
     painter = Painter(traj.scene, frames, (width, height), strip)
-    pal, clear = palette()
     delays = delays_cs(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"
@@ -306,94 +305,10 @@ def render_gif(
             tmp = stack.enter_context(atomic_output(path))
             fh = stack.enter_context(open(tmp, "wb"))
         pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
-        fh.write(_header(width, height, pal))
-        previous: np.ndarray | None = None
-        for k in range(len(frames.t)):
-            t1 = time.perf_counter()
-            current = np.asarray(painter.frame(k))
-            t2 = time.perf_counter()
-            fh.write(_encode_frame(*_delta(previous, current, clear), delays[k], clear))
-            stats["draw"] += t2 - t1
-            stats["encode"] += time.perf_counter() - t2
-            previous = current
-            pbar.update(1)
-        fh.write(b"\x3b")
+        stats["draw"], stats["encode"] = write_frames(fh, (width, height), painter.frame, delays,
+                                                      on_frame=lambda: pbar.update(1))
         result = Gif(fh.getvalue()) if path is None else Path(path)
     stats["frames"] = len(frames.t)
     if timing is not None:
         timing.update(stats)
     return result
-
-
-def _header(width: int, height: int, pal: bytes) -> bytes:
-    """GIF89a header, the global palette (256 colours) and 'loop forever'."""
-    lsd = width.to_bytes(2, "little") + height.to_bytes(2, "little") + bytes([0xF7, 0, 0])
-    loop = b"\x21\xff\x0bNETSCAPE2.0\x03\x01" + (0).to_bytes(2, "little") + b"\x00"
-    return b"GIF89a" + lsd + pal + loop
-
-
-def _delta(previous: np.ndarray | None, current: np.ndarray, clear: int
-           ) -> tuple[np.ndarray, int, int, bool]:
-    """The rectangle of ``current`` that differs from ``previous``, unchanged pixels set to
-    ``clear``; with its left and top (px) and whether it uses transparency."""
-    if previous is None:
-        return current, 0, 0, False
-    changed = previous != current
-    rows = np.flatnonzero(changed.any(axis=1))
-    if len(rows) == 0:
-        return np.full((1, 1), clear, dtype=np.uint8), 0, 0, True
-    cols = np.flatnonzero(changed.any(axis=0))
-    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    sub = current[y0:y1, x0:x1].copy()
-    sub[~changed[y0:y1, x0:x1]] = clear
-    return sub, int(x0), int(y0), True
-
-
-def _encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, delay: int,
-                  clear: int) -> bytes:
-    """One frame: graphic control extension (delay in 10 ms units, 'leave in place',
-    transparency) and the image, LZW-compressed by Pillow."""
-    h, w = pixels.shape
-    gce = bytes([0x21, 0xF9, 4, (1 << 2) | int(transparent)]) + delay.to_bytes(2, "little") \
-        + bytes([clear if transparent else 0, 0])
-    desc = b"\x2c" + b"".join(v.to_bytes(2, "little") for v in (left, top, w, h)) + b"\x00"
-    return gce + desc + _lzw(pixels)
-
-
-def _lzw(pixels: np.ndarray) -> bytes:
-    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, taken
-    from a one-frame GIF that Pillow writes (its encoder is C and keeps indices as given)."""
-    from PIL import Image
-
-    im = Image.frombuffer("L", (pixels.shape[1], pixels.shape[0]), np.ascontiguousarray(pixels),
-                          "raw", "L", 0, 1)
-    buf = io.BytesIO()
-    im.save(buf, "GIF", optimize=False, interlace=False)
-    return _image_data(buf.getvalue())
-
-
-def _image_data(gif: bytes) -> bytes:
-    """The first image's LZW data block of a GIF file, terminator included."""
-    pos = 13
-    if gif[10] & 0x80:
-        pos += 3 << ((gif[10] & 7) + 1)
-    while True:
-        marker = gif[pos]
-        if marker == 0x21:  # extension: label, then sub-blocks
-            pos += 2
-            pos = _skip_blocks(gif, pos)
-        elif marker == 0x2C:
-            flags = gif[pos + 9]
-            pos += 10
-            if flags & 0x80:
-                pos += 3 << ((flags & 7) + 1)
-            start = pos
-            return gif[start:_skip_blocks(gif, pos + 1)]
-        else:
-            raise ValueError(f"unexpected GIF block 0x{marker:02x}")
-
-
-def _skip_blocks(data: bytes, pos: int) -> int:
-    while data[pos]:
-        pos += data[pos] + 1
-    return pos + 1

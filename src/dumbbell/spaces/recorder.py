@@ -34,6 +34,7 @@ from PIL import Image, ImageDraw
 
 from ..animation.backdrop import SS, Backdrop
 from ..animation.bars import EnergyScale, bar_rows, draw_legend, draw_values
+from ..animation.gif import write_frames
 from ..animation.glyphs import Stamps, fmt_tick, font, nice_step
 from ..animation.layout import unit
 from ..animation.palette import (
@@ -48,7 +49,7 @@ from ..animation.palette import (
     palette,
     to_palette,
 )
-from ..animation.render import _delta, _encode_frame, _header, check_fps, check_size, delays_cs
+from ..animation.render import check_fps, check_size, delays_cs
 from ..animation.strip import GRID
 from ..animation.world import zigzag
 from ..errors import DumbbellError, UsageError
@@ -309,24 +310,9 @@ class Recorder:
 
 
 def _write_gif(path: Path, painter: _Painter, fps: int, timing: dict[str, float]) -> None:
-    import time
-
-    pal, clear = palette()
     n = painter.n
-    delays = delays_cs(n, fps)
-    draw = encode = 0.0
     with atomic_output(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(_header(painter.W, painter.H, pal))
-        previous = None
-        for k in range(n):
-            t1 = time.perf_counter()
-            current = np.asarray(painter.frame(k))
-            t2 = time.perf_counter()
-            fh.write(_encode_frame(*_delta(previous, current, clear), delays[k], clear))
-            draw += t2 - t1
-            encode += time.perf_counter() - t2
-            previous = current
-        fh.write(b"\x3b")
+        draw, encode = write_frames(fh, (painter.W, painter.H), painter.frame, delays_cs(n, fps))
     timing.update(draw=draw, encode=encode, frames=n)
 
 

@@ -1,0 +1,126 @@
+"""The GIF encoder that ``render_gif`` and the pymunk-space recorder share.
+
+One global palette (:func:`dumbbell.animation.palette.palette`), 'loop forever', and each frame
+after the first holding only the rectangle that changed, with unchanged pixels in it marked
+transparent (disposal 'leave in place'); Pillow's C encoder compresses each rectangle (LZW).
+Frames are arrays of palette indices (uint8, height x width); delays are in 10 ms units.
+Same frames, same bytes.
+
+The names here serve the animation's modules and :mod:`dumbbell.spaces.recorder`; the
+public API is ``render_gif`` and ``Recorder``.
+"""
+
+from __future__ import annotations
+
+import io
+import time
+from collections.abc import Callable, Sequence
+from typing import BinaryIO
+
+import numpy as np
+
+from .palette import palette
+
+__all__: list[str] = []
+
+#: The byte that ends a GIF file.
+TRAILER = b"\x3b"
+
+
+def write_frames(fh: BinaryIO, size: tuple[int, int], frame: Callable[[int], np.ndarray],
+                 delays: Sequence[int], on_frame: Callable[[], object] | None = None
+                 ) -> tuple[float, float]:
+    """Write a whole GIF of ``size`` (width, height px) to the binary file ``fh``: frame k is
+    ``frame(k)`` (palette indices), shown for ``delays[k]`` x 10 ms, for every k in
+    ``delays``. ``on_frame`` is called after each frame (a progress bar). Returns the seconds
+    spent in ``frame`` (drawing) and in encoding."""
+    pal, clear = palette()
+    fh.write(header(*size, pal))
+    previous: np.ndarray | None = None
+    draw = encode = 0.0
+    for k, delay in enumerate(delays):
+        t1 = time.perf_counter()
+        current = np.asarray(frame(k))
+        t2 = time.perf_counter()
+        fh.write(encode_frame(*delta(previous, current, clear), delay, clear))
+        draw += t2 - t1
+        encode += time.perf_counter() - t2
+        previous = current
+        if on_frame is not None:
+            on_frame()
+    fh.write(TRAILER)
+    return draw, encode
+
+
+def header(width: int, height: int, pal: bytes) -> bytes:
+    """GIF89a header, the global palette (256 colours) and 'loop forever'."""
+    lsd = width.to_bytes(2, "little") + height.to_bytes(2, "little") + bytes([0xF7, 0, 0])
+    loop = b"\x21\xff\x0bNETSCAPE2.0\x03\x01" + (0).to_bytes(2, "little") + b"\x00"
+    return b"GIF89a" + lsd + pal + loop
+
+
+def delta(previous: np.ndarray | None, current: np.ndarray, clear: int
+          ) -> tuple[np.ndarray, int, int, bool]:
+    """The rectangle of ``current`` that differs from ``previous``, unchanged pixels set to
+    ``clear``; with its left and top (px) and whether it uses transparency."""
+    if previous is None:
+        return current, 0, 0, False
+    changed = previous != current
+    rows = np.flatnonzero(changed.any(axis=1))
+    if len(rows) == 0:
+        return np.full((1, 1), clear, dtype=np.uint8), 0, 0, True
+    cols = np.flatnonzero(changed.any(axis=0))
+    y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    sub = current[y0:y1, x0:x1].copy()
+    sub[~changed[y0:y1, x0:x1]] = clear
+    return sub, int(x0), int(y0), True
+
+
+def encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, delay: int,
+                 clear: int) -> bytes:
+    """One frame: graphic control extension (delay in 10 ms units, 'leave in place',
+    transparency) and the image, LZW-compressed by Pillow."""
+    h, w = pixels.shape
+    gce = bytes([0x21, 0xF9, 4, (1 << 2) | int(transparent)]) + delay.to_bytes(2, "little") \
+        + bytes([clear if transparent else 0, 0])
+    desc = b"\x2c" + b"".join(v.to_bytes(2, "little") for v in (left, top, w, h)) + b"\x00"
+    return gce + desc + _lzw(pixels)
+
+
+def _lzw(pixels: np.ndarray) -> bytes:
+    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, taken
+    from a one-frame GIF that Pillow writes (its encoder is C and keeps indices as given)."""
+    from PIL import Image
+
+    im = Image.frombuffer("L", (pixels.shape[1], pixels.shape[0]), np.ascontiguousarray(pixels),
+                          "raw", "L", 0, 1)
+    buf = io.BytesIO()
+    im.save(buf, "GIF", optimize=False, interlace=False)
+    return _image_data(buf.getvalue())
+
+
+def _image_data(gif: bytes) -> bytes:
+    """The first image's LZW data block of a GIF file, terminator included."""
+    pos = 13
+    if gif[10] & 0x80:
+        pos += 3 << ((gif[10] & 7) + 1)
+    while True:
+        marker = gif[pos]
+        if marker == 0x21:  # extension: label, then sub-blocks
+            pos += 2
+            pos = _skip_blocks(gif, pos)
+        elif marker == 0x2C:
+            flags = gif[pos + 9]
+            pos += 10
+            if flags & 0x80:
+                pos += 3 << ((flags & 7) + 1)
+            start = pos
+            return gif[start:_skip_blocks(gif, pos + 1)]
+        else:
+            raise ValueError(f"unexpected GIF block 0x{marker:02x}")
+
+
+def _skip_blocks(data: bytes, pos: int) -> int:
+    while data[pos]:
+        pos += data[pos] + 1
+    return pos + 1
