@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import io
 import os
 import re
 import signal
@@ -20,6 +21,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from unittest import mock
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -272,7 +274,9 @@ def test_random_flags_never_give_a_traceback(tiny_budgets, args):
         signal.alarm(HANG)
         t0 = time.monotonic()
         try:
-            with contextlib.chdir(root / "cwd"):
+            # SCENE '-' reads standard input: give it the short scene.
+            stdin = io.TextIOWrapper(io.BytesIO((root / "cwd" / "short.toml").read_bytes()))
+            with contextlib.chdir(root / "cwd"), mock.patch("sys.stdin", stdin):
                 status, _, err = cli(*args)
         except Hang:
             pytest.fail(f"{args} ran past {HANG} s")

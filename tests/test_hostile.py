@@ -650,6 +650,41 @@ def test_a_deeply_nested_dict_is_a_scene_error():
         scene.with_values({"outputs.gif": deep})
 
 
+def _piped(stdin: bytes, *argv: object, cwd: Path) -> subprocess.CompletedProcess:
+    """``dumbbell ARGV`` as a real process reading ``stdin``."""
+    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1"}
+    code = "import sys; from dumbbell.cli import main; sys.exit(main())"
+    return subprocess.run([sys.executable, "-c", code, *map(str, argv)], input=stdin, cwd=cwd,
+                          check=False, env=env, capture_output=True, timeout=120)
+
+
+def test_a_scene_from_stdin_runs_as_the_same_file_does(work):
+    scene, out = work
+    text = scene.read_bytes()
+    piped = _piped(text, "simulate", "-", "-q", cwd=out)
+    direct = _piped(b"", "simulate", scene, "-q", cwd=out)
+    assert piped.returncode == 0 and piped.stdout == direct.stdout and piped.stdout
+    done = _piped(text, "render", "-", "-q", "--t-end", "0.04", cwd=out)
+    assert done.returncode == 0, done.stderr
+    done = _piped(text, "compare", "-", "-q", "--out", "c", cwd=out)
+    assert done.returncode == 0, done.stderr
+    assert "renders/stdin.gif" in files_in(out) and "c/stdin-compare.csv" in files_in(out)
+
+
+@pytest.mark.parametrize("command", ["simulate", "render", "compare"])
+@pytest.mark.parametrize("stdin,words", [
+    (b"#" * 1_000_001, ["stdin", "1 MB"]),
+    (b"[bodies\n", ["stdin", "TOML"]),
+    (b"\xff\xfe", ["stdin", "UTF-8"]),
+    (b"", ["stdin", "[bodies]"]),
+], ids=["1 MB", "not TOML", "not UTF-8", "empty"])
+def test_a_bad_scene_from_stdin_is_one_line(work, command, stdin, words):
+    _, out = work
+    done = _piped(stdin, command, "-", cwd=out)
+    line = refused(done.returncode, done.stderr.decode(), out)
+    assert all(w in line for w in words), line
+
+
 # --- 6. external services -------------------------------------------------------------------
 
 

@@ -160,6 +160,27 @@ def _stop_signals() -> Iterator[None]:
             signal.signal(n, handler if handler is not None else signal.SIG_DFL)
 
 
+#: How a scene read from standard input (SCENE ``-``) is named in messages and outputs.
+STDIN_SCENE = "stdin"
+
+
+def read_scene(path: str):
+    """The scene at ``path``, or read from standard input when ``path`` is ``-`` (at most
+    1 MB, the cap of a scene file; named :data:`STDIN_SCENE`, so ``render`` writes
+    ``renders/stdin.gif``)."""
+    from ..errors import SceneError
+    from ..model.scene import MAX_SCENE_BYTES, load_scene, load_scene_bytes
+
+    if path != "-":
+        return load_scene(path)
+    try:
+        data = sys.stdin.buffer.read(MAX_SCENE_BYTES + 1)
+    except (OSError, AttributeError, ValueError) as exc:
+        raise SceneError(f"{STDIN_SCENE}: cannot read a scene from standard input: "
+                         f"{getattr(exc, 'strerror', None) or exc}") from None
+    return load_scene_bytes(data, STDIN_SCENE)
+
+
 def _check_paths(args: argparse.Namespace, transaction) -> None:
     """Before any work: every output can be written, none is an input or another output
     (UsageError naming the flags)."""

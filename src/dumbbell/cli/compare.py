@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float
+from .app import add_quiet, positive_float, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,7 +21,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "SCENE-compare.csv, -compare-impacts.csv, -compare-errors.csv and three "
                     "PNG figures (positions, error, energy) into DIR.",
     )
-    p.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
+    p.add_argument("scene", metavar="SCENE",
+                   help="scene file (TOML); - reads it from standard input")
     p.add_argument("--out", metavar="DIR", default="compare",
                    help="folder for the outputs (default: compare)")
     p.add_argument("--dt", type=positive_float("s"), nargs="+", metavar="DT",
@@ -43,10 +44,9 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis.compare import compare
     from ..errors import UsageError
     from ..io.compare import text, write
-    from ..model.scene import load_scene
     from ..solvers import available
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene)
     solvers = None
     if args.solvers:
         solvers = [s.strip() for item in args.solvers for s in item.split(",") if s.strip()]

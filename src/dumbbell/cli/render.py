@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..animation.render import MAX_FRAMES
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int
+from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,7 +23,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "that ends badly still writes its GIF up to the failure, prints why and "
                     "exits 3.",
     )
-    p.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
+    p.add_argument("scene", metavar="SCENE",
+                   help="scene file (TOML); - reads it from standard input")
     p.add_argument("--solver", metavar="NAME",
                    help="solver (default: the scene's run.solver)")
     p.add_argument("-o", "--output", metavar="FILE.gif",
@@ -55,10 +56,10 @@ def _whole(text: str) -> int:
 
 def run(args: argparse.Namespace) -> int:
     from ..animation.render import check_fps, check_frames, check_size, render_gif, sample_every
-    from ..model.scene import GifSettings, load_scene
+    from ..model.scene import GifSettings
     from ..solvers import make_options, simulate
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene)
     gif = scene.outputs.gif or GifSettings(scene.run.t_end)
     # Validate every setting before anything runs or is written.
     fps = check_fps(args.fps if args.fps is not None else gif.fps,

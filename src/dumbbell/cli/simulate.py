@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..solvers import MAX_SAMPLES, MAX_STEPS
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int
+from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -19,7 +19,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "scene can have. A run that ends badly (unstable, tunnelled, failed) keeps "
                     "its samples up to the failure, prints one line saying why, and exits 3.",
     )
-    p.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
+    p.add_argument("scene", metavar="SCENE",
+                   help="scene file (TOML); - reads it from standard input")
     p.add_argument("--solver", metavar="NAME",
                    help="solver: euler-cromer, exact, pymunk, ... (default: the scene's "
                         "run.solver)")
@@ -44,10 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..io.trajectory import dump_csv, write_csv, write_events
-    from ..model.scene import load_scene
     from ..solvers import simulate
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene)
     traj = simulate(scene, args.solver, dt=args.dt, t_end=args.t_end, every=args.every,
                     quiet=args.quiet, max_samples=args.max_samples)
     if args.output and args.output != "-":

@@ -750,15 +750,27 @@ def load_scene(path: str | Path) -> Scene:
     path = Path(path)
     source = str(path)
     try:
-        text = _read_scene_file(path).decode("utf-8")
+        data = _read_scene_file(path)
     except FileNotFoundError:
         raise SceneError(f"{source}: no such scene file") from None
     except IsADirectoryError:
         raise SceneError(f"{source}: is a directory, not a scene file") from None
-    except UnicodeDecodeError:
-        raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
     except OSError as exc:
         raise SceneError(f"{source}: cannot read: {exc.strerror or exc}") from None
+    return load_scene_bytes(data, source)
+
+
+def load_scene_bytes(data: bytes, source: str) -> Scene:
+    """Validate a scene given as the bytes of a TOML document (at most
+    :data:`MAX_SCENE_BYTES`), read from ``source`` (which names it in messages and outputs,
+    as a file's path does). Raises :class:`SceneError` on any problem."""
+    if len(data) > MAX_SCENE_BYTES:
+        raise SceneError(f"{source}: more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
+                         "most 1 MB")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
     try:
         data = tomllib.loads(text)
     except ValueError as exc:  # TOMLDecodeError, or an integer too long to convert
