@@ -764,6 +764,11 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     """Validate a scene given as the bytes of a TOML document (at most
     :data:`MAX_SCENE_BYTES`), read from ``source`` (which names it in messages and outputs,
     as a file's path does). Raises :class:`SceneError` on any problem."""
+    if not isinstance(source, str):
+        raise SceneError(f"source = {_show(source)}: must be a str naming the scene")
+    if not isinstance(data, bytes | bytearray):
+        raise SceneError(f"{source}: data = {_show(data)}: must be the bytes of a TOML "
+                         "document")
     if len(data) > MAX_SCENE_BYTES:
         raise SceneError(f"{source}: more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
                          "most 1 MB")
