@@ -28,7 +28,7 @@ import pytest
 from dumbbell import DumbbellError
 
 #: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
-PACKAGES = ("dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis",
+PACKAGES = ("dumbbell.model", "dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis",
             "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
 TOP = ("dumbbell", "dumbbell.solvers")
@@ -307,6 +307,41 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.model.scene.load_scene": lambda f: {"path": f.scene_file},
     "dumbbell.model.scene.Scene": lambda f: fields(f.scene),
     "dumbbell.model.scene.Scene.with_values": lambda f: {"values": {"spring.stiffness": 300.0}},
+    # dumbbell.model
+    "dumbbell.model.energy.angular_momentum_cm": lambda f: {"scene": f.rigid_2d,
+                                                           "state": dict(f.traj_2d.state)},
+    "dumbbell.model.energy.column_unit": lambda f: {"name": "vA"},
+    "dumbbell.model.energy.disc_inertia": lambda f: {"mass": 0.1, "radius": 0.02},
+    "dumbbell.model.energy.energy_columns": lambda f: {"scene": f.scene},
+    "dumbbell.model.energy.energy_scale": lambda f: {"E0": 1.0,
+                                                    "terms_at_start": {"K_cm": 1.0}},
+    "dumbbell.model.energy.heat": lambda f: {
+        "scene": f.scene, "t": f.traj.t, "state": dict(f.traj.state), "events": f.traj.events},
+    "dumbbell.model.energy.impact_heat": lambda f: {"mass": 0.1, "v_before": -1.0,
+                                                   "v_after": 0.9},
+    "dumbbell.model.energy.momentum_columns": lambda f: {"scene": f.scene_2d},
+    "dumbbell.model.energy.partition": lambda f: {
+        "scene": f.scene, "t": f.traj.t, "state": dict(f.traj.state), "events": f.traj.events},
+    "dumbbell.model.energy.relative_energy_error": lambda f: {"energy": dict(f.traj.energy)},
+    "dumbbell.model.energy.rigid_moment": lambda f: {"scene": f.rigid_2d},
+    "dumbbell.model.energy.spins": lambda f: {"scene": f.scene_2d},
+    "dumbbell.model.energy.state_columns": lambda f: {"scene": f.scene},
+    "dumbbell.model.scene.Floor": lambda f: {"elasticity": 0.9, "friction": 0.0},
+    "dumbbell.model.scene.GifSettings": lambda f: {"t_end": 1.0, "fps": 25, "size": "64x64",
+                                                   "strip": True},
+    "dumbbell.model.scene.OutputSettings": lambda f: fields(f.scene.outputs),
+    "dumbbell.model.scene.Particle": lambda f: fields(f.scene.system.A),
+    "dumbbell.model.scene.PymunkSettings": lambda f: fields(f.scene.pymunk),
+    "dumbbell.model.scene.Rigid": lambda f: {"length": 0.3},
+    "dumbbell.model.scene.RunSettings": lambda f: fields(f.scene.run),
+    "dumbbell.model.scene.Spring": lambda f: {"stiffness": 200.0, "rest_length": 0.2},
+    "dumbbell.model.scene.System": lambda f: fields(f.scene.system),
+    "dumbbell.model.scene.packaged_scene": lambda f: {"name": "textbook-1d"},
+    "dumbbell.model.scene.parse_size": lambda f: {"text": "64x64"},
+    "dumbbell.model.scene.scene_from_dict": lambda f: {"data": f.scene.to_dict(),
+                                                      "source": "x.toml"},
+    "dumbbell.model.scene.scenes_dir": lambda f: {},
+    "dumbbell.model.trajectory.read_only": lambda f: {"values": np.zeros(3)},
     "dumbbell.solvers.simulate": lambda f: {
         "scene": f.scene, "solver": "exact", "dt": 1e-2, "t_end": 0.05, "every": 1,
         "quiet": True, "max_samples": 1000},

@@ -67,14 +67,14 @@ def check_fps(fps: Any, where: str = "fps") -> int:
 
 def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, int]:
     """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
-    from ..model.scene import parse_size
+    from ..model.scene import SIZE_RULE, parse_size
 
     if isinstance(size, tuple | list) and len(size) == 2:
         size = f"{size[0]}x{size[1]}"
     try:
         return parse_size(size)
-    except ValueError as exc:
-        raise UsageError(f"{where}: {exc}",
+    except ValueError:
+        raise UsageError(f"{where}: {size!r}: {SIZE_RULE}",
                          param=where.lstrip("-") if isinstance(where, str) else None) from None
 
 

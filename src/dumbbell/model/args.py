@@ -18,6 +18,9 @@ from typing import Any
 
 from ..errors import UsageError
 
+#: None: these are the checks the public functions call, not functions a user calls.
+__all__: list[str] = []
+
 
 def show(value: Any) -> str:
     """``value`` for an error message: one line, at most 60 characters."""

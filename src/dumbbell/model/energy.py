@@ -26,10 +26,14 @@ particles (``I omega`` with ``I = mu L^2`` when they form a rigid body), plus ea
 from __future__ import annotations
 
 import functools
+import numbers
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ..errors import UsageError
+from . import args
 
 if TYPE_CHECKING:
     from .scene import Scene
@@ -38,16 +42,62 @@ if TYPE_CHECKING:
 #: State columns by name (m, m/s, rad/s), one value per sample.
 Columns = Mapping[str, np.ndarray]
 
+#: The public functions; the elementwise formulas below them (translational_ke, ...) are
+#: building blocks that take numbers or arrays as they come, unchecked.
+__all__ = [
+    "BOOKKEEPING", "angular_momentum_cm", "column_unit", "disc_inertia", "energy_columns",
+    "energy_scale", "heat", "impact_heat", "momentum_columns", "partition", "relative_energy_error",
+    "rigid_moment", "spins", "state_columns",
+]
+
+
+def _number(value: Any, name: str, unit: str) -> float:
+    """``value`` as a float, NaN and inf allowed (a run that blows up passes them through,
+    and its verdict says so); UsageError naming ``name`` if it is not a number."""
+    if type(value) is float:
+        return value
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise UsageError(f"{name} = {args.show(value)}: must be a number ({unit})", param=name)
+    return float(value)
+
+
+def _length(column: Any) -> int:
+    """How many samples a column holds (-1 for what is not a column: refused next)."""
+    return len(column) if isinstance(column, np.ndarray | list | tuple) and np.ndim(column) else -1
+
+
+def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
+           ) -> dict[str, np.ndarray]:
+    """``state`` checked to be a dict of 1-d columns holding every state column of ``scene``
+    (and the spins where the particles spin), all as long as the first (or ``n``)."""
+    from .trajectory import _columns
+
+    args.mapping(state, name, "a dict of state columns by name")
+    needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if spins(scene) else [])
+    missing = [c for c in needed if c not in state]
+    if missing:
+        raise UsageError(f"{name} has no column {missing[0]!r}: needs {', '.join(needed)}",
+                         param=name)
+    if n is None:
+        n = _length(state[needed[0]])
+    return _columns({c: state[c] for c in [*needed, *(["heat"] if "heat" in state else [])]},
+                    n, name)
+
 
 def state_columns(scene: Scene) -> list[str]:
     """Position and velocity columns of a scene (m, m/s), in CSV order."""
+    scene = args.scene(scene)
     if scene.system.dimensions == 1:
         return ["xA", "vA", "xB", "vB"]
     return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
 
 
 def column_unit(name: str) -> str:
-    """The SI unit of a CSV column: s, m, m/s, rad/s or J."""
+    """The SI unit of a CSV column: s, m, m/s, rad/s or J (ColumnError for another name)."""
+    from ..errors import ColumnError
+
+    if not isinstance(name, str):
+        raise ColumnError(f"name = {args.show(name)}: must be a column name (str)", param="name")
     if name == "t":
         return "s"
     if name.startswith(("K_", "U_", "E")):
@@ -60,17 +110,18 @@ def column_unit(name: str) -> str:
         return "m/s"
     if name.startswith(("x", "y")):
         return "m"
-    raise KeyError(f"{name!r}: no such column")
+    raise ColumnError(f"name = {args.show(name)}: no such column", param="name")
 
 
 def spins(scene: Scene) -> bool:
     """True when the particles are spinning discs (:attr:`System.discs
     <dumbbell.model.scene.System.discs>`, 2D only)."""
-    return scene.system.discs
+    return args.scene(scene).system.discs
 
 
 def energy_columns(scene: Scene) -> list[str]:
     """The energy terms (J) a scene can have, in CSV order; those it cannot have are left out."""
+    scene = args.scene(scene)
     if scene.system.dimensions == 1:
         cols = ["K_cm", "K_int", "U_g", "U_spring", "E"]
     else:
@@ -93,6 +144,7 @@ BOOKKEEPING = ("E", "E_lost", "E_heat", "E_err")
 def momentum_columns(scene: Scene) -> list[str]:
     """The angular-momentum columns (kg m^2/s) of a scene, after the energy terms in the CSV:
     ``L_cm`` in 2D, none in 1D."""
+    scene = args.scene(scene)
     return ["L_cm"] if scene.system.dimensions == 2 else []
 
 
@@ -202,6 +254,9 @@ def impact_heat(mass: float, v_before: float, v_after: float) -> float:
     """Energy (J) an impact dissipates: 1/2 m (v_before^2 - v_after^2), with ``mass`` (kg) the
     effective mass at the contact point (the particle's own for a free particle; for a rigid
     body 1 / (1/M + r_x^2 / I)) and the contact point's normal velocities (m/s)."""
+    mass = _number(mass, "mass", "kg")
+    v_before = _number(v_before, "v_before", "m/s")
+    v_after = _number(v_after, "v_after", "m/s")
     return 0.5 * mass * (v_before * v_before - v_after * v_after)
 
 
@@ -209,9 +264,12 @@ def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) 
     """Energy the contacts dissipated up to each sample time ``t`` (s), in J: counted by the
     solver where the state has a ``heat`` column (pymunk), else summed over the impacts up to
     each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
+    scene = args.scene(scene)
+    t = np.asarray(args.array(t, "t", "s"))
+    state = _state(scene, state, t.size)
+    events = _impacts(events)
     if "heat" in state:
         return np.asarray(state["heat"], dtype=float)
-    events = list(events)
     mass = {"A": scene.system.A.mass, "B": scene.system.B.mass}
     times = np.array([e.t for e in events])
     amounts = np.array([e.heat if e.heat is not None
@@ -221,14 +279,30 @@ def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) 
     return total[np.searchsorted(times, t, side="right")] if len(times) else np.zeros(len(t))
 
 
+def _impacts(events: Any) -> list[Impact]:
+    """``events`` (a list or tuple of Impact) as a list; UsageError naming ``events``."""
+    from .trajectory import Impact
+
+    if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
+        raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
+                         param="events")
+    return list(events)
+
+
 def disc_inertia(mass: float, radius: float) -> float:
     """Moment of inertia of a uniform disc about its centre, 1/2 m r^2 (kg m^2)."""
+    mass = args.real(mass, "mass", "kg")
+    radius = args.real(radius, "radius", "m", lo=0.0)
     return 0.5 * mass * radius**2
 
 
 def rigid_moment(scene: Scene) -> float:
     """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
     two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
+    scene = args.scene(scene)
+    if scene.system.rigid is None:
+        raise UsageError(f"scene = {scene.name}: must be a rigid dumbbell (a [rigid] table)",
+                         param="scene")
     system = scene.system
     moment = system.mu * system.rigid.length**2
     if spins(scene):
@@ -255,6 +329,12 @@ def partition(
     """All energy columns (J, :func:`energy_columns` order) of ``scene`` at the sample times
     ``t`` (s) with the state columns ``state`` (m, m/s, rad/s) and the impacts ``events``
     (needed for E_heat on dissipative scenes)."""
+    scene = args.scene(scene)
+    t = args.array(t, "t", "s")
+    if t.ndim != 1:
+        raise UsageError(f"t = {args.show(t)}: must be a 1-d array of times (s)", param="t")
+    state = _state(scene, state, t.size)
+    events = _impacts(events)
     k, b = scene.system.k, scene.system.b
     if scene.system.dimensions == 1:
         parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
@@ -273,6 +353,11 @@ def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
     """Angular momentum about the centre of mass at each sample of a 2D ``state`` (kg m^2/s):
     the particles' ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus
     the discs' own spin ``1/2 m r^2 omega_i`` where particles may spin."""
+    scene = args.scene(scene)
+    if scene.system.dimensions != 2:
+        raise UsageError(f"scene = {scene.name}: must be a 2D scene (dimensions = 2)",
+                         param="scene")
+    state = _state(scene, state)
     mA, mB = scene.system.A.mass, scene.system.B.mass
     M = mA + mB
     Rx = (mA * state["xA"] + mB * state["xB"]) / M
@@ -330,6 +415,11 @@ def partition_from_terms(
 def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
     """The scale (J) that relative energy errors are taken against: |E(0)|, or where that is
     near zero (zero gravity, say) the largest single term at the start, or 1 J if all vanish."""
+    E0 = args.real(E0, "E0", "J", positive=False)
+    if terms_at_start is not None:
+        args.mapping(terms_at_start, "terms_at_start", "a dict of energy terms (J) or None")
+        terms_at_start = {key: args.real(v, "terms_at_start", "J", positive=False)
+                          for key, v in terms_at_start.items()}
     scale = abs(E0)
     if terms_at_start:
         largest = max(abs(v) for v in terms_at_start.values())
@@ -341,6 +431,13 @@ def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> f
 def relative_energy_error(energy: Columns) -> np.ndarray:
     """|E(t) - E(0)| / scale for every sample (dimensionless) of the energy columns ``energy``
     (J, as :func:`partition` gives them), scale from :func:`energy_scale`."""
+    from .trajectory import _columns
+
+    args.mapping(energy, "energy", "a dict of energy columns (J) by name")
+    if "E" not in energy:
+        raise UsageError("energy has no column 'E': must hold the total energy E (J)",
+                         param="energy")
+    energy = _columns(energy, _length(energy["E"]), "energy")
     E = energy["E"]
     if len(E) == 0:
         return E

@@ -27,10 +27,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
-from ..errors import SceneError
+from ..errors import SceneError, UsageError
+
+__all__ = [
+    "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "PymunkSettings",
+    "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "packaged_scene",
+    "parse_size", "scene_from_dict", "scenes_dir",
+]
 
 #: Figure names ``[outputs] figures`` may list.
 FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")
+#: What a GIF size must be.
+SIZE_RULE = "must be WIDTHxHEIGHT in pixels, each between 64 and 4096"
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
 #: Largest magnitude of any number in a scene (m, kg, m/s, N/m, ...), and the smallest mass
@@ -734,10 +742,10 @@ def _parse_size(text: Any) -> tuple[int, int] | None:
 
 
 def parse_size(text: str) -> tuple[int, int]:
-    """Parse 'WIDTHxHEIGHT' (pixels); raises ValueError with the allowed form."""
+    """Parse 'WIDTHxHEIGHT' (pixels); raises UsageError (a ValueError) with the allowed form."""
     size = _parse_size(text)
     if size is None:
-        raise ValueError(f"{text!r}: must be WIDTHxHEIGHT in pixels, each between 64 and 4096")
+        raise UsageError(f"text = {_show(text)}: {SIZE_RULE}", param="text")
     return size
 
 
@@ -822,12 +830,16 @@ def _file_kind(mode: int) -> str:
 
 def packaged_scene(name: str = "textbook-1d") -> Path:
     """Path of a scene shipped with the package (wheel) or found in the source checkout."""
+    if not isinstance(name, str) or not name or Path(name).name != name:
+        raise UsageError(f"name = {_show(name)}: must be the name of a shipped scene (a file "
+                         "name without .toml)", param="name")
     package = Path(__file__).resolve().parent.parent  # src/dumbbell, or dumbbell in a wheel
     for folder in (package / "scenes", package.parent.parent / "scenes"):
         candidate = folder / f"{name}.toml"
         if candidate.is_file():
             return candidate
-    raise SceneError(f"{name}.toml: packaged scene not found (looked in the package and scenes/)")
+    raise SceneError(f"name = {name!r}: no packaged scene {name}.toml (looked in the package "
+                     "and scenes/)")
 
 
 def scenes_dir() -> Path:

@@ -14,6 +14,7 @@ the formulas, at construction.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -34,6 +35,25 @@ FIRST_IMPACTS = 5
 #: Verdict statuses, from good to bad.
 VERDICTS = ("ok", "unstable", "tunnelled", "failed")
 
+__all__ = ["FIRST_IMPACTS", "VERDICTS", "Impact", "Trajectory", "Verdict", "read_only"]
+
+
+def _time(value: Any, name: str, optional: bool = False) -> None:
+    """UsageError naming ``name`` unless ``value`` is a finite number of seconds (or None
+    when ``optional``). A float takes the fast path: solvers build an Impact per bounce."""
+    if type(value) is float and math.isfinite(value) or optional and value is None:
+        return
+    args.real(value, name, "s", positive=False)
+
+
+def _number(value: Any, name: str, unit: str) -> None:
+    """UsageError naming ``name`` unless ``value`` is a number (``unit``). Not necessarily finite:
+    a run that blows up may record an impact on its way out, and its verdict says so."""
+    if type(value) is float or isinstance(value, int | np.floating) and not isinstance(
+            value, bool):
+        return
+    raise UsageError(f"{name} = {args.show(value)}: must be a number ({unit})", param=name)
+
 
 @dataclass(frozen=True)
 class Impact:
@@ -47,6 +67,17 @@ class Impact:
     v_after: float
     heat: float | None = None
 
+    def __post_init__(self) -> None:
+        # Cheap checks only (a float is one type test): a misspelt body or a time that is not
+        # one would mislead every table and figure built from the impacts.
+        if self.body != "A" and self.body != "B":
+            raise UsageError(f"body = {args.show(self.body)}: must be 'A' or 'B'", param="body")
+        _time(self.t, "t")
+        _number(self.v_before, "v_before", "m/s")
+        _number(self.v_after, "v_after", "m/s")
+        if self.heat is not None:
+            _number(self.heat, "heat", "J")
+
 
 @dataclass(frozen=True)
 class Verdict:
@@ -56,6 +87,13 @@ class Verdict:
     status: str = "ok"
     t: float | None = None
     reason: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.status, str) or self.status not in VERDICTS:
+            raise UsageError(f"status = {args.show(self.status)}: must be one of "
+                             f"{', '.join(VERDICTS)}", param="status")
+        _time(self.t, "t", optional=True)
+        args.text(self.reason, "reason", "a str (why the run ended so)")
 
     @property
     def ok(self) -> bool:
@@ -69,6 +107,7 @@ class Verdict:
 
 def read_only(values: np.ndarray) -> np.ndarray:
     """A read-only view of the array ``values``; the caller's own array stays writeable."""
+    args.instance(values, "values", np.ndarray, "a numpy array")
     view = values.view()
     view.flags.writeable = False
     return view
