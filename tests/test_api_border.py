@@ -28,10 +28,16 @@ import pytest
 from dumbbell import DumbbellError
 
 #: Packages whose ``__all__`` (and their public submodules' ``__all__``) is the public API.
-PACKAGES = ("dumbbell.model", "dumbbell.spaces", "dumbbell.examples", "dumbbell.plot", "dumbbell.analysis",
-            "dumbbell.io", "dumbbell.animation")
+PACKAGES = ("dumbbell.model", "dumbbell.solvers", "dumbbell.spaces", "dumbbell.examples",
+            "dumbbell.plot", "dumbbell.analysis", "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
-TOP = ("dumbbell", "dumbbell.solvers")
+TOP = ("dumbbell", "dumbbell.parallel", "dumbbell.progress")
+#: Packages not walked: the compiled loops, which import numba and are called by the solver
+#: classes only (which check the arguments first).
+INTERNAL = ("dumbbell.solvers.kernels",)
+#: Classes whose methods are a contract only (they raise NotImplementedError); every
+#: registered subclass's own are covered.
+CONTRACTS = ("dumbbell.solvers.base.Solver",)
 
 #: Values that are wrong for nearly every argument.
 HOSTILE = (None, "text", [1, 2], float("nan"), -1, object())
@@ -43,22 +49,32 @@ def _modules() -> list[types.ModuleType]:
         package = importlib.import_module(name)
         out.append(package)
         for info in pkgutil.walk_packages(package.__path__, prefix=f"{name}."):
+            if info.name.startswith(INTERNAL):
+                continue
             if not any(part.startswith("_") for part in info.name.split(".")):
                 out.append(importlib.import_module(info.name))
     return out
 
 
-def _own_methods(cls: type) -> dict[str, Callable[..., Any]]:
-    """Public methods a class defines itself: not dataclass or builtin machinery, and not
-    overrides of a base class's methods (a protocol others call, as pymunk calls a
-    SpaceDebugDrawOptions' draw_circle)."""
+def _own_methods(cls: type) -> dict[str, tuple[Callable[..., Any], bool]]:
+    """Public methods a class defines itself, each with whether it is called on an instance
+    (False: a static or class method, called on the class): not dataclass or builtin
+    machinery, and not overrides of a base class's methods from outside the package (a
+    protocol others call, as pymunk calls a SpaceDebugDrawOptions' draw_circle)."""
     out = {}
     for name, value in vars(cls).items():
-        if (name.startswith("_") and name != "__getitem__") or not inspect.isfunction(value):
+        if name.startswith("_") and name != "__getitem__":
             continue
-        if any(hasattr(base, name) for base in cls.__mro__[1:]):
+        if isinstance(value, staticmethod | classmethod):
+            fn, bound = getattr(cls, name), False
+        elif inspect.isfunction(value):
+            fn, bound = value, True
+        else:
             continue
-        out[name] = value
+        if any(hasattr(base, name) for base in cls.__mro__[1:]
+               if not base.__module__.startswith("dumbbell")):
+            continue
+        out[name] = (fn, bound)
     return out
 
 
@@ -76,9 +92,9 @@ def public() -> dict[str, Any]:
             if inspect.isclass(obj) and issubclass(obj, BaseException):
                 continue  # an exception takes any message
             found.setdefault(key, obj)
-            if inspect.isclass(obj):
-                for method, fn in _own_methods(obj).items():
-                    if _parameters(fn)[1:]:
+            if inspect.isclass(obj) and key not in CONTRACTS:
+                for method, (fn, bound) in _own_methods(obj).items():
+                    if _parameters(fn)[1 if bound else 0:]:
                         found.setdefault(f"{key}.{method}", fn)
     return found
 
@@ -118,6 +134,13 @@ class Fixtures:
         from dumbbell import load_scene
 
         return load_scene(self.scene_file)
+
+    @functools.cached_property
+    def options(self) -> Any:
+        """Run options of a short run (20 ms at 1 ms steps)."""
+        from dumbbell.solvers import RunOptions
+
+        return RunOptions(1e-3, 0.02, 1, True)
 
     @functools.cached_property
     def traj(self) -> Any:
@@ -296,6 +319,11 @@ class Fixtures:
         return spaces.check(self.space(), 1.0)[0]
 
 
+def _arity(*values: Any) -> int:
+    """How many arguments it was given (a job for ordered_map that takes anything)."""
+    return len(values)
+
+
 def fields(record: Any) -> dict[str, Any]:
     """The constructor arguments that rebuild a dataclass record."""
     return {f.name: getattr(record, f.name) for f in dataclasses.fields(record) if f.init}
@@ -342,6 +370,47 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                       "source": "x.toml"},
     "dumbbell.model.scene.scenes_dir": lambda f: {},
     "dumbbell.model.trajectory.read_only": lambda f: {"values": np.zeros(3)},
+    # dumbbell.solvers: the registered classes (called on the class) and their modules
+    "dumbbell.solvers.engine.Pymunk": lambda f: {},
+    "dumbbell.solvers.engine.Pymunk.catch_depth": lambda f: {"scene": f.scene},
+    "dumbbell.solvers.engine.Pymunk.solve": lambda f: {"scene": f.scene, "options": f.options},
+    "dumbbell.solvers.engine.Pymunk.supports": lambda f: {"scene": f.scene},
+    "dumbbell.solvers.euler_cromer.EulerCromer": lambda f: {},
+    "dumbbell.solvers.euler_cromer.EulerCromer.solve": lambda f: {"scene": f.scene,
+                                                                  "options": f.options},
+    "dumbbell.solvers.euler_cromer.EulerCromer.supports": lambda f: {"scene": f.scene},
+    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D": lambda f: {},
+    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D.solve": lambda f: {
+        "scene": f.scene_2d, "options": f.options},
+    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D.supports": lambda f: {"scene": f.scene_2d},
+    "dumbbell.solvers.exact.Exact": lambda f: {},
+    "dumbbell.solvers.exact.Exact.check_work": lambda f: {"scene": f.scene,
+                                                         "options": f.options},
+    "dumbbell.solvers.exact.Exact.solve": lambda f: {"scene": f.scene, "options": f.options},
+    "dumbbell.solvers.exact.Exact.supports": lambda f: {"scene": f.rigid_2d},
+    "dumbbell.solvers.exact.Exact.truth_for": lambda f: {"scene": f.scene},
+    "dumbbell.solvers.exact_rigid.first_impact_state": lambda f: {
+        "tilt": 30.0, "elasticity": 0.5, "mA": 0.1, "mB": 0.2, "length": 0.2, "height": 1.0,
+        "g": 9.8},
+    "dumbbell.solvers.reference.Reference": lambda f: {},
+    "dumbbell.solvers.reference.Reference.solve": lambda f: {
+        "scene": f.scene, "options": f.options, "estimate_error": False},
+    "dumbbell.solvers.reference.Reference.supports": lambda f: {"scene": f.scene_2d},
+    "dumbbell.solvers.reference.Reference.truth_for": lambda f: {"scene": f.scene_2d},
+    "dumbbell.solvers.verlet.Verlet": lambda f: {},
+    "dumbbell.solvers.verlet.Verlet.solve": lambda f: {"scene": f.scene, "options": f.options},
+    "dumbbell.solvers.verlet.Verlet.supports": lambda f: {"scene": f.scene},
+    # dumbbell.parallel, dumbbell.progress
+    "dumbbell.parallel.batches": lambda f: {"n": 10, "workers": 2},
+    "dumbbell.parallel.cap_note": lambda f: {"flag": "--workers", "workers": 4, "jobs": 3,
+                                             "what": "runs"},
+    "dumbbell.parallel.cap_workers": lambda f: {"workers": 2, "jobs": 3},
+    "dumbbell.parallel.ordered_map": lambda f: {
+        "func": _arity, "jobs": [(1,), (2, 3)], "shared": 0, "workers": 1, "scheduler": None,
+        "processes": True, "initializer": None, "initargs": (), "quiet": True, "desc": "",
+        "unit": "run", "connect_timeout": 1.0},
+    "dumbbell.progress.bar": lambda f: {"total": 10, "desc": "d", "unit": "it", "quiet": True},
+    "dumbbell.progress.progress_wanted": lambda f: {"quiet": True},
     "dumbbell.solvers.simulate": lambda f: {
         "scene": f.scene, "solver": "exact", "dt": 1e-2, "t_end": 0.05, "every": 1,
         "quiet": True, "max_samples": 1000},
@@ -774,6 +843,10 @@ def test_numpy_scalars_give_what_the_equal_python_numbers_give(tmp_path):
 # --- wrong kinds beyond the hostile values -------------------------------------------------
 
 
+def _module(name: str) -> Any:
+    return importlib.import_module(name)
+
+
 def _pymunk() -> Any:
     import pymunk
 
@@ -828,6 +901,42 @@ WRONG_KINDS: dict[str, tuple[Callable[[Fixtures], Any], str]] = {
                                .frame_count(1e300, 25), "t_end"),
     "a column that is not there": (lambda f: f.traj["K_rot"], "name"),
     "a body that is not there": (lambda f: f.traj.first_impact("C"), "body"),
+    "a status that is no verdict": (lambda f: _module("dumbbell.model.trajectory").Verdict(
+        "banana"), "status"),
+    "an impact of a third body": (lambda f: _module("dumbbell.model.trajectory").Impact(
+        0.1, "C", -1.0, 1.0), "body"),
+    "an impact at an infinite time": (lambda f: _module("dumbbell.model.trajectory").Impact(
+        math.inf, "A", -1.0, 1.0), "t"),
+    "a failure at NaN s": (lambda f: _module("dumbbell.model.trajectory").Verdict(
+        "failed", math.nan, "why"), "t"),
+    "run options with a NaN step": (lambda f: _module("dumbbell.solvers").RunOptions(
+        math.nan, 1.0), "dt"),
+    "a 2D spring scene for the exact solver": (lambda f: _module("dumbbell.solvers").METHODS[
+        "exact"].solve(f.scene_2d, f.options), "scene"),
+    "a 2D spring scene for the exact solver's budget": (lambda f: _module(
+        "dumbbell.solvers").METHODS["exact"].check_work(f.scene_2d, f.options), "scene"),
+    "an elasticity of 2": (lambda f: _module("dumbbell.solvers.exact_rigid")
+                           .first_impact_state(30.0, 2.0), "elasticity"),
+    "a negative mass": (lambda f: _module("dumbbell.solvers.exact_rigid")
+                        .first_impact_state(30.0, 0.5, mA=-0.1), "mA"),
+    "a NaN tilt": (lambda f: _module("dumbbell.solvers.exact_rigid")
+                   .first_impact_state(math.nan, 0.5), "tilt"),
+    "energy columns without E": (lambda f: _module("dumbbell.model.energy")
+                                 .relative_energy_error({"K_cm": f.traj["K_cm"]}), "energy"),
+    "a 1D scene for L_cm": (lambda f: _module("dumbbell.model.energy").angular_momentum_cm(
+        f.scene, dict(f.traj.state)), "scene"),
+    "a spring scene for the rigid moment": (lambda f: _module("dumbbell.model.energy")
+                                            .rigid_moment(f.scene), "scene"),
+    "a state without a column": (lambda f: _module("dumbbell.model.energy").partition(
+        f.scene, f.traj.t, {"xA": f.traj["xA"]}), "state"),
+    "columns shorter than t": (lambda f: _module("dumbbell.model.energy").partition(
+        f.scene, f.traj.t[:-1], dict(f.traj.state)), "state"),
+    "a size that is no size": (lambda f: _module("dumbbell.model.scene").parse_size("64x"),
+                               "text"),
+    "a scene name with a folder": (lambda f: _module("dumbbell.model.scene").packaged_scene(
+        "../textbook-1d"), "name"),
+    "a numpy float for whole workers": (lambda f: _module("dumbbell.parallel").cap_workers(
+        np.float64(2.0), 3), "workers"),
 }
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import os
 import signal
 from collections.abc import Callable, Iterable, Sequence
@@ -21,30 +22,49 @@ from typing import Any
 
 from .errors import UsageError
 
+__all__ = ["batches", "cap_note", "cap_workers", "ordered_map"]
+
+def _check(ok: bool, name: str, value: Any, allowed: str) -> None:
+    """UsageError naming ``name`` unless ``ok``. (This module sits below the model, so it
+    checks with the errors module alone, not with :mod:`dumbbell.model.args`.)"""
+    if not ok:
+        text = " ".join(repr(value).split())
+        raise UsageError(f"{name} = {text if len(text) <= 60 else text[:57] + '...'}: must be "
+                         f"{allowed}", param=name)
+
+
+def _whole(value: Any, name: str, unit: str, lo: int) -> int:
+    """``value`` (an int or a numpy integer, not a bool) as an int >= ``lo``."""
+    _check(not isinstance(value, bool) and isinstance(value, numbers.Integral)
+           and value >= lo, name, value, f"a whole number >= {lo} ({unit})")
+    return int(value)
+
+
 #: Marks "no shared argument".
 _NOTHING = object()
 
 
-def cap_workers(requested: int | None, jobs: int) -> tuple[int, bool]:
-    """(processes to start, whether that is fewer than ``requested``): min(requested, CPUs,
-    jobs), at least 1; ``requested`` None means the number of CPUs."""
-    if requested is not None and (isinstance(requested, bool) or not isinstance(requested, int)
-                                  or requested < 1):
-        raise UsageError(f"workers = {requested!r}: must be a whole number >= 1 (processes)",
-                         param="workers")
+def cap_workers(workers: int | None, jobs: int) -> tuple[int, bool]:
+    """(processes to start, whether that is fewer than ``workers``): min(workers, CPUs,
+    jobs), at least 1; ``workers`` None means the number of CPUs."""
+    if workers is not None:
+        workers = _whole(workers, "workers", "processes", 1)
+    jobs = _whole(jobs, "jobs", "jobs", 0)
     cpus = os.cpu_count() or 1
-    n = max(1, min(requested or cpus, cpus, jobs))
-    return n, requested is not None and n < requested
+    n = max(1, min(workers or cpus, cpus, jobs))
+    return n, workers is not None and n < workers
 
 
-def cap_note(flag: str, requested: int | None, jobs: int, what: str = "runs") -> str | None:
+def cap_note(flag: str, workers: int | None, jobs: int, what: str = "runs") -> str | None:
     """The one line saying that ``flag`` was capped, or None when it was not."""
-    n, capped = cap_workers(requested, jobs)
+    _check(isinstance(flag, str), "flag", flag, "the flag's name (str)")
+    _check(isinstance(what, str), "what", what, "what the jobs are called (str)")
+    n, capped = cap_workers(workers, jobs)
     if not capped:
         return None
     cpus = os.cpu_count() or 1
     why = f"there are {cpus} CPUs" if n == cpus and cpus <= jobs else f"there are {jobs} {what}"
-    return f"{flag} {requested}: starting {n} processes, as {why}"
+    return f"{flag} {workers}: starting {n} processes, as {why}"
 
 
 #: The signals that stop a run (the CLI turns them into a clean exit).
@@ -69,6 +89,8 @@ def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -
 
 def batches(n: int, workers: int) -> list[list[int]]:
     """Job indices 0..n-1 in interleaved batches: a few per worker, at most 64 jobs each."""
+    n = _whole(n, "n", "jobs", 0)
+    workers = _whole(workers, "workers", "processes", 1)
     size = max(1, min(64, n // (8 * max(1, workers))))
     count = math.ceil(n / size) if n else 0
     return [list(range(i, n, count)) for i in range(count)]
@@ -121,6 +143,25 @@ def ordered_map(
     does not answer within ``connect_timeout`` s is a UsageError naming its address."""
     from .progress import bar
 
+    _check(callable(func), "func", func, "a function")
+    _check(not isinstance(jobs, str) and isinstance(jobs, Sequence)
+           and all(isinstance(job, tuple | list) for job in jobs),
+           "jobs", jobs, "a list of argument tuples")
+    if scheduler is not None:
+        _check(isinstance(scheduler, str), "scheduler", scheduler,
+               "a Dask scheduler's address (str), 'local' or None")
+        workers = _whole(workers, "workers", "processes", 0)  # a cluster's own: 0 is fine
+    for name, value in (("processes", processes), ("quiet", quiet)):
+        _check(isinstance(value, bool) or type(value).__name__ == "bool_", name, value,
+               "True or False")
+    _check(initializer is None or callable(initializer), "initializer", initializer,
+           "a function or None")
+    _check(isinstance(initargs, tuple | list), "initargs", initargs, "a tuple of arguments")
+    for name, value in (("desc", desc), ("unit", unit)):
+        _check(isinstance(value, str), name, value, "a str")
+    _check(not isinstance(connect_timeout, bool) and isinstance(connect_timeout, numbers.Real)
+           and 0 < connect_timeout < math.inf, "connect_timeout", connect_timeout,
+           "a finite number > 0 (s)")
     if scheduler is None or scheduler == "local":
         workers, _ = cap_workers(workers, len(jobs))
     results: list[Any] = [None] * len(jobs)

@@ -2,13 +2,21 @@
 
 from __future__ import annotations
 
+import math
+import numbers
 import os
 import sys
 from typing import Any, Self
 
+from .errors import UsageError
+
+__all__ = ["bar", "progress_wanted"]
+
 
 def progress_wanted(quiet: bool = False) -> bool:
     """True when a progress bar should be drawn: stderr is a terminal, not CI, not quiet."""
+    if not isinstance(quiet, bool) and type(quiet).__name__ != "bool_":
+        raise UsageError(f"quiet = {quiet!r:.60}: must be True or False", param="quiet")
     if quiet or os.environ.get("CI"):
         return False
     return sys.stderr.isatty()
@@ -36,7 +44,16 @@ class _NoBar:
 
 
 def bar(total: float | None, desc: str, unit: str = "it", quiet: bool = False, **kw: Any) -> Any:
-    """A tqdm bar on a terminal, or a silent stand-in. Use as a context manager."""
+    """A tqdm bar on a terminal, or a silent stand-in, counting to ``total`` (None: unknown)
+    ``unit``s. Use as a context manager."""
+    # Checked here with the errors module only: progress sits below the model's checks.
+    if total is not None and (isinstance(total, bool) or not isinstance(total, numbers.Real)
+                              or not 0 <= total < math.inf):
+        raise UsageError(f"total = {total!r:.60}: must be a finite number >= 0 or None",
+                         param="total")
+    for name, value in (("desc", desc), ("unit", unit)):
+        if not isinstance(value, str):
+            raise UsageError(f"{name} = {value!r:.60}: must be a str", param=name)
     if not progress_wanted(quiet):
         return _NoBar()
     from tqdm import tqdm

@@ -9,9 +9,11 @@ registry costs nothing to load.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -30,6 +32,9 @@ MAX_IMPACTS = 100_000
 #: spring or a fast spin makes the intervals short; a graze makes the splits deep.
 MAX_SEARCH_WORK = 10_000_000
 BLOCK_WORK = 10
+
+__all__ = ["MAX_SAMPLES", "MAX_STEPS", "RunOptions", "Solver", "make_options"]
+
 #: Samples :func:`~dumbbell.solvers.simulate` keeps unless told otherwise (``max_samples``,
 #: ``--max-samples``): 5e6 rows of about ten float64 columns are about 400 MB.
 MAX_SAMPLES = 5_000_000
@@ -44,6 +49,15 @@ class RunOptions:
     t_end: float
     every: int = 1
     quiet: bool = True
+
+    def __post_init__(self) -> None:
+        # Built once a run: a wrong value here would surface deep in a solver's loop.
+        from ..model import args
+
+        args.real(self.dt, "dt", "s")
+        args.real(self.t_end, "t_end", "s")
+        args.whole(self.every, "every", "steps")
+        args.flag(self.quiet, "quiet")
 
     @property
     def n_steps(self) -> int:
@@ -101,6 +115,16 @@ class Solver:
         "name", "order", "has_step", "explicit_spring", "flip_floor", "relative_cost",
         "is_truth", "estimates_error",
     )
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Every solver's class methods check their arguments where they are entered (a
+        Scene, or a scene file's path, and RunOptions for ``solve``), so a subclass's own
+        functions can trust them."""
+        super().__init_subclass__(**kwargs)
+        for name in ("supports", "solve", "check_work", "truth_for", "catch_depth"):
+            fn = vars(cls).get(name)
+            if isinstance(fn, staticmethod):
+                setattr(cls, name, staticmethod(_checked(cls, name, fn.__func__)))
 
     @classmethod
     def supports(cls, scene: Scene) -> str | None:
@@ -196,6 +220,28 @@ def check_impacts(scene: Scene, options: RunOptions, vertical_energy: float,
         f"impacts (on this elastic floor the centre of mass stays at most {gap:.3g} s in the "
         f"air between two), past the budget of {limit:,} per run", param="t_end",
         fixes=("lower {t_end}",))
+
+def _checked(cls: type[Solver], name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` (a solver's ``name`` method, first argument the scene) with its arguments
+    checked first; ``solve`` and ``check_work`` also take only RunOptions and a scene the
+    solver supports."""
+    from ..model import args
+
+    @functools.wraps(fn)
+    def method(scene: Any, *rest: Any, **kwargs: Any) -> Any:
+        scene = args.scene(scene)
+        if name in ("solve", "check_work"):
+            options = rest[0] if rest else kwargs.pop("options", None)
+            args.instance(options, "options", RunOptions,
+                          "RunOptions (from dumbbell.solvers.make_options)")
+            reason = cls.supports(scene)
+            if reason is not None:
+                raise UsageError(f"scene = {scene.name}: {cls.name} cannot run it: {reason}",
+                                 param="scene")
+            rest = (options, *rest[1:])
+        return fn(scene, *rest, **kwargs)
+
+    return method
 
 
 def kernel_params(system: System, dt: float) -> Params:

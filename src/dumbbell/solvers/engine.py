@@ -58,6 +58,9 @@ from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
 from .verdicts import conclude, nonfinite_reason, tunnel_reason
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["Pymunk"]
+
 NAME = "pymunk"
 
 #: A position or velocity beyond this (m, m/s) counts as blown up.

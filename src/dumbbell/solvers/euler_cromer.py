@@ -28,6 +28,9 @@ from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 from .verdicts import below_floor_verdict
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["EulerCromer"]
+
 NAME = "euler-cromer"
 
 #: Steps per kernel call: the progress bar moves between calls.

@@ -30,6 +30,9 @@ from .base import RunOptions, kernel_params, point_particle_limits
 from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["EulerCromer2D"]
+
 NAME = "euler-cromer-2d"
 
 _CHUNK = 4_000_000

@@ -29,6 +29,9 @@ from . import base
 from .base import OverBudget, RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import conclude
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["Exact"]
+
 NAME = "exact"
 
 #: Root tolerance for impact times (s).

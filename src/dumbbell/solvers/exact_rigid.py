@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
+from ..errors import UsageError
 from ..model.energy import (
     gravity_potential,
     impact_heat,
@@ -54,6 +55,9 @@ from ..model.trajectory import Impact, Verdict
 from . import base
 from .base import OverBudget, SearchBudget, impact_budget_reason
 from .exact import HeightPoint
+
+#: The public API: the first impact in closed form; the rest serves the exact solver.
+__all__ = ["first_impact_state"]
 
 #: Root tolerance for impact times (s).
 ROOT_XTOL = 1e-14
@@ -374,6 +378,14 @@ def first_impact_state(
     >>> round(after.omega, 4)
     -35.4175
     """
+    from ..model import args
+
+    tilt = args.real(tilt, "tilt", "degrees from vertical", lo=-180.0, hi=180.0)
+    elasticity = args.real(elasticity, "elasticity", "restitution", lo=0.0, hi=1.0)
+    mA, mB = args.real(mA, "mA", "kg"), args.real(mB, "mB", "kg")
+    length = args.real(length, "length", "m")
+    height = args.real(height, "height", "m", lo=0.0)
+    g = args.real(g, "g", "m/s^2")
     scene = scene_from_dict({
         "dimensions": 2, "tilt": float(tilt),
         "bodies": {"A": {"mass": float(mA)}, "B": {"mass": float(mB), "height": float(height)}},
@@ -386,7 +398,8 @@ def first_impact_state(
     roots = {b: body.first_contact(s, b, 0.0, horizon) for b in "AB"}
     tau = min(roots.values())
     if not math.isfinite(tau):
-        raise ValueError("the dumbbell never reaches the floor (g = 0?)")
+        raise UsageError(f"g = {g:g}, height = {height:g}: the dumbbell never reaches the floor",
+                         param="g")
     before = body.advance(s, tau)
     hit = [b for b in "AB" if roots[b] - tau <= ROOT_XTOL * 10]
     after, _, _ = body.collide(before, hit, float(elasticity))

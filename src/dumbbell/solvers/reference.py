@@ -58,6 +58,9 @@ from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
 from .verdicts import head, judge
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["Reference"]
+
 NAME = "reference"
 
 RTOL = 1e-12
@@ -311,8 +314,10 @@ def warm_up() -> float:
 def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Trajectory:
     """Integrate ``scene`` and sample at ``i * every * dt`` (s); ``dt`` sets only the sample
     times. With ``estimate_error`` a second run at 10x tighter tolerance measures the error."""
+    from ..model import args
     from ..progress import bar
 
+    estimate_error = args.flag(estimate_error, "estimate_error")
     times = options.sample_times()
     if scene.system.dimensions == 2 and scene.system.rigid is None:
         warm_up()  # numba compiles (or loads) the kernel outside the solver's clock

@@ -32,6 +32,9 @@ from ..model.scene import Scene
 from ..model.trajectory import Impact, Verdict
 from .exact import HeightPoint
 
+#: Nothing public: the machinery the solver classes share.
+__all__: list[str] = []
+
 #: The fixed step turns the state by at most this angle (rad): RK8's local error is then
 #: about STEP_ANGLE^9, 5e-16 of the motion's scale.
 STEP_ANGLE = 0.02

@@ -21,6 +21,9 @@ from .base import RunOptions, Solver
 from .kernels import BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B, Params
 from .verdicts import conclude, nonfinite_reason
 
+#: Nothing public: the machinery the solver classes share.
+__all__: list[str] = []
+
 
 class Stepper(Solver):
     """The facts the compiled time-steppers share: a fixed step, an explicit spring step

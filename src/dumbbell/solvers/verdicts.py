@@ -28,6 +28,9 @@ from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .kernels import BIG
 
+#: Nothing public: the machinery the solver classes share.
+__all__: list[str] = []
+
 #: The explicit spring step (Euler-Cromer, Verlet, pymunk) is stable iff w*dt < this.
 STEP_LIMIT = 2.0
 

@@ -34,6 +34,9 @@ from .kernels import EVENT_BUFFER, Params
 from .stepping import Stepper, finish, run_kernel
 from .verdicts import tunnel_reason
 
+#: The public API: the solver class (its supports and solve); the rest serves it.
+__all__ = ["Verlet"]
+
 NAME = "verlet"
 
 #: Steps per kernel call: the progress bar moves between calls.
