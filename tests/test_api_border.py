@@ -364,6 +364,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.model.scene.RunSettings": lambda f: fields(f.scene.run),
     "dumbbell.model.scene.Spring": lambda f: {"stiffness": 200.0, "rest_length": 0.2},
     "dumbbell.model.scene.System": lambda f: fields(f.scene.system),
+    "dumbbell.model.scene.load_scene_bytes": lambda f: {"data": f.scene_file.read_bytes(),
+                                                       "source": "x.toml"},
     "dumbbell.model.scene.packaged_scene": lambda f: {"name": "textbook-1d"},
     "dumbbell.model.scene.parse_size": lambda f: {"text": "64x64"},
     "dumbbell.model.scene.scene_from_dict": lambda f: {"data": f.scene.to_dict(),

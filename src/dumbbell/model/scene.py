@@ -31,8 +31,8 @@ from ..errors import SceneError, UsageError
 
 __all__ = [
     "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "PymunkSettings",
-    "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "packaged_scene",
-    "parse_size", "scene_from_dict", "scenes_dir",
+    "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "load_scene_bytes",
+    "packaged_scene", "parse_size", "scene_from_dict", "scenes_dir",
 ]
 
 #: Figure names ``[outputs] figures`` may list.
