@@ -192,3 +192,11 @@ def test_stability_from_python(tmp_path):
     assert verdicts[("stiff-wdt-2.1", "exact")] == "ok"
     assert result.disagreements == []
     assert "stiff-wdt-2.1" in markdown(result) and df.attrs["units"]["t_fail"] == "s"
+
+
+def test_the_solvers_package_is_not_shadowed_by_a_function():
+    # ``import dumbbell.solvers.exact`` must leave dumbbell.solvers.exact reachable.
+    import dumbbell.solvers.exact
+
+    assert dumbbell.solvers.exact.NAME == "exact"
+    assert dumbbell.available_solvers() == list(dumbbell.solvers.METHODS)

@@ -12,12 +12,13 @@ from .animation.render import Gif, render_gif
 from .errors import ColumnError, DumbbellError, MissingExtraError, SceneError, UsageError
 from .model.scene import Scene, load_scene
 from .model.trajectory import Impact, Trajectory, Verdict
-from .solvers import available as solvers
+# Not bound to the name ``solvers``: that is the package (dumbbell.solvers.exact, ...).
+from .solvers import available as available_solvers
 from .solvers import simulate
 
 __all__ = [
     "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError",
-    "Trajectory", "UsageError", "Verdict", "bench", "compare", "load_scene", "render_gif",
-    "simulate", "solvers", "stability", "sweep",
+    "Trajectory", "UsageError", "Verdict", "available_solvers", "bench", "compare", "load_scene",
+    "render_gif", "simulate", "stability", "sweep",
 ]
 __version__ = "0.1.0"
