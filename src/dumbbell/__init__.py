@@ -12,6 +12,7 @@ from .animation.render import Gif, render_gif
 from .errors import ColumnError, DumbbellError, MissingExtraError, SceneError, UsageError
 from .model.scene import Scene, load_scene
 from .model.trajectory import Impact, Trajectory, Verdict
+
 # Not bound to the name ``solvers``: that is the package (dumbbell.solvers.exact, ...).
 from .solvers import available as available_solvers
 from .solvers import simulate
