@@ -28,6 +28,7 @@ from tests.hostile import (
     SRC,
     cli,
     files_in,
+    own_children,
     refused,
     send_when,
     short_scene,
@@ -194,7 +195,7 @@ def test_sweep_caps_workers_and_says_so_once(work):
     cap = min(os.cpu_count() or 1, 3)
     assert len(lines) == 1 and f"{cap}" in lines[0] and "10000" in lines[0], err
     assert sorted(files_in(out)) == ["short-sweep.csv", "short-sweep.png"]
-    assert not psutil.Process().children(recursive=True)
+    assert not own_children()
 
 
 def test_stability_refuses_a_case_past_the_step_cap_before_any_runs(work):

@@ -287,8 +287,9 @@ def _connect(client_class: Any, scheduler: str, timeout: float) -> Any:
         text = exc.args[0] if isinstance(exc, _NotDask) else " ".join(
             f"{type(exc).__name__}: {exc}".split())[:160]
         raise UsageError(f"scheduler {scheduler}: no Dask scheduler answered there within "
-                         f"{timeout:g} s (--connect-timeout): {text}",
-                         param="scheduler") from None
+                         f"{timeout:g} s: {text}", param="scheduler",
+                         fixes=["check the address, or wait longer with a larger "
+                                "{connect_timeout}"]) from None
     finally:
         for lg, level in zip(loggers, levels, strict=True):
             lg.setLevel(level)

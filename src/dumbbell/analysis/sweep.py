@@ -220,7 +220,8 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
             raise UsageError(
                 f"grid at {where}: dt = {options.dt:g} s over t_end = {options.t_end:g} s is "
                 f"{options.n_steps:.3g} steps; a sweep point may take at most "
-                f"{MAX_STEPS_PER_POINT:.0e}: raise dt or lower t_end", param="grid")
+                f"{MAX_STEPS_PER_POINT:.0e}", param="grid",
+                fixes=("use a larger dt", "a smaller {t_end}"))
         total += options.n_steps
         points.append(Point(index, values))
     if total > MAX_STEPS_TOTAL:
