@@ -523,6 +523,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     # dumbbell.analysis.stability
     "dumbbell.analysis.stability.Prediction": lambda f: {"status": "ok", "why": "w*dt < 2"},
     "dumbbell.analysis.stability.StabilityResult": lambda f: fields(f.stability_result),
+    "dumbbell.analysis.stability.StabilityRow": lambda f: fields(f.stability_result.rows[0]),
 
     "dumbbell.analysis.stability.default_cases": lambda f: {},
     "dumbbell.analysis.stability.default_solvers": lambda f: {"scene": f.scene},

@@ -191,6 +191,9 @@ def test_stability_from_python(tmp_path):
     assert verdicts[("stiff-wdt-1.9", "euler-cromer")] == "ok"
     assert verdicts[("stiff-wdt-2.1", "exact")] == "ok"
     assert result.disagreements == []
+    row = next(r for r in result.rows if (r.case, r.solver) == ("stiff-wdt-2.1", "euler-cromer"))
+    _frozen(row, "verdict")
+    assert row.verdict == "unstable" and row.predicted == "unstable" and row.agrees
     assert "stiff-wdt-2.1" in markdown(result) and df.attrs["units"]["t_fail"] == "s"
 
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -38,13 +38,13 @@ from ..parallel import ordered_map
 if TYPE_CHECKING:
     import pandas
 
-__all__ = ["COLUMNS", "Prediction", "StabilityResult", "default_cases", "default_solvers",
-           "find_cases", "map_scene", "map_solvers", "predict", "rest_time", "run_stability"]
+__all__ = ["AGREES", "COLUMNS", "Prediction", "StabilityResult", "StabilityRow",
+           "default_cases", "default_solvers", "find_cases", "map_scene", "map_solvers",
+           "predict", "rest_time", "run_stability"]
 
-#: Report columns, in CSV order.
-COLUMNS = ("case", "title", "solver", "dt", "w_dt", "verdict", "t_fail",
-           "max_rel_energy_error", "dissipative", "predicted", "agreement", "reason", "theory",
-           "wall_s")
+#: :attr:`StabilityRow.agreement` when the verdict is the one the theory expects; any other
+#: value says what differs.
+AGREES = "agrees"
 #: The stability map: w*dt values, mass ratios mB/mA, and steps per run.
 MAP_WDT = tuple(round(0.05 + 0.1 * i, 2) for i in range(30))
 MAP_RATIOS = tuple(float(10 ** (i / 2)) for i in range(9))
@@ -61,25 +61,56 @@ UNITS = {"case": "", "title": "", "solver": "", "dt": "s", "w_dt": "1", "verdict
 
 
 @dataclass(frozen=True)
-class StabilityResult:
-    """The catalogue's report: one row per (case, solver) run, keyed by :data:`COLUMNS`, and
-    the pairs not run because the solver cannot run the scene."""
+class StabilityRow:
+    """One (case, solver) run beside the theory: one line of stability.csv, the fields in
+    column order (units in :data:`UNITS`)."""
 
-    rows: tuple[dict[str, Any], ...]
+    case: str
+    title: str
+    solver: str
+    dt: float
+    w_dt: float
+    verdict: str
+    t_fail: float | None
+    max_rel_energy_error: float
+    dissipative: bool
+    predicted: str
+    agreement: str
+    reason: str
+    theory: str
+    wall_s: float
+
+    @property
+    def agrees(self) -> bool:
+        """Whether the verdict is the one the theory expects."""
+        return self.agreement == AGREES
+
+
+#: Report columns, in CSV order: the fields of :class:`StabilityRow`.
+COLUMNS = tuple(f.name for f in fields(StabilityRow))
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """The catalogue's report: one row per (case, solver) run, and the pairs not run because
+    the solver cannot run the scene."""
+
+    rows: tuple[StabilityRow, ...]
     skipped: tuple[str, ...] = ()
     guard: tuple[str, ...] = ()
 
     @property
-    def disagreements(self) -> list[dict[str, Any]]:
+    def disagreements(self) -> list[StabilityRow]:
         """The runs whose verdict is not the one the theory expects."""
-        return [r for r in self.rows if r["agreement"] != "agrees"]
+        return [r for r in self.rows if not r.agrees]
 
     def to_pandas(self) -> pandas.DataFrame:
         """One row per run with the CSV's columns, units in ``df.attrs["units"]``. Needs
         pip install 'dumbbell[pandas]'."""
         from ..io.frames import data_frame
 
-        return data_frame({c: [r[c] for r in self.rows] for c in COLUMNS}, units=UNITS)
+        return data_frame({c: [getattr(r, c) for r in self.rows] for c in COLUMNS},
+                          units=UNITS)
 
 
 @dataclass(frozen=True)
@@ -167,7 +198,7 @@ def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     return Prediction("ok", "no step limit applies")
 
 
-def run_case(path: str, solver: str) -> dict[str, Any]:
+def run_case(path: str, solver: str) -> StabilityRow:
     """Run one case with one solver and put the result beside the theory (one report row)."""
     from .sweep import evaluate
 
@@ -177,13 +208,16 @@ def run_case(path: str, solver: str) -> dict[str, Any]:
     wall = time.perf_counter() - t0
     expected = predict(scene, solver, scene.run.dt, scene.run.t_end)
     if result["verdict"] == expected.status:
-        agreement = "agrees"
+        agreement = AGREES
     else:
         agreement = f"DISAGREES: theory expects {expected.status}, got {result['verdict']}"
-    return {"case": scene.name, "title": scene.title, "dissipative": scene.system.dissipative,
-            "solver": solver,
-            "dt": scene.run.dt, **result, "predicted": expected.status,
-            "agreement": agreement, "theory": expected.why, "wall_s": wall}
+    return StabilityRow(case=scene.name, title=scene.title, solver=solver, dt=scene.run.dt,
+                        w_dt=result["w_dt"], verdict=result["verdict"],
+                        t_fail=result["t_fail"],
+                        max_rel_energy_error=result["max_rel_energy_error"],
+                        dissipative=scene.system.dissipative, predicted=expected.status,
+                        agreement=agreement, reason=result["reason"], theory=expected.why,
+                        wall_s=wall)
 
 
 def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple[str, str]],
@@ -214,7 +248,7 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
 
 
 def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bool = True
-              ) -> list[dict[str, Any]]:
+              ) -> list[StabilityRow]:
     """Every (case path, solver) run as a report row, in the given order."""
     workers = workers or os.cpu_count() or 1
     # The longest runs first keep the pool busy to the end; results keep the given order.
@@ -222,10 +256,10 @@ def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bo
     order = sorted(range(len(runs)), key=lambda i: -cost[runs[i]])
     done = ordered_map(run_case, [runs[i] for i in order], workers=workers, quiet=quiet,
                        desc="stability cases")
-    results: list[dict[str, Any]] = [{}] * len(runs)
+    results: list[StabilityRow | None] = [None] * len(runs)
     for i, row in zip(order, done, strict=True):
         results[i] = row
-    return results
+    return [r for r in results if r is not None]
 
 
 def _cost(path: str, solver: str) -> float:

@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note)
     if not args.quiet:
         rows = result["rows"]
-        bad = sum(r["agreement"] != "agrees" for r in rows)
+        bad = sum(not r.agrees for r in rows)
         sys.stderr.write(f"{len(rows)} runs, {len(rows) - bad} agree with the theory, "
                          f"{bad} disagree\n")
         for path in result["written"]:

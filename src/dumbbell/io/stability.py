@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ..analysis.stability import COLUMNS, StabilityResult
+from ..analysis.stability import AGREES, COLUMNS, StabilityResult
 from .tables import csv_text as _csv_text
 from .tables import write_text
 
@@ -47,28 +47,28 @@ def markdown(result: StabilityResult) -> str:
            "|---|---|---|---|---|---|---|---|---|---|"]
     previous = None
     for r in rows:
-        agree = "agrees" if r["agreement"] == "agrees" else "**DISAGREES**"
-        case, title = (r["case"], r["title"]) if r["case"] != previous else ("", "")
-        previous = r["case"]
-        out.append(f"| {case} | {title} | {r['solver']} | {_fmt(r['dt'])} | "
-                   f"{_fmt(r['w_dt'])} | {r['verdict']} | {_fmt(r['t_fail'], 't')} | "
-                   f"{_fmt(r['max_rel_energy_error'], 'err')}{' (a)' if r['dissipative'] else ''}"
-                   f" | {r['predicted']} "
-                   f"({r['theory']}) | {agree} |")
-    if any(r["dissipative"] for r in rows):
+        agree = AGREES if r.agrees else "**DISAGREES**"
+        case, title = (r.case, r.title) if r.case != previous else ("", "")
+        previous = r.case
+        out.append(f"| {case} | {title} | {r.solver} | {_fmt(r.dt)} | "
+                   f"{_fmt(r.w_dt)} | {r.verdict} | {_fmt(r.t_fail, 't')} | "
+                   f"{_fmt(r.max_rel_energy_error, 'err')}{' (a)' if r.dissipative else ''}"
+                   f" | {r.predicted} "
+                   f"({r.theory}) | {agree} |")
+    if any(r.dissipative for r in rows):
         out += ["", ("(a) The floor takes energy on purpose in this scene (elasticity below 1 "
                      "or friction), so this is the energy lost, not an error.")]
-    notes = [r for r in rows if r["verdict"] != "ok" or r["agreement"] != "agrees"]
+    notes = [r for r in rows if r.verdict != "ok" or not r.agrees]
     if notes:
         out += ["", "Runs that did not end ok, or disagree with the theory:", ""]
         for r in notes:
-            line = f"- {r['case']}, {r['solver']}: {r['verdict']}"
-            if r["t_fail"] is not None:
-                line += f" at t = {r['t_fail']:.4g} s"
-            if r["reason"]:
-                line += f": {r['reason']}"
-            if r["agreement"] != "agrees":
-                line += f". {r['agreement']} ({r['theory']})"
+            line = f"- {r.case}, {r.solver}: {r.verdict}"
+            if r.t_fail is not None:
+                line += f" at t = {r.t_fail:.4g} s"
+            if r.reason:
+                line += f": {r.reason}"
+            if not r.agrees:
+                line += f". {r.agreement} ({r.theory})"
             out.append(line)
     if guard:
         out += ["", ("Step-size guard (`dumbbell.spaces.check` on the space the pymunk solver "
@@ -83,7 +83,7 @@ def markdown(result: StabilityResult) -> str:
 def csv_text(result: StabilityResult) -> str:
     """The report as CSV with :data:`~dumbbell.analysis.stability.COLUMNS`."""
     result = _checked(result)
-    return _csv_text(COLUMNS, ([r[c] for c in COLUMNS] for r in result.rows))
+    return _csv_text(COLUMNS, ([getattr(r, c) for c in COLUMNS] for r in result.rows))
 
 
 def write(result: StabilityResult, out: Path) -> list[Path]:
