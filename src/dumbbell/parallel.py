@@ -270,6 +270,10 @@ def _probe(scheduler: str, timeout: float) -> None:
         raise _NotDask("it closed the connection without answering")
 
 
+#: The way out of an unreachable scheduler; each command spells {connect_timeout} its way.
+_SCHEDULER_FIX = "check the address, or wait longer with a larger {connect_timeout}"
+
+
 def _connect(client_class: Any, scheduler: str, timeout: float) -> Any:
     """A Dask client of ``scheduler``, or one UsageError naming the address when nothing there
     answers as a Dask scheduler within ``timeout`` s (a closed port, an HTTP server, ...)."""
@@ -288,8 +292,7 @@ def _connect(client_class: Any, scheduler: str, timeout: float) -> Any:
             f"{type(exc).__name__}: {exc}".split())[:160]
         raise UsageError(f"scheduler {scheduler}: no Dask scheduler answered there within "
                          f"{timeout:g} s: {text}", param="scheduler",
-                         fixes=["check the address, or wait longer with a larger "
-                                "{connect_timeout}"]) from None
+                         fixes=[_SCHEDULER_FIX]) from None
     finally:
         for lg, level in zip(loggers, levels, strict=True):
             lg.setLevel(level)
