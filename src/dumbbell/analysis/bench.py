@@ -98,9 +98,15 @@ CSV_COLUMNS = (
 )
 
 
+#: What the tables print in a point's verdict column for a step that was not run (its
+#: runs would have passed the budget). Not a verdict: such a point's ``verdict`` is None.
+SKIPPED = "skipped"
+
+
 @dataclass
 class Point:
-    """One (solver, dt) point. Times in s, ``error`` in m, ``energy_error`` relative."""
+    """One (solver, dt) point. Times in s, ``error`` in m, ``energy_error`` relative;
+    ``verdict`` the run's verdict status, or None when the step was skipped (not run)."""
 
     solver: str
     dt: float | None
@@ -112,7 +118,7 @@ class Point:
     impact_time_error: float = math.nan
     impacts_compared: int = 0
     impacts_truth: int = 0
-    verdict: str = "ok"
+    verdict: str | None = "ok"
     verdict_t: float | None = None
     compile_seconds: float = math.nan
     steps: int = 0
@@ -125,11 +131,17 @@ class Point:
 
     @property
     def ran(self) -> bool:
-        return self.verdict != "skipped"
+        """True unless the step was skipped."""
+        return self.verdict is not None
 
     @property
     def ok(self) -> bool:
         return self.verdict == "ok"
+
+    @property
+    def status(self) -> str:
+        """The verdict, or :data:`SKIPPED` for a step not run: what the tables print."""
+        return SKIPPED if self.verdict is None else self.verdict
 
 
 @dataclass
@@ -382,7 +394,7 @@ def _stepper_points(scene: Scene, name: str, plan: _Plan, truth_at: Any,
                      steps=options.n_steps, every=options.every, compile_seconds=compile_s)
         estimate = None if cost_per_step is None else cost_per_step * options.n_steps
         if estimate is not None and estimate * (plan.repeat + 1) > plan.budget:
-            base.verdict, base.seconds = "skipped", estimate
+            base.verdict, base.seconds = None, estimate
             base.reason = (f"estimated {estimate:.3g} s per run x {plan.repeat + 1} runs > "
                            f"budget {plan.budget:g} s")
             points.append(base)

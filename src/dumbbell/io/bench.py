@@ -32,8 +32,13 @@ def write_csv(result: BenchResult, path: Path) -> Path:
     """One row per point, columns CSV_COLUMNS (s, m, dimensionless)."""
     result = _checked(result)
     path = args.path(path, "path")
-    rows = ([row[c] for c in CSV_COLUMNS] for row in map(asdict, result.points))
+    rows = ([row[c] for c in CSV_COLUMNS] for row in map(_row, result.points))
     return write_text(path, csv_text(CSV_COLUMNS, rows))
+
+
+def _row(point: Any) -> dict[str, Any]:
+    """A point's fields as written: the verdict column says "skipped" for a step not run."""
+    return {**asdict(point), "verdict": point.status}
 
 
 def _json_value(value: Any) -> Any:
@@ -55,7 +60,7 @@ def to_json(result: BenchResult) -> dict[str, Any]:
         "budget_s": result.budget, "sample_spacing_s": result.spacing,
         "fit_max_error_m": FIT_MAX_ERROR, "fit_min_error_m": FIT_MIN_ERROR,
         "notes": result.notes,
-        "points": [asdict(p) for p in result.points],
+        "points": [_row(p) for p in result.points],
         "orders": {n: asdict(f) for n, f in result.fits.items()},
         "matched_error": result.speedups(),
     }
@@ -96,7 +101,7 @@ def markdown(result: BenchResult) -> str:
             time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
         else:
             time_s = f"~{_ms(p.seconds)} (estimate)"
-        verdict = p.verdict if p.ok else f"**{p.verdict}**" + (
+        verdict = p.status if p.ok else f"**{p.status}**" + (
             f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
         imp = _sci(p.impact_time_error)
         if p.impacts_truth:
