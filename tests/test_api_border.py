@@ -233,14 +233,17 @@ class Fixtures:
         return about_contact(self.traj_2d)
 
     @functools.cached_property
-    def maps(self) -> dict[str, list[dict[str, Any]]]:
+    def maps(self) -> dict[str, list[Any]]:
         """Stability-map rows of one made-up solver: stable up to w*dt = 2."""
         from dumbbell.analysis.stability import MAP_RATIOS, MAP_WDT
+        from dumbbell.analysis.sweep import PointResult
 
-        return {"made-up": [{"w_dt": h, "verdict": "ok" if h < 2 else "unstable",
-                             "max_rel_energy_error": h / 4 if h < 2 else math.nan,
-                             "t_fail": None if h < 2 else 0.1}
-                            for h in MAP_WDT for _ in MAP_RATIOS]}
+        return {"made-up": [PointResult(values=(("bodies.A.mass", 0.1 / r),), w_dt=h,
+                                        verdict="ok" if h < 2 else "unstable",
+                                        t_fail=None if h < 2 else 0.1,
+                                        max_rel_energy_error=h / 4 if h < 2 else math.nan,
+                                        reason="" if h < 2 else "made up")
+                            for h in MAP_WDT for r in MAP_RATIOS]}
 
     @functools.cached_property
     def run(self) -> Any:
@@ -540,6 +543,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     # dumbbell.analysis.sweep
     "dumbbell.analysis.sweep.Axis": lambda f: fields(f.sweep_result.axes[0]),
     "dumbbell.analysis.sweep.Point": lambda f: {"index": 0, "values": {"run.dt": 1e-3}},
+    "dumbbell.analysis.sweep.PointResult": lambda f: fields(f.sweep_result.rows[0]),
     "dumbbell.analysis.sweep.SweepResult": lambda f: fields(f.sweep_result),
 
     "dumbbell.analysis.sweep.check_axes": lambda f: {"axes": f.sweep_result.axes},

@@ -61,7 +61,7 @@ def test_stiff_sweep_blows_up_where_theory_says():
         assert row["largest_ok_dt"] < row["theory_dt"] <= row["first_failing_dt"]
         assert 1.7 < row["w_dt"] < 2.0
     for r in result.rows:
-        assert (r["verdict"] == "ok") == (r["w_dt"] < 2.0), r
+        assert (r.verdict == "ok") == (r.w_dt < 2.0), r
 
 
 def test_absurd_grid_is_refused_before_anything_runs(tmp_path, capsys):

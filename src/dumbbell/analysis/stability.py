@@ -38,6 +38,8 @@ from ..parallel import ordered_map
 if TYPE_CHECKING:
     import pandas
 
+    from .sweep import PointResult
+
 __all__ = ["AGREES", "COLUMNS", "Prediction", "StabilityResult", "StabilityRow",
            "default_cases", "default_solvers", "find_cases", "map_scene", "map_solvers",
            "predict", "rest_time", "run_stability"]
@@ -207,16 +209,16 @@ def run_case(path: str, solver: str) -> StabilityRow:
     result = evaluate(scene, {}, solver)
     wall = time.perf_counter() - t0
     expected = predict(scene, solver, scene.run.dt, scene.run.t_end)
-    if result["verdict"] == expected.status:
+    if result.verdict == expected.status:
         agreement = AGREES
     else:
-        agreement = f"DISAGREES: theory expects {expected.status}, got {result['verdict']}"
+        agreement = f"DISAGREES: theory expects {expected.status}, got {result.verdict}"
     return StabilityRow(case=scene.name, title=scene.title, solver=solver, dt=scene.run.dt,
-                        w_dt=result["w_dt"], verdict=result["verdict"],
-                        t_fail=result["t_fail"],
-                        max_rel_energy_error=result["max_rel_energy_error"],
+                        w_dt=result.w_dt, verdict=result.verdict,
+                        t_fail=result.t_fail,
+                        max_rel_energy_error=result.max_rel_energy_error,
                         dissipative=scene.system.dissipative, predicted=expected.status,
-                        agreement=agreement, reason=result["reason"], theory=expected.why,
+                        agreement=agreement, reason=result.reason, theory=expected.why,
                         wall_s=wall)
 
 
@@ -326,7 +328,7 @@ def map_points(scene: Scene) -> list[Any]:
 
 
 def map_rows(solver: str, workers: int | None = None, quiet: bool = True
-             ) -> list[dict[str, Any]]:
+             ) -> list[PointResult]:
     """The map's rows for one solver, in grid order."""
     from ..solvers import available
 

@@ -23,7 +23,7 @@ import itertools
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -35,8 +35,8 @@ from ..parallel import ordered_map
 if TYPE_CHECKING:
     import pandas
 
-__all__ = ["Axis", "Point", "SweepResult", "check_axes", "evaluate", "parse_axis", "plan",
-           "run_sweep", "warm_up"]
+__all__ = ["Axis", "Point", "PointResult", "SweepResult", "check_axes", "evaluate",
+           "parse_axis", "plan", "run_sweep", "warm_up"]
 
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}
@@ -50,9 +50,6 @@ MAX_POINTS = 250_000
 MAX_SAMPLES = 20_000
 #: Largest number of values on one axis.
 MAX_AXIS_VALUES = 10_000
-#: Verdicts other than ok, and how the maps paint them.
-#: CSV columns after the axes.
-RESULT_COLUMNS = ("w_dt", "verdict", "t_fail", "max_rel_energy_error", "reason")
 
 
 @dataclass(frozen=True)
@@ -231,9 +228,34 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
     return points
 
 
-def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any]:
-    """Run one grid point and summarise it: w_dt, verdict, t_fail (s or None),
-    max_rel_energy_error and reason. A solver error becomes the verdict ``failed``."""
+@dataclass(frozen=True)
+class PointResult:
+    """One grid point's run: the dotted scene values it set (``values``, (key, value) pairs
+    in the order given), then the result fields in CSV column order: w*dt (1), the verdict,
+    the time of failure (s, None if none), the largest relative energy error over the kept
+    samples (1) and the verdict's reason."""
+
+    values: tuple[tuple[str, Any], ...]
+    w_dt: float
+    verdict: str
+    t_fail: float | None
+    max_rel_energy_error: float
+    reason: str
+
+    @property
+    def cells(self) -> tuple[Any, ...]:
+        """The values set, then the result fields: in a sweep's rows, one CSV line's cells in
+        :attr:`SweepResult.columns` order."""
+        return (*(v for _, v in self.values), *(getattr(self, c) for c in RESULT_COLUMNS))
+
+
+#: CSV columns after the axes: the result fields of :class:`PointResult`.
+RESULT_COLUMNS = tuple(f.name for f in fields(PointResult) if f.name != "values")
+
+
+def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> PointResult:
+    """Run one grid point (``scene`` with the dotted ``values`` set) and summarise it as a
+    :class:`PointResult`. A solver error becomes the verdict ``failed``."""
     from ..model import args
     from ..model.scene import Scene
     from ..solvers import available
@@ -245,6 +267,7 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
     from ..solvers import make_options, simulate
 
     point = scene.with_values(values)
+    pairs = tuple(values.items())
     options = make_options(point)
     every = max(1, math.ceil(options.n_steps / (MAX_SAMPLES - 1)))
     w_dt = point.system.omega * options.dt
@@ -254,12 +277,10 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> dict[str, Any
         finite = err[np.isfinite(err)]
         max_err = float(finite.max()) if finite.size else math.nan
         verdict = traj.verdict
-        return {"w_dt": w_dt, "verdict": verdict.status, "t_fail": verdict.t,
-                "max_rel_energy_error": max_err, "reason": verdict.reason}
+        return PointResult(pairs, w_dt, verdict.status, verdict.t, max_err, verdict.reason)
     except Exception as exc:  # noqa: BLE001 - one bad point must not sink the sweep
         text = " ".join(f"{type(exc).__name__}: {exc}".split())
-        return {"w_dt": w_dt, "verdict": "failed", "t_fail": None,
-                "max_rel_energy_error": math.nan, "reason": f"solver error: {text}"}
+        return PointResult(pairs, w_dt, "failed", None, math.nan, f"solver error: {text}")
 
 
 def warm_up(solver: str) -> None:
@@ -286,7 +307,7 @@ class SweepResult:
     axes: list[Axis]
     solver: str
     t_end: float
-    rows: list[dict[str, Any]]
+    rows: list[PointResult]
     wall_time: float = 0.0
     backend: str = ""
 
@@ -301,13 +322,15 @@ class SweepResult:
         from ..io.frames import data_frame
 
         units = {a.key: "" for a in self.axes} | RESULT_UNITS
-        return data_frame({c: [row[c] for row in self.rows] for c in self.columns}, units=units)
+        cells = list(zip(*(row.cells for row in self.rows))) or [()] * len(self.columns)
+        return data_frame({c: list(v) for c, v in zip(self.columns, cells, strict=True)},
+                          units=units)
 
     def counts(self) -> dict[str, int]:
         """How many points ended with each verdict."""
         out: dict[str, int] = {}
         for row in self.rows:
-            out[row["verdict"]] = out.get(row["verdict"], 0) + 1
+            out[row.verdict] = out.get(row.verdict, 0) + 1
         return out
 
     def boundary(self) -> list[dict[str, float]]:
@@ -327,11 +350,11 @@ class SweepResult:
         for value, line in zip(other.values, table, strict=True):
             ok_dt, w_dt = math.nan, math.nan
             for j in order:
-                if line[j]["verdict"] != "ok":
+                if line[j].verdict != "ok":
                     break
-                ok_dt, w_dt = dts[j], line[j]["w_dt"]
-            first_bad = next((dts[j] for j in order if line[j]["verdict"] != "ok"), math.nan)
-            w = line[order[0]]["w_dt"] / dts[order[0]]
+                ok_dt, w_dt = dts[j], line[j].w_dt
+            first_bad = next((dts[j] for j in order if line[j].verdict != "ok"), math.nan)
+            w = line[order[0]].w_dt / dts[order[0]]
             out.append({other.key: value, "largest_ok_dt": ok_dt, "w_dt": w_dt,
                         "first_failing_dt": first_bad,
                         "theory_dt": 2.0 / w if w > 0 else math.inf})
@@ -387,7 +410,9 @@ def run_sweep(
                           connect_timeout=connect_timeout)
     wall = time.perf_counter() - t0
     by_index = {p.index: r for p, r in zip(points, results, strict=True)}
-    rows = [{**{a.key: v for a, v in zip(axes, combo, strict=True)}, **by_index[i]}
+    # A row's values are its grid coordinates only (not the t_end every point shares).
+    rows = [replace(by_index[i],
+                    values=tuple((a.key, v) for a, v in zip(axes, combo, strict=True)))
             for i, combo in enumerate(itertools.product(*(a.values for a in axes)))]
     return SweepResult(scene, list(axes), solver,
                        t_end if t_end is not None else scene.run.t_end, rows, wall, backend)

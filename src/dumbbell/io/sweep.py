@@ -30,7 +30,7 @@ def _value(value: Any) -> Any:
 def csv_text(result: SweepResult) -> str:
     """The CSV as text: the same bytes whichever backend produced the rows."""
     result = _checked(result)
-    return _csv_text(result.columns, ([_value(row[c]) for c in result.columns]
+    return _csv_text(result.columns, ([_value(v) for v in row.cells]
                                       for row in result.rows))
 
 

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP_WDT
-from ..analysis.sweep import Axis, SweepResult
+from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
 from .style import FAIL_COLOURS, pyplot
@@ -47,19 +47,14 @@ def axis_label(key: str) -> str:
     return AXIS_LABELS.get(args.text(key, "key", "a dotted scene key (str)"), key)
 
 
-#: What every row of a stability map holds (:func:`dumbbell.analysis.stability.map_rows`).
-MAP_ROW_KEYS = ("w_dt", "verdict", "max_rel_energy_error")
-
-
 def _check_maps(maps: Any) -> None:
     """``maps``: solver name -> its rows, one per point of the map's grid, in grid order."""
     points = len(MAP_WDT) * len(MAP_RATIOS)
-    allowed = (f"must map solver names to lists of {points} rows (dicts with "
-               f"{', '.join(MAP_ROW_KEYS)}) from dumbbell.analysis.stability.map_rows")
+    allowed = (f"must map solver names to lists of {points} PointResult rows from "
+               "dumbbell.analysis.stability.map_rows")
     if (not isinstance(maps, dict) or not maps
             or not all(isinstance(k, str) and isinstance(v, list | tuple) and len(v) == points
-                       and all(isinstance(r, dict) and all(k in r for k in MAP_ROW_KEYS)
-                               for r in v) for k, v in maps.items())):
+                       and all(isinstance(r, PointResult) for r in v) for k, v in maps.items())):
         raise UsageError(f"maps = {args.show(maps)}: {allowed}", param="maps")
 
 
@@ -82,7 +77,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     return ax
 
 
-def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[dict[str, Any]],
+def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResult],
              title: str, x_label: str | None = None, y_label: str | None = None,
              wdt: np.ndarray | None = None, limits: tuple[int, int] | None = None,
              colorbar: bool = True) -> Any:
@@ -101,9 +96,9 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[dict[str,
     xo, yo = np.argsort(xs), np.argsort(ys)
     grid = grid[np.ix_(yo, xo)]
     xs, ys = xs[xo], ys[yo]
-    err = np.array([[r["max_rel_energy_error"] for r in line] for line in grid], float)
-    verdict = np.array([[r["verdict"] for r in line] for line in grid])
-    w_dt = (np.array([[r["w_dt"] for r in line] for line in grid], float) if wdt is None
+    err = np.array([[r.max_rel_energy_error for r in line] for line in grid], float)
+    verdict = np.array([[r.verdict for r in line] for line in grid])
+    w_dt = (np.array([[r.w_dt for r in line] for line in grid], float) if wdt is None
             else wdt)
     xlog, ylog = _is_log(x_axis), _is_log(y_axis)
     xe, ye = _edges(xs, xlog), _edges(ys, ylog)
@@ -157,7 +152,7 @@ def _legend_line(colour: str, style: str, label: str) -> Any:
     return Line2D([], [], color=colour, ls=style, lw=2.2, label=label)
 
 
-def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> None:
+def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     """A one-axis sweep: log10 of the largest relative energy error against the value, the
     failures marked by verdict and the value where w*dt = 2."""
     if not axis.numeric:
@@ -166,8 +161,8 @@ def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> No
     order = np.argsort(xs)
     xs = xs[order]
     rows = [rows[i] for i in order]
-    err = np.array([r["max_rel_energy_error"] for r in rows], float)
-    verdicts = [r["verdict"] for r in rows]
+    err = np.array([r.max_rel_energy_error for r in rows], float)
+    verdicts = [r.verdict for r in rows]
     ok = np.array([v == "ok" for v in verdicts])
     ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label="ok")
     top = np.nanmax(err[np.isfinite(err)]) if np.isfinite(err).any() else 1.0
@@ -178,7 +173,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> No
             ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
             ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
                     label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
-    w_dt = np.array([r["w_dt"] for r in rows], float)
+    w_dt = np.array([r.w_dt for r in rows], float)
     cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
     if cross.size:
         j = int(cross[0])
@@ -197,7 +192,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[dict[str, Any]], title: str) -> No
     ax.legend(fontsize=8)
 
 
-def stability_map(maps: dict[str, list[dict[str, Any]]]) -> list[Any]:
+def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     """One panel per solver (rows of :func:`dumbbell.analysis.stability.map_rows`): log10 of
     the largest relative energy error over (w*dt, mass ratio), blow-ups marked, and the line
     w*dt = 2. Makes its own figure (the panels share one colour bar); returns the panels."""
@@ -206,13 +201,13 @@ def stability_map(maps: dict[str, list[dict[str, Any]]]) -> list[Any]:
     fig, axes = pyplot().subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
     y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
-    errs = [r["max_rel_energy_error"] for rows in maps.values() for r in rows
-            if r["verdict"] == "ok" and r["max_rel_energy_error"] > 0]
+    errs = [r.max_rel_energy_error for rows in maps.values() for r in rows
+            if r.verdict == "ok" and r.max_rel_energy_error > 0]
     lo = math.floor(math.log10(min(errs))) if errs else -16
     hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
     mesh = None
     for ax, (solver, rows) in zip(axes[0], maps.items(), strict=True):
-        wdt = np.array([[r["w_dt"] for r in rows[i::len(MAP_RATIOS)]]
+        wdt = np.array([[r.w_dt for r in rows[i::len(MAP_RATIOS)]]
                         for i in range(len(MAP_RATIOS))], float)
         mesh = draw_map(fig, ax, x_axis, y_axis, rows, solver,
                         x_label="w*dt  (w = sqrt(k/mu))", y_label="mass ratio mB/mA",
