@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..model.scene import Scene, System
-from ..model.trajectory import Trajectory
+from ..model.trajectory import Impact, Trajectory, Verdict
 from .kernels import Params
 
 #: Largest number of steps one run may take, so that no run can hang.
@@ -183,6 +183,21 @@ class SearchBudget:
                 f"the impact search's budget was reached: {self.limit:,} units of work (a "
                 f"split interval is 1, a block of 64 scanned intervals {BLOCK_WORK}; a stiff "
                 "spring or a fast spin makes intervals short); a shorter t_end fits")
+
+
+def within_budget(search: Callable[[list[Any], list[Impact]], tuple[list[Any], list[Impact],
+                                                                    Verdict]],
+                  start_time: Callable[[Any], float]) -> tuple[list[Any], list[Impact], Verdict]:
+    """Run an impact search ``search(segments, impacts)``, which fills both lists as it goes
+    and returns them with its verdict. When it reaches its work budget (:class:`OverBudget`),
+    what it found so far is kept and the verdict is ``failed`` at the start of the last
+    segment (``start_time(segment)``, s), with the budget's message as the reason."""
+    segments: list[Any] = []
+    impacts: list[Impact] = []
+    try:
+        return search(segments, impacts)
+    except OverBudget as exc:
+        return segments, impacts, Verdict("failed", start_time(segments[-1]), str(exc))
 
 
 def impact_budget_reason(count: int) -> str:

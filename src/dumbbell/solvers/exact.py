@@ -26,7 +26,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
-from .base import OverBudget, RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
+from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import conclude
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
@@ -202,12 +202,8 @@ def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], V
     ``failed`` when a particle comes to rest or the run reaches its work budget
     (:data:`~dumbbell.solvers.base.MAX_IMPACTS` impacts, :data:`~.base.MAX_SEARCH_WORK`
     units of impact search)."""
-    segs: list[Segment] = []
-    events: list[Impact] = []
-    try:
-        return _segments(scene, t_end, segs, events)
-    except OverBudget as exc:
-        return segs, events, Verdict("failed", segs[-1].t0, str(exc))
+    return base.within_budget(lambda segs, events: _segments(scene, t_end, segs, events),
+                              lambda seg: seg.t0)
 
 
 def _segments(scene: Scene, t_end: float, segs: list[Segment], events: list[Impact]

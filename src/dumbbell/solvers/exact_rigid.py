@@ -53,7 +53,7 @@ from ..model.energy import (
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
 from . import base
-from .base import OverBudget, SearchBudget, impact_budget_reason
+from .base import SearchBudget, impact_budget_reason
 from .exact import HeightPoint
 
 #: The public API: the first impact in closed form; the rest serves the exact solver.
@@ -305,12 +305,8 @@ def flight(scene: Scene, t_end: float) -> tuple[list[RigidState], list[Impact], 
     impacts between them, and a verdict: ``failed`` when an end comes to rest or the run
     reaches its work budget (:data:`~dumbbell.solvers.base.MAX_IMPACTS` impacts,
     :data:`~.base.MAX_SEARCH_WORK` units of impact search)."""
-    segs: list[RigidState] = []
-    events: list[Impact] = []
-    try:
-        return _flight(scene, t_end, segs, events)
-    except OverBudget as exc:
-        return segs, events, Verdict("failed", segs[-1].t, str(exc))
+    return base.within_budget(lambda segs, events: _flight(scene, t_end, segs, events),
+                              lambda seg: seg.t)
 
 
 def _flight(scene: Scene, t_end: float, segs: list[RigidState], events: list[Impact]
