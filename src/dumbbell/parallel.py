@@ -67,9 +67,10 @@ def cap_note(flag: str, workers: int | None, jobs: int, what: str = "runs") -> s
     return f"{flag} {workers}: starting {n} processes, as {why}"
 
 
-#: The signals that stop a run (the CLI turns them into a clean exit).
-_STOP_NUMBERS = {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
-                 if hasattr(signal, name)}
+#: Signals that end a command the way Ctrl-C does: workers stopped, no output kept. The
+#: CLI turns them into a clean exit; a pool forks with them blocked (see _on_pool).
+STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+_STOP_NUMBERS = {getattr(signal, name) for name in STOP_SIGNALS if hasattr(signal, name)}
 
 
 def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -> None:

@@ -19,6 +19,7 @@ import threading
 from collections.abc import Iterator, Sequence
 
 from ..errors import DumbbellError, UsageError
+from ..parallel import STOP_SIGNALS
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep",
@@ -122,8 +123,6 @@ def arguments(parser: argparse.ArgumentParser) -> list[argparse.Action]:
 OUTPUT_FLAGS = {"out": ("--out", True), "output": ("-o", False), "events": ("--events", False)}
 #: Input flags: argparse dest -> how a message names the input.
 INPUT_FLAGS = {"scene": "the scene"}
-#: Signals that end a command the way Ctrl-C does: workers stopped, no output kept.
-STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
 
 
 class Stopped(KeyboardInterrupt):
