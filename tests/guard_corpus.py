@@ -337,22 +337,25 @@ def advice(case: str, steps: int = ADVICE_STEPS) -> Advice:
 # --- the table -------------------------------------------------------------------------------
 
 
+HEAD = ("| case | dt (s) | estimated peak (px/s) | real peak (px/s) | estimate / real | "
+        "advice | measured | at the program's step | with the advice |")
+
+
+def row(case: str, p: Peaks, a: Advice) -> str:
+    """The table's row of ``case`` from what :func:`peaks` and :func:`advice` measured."""
+    ratio = p.estimated / p.peak if p.peak > 0 else math.inf
+    steps = [k for k in a.failing if k not in ("bias", "slop")]
+    what = [f"{a.substeps} sub-steps ({', '.join(steps)})"] if a.substeps > 1 else []
+    what += [f"{k} = {v:g}" for k, v in a.settings.items()]
+    ratio_text = f"{ratio:.2f}" if math.isfinite(ratio) else "(at rest)"
+    return (f"| {case} | {a.dt:.4g} | {p.estimated:.4g} | {p.peak:.4g} | {ratio_text} | "
+            f"{'; '.join(what) or 'none'} | {a.measure} | {a.before:.3g} | {a.after:.3g} |")
+
+
 def table() -> str:
     """The per-example table of docs/spaces.md (Markdown)."""
-    head = ("| case | dt (s) | estimated peak (px/s) | real peak (px/s) | estimate / real | "
-            "advice | measured | at the program's step | with the advice |")
-    lines = [head, "|---|---|---|---|---|---|---|---|---|"]
-    for case in CASES:
-        p = peaks(case)
-        a = advice(case)
-        ratio = p.estimated / p.peak if p.peak > 0 else math.inf
-        steps = [k for k in a.failing if k not in ("bias", "slop")]
-        what = [f"{a.substeps} sub-steps ({', '.join(steps)})"] if a.substeps > 1 else []
-        what += [f"{k} = {v:g}" for k, v in a.settings.items()]
-        ratio_text = f"{ratio:.2f}" if math.isfinite(ratio) else "(at rest)"
-        lines.append(f"| {case} | {a.dt:.4g} | {p.estimated:.4g} | {p.peak:.4g} | {ratio_text} "
-                     f"| {'; '.join(what) or 'none'} | {a.measure} | {a.before:.3g} | "
-                     f"{a.after:.3g} |")
+    lines = [HEAD, "|---|---|---|---|---|---|---|---|---|"]
+    lines += [row(case, peaks(case), advice(case)) for case in CASES]
     return "\n".join(lines)
 
 

@@ -173,7 +173,7 @@ def scan(space: Any) -> Scan:
     kinds = np.array([int(b.body_type) for b in bodies], dtype=int)
     owner = np.array([index[id(s.body)] for s in shapes], dtype=int)
     cg = _to_world(pos, angle, cog)
-    geometry = _shapes(shapes, owner, cog, pymunk)
+    geometry = _shapes(shapes, owner, cog, pymunk, pos, angle)
     filters = [s.filter for s in shapes]
     return Scan(
         space=space, bodies=bodies, in_space=in_space, kind=kinds,
@@ -191,38 +191,54 @@ def scan(space: Any) -> Scan:
     )
 
 
-def _shapes(shapes: list[Any], owner: np.ndarray, cog: np.ndarray, pymunk: Any
+def _shapes(shapes: list[Any], owner: np.ndarray, cog: np.ndarray, pymunk: Any,
+            pos: np.ndarray | None = None, angle: np.ndarray | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Bounding boxes (as pymunk last cached them, or recomputed for a shape not yet in a
-    step), thinnest extents and reaches of ``shapes``."""
+    """Bounding boxes in world coordinates (from each shape's geometry and its body's ``pos``
+    and ``angle`` now, read without touching pymunk's cached ones; nan without them), thinnest
+    extents and reaches of ``shapes``."""
     m = len(shapes)
-    bb = np.empty((m, 4))
     size = np.zeros(m)
     reach = np.zeros(m)
-    polys: dict[int, list[tuple[int, list[tuple[float, float]], float]]] = {}
+    radius = np.zeros(m)
+    # Each shape's outline points in body coordinates: a circle's centre, a segment's ends,
+    # a polygon's vertices; the box is their span plus the radius.
+    points: list[list[tuple[float, float]]] = []
+    polys: dict[int, list[int]] = {}
     for j, s in enumerate(shapes):
-        box = s.cache_bb()
-        bb[j] = (box.left, box.bottom, box.right, box.top)
         c = cog[owner[j]]
         if isinstance(s, pymunk.Circle):
             r = float(s.radius)
+            pts = [(s.offset.x, s.offset.y)]
             size[j] = 2.0 * r
-            reach[j] = math.hypot(s.offset.x - c[0], s.offset.y - c[1]) + r
         elif isinstance(s, pymunk.Segment):
             r = float(s.radius)
+            pts = [(s.a.x, s.a.y), (s.b.x, s.b.y)]
             size[j] = 2.0 * r
-            reach[j] = max(math.hypot(s.a.x - c[0], s.a.y - c[1]),
-                           math.hypot(s.b.x - c[0], s.b.y - c[1])) + r
         elif isinstance(s, pymunk.Poly):
-            verts = [(v.x, v.y) for v in s.get_vertices()]
-            polys.setdefault(len(verts), []).append((j, verts, float(s.radius)))
-    for count, group in polys.items():
-        idx = np.array([j for j, _, _ in group])
-        v = np.array([verts for _, verts, _ in group], dtype=float).reshape(-1, count, 2)
-        radius = np.array([r for _, _, r in group])
-        size[idx] = _poly_width(v) + 2.0 * radius
-        rel = v - cog[owner[idx]][:, None, :]
-        reach[idx] = np.hypot(rel[..., 0], rel[..., 1]).max(axis=1) + radius
+            r = float(s.radius)
+            pts = [(v.x, v.y) for v in s.get_vertices()]
+            polys.setdefault(len(pts), []).append(j)
+        else:
+            r, pts = 0.0, [(float(c[0]), float(c[1]))]
+        radius[j] = r
+        points.append(pts)
+        reach[j] = max(math.hypot(x - c[0], y - c[1]) for x, y in pts) + r
+    for count, idx in polys.items():
+        v = np.array([points[j] for j in idx], dtype=float).reshape(-1, count, 2)
+        size[idx] = _poly_width(v) + 2.0 * radius[idx]
+    bb = np.full((m, 4), np.nan)
+    if pos is not None and angle is not None:
+        for count in {len(p) for p in points}:
+            idx = np.array([j for j in range(m) if len(points[j]) == count], dtype=int)
+            local = np.array([points[j] for j in idx], dtype=float).reshape(-1, count, 2)
+            b = owner[idx]
+            c, s_ = np.cos(angle[b])[:, None], np.sin(angle[b])[:, None]
+            x = pos[b, 0][:, None] + c * local[..., 0] - s_ * local[..., 1]
+            y = pos[b, 1][:, None] + s_ * local[..., 0] + c * local[..., 1]
+            r = radius[idx]
+            bb[idx] = np.column_stack([x.min(axis=1) - r, y.min(axis=1) - r,
+                                       x.max(axis=1) + r, y.max(axis=1) + r])
     return bb, size, reach
 
 
@@ -279,41 +295,81 @@ def _classes(sc: Scan) -> tuple[np.ndarray, np.ndarray]:
     return which, compatible
 
 
+@dataclass
+class _Filters:
+    """What :func:`best_other` needs about who can hit whom, worked out once per scan:
+    shape classes, which classes collide, each body's classes, the pairs kept apart, and for
+    each body its one class (-1 when it has none, several, or partners kept apart: those
+    bodies take the slow path)."""
+
+    cls: np.ndarray
+    compatible: np.ndarray
+    own: dict[int, set[int]]
+    kept_apart: set[tuple[int, int]]
+    single: np.ndarray
+
+
+def _filters(sc: Scan) -> _Filters:
+    cached = getattr(sc, "_filters_cache", None)
+    if cached is not None:
+        return cached
+    cls, compatible = _classes(sc)
+    own: dict[int, set[int]] = {}
+    for j in np.flatnonzero(~sc.sensor):
+        own.setdefault(int(sc.owner[j]), set()).add(int(cls[j]))
+    kept_apart = apart(sc)
+    partnered = {a for a, _ in kept_apart}
+    single = np.full(len(sc.bodies), -1)
+    for i, classes in own.items():
+        if len(classes) == 1 and i not in partnered:
+            single[i] = next(iter(classes))
+    sc._filters_cache = _Filters(cls, compatible, own, kept_apart, single)
+    return sc._filters_cache
+
+
 def best_other(sc: Scan, value: np.ndarray, candidate: np.ndarray, idx: np.ndarray,
                mode: str) -> tuple[np.ndarray, np.ndarray]:
     """For each body of ``idx``: the least (``mode`` 'min') or largest ('max') ``value`` over
     the ``candidate`` shapes it can hit, and that shape's number (nan and -1 when there is
     none). A body can hit another body's solid (not sensor) shape when the shape filters let
-    them collide and no constraint with ``collide_bodies = False`` joins the two bodies; the
-    shapes are grouped by filter, so this is linear in bodies and shapes."""
+    them collide and no constraint with ``collide_bodies = False`` joins the two bodies. The
+    shapes are grouped by filter and ranked once, so this is linear in bodies and shapes
+    (N log N for the ranking)."""
     out = np.full(len(idx), np.nan)
     which_shape = np.full(len(idx), -1)
     if len(sc.shapes) == 0 or len(idx) == 0:
         return out, which_shape
-    solid = ~sc.sensor
-    cand = candidate & solid & ~np.isnan(value)
-    cls, compatible = _classes(sc)
+    f = _filters(sc)
+    cand = candidate & ~sc.sensor & ~np.isnan(value)
     order: dict[int, np.ndarray] = {}
-    for c in np.unique(cls[cand]):
-        members = np.flatnonzero(cand & (cls == c))
+    for c in np.unique(f.cls[cand]):
+        members = np.flatnonzero(cand & (f.cls == c))
         ranked = np.argsort(value[members], kind="stable")
         order[int(c)] = members[ranked if mode == "min" else ranked[::-1]]
-    if not order:
-        return out, which_shape
-    own: dict[int, set[int]] = {}
-    for j in np.flatnonzero(solid):
-        own.setdefault(int(sc.owner[j]), set()).add(int(cls[j]))
-    kept_apart = apart(sc)
     better = np.less if mode == "min" else np.greater
-    for k, i in enumerate(idx):
-        i = int(i)
-        for ca in own.get(i, ()):
+    idx = np.asarray(idx, dtype=int)
+    single = f.single[idx]
+    # Bodies with one filter class and no partners kept apart: the best shape of each class
+    # that collides with theirs, or the best of another body when that one is their own.
+    for cb, ranked in order.items():
+        top = int(ranked[0])
+        others = np.flatnonzero(sc.owner[ranked] != sc.owner[top])
+        alt = int(ranked[others[0]]) if len(others) else -1
+        pick = np.where(sc.owner[top] != idx, top, alt)
+        use = (single >= 0) & f.compatible[np.maximum(single, 0), cb] & (pick >= 0)
+        vals = value[np.maximum(pick, 0)]
+        take = use & ((which_shape < 0) | better(vals, out))
+        out[take], which_shape[take] = vals[take], pick[take]
+    # The others, one at a time.
+    for k in np.flatnonzero(single < 0):
+        i = int(idx[k])
+        for ca in f.own.get(i, ()):
             for cb, ranked in order.items():
-                if not compatible[ca, cb]:
+                if not f.compatible[ca, cb]:
                     continue
                 for j in ranked:
                     o = int(sc.owner[j])
-                    if o == i or (i, o) in kept_apart:
+                    if o == i or (i, o) in f.kept_apart:
                         continue
                     if which_shape[k] < 0 or better(value[j], out[k]):
                         out[k], which_shape[k] = value[j], j
@@ -328,7 +384,6 @@ def hittable_in(sc: Scan, i: int, box: np.ndarray) -> np.ndarray:
 
     if not hasattr(sc, "_number_of_shape"):
         sc._number_of_shape = {id(s): j for j, s in enumerate(sc.shapes)}
-        sc._apart = apart(sc)
     number = sc._number_of_shape
     found = sc.space.bb_query(pymunk.BB(*(float(x) for x in box)), pymunk.ShapeFilter())
     mine = np.flatnonzero((sc.owner == i) & ~sc.sensor)
@@ -338,7 +393,7 @@ def hittable_in(sc: Scan, i: int, box: np.ndarray) -> np.ndarray:
         if j is None or sc.sensor[j]:
             continue
         o = int(sc.owner[j])
-        if o == i or (i, o) in sc._apart:
+        if o == i or (i, o) in _filters(sc).kept_apart:
             continue
         if any(_collide(sc, int(a), j) for a in mine):
             out.append(j)
