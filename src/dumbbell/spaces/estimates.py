@@ -35,12 +35,15 @@ a speed from it:
 
 - **what pumps energy in**, added and named: a kinematic obstacle it can hit bounces it off at
   up to ``(1 + e)`` times the obstacle's speed; a joint to a moving kinematic body drags it at
-  that body's speed; a ``SimpleMotor`` spins it at up to its rate (plus its spin now).
+  that body's speed; a ``SimpleMotor`` spins it at up to its rate (plus its spin now); a pin
+  or slide of length 0 holding it (pymunk cannot tell which way to pull, so gravity's kick of
+  each step, ``g dt``, is undone only a step late) adds ``g dt``.
 
 ``bound`` says whether the estimate is an upper bound: True for a body that no other dynamic
 body can touch (filters, sensors and ``collide_bodies = False`` counted), joined to no other
 dynamic body, with nothing pumping energy in (no motor, no moving kinematic body it can meet,
-no restitution above 1, no custom ``velocity_func`` or spring force); then energy
+no restitution above 1, no custom ``velocity_func`` or spring force, no pin of length 0);
+then energy
 conservation bounds its speed before it meets an obstacle. Otherwise it is an estimate: a
 chain of collisions can pass on more than one collision does (a light ball dropped on a heavy
 one bounces up at three times its speed). Not counted anywhere: the push pymunk gives shapes
@@ -222,6 +225,7 @@ def estimate(sc: Scan, dt: float, unit: str = "units") -> Estimates:
     held_level = np.full(n, np.nan)
     held_by = [""] * n
     region = np.full((n, 4), np.nan)
+    loose = np.zeros(n, dtype=bool)
     pivot = np.zeros(n, dtype=bool)
     pivot_inertia = np.array(inertia, dtype=float)
     pivot_reach = np.array(own_reach, dtype=float)
@@ -267,6 +271,12 @@ def estimate(sc: Scan, dt: float, unit: str = "units") -> Estimates:
             if hold is None:
                 continue
             level, r_pivot, box = hold
+            if r_pivot is not None and not isinstance(c, pymunk.PivotJoint):
+                # A pin or slide of length 0 has no direction to pull along: gravity's kick
+                # each step is undone only by its error correction, a step late.
+                loose[k] = True
+                pumped[k].append(f"{label} has length 0: pymunk cannot tell which way to "
+                                 "pull (a PivotJoint can)")
             if math.isnan(held_level[k]) or level < held_level[k]:
                 held_level[k] = level
                 held_by[k] = label
@@ -315,7 +325,7 @@ def estimate(sc: Scan, dt: float, unit: str = "units") -> Estimates:
         free_speed = h + np.sqrt(h * h + 2.0 * budget / m + 2.0 * h * speed_cg)
         pivot_speed = np.sqrt(2.0 * budget / np.where(pivot_inertia > 0, pivot_inertia,
                                                         np.inf)) * pivot_reach
-        speed = np.where(pivot, pivot_speed, free_speed)
+        speed = np.where(pivot, pivot_speed, free_speed) + np.where(loose, g * dt, 0.0)
         # Speeds past 1e154 overflow as squares: then add them instead (larger, finite).
         linear = now + pushed + np.sqrt(2.0 * np.maximum(springs + m * g * fall, 0.0) / m)
         speed = np.where(np.isfinite(speed), speed, linear)
