@@ -459,14 +459,14 @@ def _columns(sc: Scan, idx: np.ndarray, down: np.ndarray
     first: dict[int, Any] = {}
     for j in solid[::-1]:
         first[int(sc.owner[j])] = sc.shapes[int(j)].filter
-    lo, hi = lo[idx], hi[idx]
+    # A body without a solid shape keeps infinite bounds here; it gets no filter below.
+    lo, hi = np.where(np.isfinite(lo), lo, 0.0)[idx], np.where(np.isfinite(hi), hi, 0.0)[idx]
     across = np.array([-down[1], down[0]])
     corners = [np.column_stack([x[:, 0], y[:, 1]]) for x in (lo, hi) for y in (lo, hi)]
     depth = np.max([c @ down for c in corners], axis=0)
     width = np.max([c @ across for c in corners], axis=0) - np.min(
         [c @ across for c in corners], axis=0)
-    with np.errstate(invalid="ignore"):
-        centre = 0.5 * (lo + hi)
+    centre = 0.5 * (lo + hi)
     return depth, centre, 0.5 * width, [first.get(int(i)) for i in idx]
 
 

@@ -448,9 +448,8 @@ def _summary(kind: str, rows: list[Finding], ok: bool) -> str:
     """One line for the rows of ``kind`` beyond the ones listed."""
     mark = "ok  " if ok else "FAIL"
     worst = max(rows, key=lambda f: f.value / f.limit if f.limit else math.inf)
-    what = "passed" if ok else "failed"
-    return (f"  {mark} {kind:14s} {len(rows)} more {what}; the closest to its limit: "
-            f"{worst.subject}, {worst.comparison()}")
+    what = "passed; the closest to its limit" if ok else "failed; the farthest past it"
+    return f"  {mark} {kind:14s} {len(rows)} more {what}: {worst.subject}, {worst.comparison()}"
 
 
 def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
