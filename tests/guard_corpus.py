@@ -59,10 +59,10 @@ CASES: dict[str, tuple[str, Any]] = {
 #: the pyramid's settling; longer where the peak comes late (balls rolling off the L, the
 #: tank's pushing).
 STEPS = 300
-LONGER = {"slide_and_pinjoint": 600, "tank": 600}
+LONGER = {"slide_and_pinjoint": 600}
 #: Steps for measuring what the advice changes, and most steps of one reference run.
 ADVICE_STEPS = 120
-REFERENCE_STEPS = 20_000
+REFERENCE_STEPS = 8_000
 #: Units of the corpus: every program works in pixels.
 UNITS = "px"
 #: Spring kinds of findings.
