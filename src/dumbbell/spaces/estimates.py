@@ -195,10 +195,6 @@ class Estimates:
                 for k, i in enumerate(self.idx)]
 
 
-def _fmt(x: float) -> str:
-    return f"{x:.4g}"
-
-
 def estimate(sc: Scan, dt: float, unit: str = "units") -> Estimates:
     """The reach estimates of every dynamic body of ``sc`` at steps of ``dt`` (s)."""
     import pymunk
