@@ -149,7 +149,10 @@ def _pyglet_stand_in(run: Run, budget: Callable[[], bool]) -> dict[str, types.Mo
 @contextlib.contextmanager
 def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
               on_step: Callable[[Any, float], Any] | None,
-              isolate: Callable[[Any], Any] | None) -> Iterator[None]:
+              isolate: Callable[[Any], Any] | None,
+              on_first: Callable[[Any, float], Any] | None = None,
+              substeps: int = 1,
+              on_substep: Callable[[Any, float], Any] | None = None) -> Iterator[None]:
     import pygame
     import pymunk
     import pymunk.pygame_util
@@ -167,12 +170,17 @@ def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
                 isolate(space)
             if on_start is not None:
                 on_start(space)
+            if on_first is not None:
+                on_first(space, dt)
         if space is not run.space:  # a second space (a copy): step it, do not count it
             real_step(space, dt)
             return
         if len(run.dts) >= steps:
             raise _Stop
-        real_step(space, dt)
+        for _ in range(substeps):
+            real_step(space, dt / substeps)
+            if on_substep is not None:
+                on_substep(space, dt / substeps)
         run.dts.append(dt)
         if on_step is not None:
             on_step(space, dt)
@@ -229,12 +237,18 @@ def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
 
 def run_example(name: str, steps: int, *, on_start: Callable[[Any], Any] | None = None,
                 on_step: Callable[[Any, float], Any] | None = None,
-                isolate: Callable[[Any], Any] | None = None) -> Run:
+                isolate: Callable[[Any], Any] | None = None,
+                on_first: Callable[[Any, float], Any] | None = None,
+                substeps: int = 1,
+                on_substep: Callable[[Any, float], Any] | None = None) -> Run:
     """Run ``pymunk.examples.<name>`` headless for ``steps`` calls of ``Space.step``.
 
     ``isolate(space)`` may change the space once it is built; ``on_start(space)`` is called
-    after that, before the first step; ``on_step(space, dt)`` after every step. Returns the
-    :class:`Run` (its ``space`` is left as the last step left it)."""
+    after that, before the first step; ``on_first(space, dt)`` then, with the first step's
+    dt; ``on_step(space, dt)`` after every step. ``substeps`` > 1 runs each of the program's
+    steps as that many equal steps (a step-size guard's advice applied); ``dts`` and
+    ``on_step`` still see the program's steps, ``on_substep(space, h)`` each of the equal
+    steps. Returns the :class:`Run` (its ``space`` is left as the last step left it)."""
     if name not in EXAMPLES:
         raise KeyError(f"{name!r} is not in the corpus: {', '.join(EXAMPLES)}")
     import pygame
@@ -244,7 +258,8 @@ def run_example(name: str, steps: int, *, on_start: Callable[[Any], Any] | None 
     # named like tests (basic_test), and a program that builds at import time builds afresh.
     path = importlib.util.find_spec(f"pymunk.examples.{name}").origin
     out = io.StringIO()
-    with _headless(run, steps, on_start, on_step, isolate), contextlib.redirect_stdout(out):
+    with (_headless(run, steps, on_start, on_step, isolate, on_first, substeps, on_substep),
+          contextlib.redirect_stdout(out)):
         try:
             run.module = runpy.run_path(path, run_name="__main__")
         except (_Stop, SystemExit):

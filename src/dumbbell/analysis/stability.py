@@ -274,9 +274,12 @@ def _cost(path: str, solver: str) -> float:
 
 
 def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
-    """What the step-size guard (:func:`dumbbell.spaces.check`) says about each case run by
-    pymunk, on the space the solver builds, at the case's dt: its findings and the sub-steps
-    that clear them, or that it finds nothing."""
+    """What the step-size guard (:func:`dumbbell.spaces.check`, stability only: no energy
+    swing tolerance) says about each case run by pymunk, on the space the solver builds, at
+    the case's dt: its findings and the sub-steps that clear them, or that it finds
+    nothing."""
+    import math
+
     from ..solvers.engine import build
     from ..spaces.guard import check, substeps
 
@@ -285,12 +288,12 @@ def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
         scene = load_scene(path)
         space = build(scene).space
         dt = scene.run.dt
-        found = check(space, dt)
+        found = check(space, dt, tolerance=math.inf)
         if not found:
             lines.append(f"- {scene.name} (dt = {dt:g} s): nothing to fix")
             continue
         what = "; ".join(f"{f.kind} {f.subject} {f.value:.3g} > {f.limit:.3g}" for f in found)
-        n = substeps(space, dt)
+        n = substeps(space, dt, tolerance=math.inf)
         fix = (f"{n} sub-steps (dt = {dt / n:.3g} s) clear it" if n > 1
                else "settings, not the step: " + "; ".join(f.fix for f in found))
         lines.append(f"- {scene.name} (dt = {dt:g} s): {what}; {fix}")

@@ -96,8 +96,9 @@ def arguments(name: str, doc: str, seconds: float, argv: list[str] | None) -> ar
 
 
 def print_guard(space: Any, args: argparse.Namespace) -> None:
-    """Print the step-size guard's report at the frame step and at the example's step."""
+    """Print the step-size guard's report at the frame step and at the example's step (the
+    examples are in SI units: lengths in m)."""
     from .. import spaces
 
-    print(spaces.report(space, 1.0 / args.fps))
-    print(spaces.report(space, args.dt))
+    print(spaces.report(space, 1.0 / args.fps, units="m"))
+    print(spaces.report(space, args.dt, units="m"))

@@ -27,7 +27,8 @@ _WHERE = {
     "SpringEnergy": "accounting", "Skipped": "accounting",
     "check": "guard", "survey": "guard", "suggest_dt": "guard", "substeps": "guard",
     "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
-    "spring_omega": "guard", "shape_size": "guard",
+    "spring_omega": "guard", "shape_size": "guard", "energy_swing": "guard",
+    "reach": "estimates", "Reach": "estimates",
     "HeatCounter": "heat",
     "Recorder": "recorder", "PaletteDrawOptions": "recorder", "draw_options": "recorder",
 }

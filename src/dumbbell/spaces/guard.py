@@ -1,47 +1,61 @@
-"""A step-size guard for any pymunk space: which dt is too large, by how much, and the fix.
+"""A step-size guard for any pymunk space: which dt is too large, by how much, why, and the fix.
 
-Checks (each a :class:`Finding` with the number, its limit and the fix):
+Checks (each a :class:`Finding` with the number, its limit, the relation a good value keeps,
+the fix and the reason for it):
 
-- ``spring``: a ``DampedSpring``'s explicit step is stable only while w*dt < 2, with
-  w = sqrt(k / m_eff); m_eff is the mass the spring moves along its axis, 1 / (1/m_a + 1/m_b +
-  (r_a x n)^2 / I_a + (r_b x n)^2 / I_b): the reduced mass mu for anchors at the centres of
-  gravity, the other body's mass when one end is static;
-- ``rotary-spring``: the same for a ``DampedRotarySpring`` with w = sqrt(k (1/I_a + 1/I_b));
+- ``spring``: a ``DampedSpring``'s step is explicit (symplectic Euler: positions first, then
+  the spring's impulse), so its energy is not kept but swings about a value the step does
+  keep (its modified energy). For an undamped spring of angular frequency w the swing, the
+  largest relative change of energy from any start, is ``2 w dt / (2 - w dt)`` (see
+  :func:`energy_swing`): 2 % at w dt = 0.02, 100 % at 0.67, without bound from w dt = 2
+  (unstable). The check keeps the swing under ``tolerance`` (1 % unless set); ``tolerance =
+  math.inf`` asks for stability only. w = sqrt(k / m_eff), m_eff the mass the spring moves
+  along its axis, 1 / (1/m_a + 1/m_b + (r_a x n)^2 / I_a + (r_b x n)^2 / I_b): the reduced
+  mass for anchors at the centres of gravity, the other body's mass when one end is fixed;
+- ``rotary-spring``: the same for a ``DampedRotarySpring``, w = sqrt(k (1/I_a + 1/I_b));
 - ``spring-network``: a body held by two or more springs, against an upper bound of its
   fastest vibration (see :func:`_networks`);
 - ``tunnelling``: pymunk finds a contact only once shapes overlap (no swept collisions), so a
   body moving farther in one step than half the thinnest shape it can hit plus half its own
-  size can pass through it. The speed is the larger of the present closing speed (its centre
-  of gravity plus spin times the reach of its shapes, plus the fastest obstacle's) and the
-  speed from energy (plus a kinematic obstacle's, which keeps its speed): the body's kinetic
-  energy plus ALL the potential energy (gravity down to the lowest static shape it can hit, or
-  the lowest shape when there is none, and the springs) turned into its kinetic energy. An
-  estimate, not a bound: another body's kinetic energy passed on is not counted;
-- ``slop``: ``space.collision_slop`` is the overlap left alone; more than a tenth of the
-  smallest shape lets shapes sink visibly (pymunk's 0.1 is a pixel-sized default: 10 cm in SI);
-- ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart with an
-  extra velocity, which adds energy at elastic contacts (flagged where any contact is elastic).
+  size can pass through it. The closing speed is the larger of the speed now (its fastest
+  point plus the fastest thing it can hit) and its reach estimate (:mod:`.estimates`: its own
+  energy and fall, what holds it, what others can pass on);
+- ``slop``: ``space.collision_slop`` is the overlap pymunk leaves between touching shapes;
+- ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart, which
+  adds energy at elastic contacts (flagged where any contact is elastic);
+- ``state``: a body whose position or velocity is not a finite number, or a dynamic body
+  without a valid mass or moment: no step fixes it.
+
+Lengths are in the space's own unit: pymunk has none. ``units`` names it in the messages
+('m', 'px'); without it they say 'units'. Times are in seconds.
 
 :func:`suggest_dt` returns a step (dt divided into whole sub-steps) that clears every finding
 a step can clear; slop and bias are settings, not steps. :class:`Driver` steps a space at a
-fixed frame step in sub-steps.
+fixed frame step in sub-steps. Each check reads the space once (:mod:`._scan`), so the guard
+costs time linear in bodies and shapes.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from ..errors import UsageError
 from ..model import args
-from .accounting import body_label, constraint_label, energy
+from ._scan import Scan, _shapes, best_other, hittable_in, scan
+from .estimates import Estimates, estimate, length_unit, state_problem
 
-__all__ = ["Driver", "Finding", "check", "report", "shape_size", "spring_omega", "step",
-           "substeps", "suggest_dt", "survey"]
+__all__ = ["Driver", "Finding", "check", "energy_swing", "report", "shape_size",
+           "spring_omega", "step", "substeps", "suggest_dt", "survey"]
 
-#: w*dt limit of the explicit spring step.
+#: w*dt limit of the explicit spring step (stability).
 SPRING_LIMIT = 2.0
+#: Default largest energy swing of a spring's step (a fraction: 0.01 = 1 %).
+TOLERANCE = 0.01
 #: Largest slop, as a fraction of the smallest shape's size.
 SLOP_FRACTION = 0.1
 #: Most sub-steps of one step, and most steps one call of :func:`step` or
@@ -49,14 +63,21 @@ SLOP_FRACTION = 0.1
 MAX_STEPS = 10**9
 #: Slop suggested, as a fraction of the smallest shape's size.
 SLOP_SUGGESTED = 0.01
+#: Rows of one kind a report lists before it sums up the rest.
+SHOWN = 6
+
+#: The relation a good value keeps to its limit, and the one a failing value shows.
+_FAILS = {"<": ">=", "<=": ">", ">=": "<"}
 
 
 @dataclass(frozen=True)
 class Finding:
-    """One check that failed: ``kind`` (spring, rotary-spring, tunnelling, slop, bias), the
-    ``subject`` it is about, the measured ``value`` and its ``limit`` (w*dt for springs, metres
-    per step for tunnelling, metres for slop, the bias for bias), the ``fix`` in words and the
-    largest step that clears it, ``dt_max`` (s; None when no step can)."""
+    """One check: ``kind`` (spring, rotary-spring, spring-network, tunnelling, slop, bias,
+    state), the ``subject`` it is about, the measured ``value`` and its ``limit`` (w*dt for
+    springs, length units moved per step for tunnelling, length units for slop, the bias for
+    bias), the ``relation`` a good value keeps to the limit ('<', '<=' or '>='; 'finite' for a
+    state no step fixes), the ``fix`` with its reason in words, the largest step that clears it,
+    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none)."""
 
     kind: str
     subject: str
@@ -64,29 +85,97 @@ class Finding:
     limit: float
     fix: str
     dt_max: float | None = None
+    relation: str = "<"
+    unit: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """Whether the value keeps its relation to the limit."""
+        if self.relation == "<":
+            return self.value < self.limit
+        if self.relation == "<=":
+            return self.value <= self.limit
+        if self.relation == ">=":
+            return self.value >= self.limit
+        return False
+
+    def comparison(self) -> str:
+        """'value relation limit' with the relation that holds, the numbers printed with
+        enough digits to show it."""
+        if self.relation not in _FAILS:
+            return ""
+        rel = self.relation if self.ok else _FAILS[self.relation]
+        unit = f" {self.unit}" if self.unit else ""
+        a, b = _distinct(self.value, self.limit, rel)
+        return f"{a}{unit} {rel} {b}{unit}"
 
     def __str__(self) -> str:
-        return f"{self.kind}: {self.subject}: {self.value:.4g} > {self.limit:.4g}; {self.fix}"
+        shown = self.comparison()
+        return f"{self.kind}: {self.subject}: {shown + '; ' if shown else ''}{self.fix}"
 
 
-#: What ``speeds`` may be: the present speeds, the speeds from energy, or the larger.
+def _distinct(a: float, b: float, rel: str) -> tuple[str, str]:
+    """``a`` and ``b`` printed with the fewest digits (4 or more) that keep ``rel`` true of
+    the printed numbers."""
+    holds = {"<": float.__lt__, "<=": float.__le__, ">=": float.__ge__, ">": float.__gt__}[rel]
+    for digits in range(4, 18):
+        x, y = f"{a:.{digits}g}", f"{b:.{digits}g}"
+        if holds(float(x), float(y)):
+            return x, y
+    return repr(a), repr(b)
+
+
+def energy_swing(w_dt: float) -> float:
+    """The energy swing of pymunk's step of an undamped spring at ``w_dt`` = w*dt: the largest
+    relative change of its energy from the start, over every start, 2 w dt / (2 - w dt)
+    (a fraction; inf from w dt = 2, where the step is unstable).
+
+    Why: positions first, then velocities from the new positions (symplectic Euler) keeps
+    H = v^2/2 + w^2 x^2/2 - (w^2 dt/2) x v exactly for x'' = -w^2 x; the energy
+    E = v^2/2 + w^2 x^2/2 then runs between H / (1 + w dt / 2) and H / (1 - w dt / 2)."""
+    z = args.real(w_dt, "w_dt", "-", lo=0.0)
+    return math.inf if z >= SPRING_LIMIT else 2.0 * z / (2.0 - z)
+
+
+def _swing_limit(tolerance: float) -> float:
+    """The w*dt whose energy swing is ``tolerance`` (2 for an infinite tolerance)."""
+    return SPRING_LIMIT if math.isinf(tolerance) else 2.0 * tolerance / (2.0 + tolerance)
+
+
+def _percent(fraction: float) -> str:
+    return "without bound" if math.isinf(fraction) else f"{100 * fraction:.3g} %"
+
+
+#: What ``speeds`` may be: the present speeds, the reach estimates, or the larger.
 SPEEDS = ("state", "energy", "both")
 
 
-def _check(space: Any, dt: Any, speeds: Any = "both") -> tuple[Any, float, str]:
+def _tolerance(value: Any) -> float:
+    """``tolerance``: a number > 0 (a fraction), math.inf for stability only."""
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not float(value) > 0):
+        raise UsageError(f"tolerance = {args.show(value)}: must be a number > 0 (the largest "
+                         "energy swing of a spring's step, a fraction: 0.01 = 1 %; math.inf "
+                         "for stability only)", param="tolerance")
+    return float(value)
+
+
+def _check(space: Any, dt: Any, speeds: Any = "both", tolerance: Any = TOLERANCE,
+           units: Any = None) -> tuple[Any, float, str, float, str]:
     """The guard's arguments checked at the border (UsageError naming the one that is not
-    valid): a pymunk.Space, a step > 0 (s) and one of :data:`SPEEDS`."""
-    return (args.space(space), args.real(dt, "dt", "s"), args.choice(speeds, "speeds", SPEEDS))
+    valid): a pymunk.Space, a step > 0 (s), one of :data:`SPEEDS`, a tolerance and a unit."""
+    return (args.space(space), args.real(dt, "dt", "s"), args.choice(speeds, "speeds", SPEEDS),
+            _tolerance(tolerance), length_unit(units))
 
 
 def _inverse_mass(body: Any) -> tuple[float, float]:
-    """1/m (1/kg) and 1/I (1/(kg m^2)) of a body; 0 for static, kinematic, infinite."""
+    """1/m and 1/I of a body; 0 for static, kinematic, infinite."""
     import pymunk
 
     if body.body_type != pymunk.Body.DYNAMIC:
         return 0.0, 0.0
-    inv_m = 0.0 if math.isinf(body.mass) else 1.0 / body.mass
-    inv_i = 0.0 if math.isinf(body.moment) else 1.0 / body.moment
+    inv_m = 0.0 if math.isinf(body.mass) or body.mass <= 0 else 1.0 / body.mass
+    inv_i = 0.0 if math.isinf(body.moment) or body.moment <= 0 else 1.0 / body.moment
     return inv_m, inv_i
 
 
@@ -110,106 +199,61 @@ def spring_omega(spring: Any) -> float:
         length = d.length
         n = d / length if length > 0 else pymunk.Vec2d(1.0, 0.0)
         inv = ma + mb + ia * ra.cross(n) ** 2 + ib * rb.cross(n) ** 2
-    return math.sqrt(spring.stiffness * inv)
+    w = math.sqrt(abs(spring.stiffness) * inv)
+    return w if math.isfinite(w) else math.inf
 
 
 def shape_size(shape: Any) -> float:
-    """The thinnest extent of a shape (m): a circle's diameter, a segment's thickness
-    (2 x radius), a polygon's least width across an edge plus 2 x radius."""
+    """The thinnest extent of a shape (length units): a circle's diameter, a segment's
+    thickness (2 x radius), a polygon's least width across an edge plus 2 x radius."""
     import pymunk
 
     args.pymunk_object(shape, "shape", ("Shape",))
-    if isinstance(shape, pymunk.Circle):
-        return 2.0 * shape.radius
-    if isinstance(shape, pymunk.Segment):
-        return 2.0 * shape.radius
-    if isinstance(shape, pymunk.Poly):
-        verts = shape.get_vertices()
-        width = math.inf
-        for i, p in enumerate(verts):
-            q = verts[(i + 1) % len(verts)]
-            edge = q - p
-            if edge.length == 0:
-                continue
-            n = edge.perpendicular_normal()
-            dots = [v.dot(n) for v in verts]
-            width = min(width, max(dots) - min(dots))
-        return (0.0 if math.isinf(width) else width) + 2.0 * shape.radius
-    return 0.0
+    return float(_shapes([shape], np.zeros(1, dtype=int), np.zeros((1, 2)), pymunk)[1][0])
 
 
-def _reach(body: Any, shape: Any) -> float:
-    """Farthest distance (m) of a shape's points from its body's centre of gravity."""
+def _spring_row(kind: str, subject: str, w: float, dt: float, tolerance: float,
+                extra: str = "") -> Finding:
+    """A spring's finding: w*dt against the w*dt whose swing is ``tolerance``."""
+    z = w * dt
+    limit = _swing_limit(tolerance)
+    dt_max = limit / w
+    swing = energy_swing(z) if math.isfinite(z) else math.inf
+    keeps = ("stays stable (w dt < 2)" if math.isinf(tolerance)
+             else f"keeps the swing under {_percent(tolerance)}")
+    if z >= SPRING_LIMIT:
+        now = "unstable: the energy grows without bound from w dt = 2"
+    else:
+        now = f"the energy swings by {_percent(swing)} at this step (2 w dt / (2 - w dt))"
+    fix = f"{extra}w = {w:.4g} rad/s: {now}; dt < {dt_max:.4g} s {keeps}"
+    return Finding(kind, subject, z, limit, fix, dt_max, "<")
+
+
+def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
+    """Each spring's w*dt (linear and rotary) against the step's swing and stability."""
     import pymunk
 
-    cg = body.center_of_gravity
-    if isinstance(shape, pymunk.Circle):
-        return (shape.offset - cg).length + shape.radius
-    if isinstance(shape, pymunk.Segment):
-        return max((shape.a - cg).length, (shape.b - cg).length) + shape.radius
-    if isinstance(shape, pymunk.Poly):
-        return max((v - cg).length for v in shape.get_vertices()) + shape.radius
-    return 0.0
+    rows: list[Finding] = []
+    for j, c in enumerate(space.constraints):
+        if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
+            continue
+        w = spring_omega(c)
+        if w == 0.0:
+            continue
+        kind = "rotary-spring" if isinstance(c, pymunk.DampedRotarySpring) else "spring"
+        rows.append(_spring_row(kind, f"{type(c).__name__} {j}", w, dt, tolerance))
+    return rows
 
 
-def _apart(space: Any) -> set[tuple[int, int]]:
-    """Pairs of bodies (by id) that a constraint with ``collide_bodies = False`` keeps from
-    colliding."""
-    pairs = set()
-    for c in space.constraints:
-        if not c.collide_bodies:
-            pairs.add((id(c.a), id(c.b)))
-            pairs.add((id(c.b), id(c.a)))
-    return pairs
-
-
-def _speed(shape: Any) -> float:
-    """Fastest a shape's points move now (m/s): its body's speed plus spin times reach; 0 for
-    static bodies."""
-    import pymunk
-
-    body = shape.body
-    if body.body_type == pymunk.Body.STATIC:
-        return 0.0
-    return body.velocity.length + abs(body.angular_velocity) * _reach(body, shape)
-
-
-def _can_hit(s: Any, o: Any, apart: set[tuple[int, int]] = frozenset()) -> bool:
-    return (o.body is not s.body and not o.sensor and not s.sensor
-            and (id(s.body), id(o.body)) not in apart
-            and not s.filter.rejects_collision(o.filter))
-
-
-def _level(space: Any, down: tuple[float, float], apart: set[tuple[int, int]]) -> float | None:
-    """The lowest point (largest coordinate along ``down``) of the static shapes a moving
-    shape can hit, else of all shapes; None when the space has no shapes."""
-    import pymunk
-
-    shapes = list(space.shapes)
-    moving = [s for s in shapes if s.body.body_type != pymunk.Body.STATIC]
-    static = [s for s in shapes if s.body.body_type == pymunk.Body.STATIC
-              and any(_can_hit(m, s, apart) for m in moving)]
-    pool = static or shapes
-    if not pool:
-        return None
-    low = -math.inf
-    for s in pool:
-        bb = s.cache_bb()
-        for x in (bb.left, bb.right):
-            for y in (bb.bottom, bb.top):
-                low = max(low, x * down[0] + y * down[1])
-    return low
-
-
-def _networks(space: Any, dt: float) -> list[tuple[Finding, bool]]:
+def _networks(space: Any, sc: Scan, dt: float, tolerance: float) -> list[Finding]:
     """``spring-network``: a body held by two or more linear springs vibrates faster than any
     one of them alone (a row of equal masses: up to 2 sqrt(k/m) against sqrt(2 k/m)). Bound
     (Gershgorin, translations only): w^2 <= sum over its springs of k / m + k / sqrt(m m_other),
     the other end's term dropped when it cannot move. An upper bound, so it can flag a step
-    that would still be stable; checked only for bodies with two or more springs."""
+    that would still be stable and accurate; checked only for bodies with two or more
+    springs."""
     import pymunk
 
-    rows: list[tuple[Finding, bool]] = []
     bound: dict[int, list[Any]] = {}
     for c in space.constraints:
         if not isinstance(c, pymunk.DampedSpring) or c.stiffness <= 0:
@@ -222,182 +266,230 @@ def _networks(space: Any, dt: float) -> list[tuple[Finding, bool]]:
             entry = bound.setdefault(id(here), [here, 0.0, 0])
             entry[1] += c.stiffness * (inv_here + math.sqrt(inv_here * inv_there))
             entry[2] += 1
+    rows = []
     for body, w2, count in bound.values():
-        if count < 2:
-            continue
-        w = math.sqrt(w2)
-        dt_max = SPRING_LIMIT / w
-        rows.append((Finding("spring-network", body_label(space, body), w * dt, SPRING_LIMIT,
-                             f"{count} springs on it, w <= {w:.4g} rad/s: dt < {dt_max:.4g} s",
-                             dt_max), w * dt < SPRING_LIMIT))
+        if count >= 2:
+            rows.append(_spring_row("spring-network", sc.label(sc.number(body)),
+                                    math.sqrt(w2), dt, tolerance,
+                                    f"{count} springs on it, w <= bound; "))
     return rows
 
 
-def survey(space: Any, dt: float, speeds: str = "both") -> list[tuple[Finding, bool]]:
-    """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
-    ``speeds``: 'state' (the present speeds), 'energy' or 'both' (the larger)."""
-    space, dt, speeds = _check(space, dt, speeds)
-    apart = _apart(space)
-    return (_springs(space, dt) + _networks(space, dt) + _tunnelling(space, dt, speeds, apart)
-            + _contact_settings(space, apart))
-
-
-def _springs(space: Any, dt: float) -> list[tuple[Finding, bool]]:
-    """Each spring's w*dt (linear and rotary) against the explicit step's limit."""
-    import pymunk
-
-    rows: list[tuple[Finding, bool]] = []
-    for c in space.constraints:
-        if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
-            continue
-        w = spring_omega(c)
-        if w == 0.0:
-            continue
-        kind = "rotary-spring" if isinstance(c, pymunk.DampedRotarySpring) else "spring"
-        dt_max = SPRING_LIMIT / w
-        rows.append((Finding(kind, constraint_label(space, c), w * dt, SPRING_LIMIT,
-                             f"w = {w:.4g} rad/s: dt < {dt_max:.4g} s", dt_max),
-                     w * dt < SPRING_LIMIT))
-    return rows
-
-
-def _potential(space: Any, apart: set[tuple[int, int]]) -> float:
-    """The energy (J) a body could turn into speed: the springs' energy plus each dynamic
-    body's fall to the lowest level it can reach."""
-    import pymunk
-
-    e = energy(space)
-    g = math.hypot(*space.gravity)
-    down = (space.gravity[0] / g, space.gravity[1] / g) if g > 0 else (0.0, -1.0)
-    level = _level(space, down, apart) if g > 0 else None
-    potential = e.U_spring
-    if level is not None:
-        for b in space.bodies:
-            if b.body_type != pymunk.Body.DYNAMIC:
-                continue
-            r = b.local_to_world(b.center_of_gravity)
-            potential += b.mass * g * max(0.0, level - (r[0] * down[0] + r[1] * down[1]))
-    return potential
-
-
-def _closing_speeds(body: Any, own: list[Any], targets: list[Any],
-                    potential: float) -> tuple[float, float]:
-    """How fast (m/s) ``body``'s shapes ``own`` may close on the shapes ``targets``: from the
-    present motion, and from all the energy ``potential`` (J) turned into its speed. The
-    obstacles may move too (their present speed; a kinematic one keeps its speed whatever
-    the energy)."""
-    import pymunk
-
-    reach = max(_reach(body, s) for s in own)
-    moving = [_speed(s) for s in targets]
-    driven = [_speed(s) for s in targets if s.body.body_type == pymunk.Body.KINEMATIC]
-    v_state = body.velocity.length + abs(body.angular_velocity) * reach + max(moving)
-    v_energy = (math.sqrt(body.velocity.length**2 + 2.0 * potential / body.mass)
-                + max(driven, default=0.0))
-    return v_state, v_energy
-
-
-def _tunnelling(space: Any, dt: float, speeds: str,
-                apart: set[tuple[int, int]]) -> list[tuple[Finding, bool]]:
+def _tunnelling(sc: Scan, est: Estimates, dt: float, speeds: str, unit: str) -> list[Finding]:
     """Each dynamic body that can hit something: how far it may move in one step against
     half the thinnest shape it can hit plus half its own smallest one."""
-    import pymunk
-
-    shapes = list(space.shapes)
-    sizes = [shape_size(s) for s in shapes]
-    potential = _potential(space, apart)
-    rows: list[tuple[Finding, bool]] = []
-    for b in space.bodies:
-        if b.body_type != pymunk.Body.DYNAMIC:
+    idx = est.idx
+    if len(idx) == 0:
+        return []
+    everything = np.ones(len(sc.shapes), dtype=bool)
+    thinnest, _ = best_other(sc, sc.size, everything, idx, "min")
+    shape_speed = (np.hypot(sc.v[sc.owner, 0], sc.v[sc.owner, 1])
+                   + np.abs(sc.w[sc.owner]) * sc.reach)
+    fastest, _ = best_other(sc, shape_speed, everything, idx, "max")
+    own_size = np.full(len(sc.bodies), np.inf)
+    solid = ~sc.sensor
+    np.minimum.at(own_size, sc.owner[solid], sc.size[solid])
+    rows = []
+    for k, i in enumerate(idx):
+        if not np.isnan(est.region[k]).any():
+            # A held body meets only what lies within its joint's reach.
+            near = hittable_in(sc, int(i), est.region[k])
+            thinnest[k] = sc.size[near].min() if len(near) else np.nan
+            fastest[k] = shape_speed[near].max() if len(near) else 0.0
+        if math.isnan(thinnest[k]):
             continue
-        own = [i for i, s in enumerate(shapes) if s.body is b]
-        targets = [j for j, o in enumerate(shapes)
-                   if any(_can_hit(shapes[i], o, apart) for i in own)]
-        if not targets:
-            continue
-        thinnest = min(sizes[j] for j in targets)
-        limit = 0.5 * thinnest + 0.5 * min(sizes[i] for i in own)
-        v_state, v_energy = _closing_speeds(b, [shapes[i] for i in own],
-                                            [shapes[j] for j in targets], potential)
+        limit = 0.5 * thinnest[k] + 0.5 * own_size[int(i)]
+        v_state = float(est.now[k] + fastest[k])
+        v_energy = float(est.points[k])
         v = {"state": v_state, "energy": v_energy, "both": max(v_state, v_energy)}[speeds]
         if v == 0.0 or limit == 0.0:
             continue
+        if speeds == "state" or (speeds == "both" and v_state >= v_energy):
+            why = "its speed now plus the fastest thing it can hit"
+        else:
+            why = est.source[k]
         dt_max = limit / v
-        source = "from energy" if (speeds == "energy" or
-                                   (speeds == "both" and v_energy > v_state)) else "now"
-        rows.append((Finding("tunnelling", body_label(space, b), v * dt, limit,
-                             f"{v:.4g} m/s ({source}) moves {v * dt:.3g} m per step; "
-                             f"dt < {dt_max:.4g} s", dt_max), v * dt < limit))
+        fix = (f"closes at up to {v:.4g} {unit}/s ({why}): {v * dt:.3g} {unit} per step "
+               f"against half the thinnest shape it can hit plus half its own, "
+               f"{limit:.3g} {unit}; dt < {dt_max:.4g} s")
+        rows.append(Finding("tunnelling", sc.label(int(i)), v * dt, float(limit), fix,
+                            dt_max, "<", unit))
     return rows
 
 
-def _contact_settings(space: Any, apart: set[tuple[int, int]]) -> list[tuple[Finding, bool]]:
+def _contact_settings(sc: Scan, dt: float, unit: str) -> list[Finding]:
     """The collision slop against the smallest shape, and the collision bias where elastic
     shapes can touch. Slop and bias act only where shapes can touch."""
-    shapes = list(space.shapes)
-    contacts = any(_can_hit(a, b, apart) for i, a in enumerate(shapes) for b in shapes[i + 1:])
-    if not (shapes and contacts):
+    idx = sc.dynamic
+    everything = np.ones(len(sc.shapes), dtype=bool)
+    if len(idx) == 0 or np.isnan(best_other(sc, sc.size, everything, idx, "min")[0]).all():
         return []
-    rows: list[tuple[Finding, bool]] = []
-    smallest = min(shape_size(s) for s in shapes)
-    if smallest > 0:
-        slop_limit = SLOP_FRACTION * smallest
-        rows.append((Finding("slop", "space.collision_slop", space.collision_slop,
-                             slop_limit, f"smallest shape {smallest:.3g}: set "
-                             f"space.collision_slop = {SLOP_SUGGESTED * smallest:.3g}"),
-                     space.collision_slop <= slop_limit))
-    elastic = any(s.elasticity > 0 and o.elasticity > 0 for s in shapes for o in shapes
-                  if _can_hit(s, o, apart))
-    if elastic:
-        bias = space.collision_bias
-        rows.append((Finding("bias", "space.collision_bias", bias, 1.0,
-                             "elastic contacts: set space.collision_bias = 1.0 (no "
-                             "position correction, which adds energy) if energy matters"),
-                     bias >= 1.0))
+    space = sc.space
+    solid = ~sc.sensor & (sc.size > 0)
+    rows: list[Finding] = []
+    if solid.any():
+        smallest = float(sc.size[solid].min())
+        limit = SLOP_FRACTION * smallest
+        fix = (f"slop is the overlap pymunk leaves between touching shapes: more than a "
+               f"tenth of the smallest shape ({smallest:.3g} {unit}) lets resting shapes sink "
+               f"visibly into each other; set space.collision_slop = "
+               f"{SLOP_SUGGESTED * smallest:.3g} {unit}, a hundredth of it: the sinking is "
+               f"then too small to see, and a slop above 0 keeps resting contacts from "
+               f"breaking and re-forming every step")
+        rows.append(Finding("slop", "space.collision_slop", float(space.collision_slop),
+                            limit, fix, None, "<=", unit))
+    e_body = np.zeros(len(sc.bodies))
+    np.maximum.at(e_body, sc.owner[~sc.sensor], sc.elasticity[~sc.sensor])
+    elastic_shapes = sc.elasticity > 0
+    hit, _ = best_other(sc, sc.elasticity, elastic_shapes, idx, "max")
+    if ((e_body[idx] > 0) & ~np.isnan(hit)).any():
+        bias = float(space.collision_bias)
+        per_step = 1.0 - bias**dt if 0 <= bias <= 1 else math.nan
+        fix = (f"pymunk pushes overlapping shapes apart, a fraction 1 - bias^dt of the overlap "
+               f"each step ({per_step:.3g} at this dt); the push adds energy at elastic "
+               "contacts: set space.collision_bias = 1.0 (no push) if energy matters; shapes "
+               "that overlap then stay overlapped")
+        rows.append(Finding("bias", "space.collision_bias", bias, 1.0, fix, None, ">="))
     return rows
 
 
-def check(space: Any, dt: float, speeds: str = "both") -> list[Finding]:
-    """The checks that fail at step ``dt`` (s): each a :class:`Finding` with its fix."""
-    return [f for f, ok in survey(space, dt, speeds) if not ok]
+@dataclass(frozen=True)
+class _Advice:
+    rows: list[Finding]
+    dt: float
+    substeps: int | None
+    tightest: Finding | None
+    tolerance: float
+    swing: float | None
+    unit: str
 
 
-def substeps(space: Any, dt: float, speeds: str = "both") -> int:
-    """The fewest whole sub-steps of ``dt`` (s) that clear every finding a step can clear."""
-    space, dt, speeds = _check(space, dt, speeds)
-    limits = [f.dt_max for f in check(space, dt, speeds) if f.dt_max is not None]
-    if not limits:
-        return 1
-    ratio = dt / min(limits)
-    if not ratio < MAX_STEPS:
-        raise UsageError(f"dt = {dt:g}: clearing the guard's findings would take more than "
-                         f"{MAX_STEPS:,} sub-steps of it; take a smaller dt", param="dt")
-    return math.floor(ratio) + 1
+def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
+    """Every check at ``dt`` and the sub-steps that clear the ones a step can clear."""
+    sc = scan(space)
+    problem = state_problem(sc)
+    if problem is not None:
+        who, what, value = problem
+        return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
+                       None, tolerance, None, unit)
+    est = estimate(sc, dt, unit)
+    rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance)
+            + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
+    failing = [f for f in rows if not f.ok and f.dt_max is not None]
+    tightest = min(failing, key=lambda f: f.dt_max) if failing else None
+    n: int | None = 1
+    if tightest is not None:
+        ratio = dt / tightest.dt_max if tightest.dt_max > 0 else math.inf
+        n = math.floor(ratio) + 1 if ratio < MAX_STEPS else None
+    ws = [f.value / dt for f in rows if f.kind in ("spring", "rotary-spring", "spring-network")]
+    swing = (energy_swing(max(ws) * dt / n) if ws and n is not None and math.isfinite(max(ws))
+             else None)
+    return _Advice(rows, dt, n, tightest, tolerance, swing, unit)
 
 
-def suggest_dt(space: Any, dt: float, speeds: str = "both") -> float:
+def _refuse(advice: _Advice) -> int:
+    """The sub-steps, or a DumbbellError when no step can be suggested: a state no step
+    fixes (naming the body and the value), or more than :data:`MAX_STEPS` sub-steps."""
+    for f in advice.rows:
+        if f.kind == "state":
+            raise UsageError(f"space: {f.subject}: {f.fix}", param="space")
+    if advice.substeps is None:
+        t = advice.tightest
+        raise UsageError(f"dt = {advice.dt:g}: clearing the guard's findings would take more "
+                         f"than {MAX_STEPS:,} sub-steps of it ({t.kind} of {t.subject}: needs "
+                         f"dt < {t.dt_max:.3g} s); take a smaller dt or change what makes it "
+                         "so fast or stiff", param="dt")
+    return advice.substeps
+
+
+def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
+           units: str | None = None) -> list[tuple[Finding, bool]]:
+    """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
+    ``speeds``: 'state' (the present speeds), 'energy' (the reach estimates) or 'both' (the
+    larger); ``tolerance``: the largest energy swing of a spring's step (a fraction;
+    math.inf for stability only); ``units``: the space's length unit for the messages."""
+    space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
+    return [(f, f.ok) for f in _advise(space, dt, speeds, tolerance, unit).rows]
+
+
+def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
+          units: str | None = None) -> list[Finding]:
+    """The checks that fail at step ``dt`` (s): each a :class:`Finding` with its fix (see
+    :func:`survey` for the arguments)."""
+    return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok]
+
+
+def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
+             units: str | None = None) -> int:
+    """The fewest whole sub-steps of ``dt`` (s) that clear every finding a step can clear (see
+    :func:`survey` for the arguments). A space in a state no step fixes (a NaN, a body without
+    a mass) is refused."""
+    space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
+    return _refuse(_advise(space, dt, speeds, tolerance, unit))
+
+
+def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
+               units: str | None = None) -> float:
     """A step (s) that clears every finding a step can clear: ``dt`` divided into the fewest
-    whole sub-steps (so frames at ``dt`` stay whole); ``dt`` itself when nothing fails."""
-    space, dt, speeds = _check(space, dt, speeds)
-    return dt / substeps(space, dt, speeds)
+    whole sub-steps (so frames at ``dt`` stay whole); ``dt`` itself when nothing fails. The
+    springs' energy swing at it is at most ``tolerance``; :func:`report` says what it is."""
+    space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
+    return dt / _refuse(_advise(space, dt, speeds, tolerance, unit))
 
 
-def report(space: Any, dt: float, speeds: str = "both") -> str:
-    """The guard's report as text: every check with ok or its fix, and the suggestion."""
-    space, dt, speeds = _check(space, dt, speeds)
-    rows = survey(space, dt, speeds)
-    lines = [f"step-size guard at dt = {dt:g} s:"]
-    for f, ok in rows:
-        mark = "ok  " if ok else "FAIL"
-        lines.append(f"  {mark} {f.kind:13s} {f.subject:22s} {f.value:10.4g} (limit "
-                     f"{f.limit:.4g}){'' if ok else '; ' + f.fix}")
-    n = substeps(space, dt, speeds)
-    if n > 1:
-        lines.append(f"  suggested: {n} sub-steps of dt, dt = {dt / n:.4g} s")
-    elif any(not ok for _, ok in rows):
-        lines.append("  the step is fine; the failures are settings")
+def _line(f: Finding) -> str:
+    mark = "ok  " if f.ok else "FAIL"
+    shown = f.comparison()
+    fix = "" if f.ok else (f"; {f.fix}" if shown else f.fix)
+    return f"  {mark} {f.kind:14s} {f.subject:22s} {shown}{fix}"
+
+
+def _summary(kind: str, rows: list[Finding], ok: bool) -> str:
+    """One line for the rows of ``kind`` beyond the ones listed."""
+    mark = "ok  " if ok else "FAIL"
+    worst = max(rows, key=lambda f: f.value / f.limit if f.limit else math.inf)
+    what = "passed; the closest to its limit" if ok else "failed; the farthest past it"
+    return f"  {mark} {kind:14s} {len(rows)} more {what}: {worst.subject}, {worst.comparison()}"
+
+
+def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
+           units: str | None = None) -> str:
+    """The guard's report as text: every check with ok or its fix (a kind with many rows
+    lists the first few and sums up the rest), the suggestion and its reason, and the springs'
+    energy swing at the suggested step."""
+    space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
+    advice = _advise(space, dt, speeds, tolerance, unit)
+    named = (f"lengths in {unit}" if units is not None
+             else "lengths in the space's own units: pass units='m' or 'px' to name them")
+    tol = ("stability only" if math.isinf(tolerance)
+           else f"energy swing of springs under {_percent(tolerance)}")
+    lines = [f"step-size guard at dt = {dt:g} s ({named}; {tol}):"]
+    kinds: dict[str, list[Finding]] = {}
+    for f in advice.rows:
+        kinds.setdefault(f.kind, []).append(f)
+    for kind, rows in kinds.items():
+        for ok in (False, True):
+            these = [f for f in rows if f.ok == ok]
+            lines += [_line(f) for f in these[:SHOWN]]
+            if len(these) > SHOWN:
+                lines.append(_summary(kind, these[SHOWN:], ok))
+    n = advice.substeps
+    swing = ("" if advice.swing is None else
+             f"; the springs' energy swing at it: at most {_percent(advice.swing)}")
+    if any(f.kind == "state" for f in advice.rows):
+        lines.append("  no step is suggested: fix the state first")
+    elif n is None:
+        t = advice.tightest
+        lines.append(f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
+                     f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of dt")
+    elif n > 1:
+        t = advice.tightest
+        lines.append(f"  suggested: {n} sub-steps of dt, dt = {dt / n:.4g} s, for {t.kind} of "
+                     f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
+    elif any(not f.ok for f in advice.rows):
+        lines.append(f"  the step is fine; the failures are settings{swing}")
     else:
-        lines.append("  nothing to fix")
+        lines.append(f"  nothing to fix{swing}")
     return "\n".join(lines)
 
 
@@ -412,16 +504,16 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
 
 class Driver:
     """Steps a space at a fixed frame step ``dt`` (s) in whole sub-steps: ``substeps`` given,
-    or None for the guard's suggestion at the start. ``t`` (s) counts whole frames, so it does
-    not drift with rounding."""
+    or None for the guard's suggestion at the start (``speeds`` and ``tolerance`` as in
+    :func:`survey`). ``t`` (s) counts whole frames, so it does not drift with rounding."""
 
     def __init__(self, space: Any, dt: float, substeps: int | None = None,
-                 speeds: str = "both") -> None:
-        self.space, self.dt, speeds = _check(space, dt, speeds)
+                 speeds: str = "both", tolerance: float = TOLERANCE) -> None:
+        self.space, self.dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance)
         if substeps is None:
-            substeps = globals()["substeps"](space, self.dt, speeds)
+            substeps = _refuse(_advise(self.space, self.dt, speeds, tolerance, unit))
         self.substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
-        self.h = self.dt / substeps
+        self.h = self.dt / self.substeps
         self.frames = 0
 
     @property
@@ -437,3 +529,4 @@ class Driver:
         for _ in range(frames * self.substeps):
             step_(h)
         self.frames += frames
+
