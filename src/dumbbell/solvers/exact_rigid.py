@@ -53,18 +53,12 @@ from ..model.energy import (
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
 from . import base
+from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, HeightPoint, at_rest
 from .base import SearchBudget, impact_budget_reason
-from .exact import HeightPoint
 
 #: The public API: the first impact in closed form; the rest serves the exact solver.
 __all__ = ["first_impact_state"]
 
-#: Root tolerance for impact times (s).
-ROOT_XTOL = 1e-14
-#: Intervals shorter than this (s) are not split further.
-MIN_SPLIT = 1e-13
-#: An impact slower than this (m/s) means the end has come to rest on the floor.
-REST_SPEED = 1e-9
 #: Rounds of impulses for ends that hit together.
 MAX_ROUNDS = 100
 
@@ -188,10 +182,7 @@ class RigidBody:
                 if v >= 0:
                     continue
                 if abs(v) < REST_SPEED:
-                    return s, events, Verdict(
-                        "failed", s.t,
-                        f"{b} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
-                        "inelastic floor has infinitely many impacts in finite time here")
+                    return s, events, at_rest(b, s.t, v)
                 s = self.impulse(s, b, e)
                 after = self.vertical_velocity(s, b)
                 events.append(Impact(s.t, b, v, after,
