@@ -177,14 +177,14 @@ def test_kernel_brentq_is_scipys_brentq(kernels, textbook):
             hi = root + 10.0 ** rng.uniform(-9, -2.5)
             if not (height(lo) > 0 > height(hi)):
                 continue
-            ours, ok = kernels._brentq(row, body, lo, hi, m)
+            ours, ok = kernels.brentq_fall((row, body, m), lo, hi, 1e-14)
             theirs = brentq(height, lo, hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
             assert ok and ours.hex() == theirs.hex(), (lo, hi)
             checked += 1
     assert checked > 200
     # No sign change: scipy refuses, and so does the kernel.
     row = np.array([0.0, 1.1, 0.0, 0.0, 0.0])
-    assert not kernels._brentq(row, 1, 0.0, 0.1, m)[1]
+    assert not kernels.brentq_fall((row, 1, m), 0.0, 0.1, 1e-14)[1]
 
 
 @pytest.mark.parametrize("k", [200.0, 0.0])

@@ -30,3 +30,12 @@ def at_rest(body: str, t: float, v: float) -> Verdict:
     return Verdict("failed", t,
                    f"{body} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
                    "inelastic floor has infinitely many impacts in finite time here")
+
+
+def search_failed(t: float) -> RuntimeError:
+    """The error of an impact search that could not go on in the segment starting at ``t``
+    (s): a non-finite height, or Brent's method without a sign change or convergence (where
+    scipy's ``brentq`` raises)."""
+    return RuntimeError(f"the impact search failed in the segment from t = {t:g} s: a "
+                        "non-finite height, or Brent's method found no sign change or did not "
+                        "converge")

@@ -23,6 +23,7 @@ time; the run stops there with the verdict ``failed`` and says so.
 from __future__ import annotations
 
 import functools
+import math
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -32,7 +33,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
-from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest
+from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_failed
 from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import conclude
 
@@ -70,11 +71,18 @@ def _motion(scene: Scene) -> Any:
 
 
 @functools.cache
-def _kernels() -> Any:
-    """The compiled kernels (:mod:`~dumbbell.solvers.kernels.exact`), compiled or loaded from
-    numba's cache on the first call in a process, with a small run of each."""
+def _kernels(rigid: bool = False) -> Any:
+    """The compiled kernels (:mod:`~dumbbell.solvers.kernels.exact`) of the 1D solution, or
+    with ``rigid`` of the rigid dumbbell's flight (:mod:`.exact_rigid`), compiled or loaded
+    from numba's cache on the first call in a process by a small run of each."""
     from .kernels import exact as kernels
 
+    if rigid:  # an end falling onto the floor, then sampled
+        end = kernels.End(0.1, 1.0, 0.0, 0.0, 9.8, 1.0)
+        kernels.end_contact(end, 0.0, 1.0, 0.05, 9.9, 0.1, ROOT_XTOL, MIN_SPLIT,
+                            np.array([0.0, math.inf]), 10)
+        kernels.rigid_sample(np.zeros((1, 7)), np.linspace(0.0, 1.0, 3), 0.1, -0.1, 9.8)
+        return kernels
     m = kernels.Motion(9.8, 63.0, 3969.0, 0.5, 0.5, 0.2, 1.0, ROOT_XTOL, MIN_SPLIT, REST_SPEED)
     segs = kernels.impacts(np.array([0.0, 1.1, 0.0, 0.0, 0.0]), m, 1.0, True, 10, 10**6, 10)[0]
     kernels.sample(segs, np.linspace(0.0, 1.0, 3), m)
@@ -82,10 +90,11 @@ def _kernels() -> Any:
 
 
 def warm_up() -> float:
-    """Compile (or load from numba's cache) the impact search and the sampling, once per
-    process; returns the seconds it took (about 0 once done)."""
+    """Compile (or load from numba's cache) the impact searches and the samplings, 1D and
+    rigid, once per process; returns the seconds it took (about 0 once done)."""
     t0 = time.perf_counter()
     _kernels()
+    _kernels(rigid=True)
     return time.perf_counter() - t0
 
 
@@ -135,8 +144,7 @@ def _segments(scene: Scene, t_end: float) -> tuple[np.ndarray, list[Impact], Ver
         if status == kernels.OVER_BUDGET:
             SearchBudget(work_limit).spend(int(work))  # raises OverBudget, with its reason
         if status == kernels.ROOT_FAILED:
-            raise RuntimeError(f"{scene.source}: the impact root search failed near "
-                               f"t = {float(rows[-1, 0]):g} s (a non-finite height?)")
+            raise search_failed(float(rows[-1, 0]))
         return blocks, events, Verdict()
 
     blocks, events, verdict = base.within_budget(search, lambda rows: float(rows[-1, 0]))
@@ -191,6 +199,7 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     from .exact_rigid import ROOT_XTOL as RIGID_XTOL
     from .exact_rigid import flight, sample
 
+    _kernels(rigid=True)  # compiled or loaded before the clock starts
     t0 = time.perf_counter()
     segs, events, verdict = flight(scene, options.t_end)
     t = options.sample_times()

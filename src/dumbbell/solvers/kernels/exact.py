@@ -135,21 +135,23 @@ def state(seg, tau, m):  # pragma: no cover
 
 @njit(cache=True, nogil=True)
 def _height(seg, body, tau, m):  # pragma: no cover
-    """Height (m) and vertical velocity (m/s) of ``body`` at one time, as the scalar
-    evaluation does (without a spring the rate is ``sd0`` itself)."""
-    X = seg[X0] + seg[V0] * tau - 0.5 * m.g * tau * tau
-    V = seg[V0] - m.g * tau
-    if m.w > 0:
-        cos = math.cos(m.w * tau)
-        sin = math.sin(m.w * tau)
-        s = seg[S0] * cos + (seg[SD0] / m.w) * sin
-        sd = -seg[S0] * m.w * sin + seg[SD0] * cos
-    else:
-        s = seg[S0] + seg[SD0] * tau
-        sd = seg[SD0]
-    if body == A:
-        return X + m.cA * (m.b + s), V + m.cA * sd
-    return X - m.cB * (m.b + s), V - m.cB * sd
+    """Height (m) and vertical velocity (m/s) of ``body`` at one time: :func:`state`'s. (The
+    scalar evaluation the search was written with differs without a spring, in the sign of a
+    zero rate, which no decision of the search can see.)"""
+    xA, vA, xB, vB = state(seg, tau, m)
+    return (xA, vA) if body == A else (xB, vB)
+
+
+@njit(cache=True, nogil=True)
+def _fall_point(args, tau):  # pragma: no cover
+    """:func:`_height` for the searches; ``args`` = (seg, body, m)."""
+    return _height(args[0], args[1], tau, args[2])
+
+
+@njit(cache=True, nogil=True)
+def _fall(args, tau):  # pragma: no cover
+    """The height (m) of :func:`_height`, for :func:`brentq_of`; ``args`` = (seg, body, m)."""
+    return _height(args[0], args[1], tau, args[2])[0]
 
 
 @njit(cache=True, nogil=True)
@@ -175,152 +177,195 @@ def _earliest(seg, body, m):  # pragma: no cover
     return gap / -V if V < 0 else math.inf
 
 
-@njit(cache=True, nogil=True)
-def _brentq(seg, body, xa, xb, m):  # pragma: no cover
-    """scipy's ``brentq`` (its C iteration, step for step) on the height of ``body`` over
-    [xa, xb], with xtol ``m.xtol`` and rtol 4 eps: (root, ok). Not ok where scipy raises: a NaN
-    height, no sign change, no convergence in 100 iterations."""
-    xtol, rtol = m.xtol, _BRENT_RTOL
-    xpre, xcur = xa, xb
-    xblk = 0.0
-    fblk = 0.0
-    spre = 0.0
-    scur = 0.0
-    fpre = _height(seg, body, xpre, m)[0]
-    if math.isnan(fpre):
-        return xpre, False
-    fcur = _height(seg, body, xcur, m)[0]
-    if math.isnan(fcur):
-        return xcur, False
-    if fpre == 0:
-        return xpre, True
-    if fcur == 0:
-        return xcur, True
-    if math.copysign(1.0, fpre) == math.copysign(1.0, fcur):
-        return 0.0, False
-    for _ in range(_BRENT_ITER):
-        if fpre != 0 and fcur != 0 and math.copysign(1.0, fpre) != math.copysign(1.0, fcur):
-            xblk = xpre
-            fblk = fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre = xcur
-            xcur = xblk
-            xblk = xpre
-            fpre = fcur
-            fcur = fblk
-            fblk = fpre
-        delta = (xtol + rtol * abs(xcur)) / 2
-        sbis = (xblk - xcur) / 2
-        if fcur == 0 or abs(sbis) < delta:
+def brentq_of(f):
+    """scipy's ``brentq`` (its C iteration, step for step) on ``f(args, x)``, compiled for this
+    one ``f`` (a function passed as an argument would keep numba from caching its callers):
+    ``brentq(args, xa, xb, xtol)`` is (root, ok), with rtol 4 eps; not ok where scipy raises
+    (a NaN value, no sign change, no convergence in 100 iterations)."""
+
+    @njit(cache=True, nogil=True)
+    def brentq(args, xa, xb, xtol):  # pragma: no cover
+        rtol = _BRENT_RTOL
+        xpre, xcur = xa, xb
+        xblk = 0.0
+        fblk = 0.0
+        spre = 0.0
+        scur = 0.0
+        fpre = f(args, xpre)
+        if math.isnan(fpre):
+            return xpre, False
+        fcur = f(args, xcur)
+        if math.isnan(fcur):
+            return xcur, False
+        if fpre == 0:
+            return xpre, True
+        if fcur == 0:
             return xcur, True
-        if abs(spre) > delta and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)  # extrapolate
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2 * abs(stry) < min(3 * abs(sbis) - delta, abs(spre)):  # C's MIN(|spre|, ...)
-                spre = scur  # a good short step
-                scur = stry
+        if math.copysign(1.0, fpre) == math.copysign(1.0, fcur):
+            return 0.0, False
+        for _ in range(_BRENT_ITER):
+            if fpre != 0 and fcur != 0 and math.copysign(1.0, fpre) != math.copysign(1.0, fcur):
+                xblk = xpre
+                fblk = fpre
+                spre = scur = xcur - xpre
+            if abs(fblk) < abs(fcur):
+                xpre = xcur
+                xcur = xblk
+                xblk = xpre
+                fpre = fcur
+                fcur = fblk
+                fblk = fpre
+            delta = (xtol + rtol * abs(xcur)) / 2
+            sbis = (xblk - xcur) / 2
+            if fcur == 0 or abs(sbis) < delta:
+                return xcur, True
+            if abs(spre) > delta and abs(fcur) < abs(fpre):
+                if xpre == xblk:
+                    stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
+                else:
+                    dpre = (fpre - fcur) / (xpre - xcur)  # extrapolate
+                    dblk = (fblk - fcur) / (xblk - xcur)
+                    stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+                if 2 * abs(stry) < min(3 * abs(sbis) - delta, abs(spre)):  # C's MIN(|spre|, ...)
+                    spre = scur  # a good short step
+                    scur = stry
+                else:
+                    spre = sbis
+                    scur = sbis
             else:
                 spre = sbis
                 scur = sbis
-        else:
-            spre = sbis
-            scur = sbis
-        xpre = xcur
-        fpre = fcur
-        if abs(scur) > delta:
-            xcur += scur
-        else:
-            xcur += delta if sbis > 0 else -delta
-        fcur = _height(seg, body, xcur, m)[0]
-        if math.isnan(fcur):
-            return xcur, False
-    return xcur, False
+            xpre = xcur
+            fpre = fcur
+            if abs(scur) > delta:
+                xcur += scur
+            else:
+                xcur += delta if sbis > 0 else -delta
+            fcur = f(args, xcur)
+            if math.isnan(fcur):
+                return xcur, False
+        return xcur, False
+
+    return brentq
+
+
+#: :func:`brentq_of` the falling particle's height (:func:`_fall`).
+brentq_fall = brentq_of(_fall)
+
+
+#: What an interval of a height search holds: no crossing, a crossing (found), or unknown.
+CLEARED, FOUND, SPLIT = 0, 1, 2
+
+
+def search_of(point, judge):
+    """The depth-first search of one suspect interval, compiled for one height curve:
+    ``point(args, tau)`` is (height, rate) at ``tau``; ``judge(args, lo, flo, dlo, hi, fhi,
+    dhi, C)`` says what [lo, hi] holds, as (:data:`CLEARED`, :data:`FOUND` or :data:`SPLIT`,
+    root, status). Unknown intervals are split at their middle, the left half searched first,
+    each split one unit of ``work`` = [spent, allowed]. ``search(args, lo, flo, dlo, hi, fhi,
+    dhi, C, work, stack)`` is (first root or inf, status)."""
+
+    @njit(cache=True, nogil=True)
+    def search(args, lo, flo, dlo, hi, fhi, dhi, C, work, stack):  # pragma: no cover
+        stack[0, 0], stack[0, 1], stack[0, 2] = lo, flo, dlo
+        stack[0, 3], stack[0, 4], stack[0, 5] = hi, fhi, dhi
+        top = 1
+        while top > 0:
+            top -= 1
+            lo, flo, dlo = stack[top, 0], stack[top, 1], stack[top, 2]
+            hi, fhi, dhi = stack[top, 3], stack[top, 4], stack[top, 5]
+            kind, root, status = judge(args, lo, flo, dlo, hi, fhi, dhi, C)
+            if kind == FOUND:
+                return root, status
+            if kind == CLEARED:
+                continue
+            work[0] += 1
+            if work[0] > work[1]:
+                return math.inf, OVER_BUDGET
+            if top + 2 > stack.shape[0]:
+                return math.inf, ROOT_FAILED
+            mid = 0.5 * (lo + hi)
+            fmid, dmid = point(args, mid)
+            # The right half waits below the left one.
+            stack[top, 0], stack[top, 1], stack[top, 2] = mid, fmid, dmid
+            stack[top, 3], stack[top, 4], stack[top, 5] = hi, fhi, dhi
+            stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = lo, flo, dlo
+            stack[top + 1, 3], stack[top + 1, 4], stack[top + 1, 5] = mid, fmid, dmid
+            top += 2
+        return math.inf, DONE
+
+    return search
+
+
+def scan_of(point, search):
+    """The scan for a first root, compiled for one height curve (``point`` and ``search`` as
+    for :func:`search_of`): ``scan(args, lo, stop, h, C, work, block_work, stack)`` walks
+    [lo, stop] in blocks of 64 intervals of ``h`` (``block_work`` units of ``work`` each),
+    clears an interval whose ends lie above the floor by more than its dip below the chord
+    (at most C h^2 / 8), searches the others in order, and returns the first root (or inf)
+    and a status. A block's points are evaluated as the scan reaches them: an interval's
+    verdict reads its two ends only, and the scan stops at the first root."""
+
+    @njit(cache=True, nogil=True)
+    def scan(args, lo, stop, h, C, work, block_work, stack):  # pragma: no cover
+        taus = np.empty(_BLOCK + 1)
+        fs = np.empty(_BLOCK + 1)
+        ds = np.empty(_BLOCK + 1)
+        while lo < stop:
+            work[0] += block_work
+            if work[0] > work[1]:
+                return math.inf, OVER_BUDGET
+            for k in range(_BLOCK + 1):
+                taus[k] = _np_min(lo + h * k, stop)
+                fs[k], ds[k] = point(args, taus[k])
+                if k == 0:
+                    continue
+                j = k - 1
+                width = taus[k] - taus[j]
+                lower = _np_min(fs[j], fs[k]) - C * width * width / 8.0
+                if lower <= 0 and width > 0:
+                    root, status = search(args, taus[j], fs[j], ds[j], taus[k], fs[k], ds[k],
+                                          C, work, stack)
+                    if status != DONE or root < math.inf:
+                        return root, status
+            lo = taus[_BLOCK]
+        return math.inf, DONE
+
+    return scan
 
 
 @njit(cache=True, nogil=True)
-def _search(seg, body, lo, flo, dlo, hi, fhi, dhi, C, m, work, stack):  # pragma: no cover
-    """First downward crossing of the floor in [lo, hi], or inf; depth first, left half first.
-    An interval is cleared (below its chord by at most C h^2/8), known to hold one crossing
-    (strictly decreasing: refined by brentq), given up below ``m.min_split``, or split.
-    Returns (root, status); each split spends one unit of ``work`` = [spent, limit]."""
-    top = 0
-    stack[0, 0], stack[0, 1], stack[0, 2] = lo, flo, dlo
-    stack[0, 3], stack[0, 4], stack[0, 5] = hi, fhi, dhi
-    top = 1
-    while top > 0:
-        top -= 1
-        lo, flo, dlo = stack[top, 0], stack[top, 1], stack[top, 2]
-        hi, fhi, dhi = stack[top, 3], stack[top, 4], stack[top, 5]
-        width = hi - lo
-        if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
-            continue
-        if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
-            root, ok = _brentq(seg, body, lo, hi, m)
-            return root, DONE if ok else ROOT_FAILED
-        if width < m.min_split:
-            if fhi <= 0:
-                return hi, DONE
-            continue
-        work[0] += 1
-        if work[0] > work[1]:
-            return math.inf, OVER_BUDGET
-        if top + 2 > stack.shape[0]:
-            return math.inf, ROOT_FAILED
-        mid = 0.5 * (lo + hi)
-        fmid, dmid = _height(seg, body, mid, m)
-        # The right half waits below the left one.
-        stack[top, 0], stack[top, 1], stack[top, 2] = mid, fmid, dmid
-        stack[top, 3], stack[top, 4], stack[top, 5] = hi, fhi, dhi
-        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = lo, flo, dlo
-        stack[top + 1, 3], stack[top + 1, 4], stack[top + 1, 5] = mid, fmid, dmid
-        top += 2
-    return math.inf, DONE
+def _fall_judge(args, lo, flo, dlo, hi, fhi, dhi, C):  # pragma: no cover
+    """What [lo, hi] holds of the particle's downward crossing (``args`` = (seg, body, m)):
+    cleared (above the floor by more than the dip C h^2/8), one crossing (strictly
+    decreasing, as min(rate) + C h < 0 proves: refined by Brent's method), or, below
+    ``m.min_split``, a crossing at ``hi`` if it is at or below the floor."""
+    width = hi - lo
+    if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
+        return CLEARED, math.inf, DONE
+    if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
+        root, ok = brentq_fall(args, lo, hi, args[2].xtol)
+        return FOUND, root, DONE if ok else ROOT_FAILED
+    if width < args[2].min_split:
+        return (FOUND, hi, DONE) if fhi <= 0 else (CLEARED, math.inf, DONE)
+    return SPLIT, math.inf, DONE
+
+
+_fall_scan = scan_of(_fall_point, search_of(_fall_point, _fall_judge))
 
 
 @njit(cache=True, nogil=True)
 def first_root(seg, body, start, stop, m, work, block_work, stack):  # pragma: no cover
     """First time in (start, stop] (s after the segment's start) at which ``body`` crosses the
-    floor going down, or inf, and a status: blocks of 64 intervals of a sixteenth of a period
-    (at most 0.05 s) from the earliest possible time (``block_work`` units of ``work`` each),
-    scanned in order, each suspect interval searched (:func:`_search`)."""
+    floor going down, or inf, and a status: the scan (:func:`scan_of`) in steps of a
+    sixteenth of a period (at most 0.05 s) from the earliest possible time."""
     S = amplitude(seg, m)
     c = m.cB if body == B else m.cA
     C = m.g + (c * m.w2 * S if m.w > 0 else 0.0)
     period = 2 * math.pi / m.w if m.w > 0 else math.inf
     h = min(period / 16.0, 0.05)
-    earliest = _earliest(seg, body, m)
-    a = max(start, earliest)
-    taus = np.empty(_BLOCK + 1)
-    fs = np.empty(_BLOCK + 1)
-    ds = np.empty(_BLOCK + 1)
-    points = _BLOCK + 1
-    while a < stop:
-        work[0] += block_work
-        if work[0] > work[1]:
-            return math.inf, OVER_BUDGET
-        # The block's points are evaluated as the scan reaches them: an interval's verdict
-        # reads its two ends only, and the scan stops at the first root.
-        for k in range(points):
-            taus[k] = _np_min(a + h * k, stop)
-            xA, vA, xB, vB = state(seg, taus[k], m)
-            fs[k], ds[k] = (xA, vA) if body == A else (xB, vB)
-            if k == 0:
-                continue
-            j = k - 1
-            width = taus[k] - taus[j]
-            lower = _np_min(fs[j], fs[k]) - C * width * width / 8.0
-            if lower <= 0 and width > 0:
-                root, status = _search(seg, body, taus[j], fs[j], ds[j], taus[k], fs[k], ds[k],
-                                       C, m, work, stack)
-                if status != DONE or root < math.inf:
-                    return root, status
-        a = taus[points - 1]
-    return math.inf, DONE
+    a = max(start, _earliest(seg, body, m))
+    return _fall_scan((seg, body, m), a, stop, h, C, work, block_work, stack)
 
 
 @njit(cache=True, nogil=True)
@@ -424,4 +469,122 @@ def sample(segs, t, m):  # pragma: no cover
         while k < last and segs[k + 1, T0] <= t[i]:
             k += 1
         out[0, i], out[1, i], out[2, i], out[3, i] = state(segs[k], t[i] - segs[k, T0], m)
+    return out
+
+
+# --- the rigid 2D dumbbell (:mod:`dumbbell.solvers.exact_rigid`) ----------------------------
+
+
+class End(NamedTuple):
+    """One end of the rigid dumbbell over one segment, as its height search reads it."""
+
+    arm: float  #: signed arm a (m): the end's height is Y + a sin(theta)
+    omega: float  #: angular velocity (rad/s)
+    theta: float  #: axis angle at the segment's start (rad)
+    VY: float  #: vertical velocity of the centre of mass at the start (m/s)
+    g: float  #: gravitational acceleration (m/s^2)
+    h0: float  #: the end's height at the start (m)
+
+
+@njit(cache=True, nogil=True)
+def end_height(end, tau):  # pragma: no cover
+    """Height (m) and vertical velocity (m/s) of the end ``end`` at ``tau`` (s) after the
+    segment's start, relative to its start: ``a (sin(theta) - sin(theta0))`` written as
+    ``2 a cos(theta0 + w tau / 2) sin(w tau / 2)``."""
+    a, w, theta, VY, g, h0 = end
+    half = 0.5 * w * tau
+    y = (h0 + VY * tau - 0.5 * g * tau * tau
+         + 2.0 * a * math.cos(theta + half) * math.sin(half))
+    return y, VY - g * tau + a * w * math.cos(theta + w * tau)
+
+
+@njit(cache=True, nogil=True)
+def _end_point(args, tau):  # pragma: no cover
+    """:func:`end_height` for the searches; ``args`` = (end, D, xtol, min_split)."""
+    return end_height(args[0], tau)
+
+
+@njit(cache=True, nogil=True)
+def _end_y(end, tau):  # pragma: no cover
+    """The height of :func:`end_height`, for :func:`brentq_of`."""
+    return end_height(end, tau)[0]
+
+
+@njit(cache=True, nogil=True)
+def _end_v(end, tau):  # pragma: no cover
+    """The vertical velocity of :func:`end_height`, for :func:`brentq_of`."""
+    return end_height(end, tau)[1]
+
+
+_brentq_end_y = brentq_of(_end_y)
+_brentq_end_v = brentq_of(_end_v)
+
+
+@njit(cache=True, nogil=True)
+def _end_judge(args, lo, flo, dlo, hi, fhi, dhi, C):  # pragma: no cover
+    """What [lo, hi] holds of the end's first contact, moving down (``args`` = (end, D, xtol,
+    min_split)): as :func:`_fall_judge`, and besides: an end already at the floor moving down
+    at ``lo`` touches there; an interval on which the height is provably convex
+    (``|y'''| <= D``) and the velocity changes sign holds one minimum, found as the root of
+    the velocity, and the end touches the floor iff that minimum is <= 0."""
+    end, D, xtol, min_split = args
+    if flo <= 0 and dlo < 0:
+        return FOUND, lo, DONE  # at the floor moving down already (see exact_rigid)
+    width = hi - lo
+    if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
+        return CLEARED, math.inf, DONE
+    if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
+        root, ok = _brentq_end_y(end, lo, hi, xtol)
+        return FOUND, root, DONE if ok else ROOT_FAILED
+    if flo > 0 and fhi > 0 and dlo < 0 < dhi and (dhi - dlo) - D * width * width / 4 > 0:
+        t_min, ok = _brentq_end_v(end, lo, hi, xtol)
+        if not ok:
+            return FOUND, t_min, ROOT_FAILED
+        if end_height(end, t_min)[0] > 0:
+            return CLEARED, math.inf, DONE
+        root, ok = _brentq_end_y(end, lo, t_min, xtol)
+        return FOUND, root, DONE if ok else ROOT_FAILED
+    if width < min_split:
+        return (FOUND, hi, DONE) if flo > 0 and fhi <= 0 else (CLEARED, math.inf, DONE)
+    return SPLIT, math.inf, DONE
+
+
+_end_scan = scan_of(_end_point, search_of(_end_point, _end_judge))
+
+
+@njit(cache=True, nogil=True)
+def end_contact(end, lo, stop, h, C, D, xtol, min_split, work, block_work):  # pragma: no cover
+    """First time in [lo, stop] (s after the segment's start) at which ``end`` reaches the
+    floor moving down, or inf, and a status: the scan (:func:`scan_of`) in steps of ``h``,
+    ``C`` and ``D`` bounds on the height's second and third derivatives."""
+    return _end_scan((end, D, xtol, min_split), lo, stop, h, C, work, block_work,
+                     np.empty((_STACK, 6)))
+
+
+@njit(cache=True, nogil=True)
+def rigid_sample(segs, t, arm_a, arm_b, g):  # pragma: no cover
+    """xA, yA, vxA, vyA, xB, yB, vxB, vyB (m, m/s) and omega (rad/s), as rows, at the sorted
+    times ``t`` (s), each from the last segment (rows t, X, Y, VX, VY, theta, omega) that
+    starts at or before it (the first for earlier times)."""
+    out = np.empty((9, t.shape[0]))
+    k = 0
+    last = segs.shape[0] - 1
+    for i in range(t.shape[0]):
+        while k < last and segs[k + 1, 0] <= t[i]:
+            k += 1
+        t0, X0, Y0, VX, VY0, theta0, omega = segs[k, 0], segs[k, 1], segs[k, 2], \
+            segs[k, 3], segs[k, 4], segs[k, 5], segs[k, 6]
+        tau = t[i] - t0
+        X = X0 + VX * tau
+        Y = Y0 + VY0 * tau - 0.5 * g * tau * tau
+        VY = VY0 - g * tau
+        th = theta0 + omega * tau
+        cos = math.cos(th)
+        sin = math.sin(th)
+        for row, a in ((0, arm_a), (4, arm_b)):
+            out[row, i] = X + a * cos
+            out[row + 1, i] = Y + a * sin
+            out[row + 2, i] = VX - omega * a * sin + 0.0 * tau
+            out[row + 3, i] = VY + omega * a * cos
+        out[8, i] = omega
     return out
