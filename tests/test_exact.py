@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 from dumbbell import simulate
+from dumbbell.model.scene import load_scene
 from dumbbell.solvers.exact import segments
-from tests.conftest import make_scene
+from dumbbell.solvers.exact_rigid import flight
+from tests.conftest import SCENES, make_scene
 
 
 def test_first_impact_at_the_free_fall_time(textbook):
@@ -215,23 +217,50 @@ def test_kernel_samples_are_the_closed_form_as_numpy_evaluates_it(kernels, k):
         assert np.array_equal(got[c], want[c]), c
 
 
-def test_the_compiled_search_gives_the_floats_of_its_source_run_by_python(textbook):
+def test_rigid_samples_are_the_closed_form_as_numpy_evaluates_it(kernels):
+    rng = np.random.default_rng(4)
+    starts = np.sort(rng.uniform(0, 5, 6))
+    starts[0] = 0.0
+    rows = np.column_stack([starts, *(rng.uniform(-3, 3, (6, 6)).T)])  # t X Y VX VY theta omega
+    t = np.sort(rng.uniform(0, 6, 2000))
+    arm_a, arm_b, g = 0.12, -0.08, 9.8
+    got = kernels.rigid_sample(rows, t, arm_a, arm_b, g)
+    owner = np.searchsorted(starts, t, side="right") - 1
+    t0, X0, Y0, VX, VY0, theta, omega = (rows[owner, c] for c in range(7))
+    tau = t - t0
+    X, Y = X0 + VX * tau, Y0 + VY0 * tau - 0.5 * g * tau * tau
+    VY = VY0 - g * tau
+    cos, sin = np.cos(theta + omega * tau), np.sin(theta + omega * tau)
+    want = [col for a in (arm_a, arm_b) for col in (
+        X + a * cos, Y + a * sin, VX - omega * a * sin + 0.0 * tau, VY + omega * a * cos)]
+    for c in range(8):
+        assert np.array_equal(got[c], want[c]), c
+    assert np.array_equal(got[8], omega)
+
+
+def test_the_compiled_searches_give_the_floats_of_their_source_run_by_python(textbook):
     # The same kernels interpreted by Python (numba disabled): math.cos, math.sqrt and float
-    # arithmetic in the source's order. Compiling must not change one bit of an impact.
+    # arithmetic in the source's order. Compiling must not change one bit of an impact, in 1D
+    # or for the rigid dumbbell.
+    rigid = load_scene(SCENES / "rigid-2d.toml")
     code = ("import json; from dumbbell.model.scene import load_scene; "
             "from dumbbell.solvers.exact import segments; "
+            "from dumbbell.solvers.exact_rigid import flight; "
             "from tests.test_exact import _hexed; "
-            f"print(json.dumps(_hexed(segments(load_scene({str(textbook.source)!r}), 2.5))))")
+            f"print(json.dumps([_hexed(segments(load_scene({str(textbook.source)!r}), 2.5)), "
+            f"_hexed(flight(load_scene({str(rigid.source)!r}), 4.0))]))")
     interpreted = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                                  check=True, cwd=Path(__file__).parent.parent,
                                  env={**os.environ, "NUMBA_DISABLE_JIT": "1"}).stdout
-    compiled = _hexed(segments(textbook, 2.5))
-    assert len(compiled) > 8 and json.loads(interpreted) == compiled
+    compiled = [_hexed(segments(textbook, 2.5)), _hexed(flight(rigid, 4.0))]
+    assert len(compiled[0]) > 8 and len(compiled[1]) > 8
+    assert json.loads(interpreted) == compiled
 
 
 def _hexed(found):
-    """Segments, impacts and verdict of :func:`segments` as exact strings (floats in hex)."""
+    """Segments, impacts and verdict of a search as exact strings (floats in hex)."""
     segs, events, verdict = found
     return ([[x.hex() for x in vars(g).values()] for g in segs]
-            + [[i.t.hex(), i.body, i.v_before.hex(), i.v_after.hex()] for i in events]
+            + [[i.t.hex(), i.body, i.v_before.hex(), i.v_after.hex(), repr(i.heat)]
+               for i in events]
             + [str(verdict)])

@@ -17,6 +17,9 @@ of these heights, found by a search that cannot miss one, grazing touches includ
   that minimum is <= 0 (a graze at 1e-7 m/s is found; a miss by 1e-9 m is not);
 - anything else is split in two, down to 1e-13 s.
 
+The search and the sampling run compiled with numba (:mod:`.kernels.exact`), with the floats
+of the same arithmetic in Python and numpy, and of scipy's ``brentq``, bit for bit.
+
 Heights are computed relative to the segment's start, ``a (sin(theta) - sin(theta0)) =
 2 a cos(theta0 + omega tau / 2) sin(omega tau / 2)``, and the end that just hit the floor starts
 its segment at height 0 exactly, so that a slow rebound is not lost to rounding. Impacts follow
