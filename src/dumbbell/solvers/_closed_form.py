@@ -34,8 +34,8 @@ def at_rest(body: str, t: float, v: float) -> Verdict:
 
 def search_failed(t: float) -> RuntimeError:
     """The error of an impact search that could not go on in the segment starting at ``t``
-    (s): a non-finite height, or Brent's method without a sign change or convergence (where
-    scipy's ``brentq`` raises)."""
+    (s): a non-finite height, a bracket Brent's method could not solve (where scipy's
+    ``brentq`` raises), or no answer within a run's whole search budget."""
     return RuntimeError(f"the impact search failed in the segment from t = {t:g} s: a "
-                        "non-finite height, or Brent's method found no sign change or did not "
-                        "converge")
+                        "non-finite height, a bracket Brent's method could not solve, or no "
+                        "answer within the search's budget")

@@ -196,7 +196,6 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     """The rigid 2D dumbbell in closed form (:mod:`.exact_rigid`) at the sample times (s)."""
     from ..model.energy import rigid_moment
-    from .exact_rigid import ROOT_XTOL as RIGID_XTOL
     from .exact_rigid import flight, sample
 
     _kernels(rigid=True)  # compiled or loaded before the clock starts
@@ -209,7 +208,7 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     wall = time.perf_counter() - t0
     return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
                     wall_time=wall, truth=True,
-                    info={"segments": len(segs), "root_xtol": RIGID_XTOL,
+                    info={"segments": len(segs), "root_xtol": ROOT_XTOL,
                           "moment": rigid_moment(scene)})
 
 

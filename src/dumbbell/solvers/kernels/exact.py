@@ -1,7 +1,8 @@
-"""The numba kernels of ``exact`` in 1D: the impact search and the sampling of the closed form.
+"""The numba kernels of ``exact``: the impact searches and the samplings of its closed forms.
 
-:mod:`dumbbell.solvers.exact` explains the method and why no impact can be missed; this module
-is its arithmetic, compiled. The floats are the contract: every operation, its order and its
+:mod:`dumbbell.solvers.exact` (1D) and :mod:`dumbbell.solvers.exact_rigid` (the rigid 2D
+dumbbell) explain the method and why no impact can be missed; this module is their
+arithmetic, compiled. The floats are the contract: every operation, its order and its
 library call (``math.cos``, ``math.sqrt``, Python's own ``math.hypot`` algorithm, scipy's
 ``brentq`` iteration) reproduce the pure-Python and numpy evaluation this solver was defined
 by, bit for bit, so that impact times and samples do not depend on whether the search runs
