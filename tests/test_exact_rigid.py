@@ -4,6 +4,7 @@ missed, grazing ones included, and the impulse law, against independent calculat
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -227,3 +228,25 @@ def test_a_truth_that_misses_an_impact_ends_failed(rigid, textbook):
                                       run.verdict, None, truth=True)
         assert verdict.status == "failed" and verdict.t == run.t[j] and keep == j + 1
         assert all(len(col) == keep for col in energy.values())
+
+
+def test_exact_and_exact_rigid_do_not_import_each_other():
+    # exact runs the rigid scenes through exact_rigid; what both need lives in _closed_form,
+    # so the dependency goes one way, at any level of the files (functions included).
+    import ast
+
+    import dumbbell.solvers
+
+    def imported(name):
+        path = Path(dumbbell.solvers.__file__).parent / f"{name}.py"
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                found.add(("." * node.level) + (node.module or ""))
+            elif isinstance(node, ast.Import):
+                found.update(alias.name for alias in node.names)
+        return found
+
+    assert ".exact_rigid" in imported("exact")
+    assert not {".exact", "dumbbell.solvers.exact", "..exact"} & imported("exact_rigid")
+    assert not {"..exact", "dumbbell.solvers.exact"} & imported("kernels/exact")

@@ -6,10 +6,15 @@ stretch ``s = xA - xB - b`` is a harmonic oscillator with ``w = sqrt(k/mu)``. Im
 first roots of a particle's height, found by a search that cannot miss one: on an interval of
 length h the height dips at most ``C h^2/8`` below its chord, with
 ``C = g + (m_other/M) w^2 S`` bounding its curvature (S the oscillation's amplitude), so an
-interval is either cleared, split, or known to hold one crossing that ``brentq`` refines to
-about 1e-14 s. That is the precision of one impact: the chaotic map amplifies rounding about
-tenfold per impact, so late impacts are known less well. Grazing impacts are found by the splitting. Positions and velocities are then
-evaluated in closed form at the sample times.
+interval is either cleared, split, or known to hold one crossing that Brent's method refines
+to about 1e-14 s. That is the precision of one impact: the chaotic map amplifies rounding
+about tenfold per impact, so late impacts are known less well. Grazing impacts are found by
+the splitting. Positions and velocities are then evaluated in closed form at the sample
+times, all of them in one pass.
+
+The search and the sampling are compiled with numba (:mod:`.kernels.exact`, loaded on the
+first run), and give the floats of the same arithmetic evaluated in Python and numpy, with
+scipy's ``brentq``, bit for bit.
 
 A particle that comes to rest on an inelastic floor would bounce infinitely often in finite
 time; the run stops there with the verdict ``failed`` and says so.
@@ -17,15 +22,18 @@ time; the run stops there with the verdict ``failed`` and says so.
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
+from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_failed
 from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import conclude
 
@@ -33,17 +41,8 @@ from .verdicts import conclude
 __all__ = ["Exact"]
 
 NAME = "exact"
-
-#: Root tolerance for impact times (s).
-ROOT_XTOL = 1e-14
-#: Intervals shorter than this (s) are not split further: a dip below the floor inside one
-#: would be shallower than C * MIN_SPLIT^2 / 8, about 1e-25 m.
-MIN_SPLIT = 1e-13
-#: A point of a particle's height curve, as the root searches pass it: time (s), height (m)
-#: and vertical velocity (m/s).
-HeightPoint = tuple[float, float, float]
-#: An impact slower than this (m/s) means the particle has come to rest on the floor.
-REST_SPEED = 1e-9
+#: The state columns, in the order the sampling kernel writes them.
+_COLUMNS = ("xA", "vA", "xB", "vB")
 
 
 @dataclass(frozen=True)
@@ -58,131 +57,45 @@ class Segment:
     sd0: float
 
 
-class _Motion:
-    """Closed-form motion of one segment; ``tau`` is the time since the segment began (s)."""
+def _motion(scene: Scene) -> Any:
+    """The scalars of the closed-form motion, as the kernels read them
+    (:class:`~dumbbell.solvers.kernels.exact.Motion`)."""
+    from .kernels.exact import Motion
 
-    def __init__(self, scene: Scene):
-        self.g = scene.system.g
-        self.M = scene.system.M
-        self.cA = scene.system.B.mass / scene.system.M  # xA = X + cA (b + s)
-        self.cB = scene.system.A.mass / scene.system.M  # xB = X - cB (b + s)
-        self.b = scene.system.b
-        self.w = scene.system.omega
-
-    def stretch(self, seg: Segment, tau):
-        if self.w > 0:
-            cos, sin = np.cos(self.w * tau), np.sin(self.w * tau)
-            return (seg.s0 * cos + (seg.sd0 / self.w) * sin,
-                    -seg.s0 * self.w * sin + seg.sd0 * cos)
-        return seg.s0 + seg.sd0 * tau, seg.sd0 + 0.0 * tau
-
-    def state(self, seg: Segment, tau):
-        """xA, vA, xB, vB at ``tau`` (scalars or arrays)."""
-        X = seg.X0 + seg.V0 * tau - 0.5 * self.g * tau * tau
-        V = seg.V0 - self.g * tau
-        s, sd = self.stretch(seg, tau)
-        return (X + self.cA * (self.b + s), V + self.cA * sd,
-                X - self.cB * (self.b + s), V - self.cB * sd)
-
-    def height(self, seg: Segment, body: str, tau):
-        """Height of ``body`` (m) and its rate (m/s) at ``tau`` (an array of times)."""
-        xA, vA, xB, vB = self.state(seg, tau)
-        return (xA, vA) if body == "A" else (xB, vB)
-
-    def height_at(self, seg: Segment, body: str, tau: float) -> tuple[float, float]:
-        """:meth:`height` at one time, in plain floats: the root search calls it hundreds of
-        times per impact, where numpy's per-call overhead would dominate."""
-        X = seg.X0 + seg.V0 * tau - 0.5 * self.g * tau * tau
-        V = seg.V0 - self.g * tau
-        if self.w > 0:
-            cos, sin = math.cos(self.w * tau), math.sin(self.w * tau)
-            s = seg.s0 * cos + (seg.sd0 / self.w) * sin
-            sd = -seg.s0 * self.w * sin + seg.sd0 * cos
-        else:
-            s, sd = seg.s0 + seg.sd0 * tau, seg.sd0
-        if body == "A":
-            return X + self.cA * (self.b + s), V + self.cA * sd
-        return X - self.cB * (self.b + s), V - self.cB * sd
-
-    def amplitude(self, seg: Segment) -> float:
-        """Largest |s| the segment reaches (m); inf without a spring."""
-        return math.hypot(seg.s0, seg.sd0 / self.w) if self.w > 0 else math.inf
-
-    def segment_at(self, t0: float, xA: float, vA: float, xB: float, vB: float) -> Segment:
-        mA_M, mB_M = self.cB, self.cA
-        return Segment(t0, mA_M * xA + mB_M * xB, mA_M * vA + mB_M * vB,
-                       xA - xB - self.b, vA - vB)
+    system = scene.system
+    w = float(system.omega)
+    return Motion(float(system.g), w, w**2, float(system.B.mass / system.M),
+                  float(system.A.mass / system.M), float(system.b),
+                  float(system.floor.elasticity) if system.floor is not None else 1.0,
+                  ROOT_XTOL, MIN_SPLIT, REST_SPEED)
 
 
-def _earliest_possible(motion: _Motion, seg: Segment, body: str) -> float:
-    """No impact of ``body`` can happen before this time (s): its height stays within
-    c*S of the centre-of-mass curve, so the centre of mass must first fall to that level."""
-    S = motion.amplitude(seg)
-    if not math.isfinite(S):
-        return 0.0
-    level = motion.cB * (motion.b + S) if body == "B" else motion.cA * (S - motion.b)
-    gap = seg.X0 - level
-    if gap <= 0:
-        return 0.0
-    g, V0 = motion.g, seg.V0
-    if g > 0:
-        return (V0 + math.sqrt(V0 * V0 + 2.0 * g * gap)) / g
-    return gap / -V0 if V0 < 0 else math.inf
+@functools.cache
+def _kernels(rigid: bool = False) -> Any:
+    """The compiled kernels (:mod:`~dumbbell.solvers.kernels.exact`) of the 1D solution, or
+    with ``rigid`` of the rigid dumbbell's flight (:mod:`.exact_rigid`), compiled or loaded
+    from numba's cache on the first call in a process by a small run of each."""
+    from .kernels import exact as kernels
+
+    if rigid:  # an end falling onto the floor, then sampled
+        end = kernels.End(0.1, 1.0, 0.0, 0.0, 9.8, 1.0)
+        kernels.end_contact(end, 0.0, 1.0, 0.05, 9.9, 0.1, ROOT_XTOL, MIN_SPLIT,
+                            np.array([0.0, math.inf]), 10)
+        kernels.rigid_sample(np.zeros((1, 7)), np.linspace(0.0, 1.0, 3), 0.1, -0.1, 9.8)
+        return kernels
+    m = kernels.Motion(9.8, 63.0, 3969.0, 0.5, 0.5, 0.2, 1.0, ROOT_XTOL, MIN_SPLIT, REST_SPEED)
+    segs = kernels.impacts(np.array([0.0, 1.1, 0.0, 0.0, 0.0]), m, 1.0, True, 10, 10**6, 10)[0]
+    kernels.sample(segs, np.linspace(0.0, 1.0, 3), m)
+    return kernels
 
 
-def _first_root(motion: _Motion, seg: Segment, body: str, start: float, stop: float,
-                budget: SearchBudget | None = None) -> float:
-    """First time in (start, stop] at which ``body`` crosses the floor going down, or inf;
-    each block scanned and
-    interval split counts against ``budget``."""
-    from scipy.optimize import brentq  # scipy loads only when the exact solver runs
-
-    S = motion.amplitude(seg)
-    c = motion.cB if body == "B" else motion.cA
-    C = motion.g + (c * motion.w**2 * S if motion.w > 0 else 0.0)
-    period = 2 * math.pi / motion.w if motion.w > 0 else math.inf
-    h = min(period / 16.0, 0.05)
-    a = max(start, _earliest_possible(motion, seg, body))
-    block = 64
-
-    def f(tau: float) -> tuple[float, float]:
-        return motion.height_at(seg, body, tau)
-
-    def search(low: HeightPoint, high: HeightPoint) -> float:
-        # Curvature bound: below the chord by at most C h^2 / 8; the slope changes by <= C h.
-        (lo, flo, dlo), (hi, fhi, dhi) = low, high
-        width = hi - lo
-        if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
-            return math.inf
-        if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
-            # Strictly decreasing on the interval: exactly one crossing.
-            return brentq(lambda x: f(x)[0], lo, hi, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
-        if width < MIN_SPLIT:
-            return hi if fhi <= 0 else math.inf
-        if budget is not None:
-            budget.spend()
-        mid = 0.5 * (lo + hi)
-        middle = (mid, *f(mid))
-        left = search(low, middle)
-        if left < math.inf:
-            return left
-        return search(middle, high)
-
-    while a < stop:
-        if budget is not None:
-            budget.spend(base.BLOCK_WORK)
-        taus = np.minimum(a + h * np.arange(block + 1), stop)
-        fs, ds = motion.height(seg, body, taus)
-        width = np.diff(taus)
-        lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
-        suspect = np.flatnonzero((lower <= 0) & (width > 0))
-        for j in suspect:
-            root = search((float(taus[j]), float(fs[j]), float(ds[j])),
-                          (float(taus[j + 1]), float(fs[j + 1]), float(ds[j + 1])))
-            if root < math.inf:
-                return root
-        a = taus[-1]
-    return math.inf
+def warm_up() -> float:
+    """Compile (or load from numba's cache) the impact searches and the samplings, 1D and
+    rigid, once per process; returns the seconds it took (about 0 once done)."""
+    t0 = time.perf_counter()
+    _kernels()
+    _kernels(rigid=True)
+    return time.perf_counter() - t0
 
 
 def supports(scene: Scene) -> str | None:
@@ -202,54 +115,40 @@ def segments(scene: Scene, t_end: float) -> tuple[list[Segment], list[Impact], V
     ``failed`` when a particle comes to rest or the run reaches its work budget
     (:data:`~dumbbell.solvers.base.MAX_IMPACTS` impacts, :data:`~.base.MAX_SEARCH_WORK`
     units of impact search)."""
-    return base.within_budget(lambda segs, events: _segments(scene, t_end, segs, events),
-                              lambda seg: seg.t0)
+    rows, events, verdict = _segments(scene, t_end)
+    return [Segment(*row) for row in rows.tolist()], events, verdict
 
 
-def _segments(scene: Scene, t_end: float, segs: list[Segment], events: list[Impact]
-              ) -> tuple[list[Segment], list[Impact], Verdict]:
-    """:func:`segments`, filling ``segs`` and ``events`` as it goes."""
-    motion = _Motion(scene)
-    budget = SearchBudget(base.MAX_SEARCH_WORK)
-    A, B = scene.system.A, scene.system.B
-    seg = motion.segment_at(0.0, A.height, A.vy, B.height, B.vy)
-    segs.append(seg)
-    if scene.system.floor is None:
-        return segs, events, Verdict()
-    e = scene.system.floor.elasticity
-    # After an impact the particle is on the floor moving up: no new root before this time.
-    start = {"A": 0.0, "B": 0.0}
-    limit = base.MAX_IMPACTS
-    while len(events) < limit:
-        horizon = t_end - seg.t0
-        roots = {body: _first_root(motion, seg, body, start[body], horizon, budget)
-                 for body in "AB"}
-        tau = min(roots.values())
-        if not tau <= horizon:
-            return segs, events, Verdict()
-        xA, vA, xB, vB = (float(v) for v in motion.state(seg, tau))
-        t_hit = seg.t0 + tau
-        velocities = {"A": vA, "B": vB}
-        hit = [body for body in "AB" if roots[body] - tau <= ROOT_XTOL * 10]
-        for body in hit:
-            v = velocities[body]
-            if abs(v) < REST_SPEED:
-                return segs, events, Verdict(
-                    "failed", t_hit,
-                    f"{body} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
-                    "inelastic floor has infinitely many impacts in finite time here",
-                )
-            velocities[body] = -e * v
-            events.append(Impact(t_hit, body, v, velocities[body]))
-        seg = motion.segment_at(t_hit, xA, velocities["A"], xB, velocities["B"])
-        segs.append(seg)
-        C = motion.g + max(motion.cA, motion.cB) * motion.w**2 * motion.amplitude(seg)
-        for body in "AB":
-            v_up = velocities[body]
-            start[body] = (v_up / C if body in hit and C > 0 else 0.0)
-            if body in hit and C == 0:
-                start[body] = horizon  # straight line up, never to return
-    return segs, events, Verdict("failed", seg.t0, impact_budget_reason(limit))
+def _segments(scene: Scene, t_end: float) -> tuple[np.ndarray, list[Impact], Verdict]:
+    """:func:`segments`, the segments as rows (t0, X0, V0, s0, sd0) of an array."""
+    kernels = _kernels()
+    m = _motion(scene)
+    A, B, floor = scene.system.A, scene.system.B, scene.system.floor
+    mA_M, mB_M = m.cB, m.cA
+    first = np.array([0.0, mA_M * A.height + mB_M * B.height, mA_M * A.vy + mB_M * B.vy,
+                      A.height - B.height - m.b, A.vy - B.vy], dtype=np.float64)
+    limit, work_limit = base.MAX_IMPACTS, base.MAX_SEARCH_WORK
+
+    def search(blocks: list[np.ndarray], events: list[Impact]
+               ) -> tuple[list[np.ndarray], list[Impact], Verdict]:
+        rows, hits, status, rest, work = kernels.impacts(
+            first, m, float(t_end), floor is not None, int(limit), int(work_limit),
+            int(base.BLOCK_WORK))
+        blocks.append(rows)
+        events += [Impact(t, "AB"[int(body)], v, after) for t, body, v, after in hits.tolist()]
+        if status == kernels.REST:
+            return blocks, events, at_rest("AB"[int(rest[1])], float(rest[0]), float(rest[2]))
+        if status == kernels.IMPACT_LIMIT:
+            return blocks, events, Verdict("failed", float(rows[-1, 0]),
+                                           impact_budget_reason(limit))
+        if status == kernels.OVER_BUDGET:
+            SearchBudget(work_limit).spend(int(work))  # raises OverBudget, with its reason
+        if status == kernels.ROOT_FAILED:
+            raise search_failed(float(rows[-1, 0]))
+        return blocks, events, Verdict()
+
+    blocks, events, verdict = base.within_budget(search, lambda rows: float(rows[-1, 0]))
+    return blocks[0], events, verdict
 
 
 def vertical_energy(scene: Scene) -> float:
@@ -280,31 +179,26 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     check_work(scene, options)
     if scene.system.rigid is not None:
         return _solve_rigid(scene, options)
+    kernels = _kernels()  # compiled or loaded before the clock starts
     t0 = time.perf_counter()
-    segs, events, verdict = segments(scene, options.t_end)
-    motion = _Motion(scene)
+    rows, events, verdict = _segments(scene, options.t_end)
     t = options.sample_times()
     if not verdict.ok:
         t = t[t <= verdict.t]
-    # Sample times are sorted, so each segment owns one contiguous slice of them.
-    bounds = np.searchsorted(t, [s.t0 for s in segs[1:]], side="left")
-    cols = {name: np.empty_like(t) for name in ("xA", "vA", "xB", "vB")}
-    for seg, lo, hi in zip(segs, [0, *bounds], [*bounds, len(t)], strict=True):
-        if hi > lo:
-            for name, value in zip(cols, motion.state(seg, t[lo:hi] - seg.t0), strict=True):
-                cols[name][lo:hi] = value
+    out = kernels.sample(rows, t, _motion(scene))
+    cols = {name: out[c] for c, name in enumerate(_COLUMNS)}
     wall = time.perf_counter() - t0
     return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
-                    wall_time=wall, info={"segments": len(segs), "root_xtol": ROOT_XTOL},
+                    wall_time=wall, info={"segments": len(rows), "root_xtol": ROOT_XTOL},
                     truth=True)
 
 
 def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     """The rigid 2D dumbbell in closed form (:mod:`.exact_rigid`) at the sample times (s)."""
     from ..model.energy import rigid_moment
-    from .exact_rigid import ROOT_XTOL as RIGID_XTOL
     from .exact_rigid import flight, sample
 
+    _kernels(rigid=True)  # compiled or loaded before the clock starts
     t0 = time.perf_counter()
     segs, events, verdict = flight(scene, options.t_end)
     t = options.sample_times()
@@ -314,7 +208,7 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     wall = time.perf_counter() - t0
     return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
                     wall_time=wall, truth=True,
-                    info={"segments": len(segs), "root_xtol": RIGID_XTOL,
+                    info={"segments": len(segs), "root_xtol": ROOT_XTOL,
                           "moment": rigid_moment(scene)})
 
 
@@ -333,6 +227,7 @@ class Exact(Solver):
     supports = staticmethod(supports)
     solve = staticmethod(solve)
     check_work = staticmethod(check_work)
+    warm_up = staticmethod(warm_up)
 
     @staticmethod
     def truth_for(scene: Scene) -> bool:

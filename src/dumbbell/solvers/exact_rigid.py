@@ -17,6 +17,9 @@ of these heights, found by a search that cannot miss one, grazing touches includ
   that minimum is <= 0 (a graze at 1e-7 m/s is found; a miss by 1e-9 m is not);
 - anything else is split in two, down to 1e-13 s.
 
+The search and the sampling run compiled with numba (:mod:`.kernels.exact`), with the floats
+of the same arithmetic in Python and numpy, and of scipy's ``brentq``, bit for bit.
+
 Heights are computed relative to the segment's start, ``a (sin(theta) - sin(theta0)) =
 2 a cos(theta0 + omega tau / 2) sin(omega tau / 2)``, and the end that just hit the floor starts
 its segment at height 0 exactly, so that a slow rebound is not lost to rounding. Impacts follow
@@ -36,9 +39,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import UsageError
 from ..model.energy import (
@@ -53,18 +56,12 @@ from ..model.energy import (
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Impact, Verdict
 from . import base
+from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_failed
 from .base import SearchBudget, impact_budget_reason
-from .exact import HeightPoint
 
 #: The public API: the first impact in closed form; the rest serves the exact solver.
 __all__ = ["first_impact_state"]
 
-#: Root tolerance for impact times (s).
-ROOT_XTOL = 1e-14
-#: Intervals shorter than this (s) are not split further.
-MIN_SPLIT = 1e-13
-#: An impact slower than this (m/s) means the end has come to rest on the floor.
-REST_SPEED = 1e-9
 #: Rounds of impulses for ends that hit together.
 MAX_ROUNDS = 100
 
@@ -129,38 +126,18 @@ class RigidBody:
         return self.g + abs(self.arm[body]) * s.omega * s.omega
 
     def height(self, s: RigidState, body: str, tau: float) -> tuple[float, float]:
-        """Height (m) and vertical velocity (m/s) of ``body`` at ``tau`` after ``s``."""
-        a, w = self.arm[body], s.omega
-        half = 0.5 * w * tau
-        h0 = s.hA if body == "A" else s.hB
-        y = (h0 + s.VY * tau - 0.5 * self.g * tau * tau
-             + 2.0 * a * math.cos(s.theta + half) * math.sin(half))
-        return y, s.VY - self.g * tau + a * w * math.cos(s.theta + w * tau)
+        """Height (m) and vertical velocity (m/s) of ``body`` at ``tau`` after ``s``
+        (:func:`~dumbbell.solvers.kernels.exact.end_height`)."""
+        from .kernels.exact import end_height
 
-    def heights(self, s: RigidState, body: str, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`height` for an array of times."""
-        a, w = self.arm[body], s.omega
-        half = 0.5 * w * tau
-        h0 = s.hA if body == "A" else s.hB
-        y = (h0 + s.VY * tau - 0.5 * self.g * tau * tau
-             + 2.0 * a * np.cos(s.theta + half) * np.sin(half))
-        return y, s.VY - self.g * tau + a * w * np.cos(s.theta + w * tau)
+        return end_height(self._end(s, body), float(tau))
 
-    def columns(self, s: RigidState, tau: np.ndarray) -> dict[str, np.ndarray]:
-        """Positions (m), velocities (m/s) and ``omega`` (rad/s) at ``tau`` after ``s``."""
-        X = s.X + s.VX * tau
-        Y = s.Y + s.VY * tau - 0.5 * self.g * tau * tau
-        VY = s.VY - self.g * tau
-        th = s.theta + s.omega * tau
-        cos, sin = np.cos(th), np.sin(th)
-        cols: dict[str, np.ndarray] = {}
-        for body in "AB":
-            a = self.arm[body]
-            cols.update({f"x{body}": X + a * cos, f"y{body}": Y + a * sin,
-                         f"vx{body}": s.VX - s.omega * a * sin + 0.0 * tau,
-                         f"vy{body}": VY + s.omega * a * cos})
-        cols["omega"] = np.full(np.shape(tau), s.omega)
-        return cols
+    def _end(self, s: RigidState, body: str) -> Any:
+        """What the compiled height search reads of ``body`` in segment ``s``."""
+        from .kernels.exact import End
+
+        return End(float(self.arm[body]), float(s.omega), float(s.theta), float(s.VY),
+                   float(self.g), float(s.hA if body == "A" else s.hB))
 
     # --- impacts ---------------------------------------------------------------------------
     def effective_mass(self, s: RigidState, body: str) -> float:
@@ -188,10 +165,7 @@ class RigidBody:
                 if v >= 0:
                     continue
                 if abs(v) < REST_SPEED:
-                    return s, events, Verdict(
-                        "failed", s.t,
-                        f"{b} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
-                        "inelastic floor has infinitely many impacts in finite time here")
+                    return s, events, at_rest(b, s.t, v)
                 s = self.impulse(s, b, e)
                 after = self.vertical_velocity(s, b)
                 events.append(Impact(s.t, b, v, after,
@@ -205,66 +179,27 @@ class RigidBody:
                       budget: SearchBudget | None = None) -> float:
         """First time in [start, stop] (s after ``s``) at which ``body`` reaches the floor
         moving down, or inf; each block scanned and interval split counts against
-        ``budget``. See the module docstring for why no root can be missed."""
-        a, w = self.arm[body], s.omega
+        ``budget``. See the module docstring for why no root can be missed; the search runs
+        compiled (:func:`~dumbbell.solvers.kernels.exact.end_contact`)."""
+        from .kernels import exact as kernels
+
+        w = s.omega
         C = self.curvature(s, body)
-        D = abs(a) * abs(w) ** 3  # bound on |y'''|
+        D = abs(self.arm[body]) * abs(w) ** 3  # bound on |y'''|
         lo = max(start, self._earliest(s, body))
         if lo > stop:
             return math.inf
         h = 0.05 if w == 0 else min(0.05, 2 * math.pi / abs(w) / 16.0)
-
-        def f(tau: float) -> float:
-            return self.height(s, body, tau)[0]
-
-        def fd(tau: float) -> float:
-            return self.height(s, body, tau)[1]
-
-        def search(low: HeightPoint, high: HeightPoint) -> float:
-            (lo, flo, dlo), (hi, fhi, dhi) = low, high
-            if flo <= 0 and dlo < 0:
-                # Already at the floor moving down: the search began on the root, as when
-                # _earliest is the contact time itself (an end straight below the centre of
-                # mass) and rounding puts it a hair past. Every split of this interval would
-                # start at or below the floor and none could clear it.
-                return lo
-            width = hi - lo
-            if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
-                return math.inf
-            if flo > 0 and fhi <= 0 and min(dlo, dhi) + C * width < 0:
-                return brentq(f, lo, hi, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
-            if flo > 0 and fhi > 0 and dlo < 0 < dhi and (dhi - dlo) - D * width * width / 4 > 0:
-                # y'' >= (dhi - dlo)/h - D h/4 > 0 here: y is convex, one minimum, at y' = 0.
-                t_min = brentq(fd, lo, hi, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
-                if f(t_min) > 0:
-                    return math.inf
-                return brentq(f, lo, t_min, xtol=ROOT_XTOL, rtol=4 * np.finfo(float).eps)
-            if width < MIN_SPLIT:
-                return hi if flo > 0 and fhi <= 0 else math.inf
-            if budget is not None:
-                budget.spend()
-            mid = 0.5 * (lo + hi)
-            middle = (mid, *self.height(s, body, mid))
-            left = search(low, middle)
-            if left < math.inf:
-                return left
-            return search(middle, high)
-
-        block = 64
-        while lo < stop:
-            if budget is not None:
-                budget.spend(base.BLOCK_WORK)
-            taus = np.minimum(lo + h * np.arange(block + 1), stop)
-            fs, ds = self.heights(s, body, taus)
-            width = np.diff(taus)
-            lower = np.minimum(fs[:-1], fs[1:]) - C * width * width / 8.0
-            for j in np.flatnonzero((lower <= 0) & (width > 0)):
-                root = search((float(taus[j]), float(fs[j]), float(ds[j])),
-                              (float(taus[j + 1]), float(fs[j + 1]), float(ds[j + 1])))
-                if root < math.inf:
-                    return root
-            lo = float(taus[-1])
-        return math.inf
+        # Without a run's budget, one search still stops: at a run's whole budget.
+        allowed = base.MAX_SEARCH_WORK if budget is None else budget.limit - budget.work
+        work = np.array([0.0, float(allowed)])
+        root, status = kernels.end_contact(self._end(s, body), float(lo), float(stop), h, C, D,
+                                           ROOT_XTOL, MIN_SPLIT, work, base.BLOCK_WORK)
+        if budget is not None:
+            budget.spend(int(work[0]))  # raises OverBudget where the search stopped for it
+        if status == kernels.ROOT_FAILED or status == kernels.OVER_BUDGET:
+            raise search_failed(s.t)
+        return root
 
     def _earliest(self, s: RigidState, body: str) -> float:
         """No contact of ``body`` before this time (s after ``s``): the end is at most |a|
@@ -344,17 +279,14 @@ def _flight(scene: Scene, t_end: float, segs: list[RigidState], events: list[Imp
 
 
 def sample(scene: Scene, segs: list[RigidState], t: np.ndarray) -> dict[str, np.ndarray]:
-    """The state columns at the sorted times ``t`` (s), each from the segment it falls in."""
+    """The state columns at the sorted times ``t`` (s), each from the segment it falls in,
+    all in one compiled pass (:func:`~dumbbell.solvers.kernels.exact.rigid_sample`)."""
+    from .kernels.exact import rigid_sample
+
     body = RigidBody(scene)
-    bounds = np.searchsorted(t, [s.t for s in segs[1:]], side="left")
-    cols: dict[str, np.ndarray] = {}
-    names = [*state_columns(scene), "omega"]
-    for name in names:
-        cols[name] = np.empty_like(t)
-    for seg, lo, hi in zip(segs, [0, *bounds], [*bounds, len(t)], strict=True):
-        if hi > lo:
-            for name, value in body.columns(seg, t[lo:hi] - seg.t).items():
-                cols[name][lo:hi] = value
+    rows = np.array([[s.t, s.X, s.Y, s.VX, s.VY, s.theta, s.omega] for s in segs], dtype=float)
+    out = rigid_sample(rows, t, float(body.arm["A"]), float(body.arm["B"]), float(body.g))
+    cols = dict(zip([*state_columns(scene), "omega"], out, strict=True))
     if spins(scene):
         cols["omegaA"] = cols["omega"].copy()
         cols["omegaB"] = cols["omega"].copy()

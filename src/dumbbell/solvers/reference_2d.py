@@ -30,7 +30,7 @@ from scipy.optimize import brentq
 from ..model.energy import spins
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Verdict
-from .exact import HeightPoint
+from ._closed_form import HeightPoint
 
 #: Nothing public: the machinery the solver classes share.
 __all__: list[str] = []
