@@ -437,6 +437,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: {"name": "E"},
     "dumbbell.model.trajectory.Impact": lambda f: fields(f.traj.events[0]),
     "dumbbell.model.trajectory.Verdict": lambda f: fields(f.traj.verdict),
+    "dumbbell.model.trajectory.Contact": lambda f: {"t_start": 0.1, "t_end": 0.2, "body": "A"},
     "dumbbell.animation.render.render_gif": lambda f: {
         "traj": f.traj, "path": None, "quiet": True, "fps": 10, "size": "64x64",
         "strip": True, "t_end": 0.2, "timing": {}, "max_frames": 100},

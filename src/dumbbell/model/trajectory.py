@@ -37,7 +37,7 @@ VERDICTS = ("ok", "unstable", "tunnelled", "failed")
 
 _FINITE = math.isfinite
 
-__all__ = ["FIRST_IMPACTS", "VERDICTS", "Impact", "Trajectory", "Verdict", "read_only"]
+__all__ = ["FIRST_IMPACTS", "VERDICTS", "Contact", "Impact", "Trajectory", "Verdict", "read_only"]
 
 
 def _time(value: Any, name: str, optional: bool = False) -> None:
@@ -84,6 +84,31 @@ class Impact:
         _number(self.v_after, "v_after", "m/s")
         if self.heat is not None:
             _number(self.heat, "heat", "J")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A lasting contact with the floor, not an impact: body ('A' or 'B') resting or rolling on
+    the floor from ``t_start`` to ``t_end`` (s; the run's end if it still touches then). Only a
+    contact solver (pymunk) has them; how they are told from impacts: docs/solvers.md."""
+
+    t_start: float
+    t_end: float
+    body: str
+
+    def __post_init__(self) -> None:
+        if self.body != "A" and self.body != "B":
+            raise UsageError(f"body = {args.show(self.body)}: must be 'A' or 'B'", param="body")
+        _time(self.t_start, "t_start")
+        _time(self.t_end, "t_end")
+        if not self.t_start <= self.t_end:
+            raise UsageError(f"t_end = {self.t_end!r} s: must not come before t_start = "
+                             f"{self.t_start!r} s", param="t_end")
+
+    @property
+    def duration(self) -> float:
+        """How long the contact lasts (s)."""
+        return self.t_end - self.t_start
 
 
 @dataclass(frozen=True)
@@ -145,6 +170,8 @@ def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
 class Trajectory:
     """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
 
+    ``events`` are the impacts; ``contacts`` the lasting contacts with the floor (resting or
+    rolling: a contact solver's, told apart from impacts as docs/solvers.md says).
     ``dt`` is the step used (s; None for the exact solution), ``every`` how many steps lie
     between samples, ``wall_time`` the solver's run time (s), ``info`` solver-specific notes
     (for example settings used, or an estimated error). ``energy`` holds the energy columns
@@ -164,6 +191,7 @@ class Trajectory:
     wall_time: float = 0.0
     info: Mapping[str, Any] = field(default_factory=dict)
     energy: Mapping[str, np.ndarray] | None = field(default=None, repr=False)
+    contacts: tuple[Contact, ...] = ()
 
     def __post_init__(self) -> None:
         # The one place a frozen Trajectory's fields are set: checked, then copies and
@@ -184,6 +212,12 @@ class Trajectory:
             raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
                              param="events")
         put(self, "events", tuple(events))
+        contacts = self.contacts
+        if not isinstance(contacts, list | tuple) or not all(
+                isinstance(c, Contact) for c in contacts):
+            raise UsageError(f"contacts = {args.show(contacts)}: must be a list of Contact",
+                             param="contacts")
+        put(self, "contacts", tuple(contacts))
         put(self, "info", dict(args.mapping(self.info, "info", "a dict")))
         energy = self.energy
         if energy is None:
@@ -232,12 +266,15 @@ class Trajectory:
         return len(self.t)
 
     def __repr__(self) -> str:
-        """One line: scene, solver, dt, time span, samples, impacts, verdict."""
+        """One line: scene, solver, dt, time span, samples, impacts (and lasting contacts, if
+        any), verdict."""
         dt = "-" if self.dt is None else f"{self.dt:g} s"
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
         verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
+        contacts = f", {len(self.contacts)} contacts" if self.contacts else ""
         return (f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, t={span}, "
-                f"{len(self.t)} samples, {len(self.events)} impacts, verdict: {verdict}>")
+                f"{len(self.t)} samples, {len(self.events)} impacts{contacts}, "
+                f"verdict: {verdict}>")
 
     def _repr_html_(self) -> str:
         """A small table for notebooks: the one-line summary, the energy terms (J) at the start
@@ -255,13 +292,22 @@ class Trajectory:
         more = len(self.events) - FIRST_IMPACTS
         if more > 0:
             impacts += f"<tr><td colspan='4'>... and {more} more</td></tr>"
+        contacts = "".join(f"<tr><td>{escape(c.body)}</td><td>{c.t_start:.6g}</td>"
+                           f"<td>{c.t_end:.6g}</td></tr>"
+                           for c in self.contacts[:FIRST_IMPACTS])
+        more = len(self.contacts) - FIRST_IMPACTS
+        if more > 0:
+            contacts += f"<tr><td colspan='3'>... and {more} more</td></tr>"
+        if contacts:
+            contacts = ("<table><tr><th>lasting contact: body</th><th>from t (s)</th>"
+                        f"<th>to t (s)</th></tr>{contacts}</table>")
         return (
             f"<div><p><code>{escape(repr(self))}</code></p>"
             f"<p><b>verdict:</b> {escape(str(self.verdict))}</p>"
             "<table><tr><th>energy</th><th>start</th><th>end</th></tr>"
             f"{''.join(rows)}</table>"
             f"<table><tr><th>impact t (s)</th><th>body</th><th>v before (m/s)</th>"
-            f"<th>v after (m/s)</th></tr>{impacts}</table></div>")
+            f"<th>v after (m/s)</th></tr>{impacts}</table>{contacts}</div>")
 
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every
