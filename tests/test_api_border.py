@@ -629,8 +629,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.plot.trajectory.energy": lambda f: {"traj": f.traj_2d, "ax": f.ax(),
                                                   "window": 0.6},
     "dumbbell.plot.trajectory.heights": lambda f: {"traj": f.traj},
-    "dumbbell.plot.trajectory.momentum_axis": lambda f: {
-        "ax": f.ax(), "traj": f.traj_2d, "window": 0.5, "loc": "upper left", "ncol": 2},
+    "dumbbell.plot.trajectory.momentum_panel": lambda f: {
+        "traj": f.traj_2d, "ax": f.ax(), "window": 0.5},
     "dumbbell.plot.compare.compare": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_positions": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_energy": lambda f: {"result": f.comparison, "ax": f.ax()},
