@@ -166,6 +166,15 @@ def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
     return out
 
 
+def _first_rows(cells: list[list[str]], total: int) -> str:
+    """HTML table rows of ``cells`` (the first :data:`FIRST_IMPACTS` items' cell texts), then
+    one saying how many more of ``total`` items there are."""
+    rows = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in cells)
+    if total > len(cells):
+        rows += f"<tr><td colspan='{len(cells[0])}'>... and {total - len(cells)} more</td></tr>"
+    return rows
+
+
 @dataclass(frozen=True, eq=False)
 class Trajectory:
     """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
@@ -286,18 +295,11 @@ class Trajectory:
         rows = [f"<tr><th>{escape(name)} (J)</th><td>{self[name][0]:.6g}</td>"
                 f"<td>{self[name][-1]:.6g}</td></tr>"
                 for name in energy_columns(self.scene)] if len(self.t) else []
-        impacts = "".join(f"<tr><td>{e.t:.6g}</td><td>{escape(e.body)}</td>"
-                          f"<td>{e.v_before:.4g}</td><td>{e.v_after:.4g}</td></tr>"
-                          for e in self.events[:FIRST_IMPACTS])
-        more = len(self.events) - FIRST_IMPACTS
-        if more > 0:
-            impacts += f"<tr><td colspan='4'>... and {more} more</td></tr>"
-        contacts = "".join(f"<tr><td>{escape(c.body)}</td><td>{c.t_start:.6g}</td>"
-                           f"<td>{c.t_end:.6g}</td></tr>"
-                           for c in self.contacts[:FIRST_IMPACTS])
-        more = len(self.contacts) - FIRST_IMPACTS
-        if more > 0:
-            contacts += f"<tr><td colspan='3'>... and {more} more</td></tr>"
+        impacts = _first_rows([[f"{e.t:.6g}", escape(e.body), f"{e.v_before:.4g}",
+                                f"{e.v_after:.4g}"] for e in self.events[:FIRST_IMPACTS]],
+                              len(self.events))
+        contacts = _first_rows([[escape(c.body), f"{c.t_start:.6g}", f"{c.t_end:.6g}"]
+                                for c in self.contacts[:FIRST_IMPACTS]], len(self.contacts))
         if contacts:
             contacts = ("<table><tr><th>lasting contact: body</th><th>from t (s)</th>"
                         f"<th>to t (s)</th></tr>{contacts}</table>")
