@@ -8,8 +8,8 @@ Each figure is drawn by the same code and at the same size as its command draws 
 the suite fast the inputs are lighter than the shipped renders' (pymunk at dt = 1e-4 s, fewer
 grid points and tilts, shorter runs): the layouts do not depend on them, since legends sit
 outside the axes and notes outside the data. ``DUMBBELL_FIGCHECK=shipped pytest
-tests/test_figures.py`` draws them from exactly the shipped commands' inputs instead (about
-5 minutes on 2 cores).
+tests/test_figures.py`` draws them from exactly the shipped commands' inputs instead (7 minutes
+on 2 busy cores, most of it the full bench).
 """
 
 from __future__ import annotations
