@@ -437,6 +437,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: {"name": "E"},
     "dumbbell.model.trajectory.Impact": lambda f: fields(f.traj.events[0]),
     "dumbbell.model.trajectory.Verdict": lambda f: fields(f.traj.verdict),
+    "dumbbell.model.trajectory.Contact": lambda f: {"t_start": 0.1, "t_end": 0.2, "body": "A"},
     "dumbbell.animation.render.render_gif": lambda f: {
         "traj": f.traj, "path": None, "quiet": True, "fps": 10, "size": "64x64",
         "strip": True, "t_end": 0.2, "timing": {}, "max_frames": 100},
@@ -628,8 +629,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.plot.trajectory.energy": lambda f: {"traj": f.traj_2d, "ax": f.ax(),
                                                   "window": 0.6},
     "dumbbell.plot.trajectory.heights": lambda f: {"traj": f.traj},
-    "dumbbell.plot.trajectory.momentum_axis": lambda f: {
-        "ax": f.ax(), "traj": f.traj_2d, "window": 0.5, "loc": "upper left", "ncol": 2},
+    "dumbbell.plot.trajectory.momentum_panel": lambda f: {
+        "traj": f.traj_2d, "ax": f.ax(), "window": 0.5},
     "dumbbell.plot.compare.compare": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_positions": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_energy": lambda f: {"result": f.comparison, "ax": f.ax()},

@@ -276,3 +276,45 @@ def test_printed_values_that_round_to_zero_have_no_minus_sign():
             want = f"{value:.{d}f}".replace("-", "") if float(f"{value:.{d}f}") == 0 \
                 else f"{value:.{d}f}"
             assert fixed(value, d) == want
+
+
+def test_strip_marks_a_lasting_contact_along_its_foot_and_impacts_across_it(short):
+    """A contact is a bar in the particle's colour at the strip's foot over its time span;
+    an impact a faint line across the strip (and the contact none)."""
+    import dataclasses
+
+    from dumbbell.animation.render import frames_of
+    from dumbbell.animation.strip import IMPACT
+    from dumbbell.model.trajectory import Contact
+
+    traj = dataclasses.replace(short, contacts=(Contact(0.2, 0.6, "B"), Contact(0.7, 1.0, "A")))
+    frames = frames_of(traj, 25, 1.0)
+    painter = Painter(traj.scene, frames, (640, 360), True)
+    strip = painter.strip
+    rgb = np.asarray(painter.frame(0).convert("RGB"))     # the cursor at t = 0
+    sx0, _, sx1, sy1 = strip.box
+    cols = np.arange(sx0 + 2, sx1 - 1)
+    t = (cols - strip.inner_x) / strip.px_per_s         # the window shows [0, 1] s
+
+    def where(row: int, rgb_colour: tuple[int, int, int]) -> np.ndarray:
+        return np.all(rgb[row, cols] == np.array(rgb_colour), axis=1)
+
+    red, blue = where(sy1 - 1, TERM_RGB["B"]), where(sy1 - 2, TERM_RGB["A"])
+    assert red[(t > 0.21) & (t < 0.59)].all() and not red[(t < 0.19) | (t > 0.61)].any()
+    assert blue[(t > 0.71) & (t < 0.99)].all() and not blue[t < 0.69].any()
+    # The impacts (the textbook's first two, before 0.6 s) cross the strip; B's bar does not.
+    lines = t[where(strip.box[1] + 2, IMPACT)]           # above the curves (PAD)
+    assert len(lines) and all(min(abs(x - e.t) for e in short.events) < 0.01 for x in lines)
+
+
+def test_contact_checks_its_fields():
+    from dumbbell.errors import UsageError
+    from dumbbell.model.trajectory import Contact
+
+    assert Contact(0.1, 0.4, "A").duration == pytest.approx(0.3)
+    with pytest.raises(UsageError, match="body"):
+        Contact(0.1, 0.4, "C")
+    with pytest.raises(UsageError, match="t_end"):
+        Contact(0.4, 0.1, "B")
+    with pytest.raises(UsageError, match="t_start"):
+        Contact(float("nan"), 0.1, "B")

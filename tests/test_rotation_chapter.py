@@ -102,11 +102,25 @@ def test_topple_closed_form_by_quadrature_and_ode(topple_scene):
 
 def test_topple_in_pymunk(topple_scene):
     cf = closed_form(topple_scene)
-    m = measure(simulate(topple_scene, "pymunk"))
+    traj = simulate(topple_scene, "pymunk")
+    m = measure(traj)
     assert m.v_top == pytest.approx(math.sqrt(2 * cf.g * cf.L), rel=0.01)
     assert m.v_top == pytest.approx(cf.landing_speeds()[1], rel=0.01)
     assert m.cm_drift < 1e-6
     assert m.fall_time == pytest.approx(cf.fall_time(), rel=0.01)
+    # B rests on the floor throughout: contact, not impacts. The one impact is A's landing,
+    # at the closed form's time and top speed (the contact point's, straight down).
+    assert [e.body for e in traj.events] == ["A"]
+    landing = traj.events[0]
+    assert landing.t == pytest.approx(cf.fall_time(), rel=1e-4)
+    assert -landing.v_before == pytest.approx(cf.landing_speeds()[1], rel=1e-3)
+    assert abs(landing.v_after) < 1e-9           # e = 0: the landing ends the motion
+    t_end = float(traj.t[-1])
+    spans = {c.body: (c.t_start, c.t_end) for c in traj.contacts}
+    assert len(traj.contacts) == 2 and set(spans) == {"A", "B"}
+    assert spans["B"][0] <= topple_scene.run.dt and spans["B"][1] == t_end
+    assert spans["A"] == (landing.t, t_end)
+    assert "1 impacts, 2 contacts" in repr(traj)
 
 
 def test_topple_refuses_what_it_cannot_describe(topple_scene):

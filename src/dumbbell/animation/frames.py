@@ -16,7 +16,8 @@ class Frames:
     of x and height), every energy column (J), and in ``lo``/``hi`` the least and largest value
     of each column since the previous frame (J; what happened between two frames, an impact for
     example, stays visible). ``series_t``/``series`` are the samples the strip draws;
-    ``impacts`` the impact times (s); ``t_end`` the end of the animation (s)."""
+    ``impacts`` the impact times (s); ``contacts`` the lasting contacts with the floor as
+    (body, start s, end s); ``t_end`` the end of the animation (s)."""
 
     t: np.ndarray
     A: np.ndarray
@@ -29,3 +30,4 @@ class Frames:
     impacts: tuple[float, ...]
     t_end: float
     L_cm: np.ndarray | None = None  # angular momentum about the centre of mass (kg m^2/s), 2D
+    contacts: tuple[tuple[str, float, float], ...] = ()

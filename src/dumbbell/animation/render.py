@@ -193,6 +193,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
         series_t=t[keep], series={k: v[keep] for k, v in energy.items()},
         impacts=tuple(e.t for e in traj.events), t_end=max(window, 1e-9),
         L_cm=traj["L_cm"][idx] if traj.scene.system.dimensions == 2 else None,
+        contacts=tuple((c.body, c.t_start, c.t_end) for c in traj.contacts),
     )
 
 

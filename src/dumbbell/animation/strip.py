@@ -1,6 +1,7 @@
 """The strip of the energy time series: a window of :data:`WINDOW` s that scrolls with a
-cursor (time ticks and labels move with it; faint lines mark the impacts), on the energy
-panel's fixed scale.
+cursor (time ticks and labels move with it; faint lines mark the impacts, and a thin bar in a
+particle's colour along the strip's foot the time it rests or rolls on the floor), on the
+energy panel's fixed scale.
 
 The curves of the whole animation are drawn once on a long 'tape'; a frame pastes the window
 it shows, its time labels and the cursor.
@@ -46,6 +47,8 @@ PAD = 4          # between the strip's frame and the highest and lowest energy
 TICK = 3         # length of a time tick under the strip (at least 2 px)
 LABEL_GAP = 4    # between the strip and its tick labels
 IMPACT_TICK = 4  # an impact's tick at the foot of the strip
+CONTACT_BAR = 1  # height of a lasting contact's bar at the foot (B lowest, A above it), below
+#                  the zero line of the curves (PAD above the foot, LINE wide)
 LINE = 2         # width of the curves (at least 1 px)
 CURSOR = 1.5     # width of the cursor (at least 1 px)
 LABEL_OVERHANG = 3  # time labels may start this far left of the strip's frame
@@ -134,6 +137,9 @@ class Strip:
         edge = (self.box[3] - self.tape_y) * S
         ticks = [k * self.t_step for k in range(math.floor(fr.t_end / self.t_step + 1e-9) + 1)]
         impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
+        bar = max(1, round(CONTACT_BAR * u)) * S
+        contacts = [(edge - (1 if body == "B" else 2) * bar, TERM_RGB[body], t0,
+                     min(t1, fr.t_end)) for body, t0, t1 in fr.contacts if t0 <= fr.t_end]
         # Fast terms as pale bands, the others as lines; E on top.
         order = [n for n in names if n != "E"] + ["E"]
         t = fr.series_t
@@ -189,6 +195,10 @@ class Strip:
                     lines.append((name, list(zip(xs.tolist(), yy.tolist(), strict=True))))
             for name, pts in lines:
                 d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
+            for y, colour, t0, t1 in contacts:  # resting or rolling on the floor: a bar
+                x0, x1 = (t0 * p - c0) * S, (t1 * p - c0) * S
+                if x1 >= -S and x0 <= (c1 - c0 + 1) * S:
+                    d.rectangle([x0, y, x1, y + bar - 1], fill=colour)
             tape.paste(to_palette(img), (c0, 0))
         return tape
 

@@ -37,7 +37,7 @@ VERDICTS = ("ok", "unstable", "tunnelled", "failed")
 
 _FINITE = math.isfinite
 
-__all__ = ["FIRST_IMPACTS", "VERDICTS", "Impact", "Trajectory", "Verdict", "read_only"]
+__all__ = ["FIRST_IMPACTS", "VERDICTS", "Contact", "Impact", "Trajectory", "Verdict", "read_only"]
 
 
 def _time(value: Any, name: str, optional: bool = False) -> None:
@@ -84,6 +84,31 @@ class Impact:
         _number(self.v_after, "v_after", "m/s")
         if self.heat is not None:
             _number(self.heat, "heat", "J")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A lasting contact with the floor, not an impact: body ('A' or 'B') resting or rolling on
+    the floor from ``t_start`` to ``t_end`` (s; the run's end if it still touches then). Only a
+    contact solver (pymunk) has them; how they are told from impacts: docs/solvers.md."""
+
+    t_start: float
+    t_end: float
+    body: str
+
+    def __post_init__(self) -> None:
+        if self.body != "A" and self.body != "B":
+            raise UsageError(f"body = {args.show(self.body)}: must be 'A' or 'B'", param="body")
+        _time(self.t_start, "t_start")
+        _time(self.t_end, "t_end")
+        if not self.t_start <= self.t_end:
+            raise UsageError(f"t_end = {self.t_end!r} s: must not come before t_start = "
+                             f"{self.t_start!r} s", param="t_end")
+
+    @property
+    def duration(self) -> float:
+        """How long the contact lasts (s)."""
+        return self.t_end - self.t_start
 
 
 @dataclass(frozen=True)
@@ -141,10 +166,21 @@ def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
     return out
 
 
+def _first_rows(cells: list[list[str]], total: int) -> str:
+    """HTML table rows of ``cells`` (the first :data:`FIRST_IMPACTS` items' cell texts), then
+    one saying how many more of ``total`` items there are."""
+    rows = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>" for row in cells)
+    if total > len(cells):
+        rows += f"<tr><td colspan='{len(cells[0])}'>... and {total - len(cells)} more</td></tr>"
+    return rows
+
+
 @dataclass(frozen=True, eq=False)
 class Trajectory:
     """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
 
+    ``events`` are the impacts; ``contacts`` the lasting contacts with the floor (resting or
+    rolling: a contact solver's, told apart from impacts as docs/solvers.md says).
     ``dt`` is the step used (s; None for the exact solution), ``every`` how many steps lie
     between samples, ``wall_time`` the solver's run time (s), ``info`` solver-specific notes
     (for example settings used, or an estimated error). ``energy`` holds the energy columns
@@ -164,6 +200,7 @@ class Trajectory:
     wall_time: float = 0.0
     info: Mapping[str, Any] = field(default_factory=dict)
     energy: Mapping[str, np.ndarray] | None = field(default=None, repr=False)
+    contacts: tuple[Contact, ...] = ()
 
     def __post_init__(self) -> None:
         # The one place a frozen Trajectory's fields are set: checked, then copies and
@@ -184,6 +221,12 @@ class Trajectory:
             raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
                              param="events")
         put(self, "events", tuple(events))
+        contacts = self.contacts
+        if not isinstance(contacts, list | tuple) or not all(
+                isinstance(c, Contact) for c in contacts):
+            raise UsageError(f"contacts = {args.show(contacts)}: must be a list of Contact",
+                             param="contacts")
+        put(self, "contacts", tuple(contacts))
         put(self, "info", dict(args.mapping(self.info, "info", "a dict")))
         energy = self.energy
         if energy is None:
@@ -232,12 +275,15 @@ class Trajectory:
         return len(self.t)
 
     def __repr__(self) -> str:
-        """One line: scene, solver, dt, time span, samples, impacts, verdict."""
+        """One line: scene, solver, dt, time span, samples, impacts (and lasting contacts, if
+        any), verdict."""
         dt = "-" if self.dt is None else f"{self.dt:g} s"
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
         verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
+        contacts = f", {len(self.contacts)} contacts" if self.contacts else ""
         return (f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, t={span}, "
-                f"{len(self.t)} samples, {len(self.events)} impacts, verdict: {verdict}>")
+                f"{len(self.t)} samples, {len(self.events)} impacts{contacts}, "
+                f"verdict: {verdict}>")
 
     def _repr_html_(self) -> str:
         """A small table for notebooks: the one-line summary, the energy terms (J) at the start
@@ -249,19 +295,21 @@ class Trajectory:
         rows = [f"<tr><th>{escape(name)} (J)</th><td>{self[name][0]:.6g}</td>"
                 f"<td>{self[name][-1]:.6g}</td></tr>"
                 for name in energy_columns(self.scene)] if len(self.t) else []
-        impacts = "".join(f"<tr><td>{e.t:.6g}</td><td>{escape(e.body)}</td>"
-                          f"<td>{e.v_before:.4g}</td><td>{e.v_after:.4g}</td></tr>"
-                          for e in self.events[:FIRST_IMPACTS])
-        more = len(self.events) - FIRST_IMPACTS
-        if more > 0:
-            impacts += f"<tr><td colspan='4'>... and {more} more</td></tr>"
+        impacts = _first_rows([[f"{e.t:.6g}", escape(e.body), f"{e.v_before:.4g}",
+                                f"{e.v_after:.4g}"] for e in self.events[:FIRST_IMPACTS]],
+                              len(self.events))
+        contacts = _first_rows([[escape(c.body), f"{c.t_start:.6g}", f"{c.t_end:.6g}"]
+                                for c in self.contacts[:FIRST_IMPACTS]], len(self.contacts))
+        if contacts:
+            contacts = ("<table><tr><th>lasting contact: body</th><th>from t (s)</th>"
+                        f"<th>to t (s)</th></tr>{contacts}</table>")
         return (
             f"<div><p><code>{escape(repr(self))}</code></p>"
             f"<p><b>verdict:</b> {escape(str(self.verdict))}</p>"
             "<table><tr><th>energy</th><th>start</th><th>end</th></tr>"
             f"{''.join(rows)}</table>"
             f"<table><tr><th>impact t (s)</th><th>body</th><th>v before (m/s)</th>"
-            f"<th>v after (m/s)</th></tr>{impacts}</table></div>")
+            f"<th>v after (m/s)</th></tr>{impacts}</table>{contacts}</div>")
 
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every

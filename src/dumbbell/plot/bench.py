@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
 from ..model import args
 from ..solvers import solver_class
-from .style import pyplot, solver_style
+from .style import legend_outside, pyplot, solver_style
 
 __all__ = ["convergence", "work_precision"]
 
@@ -67,8 +67,8 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.margins(x=0.07, y=0.06)  # room for the labels of the outermost points
-    ax.set_xlabel(f"run time (s, fastest of at least {result.repeat} runs)")
-    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_xlabel(f"run time [s], fastest of at least {result.repeat} runs")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
     ax.set_title(f"Work-precision: {result.scene}, {result.t_end:g} s simulated; "
                  f"labels: dt (s)", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
@@ -82,14 +82,31 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
 
 #: Where a point's label may go, in order of preference: offset (points) and alignment.
 _LABEL_SPOTS = ((7, 2, "left"), (6, -11, "left"), (-7, 2, "right"), (-7, -11, "right"),
-                (7, 9, "left"), (7, -18, "left"), (-7, 9, "right"), (-7, -18, "right"))
+                (7, 9, "left"), (7, -18, "left"), (-7, 9, "right"), (-7, -18, "right"),
+                (-4, 8, "right"), (4, 8, "left"), (-4, -17, "right"), (4, -17, "left"))
+
+
+def _crossed(ax: Any, box: tuple[float, float, float, float]) -> bool:
+    """Whether a drawn line of ``ax`` (a curve or a marked level) runs through ``box`` (px)."""
+    from matplotlib.path import Path
+    from matplotlib.transforms import Bbox
+
+    bbox = Bbox.from_extents(*box)
+    for line in ax.lines:
+        if line.get_linestyle() in ("None", "", " ", "none") or not line.get_visible():
+            continue
+        xy = line.get_transform().transform_path(line.get_path()).vertices
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        if len(xy) > 1 and Path(xy).intersects_bbox(bbox, filled=False):
+            return True
+    return False
 
 
 def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
                   size: float = 7.5) -> None:
     """Write each (text, x, y, colour) beside its point, at the first spot whose box stays
-    inside the axes and overlaps neither a marker nor a label already placed (else at the
-    first spot)."""
+    inside the axes and overlaps neither a marker, a label already placed nor a line (else at
+    the first spot)."""
     px = ax.figure.dpi / 72.0
     xy = ax.transData.transform([(x, y) for _, x, y, _ in labels]) if labels else []
     taken = [(u - 6, v - 6, u + 6, v + 6) for u, v in xy]  # the markers
@@ -104,7 +121,7 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
             inside = (frame.x0 <= box[0] and box[2] <= frame.x1 and frame.y0 <= box[1]
                       and box[3] <= frame.y1)
             if inside and not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3]
-                                  and b[1] < box[3] for b in taken):
+                                  and b[1] < box[3] for b in taken) and not _crossed(ax, box):
                 chosen = spot
                 taken.append(box)
                 break
@@ -118,7 +135,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(7.2, 5.0), dpi=100)
+        fig, ax = pyplot().subplots(figsize=(9.6, 5.0), dpi=100)
     names = [n for n in dict.fromkeys(p.solver for p in result.points)
              if solver_class(n).has_step]
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
@@ -129,7 +146,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
         good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
         bad = [p for p in pts if not math.isfinite(p.error)]
         fit = result.fits.get(name)
-        label = name + (f": fitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
+        label = name + (f":\nfitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
                         f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
         ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
                 lw=0, label=label)
@@ -139,17 +156,16 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
         if bad:
             ax.plot([p.dt for p in bad], [top] * len(bad), ls="none", marker="x", color=colour,
                     ms=9, mew=2, label=f"{name}: failed")
-    ax.axhline(FIT_MAX_ERROR, color="grey", ls=":", lw=1)
-    ax.text(0.01, FIT_MAX_ERROR, f" fits use errors below {FIT_MAX_ERROR:g} m",
-            transform=ax.get_yaxis_transform(), fontsize=7.5, color="grey", va="bottom")
+    ax.axhline(FIT_MAX_ERROR, color="grey", ls=":", lw=1,
+               label=f"fits use errors below {FIT_MAX_ERROR:g} m")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time step dt (s)")
-    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] (m)")
+    ax.set_xlabel("time step dt [s]")
+    ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
     ax.set_title(f"Convergence: {result.scene}, error over [0, {result.window:g} s]; "
                  "lines: least-squares fits", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    legend_outside(ax)
     if own:
         fig.tight_layout()
     return ax

@@ -1,6 +1,8 @@
 """Figures of a comparison (:class:`dumbbell.analysis.compare.Comparison`): heights of each
 solver over the truth, position error against time, and E(t) per solver. Each draws on the
-axes it is given or makes its own figure, and returns the axes; none saves."""
+axes it is given or makes its own figure, and returns the axes; none saves. Legends sit outside
+the axes, on the right, and every marked line (the window, 1 mm, the truth's impacts) has its
+entry there."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ import numpy as np
 from ..analysis.compare import DIVERGED, Comparison
 from ..analysis.metrics import energy_error
 from ..model import args
-from .style import ROW_COLOURS, ROW_DASHES, pyplot
+from .style import ROW_COLOURS, ROW_DASHES, legend_outside, pyplot
 
 __all__ = ["compare", "compare_energy", "compare_positions"]
 
@@ -38,11 +40,12 @@ def _heights_panel(ax: Any, result: Comparison, body: str) -> None:
         mm = r.t <= shown + 1e-12
         ax.plot(r.t[mm], r[f"{key}{body}"][mm], color=colour, lw=1.1, label=row.label,
                 ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)])
-    ax.axvspan(result.window, max(shown, result.window), color="0.93", zorder=0)
+    ax.axvspan(result.window, max(shown, result.window), color="0.93", zorder=0,
+               label="after the window:\nthe runs part (chaos)")
     ax.set_ylabel(f"{key}_{body} [m]")
     ax.set_title(f"particle {body} ({'top' if body == 'A' else 'bottom'})", fontsize=9)
     ax.grid(True, color="0.9", lw=0.6)
-    ax.legend(loc="upper right", fontsize=8)
+    legend_outside(ax)
 
 
 def compare_positions(result: Comparison, ax: Any = None) -> Any:
@@ -54,11 +57,9 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
         ax.set_xlabel("t [s]")
         ax.set_xlim(0, _shown(result))
         return ax
-    fig, axes = pyplot().subplots(2, 1, figsize=(10, 6.4), sharex=True)
+    fig, axes = pyplot().subplots(2, 1, figsize=(11, 6.4), sharex=True)
     for panel, body in zip(axes, "AB", strict=True):
         _heights_panel(panel, result, body)
-    axes[0].text(result.window, 1.0, "  after the window: the runs part (chaos)",
-                 transform=axes[0].get_xaxis_transform(), va="top", fontsize=8, color="0.4")
     axes[-1].set_xlabel("t [s]")
     axes[-1].set_xlim(0, _shown(result))
     fig.suptitle(f"{result.scene.title}: heights, each solver over the truth", fontsize=10)
@@ -72,19 +73,20 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(10, 4.6))
+        fig, ax = pyplot().subplots(figsize=(11, 4.6))
     scene, truth = result.scene, result.truth
     for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
         t = row.traj.t[: len(row.error)]
         ax.semilogy(t, np.maximum(row.error, 1e-17), color=colour, lw=1.1,
                     ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
-                    label=f"{row.label}: {row.window_error:.2g} m max in [0, {result.window:g}] s")
-    ax.axvline(result.window, color="0.4", ls="--", lw=0.8)
-    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8)
-    ax.text(0.002, DIVERGED, " 1 mm", va="bottom", fontsize=8, color="0.4",
-            transform=ax.get_yaxis_transform())
-    for ev in truth.events:
-        ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0)
+                    label=f"{row.label}: {row.window_error:.2g} m max\nin [0, {result.window:g}] s")
+    ax.axvline(result.window, color="0.4", ls="--", lw=0.8,
+               label=f"end of the {result.window:g} s window")
+    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8,
+               label=f"{DIVERGED * 1e3:g} mm: the runs have parted")
+    for i, ev in enumerate(truth.events):
+        ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0,
+                   label=f"impacts of the truth ({truth.solver})" if i == 0 else None)
     positive = np.concatenate([row.error[row.error > 0] for row in result.rows] or [[1.0]])
     if positive.size:
         ax.set_ylim(bottom=max(1e-16, float(np.percentile(positive, 1)) / 10))
@@ -92,9 +94,8 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     ax.set_ylabel("largest |position error| [m]")
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"{scene.title}: position error against {truth.solver} (grey lines: its "
-                 f"impacts; dashed: the {result.window:g} s window)", fontsize=9)
+    legend_outside(ax)
+    ax.set_title(f"{scene.title}: position error against {truth.solver}", fontsize=9)
     if own:
         fig.tight_layout()
     return ax
@@ -105,7 +106,7 @@ def _truth_label(truth: Any) -> str:
     scene (nothing to measure its energy against)."""
     error = energy_error(truth, None)
     name = f"{truth.solver} (truth)"
-    return f"{name}: energy error {error:.1e}" if np.isfinite(error) else name
+    return f"{name}:\nenergy error {error:.1e}" if np.isfinite(error) else name
 
 
 def compare_energy(result: Comparison, ax: Any = None) -> Any:
@@ -113,21 +114,21 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(10, 4.6))
+        fig, ax = pyplot().subplots(figsize=(11, 4.6))
     scene, truth = result.scene, result.truth
     E0 = float(truth["E"][0]) or 1.0
     for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
         r = row.traj
         ax.plot(r.t, r["E"] / E0 - 1.0, color=colour, lw=1.0,
                 ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
-                label=f"{row.label}: energy error {row.energy_error:.2e}")
+                label=f"{row.label}:\nenergy error {row.energy_error:.2e}")
     ax.plot(truth.t, truth["E"] / E0 - 1.0, color="black", lw=1.2,
             label=_truth_label(truth))
     ax.set_xlabel("t [s]")
-    ax.set_ylabel("E(t) / E(0) - 1")
+    ax.set_ylabel("E(t) / E(0) - 1 [1]")
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, color="0.9", lw=0.6)
-    ax.legend(loc="lower left", fontsize=8)
+    legend_outside(ax)
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
     ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
                  fontsize=9)

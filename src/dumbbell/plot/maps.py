@@ -13,7 +13,7 @@ from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
-from .style import FAIL_COLOURS, pyplot
+from .style import FAIL_COLOURS, legend_outside, pyplot
 
 __all__ = ["axis_label", "stability_map", "sweep_map"]
 
@@ -39,7 +39,7 @@ def _is_log(axis: Axis) -> bool:
 AXIS_LABELS = {"spring.stiffness": "k, spring constant [N/m]", "run.dt": "dt, time step [s]",
                "bodies.A.mass": "m_A [kg]", "bodies.B.mass": "m_B [kg]",
                "spring.rest_length": "b, rest length [m]", "gravity.g": "g [m/s^2]",
-               "floor.elasticity": "floor elasticity", "run.t_end": "t_end [s]"}
+               "floor.elasticity": "floor elasticity [1]", "run.t_end": "t_end [s]"}
 
 
 def axis_label(key: str) -> str:
@@ -80,11 +80,12 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
 def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResult],
              title: str, x_label: str | None = None, y_label: str | None = None,
              wdt: np.ndarray | None = None, limits: tuple[int, int] | None = None,
-             colorbar: bool = True) -> Any:
+             colorbar: bool = True, legend_drop: float = 0.13) -> Any:
     """Paint a 2D grid of sweep rows (x outer, y inner, as in grid order) on ``ax``:
     colour by log10 of the largest relative energy error (between ``limits``, else fitted),
     failures by verdict, and the contour w*dt = 2 (from the rows' w_dt, or ``wdt`` given on
-    the same grid). Returns the colour mesh."""
+    the same grid); the legend hangs ``legend_drop`` axes heights below the axes, under the
+    x label. Returns the colour mesh."""
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -112,7 +113,7 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
                          shading="flat")
     if colorbar:
         cbar = fig.colorbar(mesh, ax=ax, pad=0.02)
-        cbar.set_label("log10 of the largest relative energy error |E - E0| / |E0|")
+        cbar.set_label("log10 of the largest relative energy error |E - E0| / |E0| [1]")
     handles = []
     for code, (name, colour) in enumerate(FAIL_COLOURS.items()):
         mask = verdict == name
@@ -141,7 +142,7 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
     ax.set_xlabel(x_label or axis_label(x_axis.key))
     ax.set_ylabel(y_label or axis_label(y_axis.key))
     ax.set_title(title, fontsize=10)
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -legend_drop), ncol=2,
               fontsize=8, frameon=False)
     return mesh
 
@@ -186,10 +187,10 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     if _is_log(axis):
         ax.set_xscale("log")
     ax.set_xlabel(axis_label(axis.key))
-    ax.set_ylabel("largest relative energy error")
+    ax.set_ylabel("largest relative energy error [1]")
     ax.set_title(title, fontsize=10)
     ax.grid(True, color="0.9")
-    ax.legend(fontsize=8)
+    legend_outside(ax)
 
 
 def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
@@ -210,12 +211,12 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
         wdt = np.array([[r.w_dt for r in rows[i::len(MAP_RATIOS)]]
                         for i in range(len(MAP_RATIOS))], float)
         mesh = draw_map(fig, ax, x_axis, y_axis, rows, solver,
-                        x_label="w*dt  (w = sqrt(k/mu))", y_label="mass ratio mB/mA",
-                        wdt=wdt, limits=(lo, hi), colorbar=False)
+                        x_label="w*dt, w = sqrt(k/mu) [1]", y_label="mass ratio mB/mA [1]",
+                        wdt=wdt, limits=(lo, hi), colorbar=False, legend_drop=0.2)
     fig.subplots_adjust(left=0.055, right=0.9, bottom=0.25, top=0.86, wspace=0.25)
     cax = fig.add_axes((0.92, 0.25, 0.013, 0.61))
     cbar = fig.colorbar(mesh, cax=cax)
-    cbar.set_label("log10 of the largest relative energy error")
+    cbar.set_label("log10 of the largest relative energy error [1]")
     fig.suptitle(f"Stability of the explicit spring step: {MAP_STEPS} steps per run, no floor, "
                  f"no gravity; 'unstable' = non-finite or energy error > {MAP_UNSTABLE_ENERGY:g}",
                  fontsize=10)

@@ -1,13 +1,16 @@
 """Figures of the rotation chapter's preview: apparent restitution against tilt, and the topple
 against its closed form. Each draws on the axes it is given (or a new figure) and returns them;
-none saves or switches matplotlib's backend."""
+none saves or switches matplotlib's backend. Legends sit outside the axes, on the right."""
 
 from __future__ import annotations
 
 import math
+import textwrap
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from .style import legend_outside
 
 if TYPE_CHECKING:
     from ..analysis.contact import ContactMomentum
@@ -35,40 +38,37 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     Returns the three axes."""
     from ..analysis.restitution import RestitutionResult, e_eff_rigid, k_rot_share_rigid
     from ..model import args
-
     args.instance(result, "result", RestitutionResult,
                   "a RestitutionResult (from dumbbell.analysis.restitution.restitution)")
     ax = args.axes(ax, count=3)
 
-    top, mid, bottom = _axes(ax, 3, figsize=(8.5, 9.0), sharex=True,
+    top, mid, bottom = _axes(ax, 3, figsize=(11.0, 9.0), sharex=True,
                              gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
     th = np.linspace(float(result.theta.min()), float(result.theta.max()), 400)
     top.axhline(0, color="0.5", lw=0.8)
     top.plot(th, e_eff_rigid(th, result.e, result.q), color="black", lw=1.6,
-             label=f"rigid, formula (e - q sin²θ)/(1 + q sin²θ), q = {result.q:.3g}")
+             label=f"rigid, formula\n(e - q sin²θ)/(1 + q sin²θ), q = {result.q:.3g}")
     top.plot(result.theta, result.truth, "o", ms=9, mfc="none", mec="#d62728", mew=1.6,
-             label=f"rigid, truth ({result.truth_solver}), first impact")
+             label=f"rigid, truth ({result.truth_solver}),\nfirst impact")
     top.plot(result.theta, result.pymunk, "x", ms=8, color="#2ca02c", mew=1.8,
-             label=f"rigid, pymunk dt = {result.pymunk_dt:g} s, first impact")
+             label=f"rigid, pymunk dt = {result.pymunk_dt:g} s,\nfirst impact")
     for (k, cols), colour in zip(result.springs.items(), SPRING_COLOURS, strict=False):
         top.plot(result.theta, cols["e_eff"], "s--", ms=5, color=colour, lw=1.1,
-                 label=f"spring k = {k:g} N/m (pymunk), leaving after the first cluster")
+                 label=f"spring k = {k:g} N/m (pymunk),\nleaving after the first cluster")
     cross = result.sign_change
     if math.isfinite(cross) and th[0] <= cross <= th[-1]:
         top.axvline(cross, color="0.4", ls=":", lw=1.2)
-        note = (f"rigid e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q):\npast it the "
-                "centre of mass keeps moving down after the bounce")
+        note = (f"the rigid dumbbell's e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q, "
+                "dotted): past it the centre of mass keeps moving down after the bounce")
     elif math.isfinite(cross):
-        note = (f"rigid e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q),\noutside the "
-                "tilts run here")
+        note = (f"the rigid dumbbell's e_eff changes sign at θ = {cross:.1f}° (sin²θ = e/q), "
+                "outside the tilts run here")
     else:
-        note = "rigid e_eff stays positive at every tilt (e > q)"
-    top.text(0.99, 0.6, note, transform=top.transAxes, ha="right", va="center", fontsize=8.5,
-             bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
-    top.set_ylabel("e_eff = -V_after / V_before")
+        note = "the rigid dumbbell's e_eff stays positive at every tilt (e > q)"
+    top.set_ylabel("e_eff = -V_after / V_before [1]")
     top.set_title(f"Apparent restitution of a dumbbell dropped at tilt θ on a floor with "
-                  f"e = {result.e:g}", fontsize=10.5)
-    top.legend(fontsize=7.5, loc="lower left", framealpha=0.92)
+                  f"e = {result.e:g}\n" + "\n".join(textwrap.wrap(note, 100)), fontsize=10)
+    legend_outside(top, fontsize=7.5)
 
     series = [("rigid (pymunk)", result.rigid_impacts, "#2ca02c")]
     series += [(f"k = {k:g} N/m", cols["impacts"], c) for (k, cols), c in
@@ -78,21 +78,22 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     for j, (label, impacts, colour) in enumerate(series):
         x = result.theta + (j - (len(series) - 1) / 2) * bar
         mid.bar(x, impacts, width=bar, color=colour, label=label)
-    mid.set_ylabel("impacts in the\nfirst cluster")
-    mid.set_ylim(0, 1.3 * max(float(np.max(s[1])) for s in series))
-    mid.legend(fontsize=7, loc="upper right", ncol=4)
+    mid.set_ylabel("impacts in the\nfirst cluster [1]")
+    mid.set_ylim(0, 1.15 * max(float(np.max(s[1])) for s in series))
+    mid.yaxis.get_major_locator().set_params(integer=True)    # counts
+    legend_outside(mid, fontsize=7.5)
 
     bottom.plot(th, k_rot_share_rigid(th, result.e, result.q), color="black", lw=1.6,
-                label="rigid, formula (1+e)² q sin²θ / (1 + q sin²θ)², after the first impact")
+                label="rigid, formula (1+e)² q sin²θ / (1 + q sin²θ)²,\nafter the first impact")
     bottom.plot(result.theta, result.rigid_k_rot_share, "x", ms=8, color="#2ca02c", mew=1.8,
-                label="rigid, pymunk, after the first impact")
+                label="rigid, pymunk,\nafter the first impact")
     for (k, cols), colour in zip(result.springs.items(), SPRING_COLOURS, strict=False):
         bottom.plot(result.theta, cols["K_rot_share"], "s--", ms=5, color=colour, lw=1.1,
                     label=f"k = {k:g} N/m, after the first cluster")
-    bottom.set_ylabel("K_rot / K before")
+    bottom.set_ylabel("K_rot / K before [1]")
     bottom.set_ylim(0, 1.05)
     bottom.set_xlabel("tilt θ of the axis from vertical [degrees]")
-    bottom.legend(fontsize=7, loc="upper right")
+    legend_outside(bottom, fontsize=7.5)
     for a in (top, mid, bottom):
         a.grid(True, color="0.9")
     return top, mid, bottom
@@ -111,28 +112,33 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
                   "a ToppleMeasure (from dumbbell.analysis.topple.measure)")
     ax = args.axes(ax, count=3)
     solver = args.text(solver, "solver", "a str (the name in the legend)")
-    a1, a2, a3 = _axes(ax, 3, figsize=(8.5, 8.0), sharex=True)
+    a1, a2, a3 = _axes(ax, 3, figsize=(10.5, 8.0), sharex=True)
     t, theta = cf.angle_curve()
     step = max(1, len(measured.t) // 60)
     a1.plot(t, np.degrees(theta), color="black", lw=1.6, label="closed form (quadrature)")
     a1.plot(measured.t[::step], np.degrees(measured.theta[::step]), "o", ms=4, mfc="none",
             color="#2ca02c", label=solver)
-    a1.axhline(90, color="0.6", lw=0.8, ls=":")
+    a1.axhline(90, color="0.6", lw=0.8, ls=":", label="θ = 90°: lying on the floor")
     a1.set_ylabel("tilt θ [degrees]")
-    T = cf.fall_time()
-    a1.annotate(f"landing: closed form {T:.5f} s, {solver} {measured.fall_time:.5f} s",
-                (T, 90), xytext=(-250, -30), textcoords="offset points", fontsize=8.5,
-                arrowprops={"arrowstyle": "->", "color": "0.4"})
-    a1.legend(fontsize=8, loc="upper left")
+    a1.set_ylim(0, 100)
+    T, late = cf.fall_time(), measured.fall_time - cf.fall_time()
+    # To the microsecond: the two landings differ by a few µs at dt = 1e-5 s.
+    a1.annotate(f"landing (θ = 90°):\nclosed form {T:.6f} s\n{solver} {measured.fall_time:.6f} s"
+                f"\n({solver} {abs(late) * 1e6:.0f} µs {'late' if late >= 0 else 'early'})",
+                (T, 90), xytext=(0.03, 0.83), textcoords="axes fraction", va="top",
+                fontsize=8.5, arrowprops={"arrowstyle": "->", "color": "0.4",
+                                          "shrinkA": 4, "shrinkB": 2})
+    legend_outside(a1)
 
-    a2.axhline(0, color="black", lw=1.6, label="closed form: no horizontal force, x_cm stays put")
+    a2.axhline(0, color="black", lw=1.6,
+               label="closed form: no\nhorizontal force,\nx_cm stays put")
     a2.plot(measured.t, measured.cm_x, color="#2ca02c", lw=1, label=solver)
     a2.set_ylabel("x_cm - x_cm(0) [m]")
     lim = max(1e-6, 2 * float(np.max(np.abs(measured.cm_x))))
     a2.set_ylim(-lim, lim)
     a2.text(0.01, 0.08, f"largest drift: {measured.cm_drift:.2g} m", transform=a2.transAxes,
             fontsize=8.5)
-    a2.legend(fontsize=8, loc="upper left")
+    legend_outside(a2)
 
     w = cf.omega(theta)
     vA = w * np.sqrt((cf.L - cf.a) ** 2 * np.cos(theta) ** 2 + cf.L**2 * np.sin(theta) ** 2)
@@ -141,12 +147,12 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
             color="#2ca02c", label=solver)
     v_cf = cf.landing_speeds()[1]
     a3.axhline(math.sqrt(2 * cf.g * cf.L), color="0.5", ls=":", lw=1,
-               label=f"√(2gL) = {math.sqrt(2 * cf.g * cf.L):.4f} m/s (started upright)")
+               label=f"√(2gL) = {math.sqrt(2 * cf.g * cf.L):.4f} m/s\n(started upright)")
     a3.set_ylabel("speed of the top particle [m/s]")
     a3.set_xlabel("t [s]")
-    a3.text(0.01, 0.55, f"at the landing: closed form {v_cf:.4f} m/s,\n{solver} "
-            f"{measured.v_top:.4f} m/s", transform=a3.transAxes, fontsize=8.5)
-    a3.legend(fontsize=8, loc="upper left")
+    a3.text(0.01, 0.55, f"at the landing: closed form {v_cf:.5f} m/s,\n{solver} "
+            f"{measured.v_top:.5f} m/s", transform=a3.transAxes, fontsize=8.5)
+    legend_outside(a3)
     for a in (a1, a2, a3):
         a.grid(True, color="0.9")
     a1.set_title(f"Toppling rigid dumbbell: L = {cf.L:g} m, released at "
@@ -164,18 +170,18 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
                   "a ContactMomentum (from dumbbell.analysis.contact.about_contact)")
     ax = args.axes(ax)
     solver = args.text(solver, "solver", "a str (the name in the title)")
-    ax = _axes(ax, 1, figsize=(8.5, 4.6))
+    ax = _axes(ax, 1, figsize=(10.5, 4.8))
     t = (cm.t - cm.impact.t) * 1e3
     ax.axvline(0, color="0.6", lw=0.8, ls=":")
-    ax.plot(t, cm.L_cm, color="#2ca02c", lw=1.4, label="L_cm, spin about the centre of mass")
+    ax.plot(t, cm.L_cm, color="#2ca02c", lw=1.4, label="L_cm, spin about the\ncentre of mass")
     ax.plot(t, cm.L_orbit, color="#1f77b4", lw=1.4, ls="--",
-            label="M (R - P) x V, the centre of mass's orbit about P")
-    ax.plot(t, cm.L_P, color="black", lw=2.0, label="L_P, their sum: about the contact point")
+            label="M (R - P) x V, the centre\nof mass's orbit about P")
+    ax.plot(t, cm.L_P, color="black", lw=2.0, label="L_P, their sum: about\nthe contact point")
     ax.set_xlabel(f"t - t_impact [ms]   (impact of {cm.impact.body} at {cm.impact.t:.6f} s, "
                   f"P = ({cm.px:.4f} m, 0))")
     ax.set_ylabel("angular momentum [kg m²/s]")
     ax.grid(True, color="0.9")
-    ax.legend(fontsize=8, loc="best")
+    legend_outside(ax)
     who = f" ({solver})" if solver else ""
     ax.set_title(f"Through a frictionless impact{who}: L_cm jumps {cm.L_cm_before:+.5f} → "
                  f"{cm.L_cm_after:+.5f}, L_P stays {cm.before:+.6f} → {cm.after:+.6f} "

@@ -51,6 +51,16 @@ def solver_style(name: str, i: int) -> tuple[str, str]:
     return SOLVER_STYLES.get(name, (f"C{i % 10}", "D"))
 
 
+def legend_outside(ax: Any, *args: Any, **kwargs: Any) -> Any:
+    """``ax.legend(*args, **kwargs)`` outside the axes, on the right, its top level with the
+    axes' top: no curve of the axes can run through it, whatever the data (the figures are
+    checked for that). ``fontsize`` is 8 unless given. Returns the legend. For the package's
+    figures (not exported): ``ax`` is theirs."""
+    kwargs.setdefault("fontsize", 8)
+    return ax.legend(*args, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+                     **kwargs)
+
+
 def pyplot() -> Any:
     """matplotlib.pyplot, imported on first use (whatever backend is configured)."""
     import matplotlib.pyplot as plt

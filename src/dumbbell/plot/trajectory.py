@@ -9,6 +9,8 @@
 All show the textbook's window, 0 to 2 s, and mark the first impact. Each draws on the axes
 it is given, or makes its own figure when given none, and returns the axes; none saves (see
 :func:`dumbbell.io.figures.save_figure`). Matplotlib is imported only when a figure is drawn.
+Legends sit outside the axes, on the right, and the first impact's time above the top axes,
+so that no curve runs through text whatever the data.
 """
 
 from __future__ import annotations
@@ -20,15 +22,12 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ..model.trajectory import Trajectory
-from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, pyplot
+from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, legend_outside, pyplot
 
-__all__ = ["WINDOW", "energy", "heights", "kinetic", "momentum_axis", "positions", "potential"]
+__all__ = ["WINDOW", "energy", "heights", "kinetic", "momentum_panel", "positions", "potential"]
 
 #: The textbook's time window (s).
 WINDOW = 2.0
-#: Where matplotlib can put a legend.
-LEGEND_LOCATIONS = ("best", "upper right", "upper left", "lower left", "lower right", "right",
-                    "center left", "center right", "lower center", "upper center", "center")
 
 
 def _window(traj: Trajectory, window: float) -> np.ndarray:
@@ -59,19 +58,23 @@ def _positions_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.set_ylabel(f"{name} [m]")
     top = float(np.nanmax(a)) if len(a) else 1.0
     ax.set_ylim(min(-0.05, float(np.nanmin(b)) - 0.05) if len(b) else -0.05, top * 1.08 + 0.02)
-    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    legend_outside(ax)
 
 
 def _mark_first_impact(axes: list[Any], traj: Trajectory, window: float, text: bool) -> None:
+    """A dashed line at the first impact through every panel, and its time written above the
+    top panel (outside it: no curve can cross the words), on the side with more room."""
     first = traj.first_impact()
     if first is None or first.t > window:
         return
     for ax in axes:
         ax.axvline(first.t, color="0.5", lw=0.8, ls="--", zorder=1)
     if text:
+        left = first.t <= 0.6 * window
         axes[0].annotate(f"first impact, t = {first.t:.4f} s", xy=(first.t, 1.0),
-                         xycoords=("data", "axes fraction"), xytext=(4, -12),
-                         textcoords="offset points", fontsize=8, color="0.3")
+                         xycoords=("data", "axes fraction"), xytext=(2 if left else -2, 2),
+                         textcoords="offset points", ha="left" if left else "right",
+                         va="bottom", fontsize=8, color="0.3")
 
 
 def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) -> None:
@@ -85,9 +88,8 @@ def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) ->
     values = np.concatenate([traj[name][m] for name in names])
     lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
     span = hi - min(lo, 0.0)
-    # Head room above the curves keeps the legend off the total-energy line.
-    ax.set_ylim(min(lo, 0.0) - 0.04 * span, hi + 0.3 * span)
-    ax.legend(loc="upper center", fontsize=8, framealpha=0.9, ncol=len(names))
+    ax.set_ylim(min(lo, 0.0) - 0.04 * span, hi + 0.08 * span)
+    legend_outside(ax)
 
 
 def _frame(axes: list[Any], traj: Trajectory, window: float) -> None:
@@ -112,7 +114,8 @@ def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle:
     # A solver without a step takes dt only as the sample spacing: not worth a title.
     dt = f", dt = {traj.dt:g} s" if traj.dt and solver_class(traj.solver).has_step else ""
     fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
-    fig.tight_layout()
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
 
 
 def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
@@ -122,7 +125,7 @@ def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
         _positions_panel(ax, traj, window)
         _frame([ax], traj, window)
         return ax
-    fig, ax = pyplot().subplots(figsize=(8, 4.2))
+    fig, ax = pyplot().subplots(figsize=(9.5, 4.2))
     _positions_panel(ax, traj, window)
     _title(fig, [ax], traj, window,
            "the centre of mass falls on parabolas; the particles oscillate about it")
@@ -137,7 +140,7 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
         _energy_panel(ax, traj, names, window)
         _frame([ax], traj, window)
         return ax
-    fig, (top, bottom) = pyplot().subplots(2, 1, figsize=(8, 6.4), sharex=True)
+    fig, (top, bottom) = pyplot().subplots(2, 1, figsize=(9.5, 6.4), sharex=True)
     _positions_panel(top, traj, window)
     _energy_panel(bottom, traj, names, window)
     _title(fig, [top, bottom], traj, window, subtitle)
@@ -189,45 +192,39 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.set_xlim(mid - half, mid + half)
     ax.set_ylim(lo, hi)
     ax.set_aspect("equal", adjustable="box")
+    ax.locator_params(axis="x", nbins=4)    # a narrow panel: few x labels, none touching
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(f"in the plane, 0-{window:g} s\n(axis every 0.1 s, dark = later)", fontsize=8)
 
 
-def momentum_axis(ax: Any, traj: Trajectory, window: float, loc: str = "upper center",
-                  ncol: int = 3) -> None:
-    """L_cm (kg m^2/s) on a right-hand axis of ``ax``: flat in flight, a step at each impact.
-    The legend of ``ax`` moves to the right-hand axis (at ``loc``, in ``ncol`` columns)."""
+def momentum_panel(ax: Any, traj: Trajectory, window: float = WINDOW) -> Any:
+    """L_cm, the angular momentum about the centre of mass (kg m^2/s, 2D), against time on
+    ``ax``: flat in flight, a step at each impact. Returns the axes."""
     traj, ax, window = _checked(traj, ax, window)
     if ax is None:
-        raise UsageError("ax = None: must be a matplotlib Axes (the axes to add to)",
-                              param="ax")
-    loc = args.choice(loc, "loc", LEGEND_LOCATIONS)
-    ncol = args.whole(ncol, "ncol", "legend columns")
+        raise UsageError("ax = None: must be a matplotlib Axes (the panel to draw on)",
+                         param="ax")
+    if traj.scene.system.dimensions != 2:
+        raise UsageError(f"traj = {traj.scene.name}: L_cm needs a 2D scene (dimensions = 2)",
+                         param="traj")
     m = _window(traj, window)
-    right = ax.twinx()
     L = traj["L_cm"][m]
-    right.plot(traj.t[m], L, color=MOMENTUM_COLOUR, lw=1.0, ls=(0, (5, 2)),
-               label="L_cm, about the centre of mass (right axis)")
-    lo, hi = float(np.nanmin(L)), float(np.nanmax(L))
+    ax.plot(traj.t[m], L, color=MOMENTUM_COLOUR, lw=1.2, label="L_cm, about the\ncentre of mass")
+    lo, hi = (float(np.nanmin(L)), float(np.nanmax(L))) if len(L) else (0.0, 0.0)
     pad = 0.1 * max(hi - lo, abs(hi), abs(lo), 1e-12)
-    right.set_ylim(lo - pad, hi + 3 * pad)
-    right.set_ylabel("L_cm [kg m^2/s]", color=MOMENTUM_COLOUR)
-    right.tick_params(axis="y", colors=MOMENTUM_COLOUR, labelsize=8)
-    # One legend, drawn on the upper axis so that the dashed line does not run through it.
-    handles, labels = ax.get_legend_handles_labels()
-    extra = right.get_legend_handles_labels()
-    if ax.get_legend() is not None:
-        ax.get_legend().remove()
-    right.legend(handles + extra[0], labels + extra[1], loc=loc, fontsize=8 if ncol > 1 else 7.5,
-                 framealpha=0.9, ncol=ncol)
+    ax.set_ylim(lo - pad, hi + pad)
+    ax.set_ylabel("L_cm [kg m²/s]")
+    legend_outside(ax)
+    return ax
 
 
 def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """How the energy is shared (J). On ``ax``: every energy term the scene has. Without:
     positions (and, in 2D, the motion in the plane), then two panels, the centre of mass's
     terms (K_cm, U_g) with E and E_lost, and the internal ones (K_int, or K_rot, K_vib,
-    U_spring and K_spin); returns the centre-of-mass panel."""
+    U_spring and K_spin), and in 2D a panel of L_cm (:func:`momentum_panel`); returns the
+    centre-of-mass panel."""
     traj, ax, window = _checked(traj, ax, window)
     cols = traj.columns
     outer = [n for n in ("K_cm", "U_g", "E", "E_lost", "E_heat") if n in cols]
@@ -236,25 +233,37 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
         _energy_panel(ax, traj, outer + inner, window)
         _frame([ax], traj, window)
         return ax
-    fig = pyplot().figure(figsize=(10, 8.6))
     wide = traj.scene.system.dimensions == 2
-    grid = fig.add_gridspec(3, 3 if wide else 1, height_ratios=[1.1, 1, 1])
-    top = fig.add_subplot(grid[0, :2] if wide else grid[0, 0])
+    spin = wide and "L_cm" in cols and bool(inner)
+    # Constrained layout: the time panels stay aligned in one column whatever their legends
+    # (outside, on the right) need; in 2D the motion in the plane sits right of the legends.
+    fig = pyplot().figure(figsize=(11.5 if wide else 10.0, 10.8 if spin else 8.8),
+                          layout="constrained")
+    rows = 4 if spin else 3
+    grid = fig.add_gridspec(rows, 2 if wide else 1, width_ratios=[3.2, 1] if wide else None,
+                            height_ratios=[1.15, 1, 1, 0.55][:rows])
+    top = fig.add_subplot(grid[0, 0])
     _positions_panel(top, traj, window)
     if wide:
-        _plane_panel(fig.add_subplot(grid[0, 2]), traj, window)
-    middle = fig.add_subplot(grid[1, :], sharex=top)
-    bottom = fig.add_subplot(grid[2, :], sharex=top)
+        _plane_panel(fig.add_subplot(grid[0:2, 1]), traj, window)
+    middle = fig.add_subplot(grid[1, 0], sharex=top)
+    bottom = fig.add_subplot(grid[2, 0], sharex=top)
+    panels = [top, middle, bottom]
     _energy_panel(middle, traj, outer, window)
     middle.set_title("centre of mass: K_cm and U_g trade on each parabola; " + (
-        "the floor takes energy out: E + E_lost stays at E(0); E_heat is what the contacts "
-        "dissipated" if "E_lost" in cols
-        else "E stays constant"), fontsize=9)
+        "E + E_lost stays at E(0) (the floor takes energy out;\nE_heat is what the contacts "
+        "dissipated)" if "E_lost" in cols else "E stays constant"), fontsize=9)
     if inner:
         _energy_panel(bottom, traj, inner, window)
         bottom.set_title("internal: the impacts feed the motion relative to the centre of mass",
                          fontsize=9)
-        if "L_cm" in cols:
-            momentum_axis(bottom, traj, window)
-    _title(fig, [top, middle, bottom], traj, window, "how the energy is shared")
+    if spin:
+        low = fig.add_subplot(grid[3, 0], sharex=top)
+        momentum_panel(low, traj, window)
+        low.set_title("angular momentum about the centre of mass: constant in flight, changed "
+                      "only by impacts", fontsize=9)
+        panels.append(low)
+    for ax in panels[:-1]:
+        ax.tick_params(labelbottom=False)
+    _title(fig, panels, traj, window, "how the energy is shared")
     return middle

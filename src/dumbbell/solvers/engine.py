@@ -36,6 +36,9 @@ them); friction 1.0 on the circles and the scene's friction on the floor (also m
 
 Only every ``every``-th step is read back from the engine (reading costs about as much as a
 step); impacts come from collision callbacks, so the inner loop is a bare ``Space.step`` loop.
+A circle that rests or rolls on the floor is not an impact: a touch that approaches slower than
+``CONTACT_STEPS * g * dt`` resumes a contact, and touching that lasts is reported as a
+:class:`~dumbbell.model.trajectory.Contact` (``Trajectory.contacts``; see :class:`_FloorLog`).
 Verdicts: a non-finite or blown-up state is ``unstable``; a particle whose centre is more than
 its radius below the floor and still moving down (pymunk finds contacts only once shapes
 overlap, so a step that carries a circle deep into the floor box lets it through) is
@@ -44,6 +47,7 @@ overlap, so a step that carries a circle deep into the floor box lets it through
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -54,7 +58,7 @@ import numpy as np
 
 from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
 from ..model.scene import Particle, Scene
-from ..model.trajectory import Impact, Trajectory, Verdict
+from ..model.trajectory import Contact, Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
 from .verdicts import conclude, nonfinite_reason, tunnel_reason
 
@@ -275,29 +279,86 @@ def _energy(
     return partition_from_terms(scene, t, state, events, evaluate(inv, st))
 
 
-def _impact_log(world: World, dt: float, step: Callable[[], int]) -> list[Impact]:
-    """The list into which the circles' floor contacts are recorded as they happen: each an
-    :class:`Impact` at the end of the step ``step()`` (index, step ``dt`` in s) in which it
-    began, with the vertical velocity (m/s) before and after the contact's impulses."""
-    events: list[Impact] = []
-    pending: dict[str, list[float]] = {}
+#: A touch of the floor that approaches slower than what gravity builds in this many steps
+#: (``CONTACT_STEPS * g * dt``) is contact, not an impact; touching for this many steps or
+#: more is a lasting contact. Why ten: docs/solvers.md, "Impacts and contacts".
+CONTACT_STEPS = 10
 
-    def begin(arbiter: Any, _space: Any, _data: Any) -> None:
-        shape = arbiter.shapes[0]
-        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
-        pending[name] = [(step() + 1) * dt, _vertical_velocity(shape.body, shape)]
 
-    def post_solve(arbiter: Any, _space: Any, _data: Any) -> None:
-        shape = arbiter.shapes[0]
-        name = "A" if shape.collision_type == _PARTICLE_TYPE["A"] else "B"
-        hit = pending.pop(name, None)
+class _FloorLog:
+    """The circles' floor contacts as they happen, told apart into impacts and lasting contacts.
+
+    Each time a circle begins to touch the floor (a new pymunk arbiter), its approach speed is
+    its downward velocity then. Faster than ``v_th = CONTACT_STEPS * g * dt`` (m/s): an
+    :class:`Impact` at the end of the step ``step()`` (index; step ``dt`` in s) in which it
+    began, with the vertical velocity before and after the contact's impulses. Slower: a circle
+    that rests or rolls on the floor and lost the contact for a step or two (the engine only
+    keeps an arbiter while the shapes overlap), so the touch resumes the touching before it.
+    A run of touching that lasts ``CONTACT_STEPS`` steps or more is a :class:`Contact`.
+    :meth:`notes` counts the slow touches and gives the fastest, so that a run shows how far
+    below the threshold its contacts stayed."""
+
+    def __init__(self, world: World, dt: float, g: float, step: Callable[[], int]) -> None:
+        self.dt, self.step = dt, step
+        self.v_th = CONTACT_STEPS * g * dt
+        self.events: list[Impact] = []
+        self._pending: dict[str, list[float]] = {}
+        self._since: dict[str, int] = {}              # body -> step its touching began
+        self._left: dict[str, tuple[int, int]] = {}   # body -> (began, left) of its last
+        self._runs: list[tuple[str, int, int]] = []   # finished runs: body, began, left
+        self.slow, self.fastest_slow = 0, 0.0         # touches slower than v_th; the fastest
+        for name in "AB":
+            world.space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=self._begin,
+                                     post_solve=self._post_solve, separate=self._separate)
+
+    @staticmethod
+    def _name(arbiter: Any) -> str:
+        return "A" if arbiter.shapes[0].collision_type == _PARTICLE_TYPE["A"] else "B"
+
+    def _begin(self, arbiter: Any, _space: Any, _data: Any) -> None:
+        shape, name, i = arbiter.shapes[0], self._name(arbiter), self.step()
+        v = _vertical_velocity(shape.body, shape)
+        impact = -v > self.v_th
+        if not impact:
+            self.slow += 1
+            self.fastest_slow = max(self.fastest_slow, -v)
+        last = self._left.pop(name, None)
+        if last is not None and not impact:
+            self._since[name] = last[0]               # the same contact, resumed
+            return
+        if last is not None:
+            self._runs.append((name, *last))
+        self._since[name] = i
+        if impact:
+            self._pending[name] = [(i + 1) * self.dt, v]
+
+    def _post_solve(self, arbiter: Any, _space: Any, _data: Any) -> None:
+        name = self._name(arbiter)
+        hit = self._pending.pop(name, None)
         if hit is not None:
-            events.append(Impact(hit[0], name, hit[1], _vertical_velocity(shape.body, shape)))
+            shape = arbiter.shapes[0]
+            self.events.append(Impact(hit[0], name, hit[1], _vertical_velocity(shape.body, shape)))
 
-    for name in "AB":
-        world.space.on_collision(_PARTICLE_TYPE[name], _FLOOR_TYPE, begin=begin,
-                                 post_solve=post_solve)
-    return events
+    def _separate(self, arbiter: Any, _space: Any, _data: Any) -> None:
+        name, i = self._name(arbiter), self.step()
+        self._left[name] = (self._since.pop(name, i), i)
+
+    def notes(self) -> dict[str, float]:
+        """For the trajectory's ``info``: the threshold ``impact_threshold`` (m/s), how many
+        touches were slower (``contact_touches``) and the fastest of them (m/s,
+        ``contact_approach_max``; 0 without any)."""
+        return {"impact_threshold": self.v_th, "contact_touches": self.slow,
+                "contact_approach_max": self.fastest_slow}
+
+    def contacts(self, t_end: float) -> tuple[Contact, ...]:
+        """The lasting contacts up to ``t_end`` (s, the run's last sample): runs of touching of
+        ``CONTACT_STEPS`` steps or more, one still touching at the end lasting until then."""
+        end = t_end / self.dt
+        runs = [*self._runs, *((n, *run) for n, run in self._left.items()),
+                *((n, began, end) for n, began in self._since.items())]
+        out = [Contact((a + 1) * self.dt, min(t_end, (b + 1) * self.dt), name)
+               for name, a, b in runs if b - a >= CONTACT_STEPS and (a + 1) * self.dt <= t_end]
+        return tuple(sorted(out, key=lambda c: (c.t_start, c.body)))
 
 
 @dataclass(frozen=True)
@@ -364,8 +425,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
 
     counter = HeatCounter(space)
     heat = np.zeros(options.n_samples)
-    i = 0  # step index; the impact log reads it (a closure cell), so the loop pays nothing
-    events = _impact_log(world, dt, lambda: i) if world.floors else []
+    i = 0  # step index; the floor log reads it (a closure cell), so the loop pays nothing
+    log = _FloorLog(world, dt, scene.system.g, lambda: i) if world.floors else None
     watch = _Watch.of(scene, world, names)
     step = space.step
     verdict: Verdict | None = None
@@ -399,10 +460,14 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     info = {"steps": min(n, kept * every) if verdict else n, **cfg}
     if world.rigid_body is not None:
         info["moment"] = world.rigid_body.moment
+    if log is not None:
+        info.update(log.notes())
     t = options.sample_times(kept)
-    events = [e for e in events if verdict is None or e.t <= verdict.t]
-    return conclude(scene, NAME, t, state, events, verdict or Verdict(), dt=dt, every=every,
+    events = [e for e in log.events if verdict is None or e.t <= verdict.t] if log else []
+    traj = conclude(scene, NAME, t, state, events, verdict or Verdict(), dt=dt, every=every,
                     wall_time=wall, info=info, energy=_energy(scene, world, t, state, events))
+    contacts = log.contacts(float(traj.t[-1])) if log and len(traj.t) else ()
+    return dataclasses.replace(traj, contacts=contacts) if contacts else traj
 
 
 class Pymunk(Solver):
