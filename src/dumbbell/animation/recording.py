@@ -325,6 +325,111 @@ def _clip(v: float) -> float:
     return min(max(v, -CLIP), CLIP) if not math.isnan(v) else -CLIP
 
 
+class Pen:
+    """Draws primitives through ``view`` on ``d``, an image ``S`` times the size whose corner
+    is the frame's pixel ``corner`` and which is ``size`` frame pixels large (``u``: the
+    frame's length unit); what lies wholly outside it is skipped."""
+
+    def __init__(self, d: ImageDraw.ImageDraw, u: float, S: int, view: View,
+                 corner: tuple[float, float], size: tuple[float, float]) -> None:
+        self.d, self.u, self.S, self.flip = d, u, S, view.flip
+        self.width = max(1, round(1.5 * u * S))
+        self.ox, self.oy = (view.ox - corner[0]) * S, (view.oy - corner[1]) * S
+        self.sS = view.s * S
+        self.lim_x, self.lim_y = size[0] * S, size[1] * S
+
+    def draw(self, items: tuple[tuple, ...] | list[tuple]) -> None:
+        for it in items:
+            getattr(self, it[0])(it)
+
+    def P(self, x: float, y: float) -> tuple[float, float]:
+        """The pixel (on this image) of world point (x, y), clipped."""
+        return _clip(self.ox + x * self.sS), _clip(self.oy + y * self.flip * self.sS)
+
+    def outside(self, xs: list[float], ys: list[float], m: float) -> bool:
+        return (max(xs) < -m or min(xs) > self.lim_x + m or max(ys) < -m
+                or min(ys) > self.lim_y + m)
+
+    @staticmethod
+    def colours(ink: int) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
+        """Outline and fill of a shape of ``ink`` (-1: static or kinematic, grey)."""
+        if ink < 0:
+            return GREY, STATIC_FILL
+        rgb = BODY_INKS[ink]
+        return rgb, blend(rgb, 0.33)
+
+    def circle(self, it: tuple) -> None:
+        _, ink, _, x, y, r, angle = it
+        (X, Y), R = self.P(x, y), min(max(r * self.sS, 1.5 * self.u * self.S), CLIP)
+        if math.isnan(R) or self.outside([X], [Y], R):
+            return
+        out, fill = self.colours(ink)
+        self.d.ellipse([X - R, Y - R, X + R, Y + R], fill=fill, outline=out, width=self.width)
+        if math.isfinite(angle):
+            self.d.line([(X, Y), (X + R * math.cos(angle), Y + self.flip * R * math.sin(angle))],
+                        fill=out, width=self.width)
+
+    def seg(self, it: tuple) -> None:
+        _, ink, _, ax, ay, bx, by, r = it
+        ends = [self.P(ax, ay), self.P(bx, by)]
+        line = self.width
+        w = max(line, round(min(2 * r * self.sS, CLIP))) if not math.isnan(r) else line
+        if self.outside([e[0] for e in ends], [e[1] for e in ends], w):
+            return
+        out, fill = self.colours(ink)
+        self.d.line(ends, fill=out, width=w)
+        if w > 2 * line:
+            # A fat segment: its outline, then its fill inside, with round ends.
+            for width, ink_rgb in ((w, out), (w - 2 * line, fill)):
+                for X, Y in ends:
+                    self.d.ellipse([X - width / 2, Y - width / 2, X + width / 2,
+                                    Y + width / 2], fill=ink_rgb)
+                if ink_rgb == fill:
+                    self.d.line(ends, fill=fill, width=width)
+
+    def poly(self, it: tuple) -> None:
+        _, ink, _, verts, _ = it
+        pts = [self.P(*v) for v in verts]
+        if len(pts) < 2 or self.outside([p[0] for p in pts], [p[1] for p in pts], self.width):
+            return
+        out, fill = self.colours(ink)
+        self.d.polygon(pts, fill=fill, outline=out, width=self.width)
+
+    def spring(self, it: tuple) -> None:
+        pa, pb = self.P(it[3], it[4]), self.P(it[5], it[6])
+        if not self.outside([pa[0], pb[0]], [pa[1], pb[1]], 6 * self.u * self.S):
+            # Coils at most a tenth of the spring's drawn length wide: a web of short springs
+            # stays legible.
+            amp = min(SPRING_WIDTH * self.u * self.S, 0.1 * math.dist(pa, pb))
+            self.d.line(zigzag(pa, pb, amp, COILS), fill=SPRING, width=self.width,
+                        joint="curve")
+
+    def line(self, it: tuple) -> None:
+        pa, pb = self.P(it[3], it[4]), self.P(it[5], it[6])
+        if not self.outside([pa[0], pb[0]], [pa[1], pb[1]], self.width):
+            self.d.line([pa, pb], fill=SPRING, width=self.width)
+
+    def dot(self, it: tuple) -> None:
+        X, Y = self.P(it[3], it[4])
+        R = 3 * self.u * self.S
+        if not self.outside([X], [Y], R):
+            self.d.ellipse([X - R, Y - R, X + R, Y + R], fill=INK)
+
+    def rotary(self, it: tuple) -> None:
+        """A coil of 2.5 turns about the pivot, turned by the spring's twist."""
+        _, _, _, x, y, twist = it
+        X, Y = self.P(x, y)
+        if self.outside([X], [Y], 12 * self.u * self.S) or not math.isfinite(twist):
+            return
+        pts = []
+        for i in range(61):
+            f = i / 60
+            a = f * 2.5 * 2 * math.pi + twist
+            rr = (4 + 8 * f) * self.u * self.S
+            pts.append((X + rr * math.cos(a), Y + self.flip * rr * math.sin(a)))
+        self.d.line(pts, fill=SPRING, width=self.width, joint="curve")
+
+
 class Painter(Backdrop):
     """Draws a :class:`Recording`'s frames in the fixed palette (see the module docstring)."""
 
@@ -424,101 +529,6 @@ class Painter(Backdrop):
         sx0, _, sx1, _ = self.strip_box
         return sx0 + 1 + (sx1 - sx0 - 2) * (t - self.t[0]) / self.t_end
 
-    # --- drawing primitives ---------------------------------------------------------------
-
-    def _draw_items(self, d: ImageDraw.ImageDraw, items: tuple[tuple, ...] | list[tuple],
-                    S: int, view: View, corner: tuple[float, float],
-                    size: tuple[float, float]) -> None:
-        """Draw ``items`` on ``d``, an image ``S`` times the size whose corner is the pixel
-        ``corner`` of the frame and which is ``size`` px (frame pixels) large; items wholly
-        outside it are skipped."""
-        u, s, flip = self.u, view.s, view.flip
-        cx, cy = corner
-        line = max(1, round(1.5 * u * S))
-        ox, oy = (view.ox - cx) * S, (view.oy - cy) * S
-        sS = s * S
-        fS = flip * sS
-        lim_x, lim_y = size[0] * S, size[1] * S
-
-        def P(x: float, y: float) -> tuple[float, float]:
-            return _clip(ox + x * sS), _clip(oy + y * fS)
-
-        def outside(xs: list[float], ys: list[float], m: float) -> bool:
-            return (max(xs) < -m or min(xs) > lim_x + m or max(ys) < -m or min(ys) > lim_y + m)
-
-        def colours(ink: int) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
-            if ink < 0:
-                return GREY, STATIC_FILL
-            rgb = BODY_INKS[ink]
-            return rgb, blend(rgb, 0.33)
-
-        for it in items:
-            kind = it[0]
-            if kind == "circle":
-                _, ink, _, x, y, r, angle = it
-                (X, Y), R = P(x, y), min(max(r * sS, 1.5 * u * S), CLIP)
-                if math.isnan(R) or outside([X], [Y], R):
-                    continue
-                out, fill = colours(ink)
-                d.ellipse([X - R, Y - R, X + R, Y + R], fill=fill, outline=out, width=line)
-                if math.isfinite(angle):
-                    d.line([(X, Y), (X + R * math.cos(angle), Y + flip * R * math.sin(angle))],
-                           fill=out, width=line)
-            elif kind == "seg":
-                _, ink, _, ax, ay, bx, by, r = it
-                (X0, Y0), (X1, Y1) = P(ax, ay), P(bx, by)
-                w = max(line, round(min(2 * r * sS, CLIP))) if not math.isnan(r) else line
-                if outside([X0, X1], [Y0, Y1], w):
-                    continue
-                out, fill = colours(ink)
-                d.line([(X0, Y0), (X1, Y1)], fill=out, width=w)
-                if w > 2 * line:
-                    # A fat segment: its outline, then its fill inside, with round ends.
-                    inner = w - 2 * line
-                    for X, Y in ((X0, Y0), (X1, Y1)):
-                        d.ellipse([X - w / 2, Y - w / 2, X + w / 2, Y + w / 2], fill=out)
-                    d.line([(X0, Y0), (X1, Y1)], fill=fill, width=inner)
-                    for X, Y in ((X0, Y0), (X1, Y1)):
-                        d.ellipse([X - inner / 2, Y - inner / 2, X + inner / 2, Y + inner / 2],
-                                  fill=fill)
-            elif kind == "poly":
-                _, ink, _, verts, _ = it
-                pts = [P(*v) for v in verts]
-                if len(pts) < 2 or outside([p[0] for p in pts], [p[1] for p in pts], line):
-                    continue
-                out, fill = colours(ink)
-                d.polygon(pts, fill=fill, outline=out, width=line)
-            elif kind in ("spring", "line"):
-                _, _, _, ax, ay, bx, by = it
-                pa, pb = P(ax, ay), P(bx, by)
-                if outside([pa[0], pb[0]], [pa[1], pb[1]], 6 * u * S):
-                    continue
-                if kind == "spring":
-                    # Coils at most a tenth of the spring's drawn length wide: a web of short
-                    # springs stays legible.
-                    amp = min(SPRING_WIDTH * u * S, 0.1 * math.dist(pa, pb))
-                    pts = zigzag(pa, pb, amp, COILS)
-                else:
-                    pts = [pa, pb]
-                d.line(pts, fill=SPRING, width=line, joint="curve" if kind == "spring" else None)
-            elif kind == "dot":
-                X, Y = P(it[3], it[4])
-                R = 3 * u * S
-                if not outside([X], [Y], R):
-                    d.ellipse([X - R, Y - R, X + R, Y + R], fill=INK)
-            elif kind == "rotary":
-                _, _, _, x, y, twist = it
-                X, Y = P(x, y)
-                if outside([X], [Y], 12 * u * S) or not math.isfinite(twist):
-                    continue
-                pts = []
-                for i in range(61):
-                    f = i / 60
-                    a = f * 2.5 * 2 * math.pi + twist
-                    rr = (4 + 8 * f) * u * S
-                    pts.append((X + rr * math.cos(a), Y + flip * rr * math.sin(a)))
-                d.line(pts, fill=SPRING, width=line, joint="curve")
-
     def _base(self) -> Image.Image:
         """The frame without its scene: white, the energy panel's legend and strip (RGB,
         :data:`SS` times the size)."""
@@ -545,8 +555,8 @@ class Painter(Backdrop):
         u, S = self.u, SS
         img = self.base.copy()
         scene = Image.new("RGB", (self.scene_w * S, self.H * S), WHITE)
-        self._draw_items(ImageDraw.Draw(scene), self.rec.statics[version], S, view, (0, 0),
-                         (self.scene_w, self.H))
+        Pen(ImageDraw.Draw(scene), self.u, S, view, (0, 0), (self.scene_w, self.H)).draw(
+            self.rec.statics[version])
         img.paste(scene, (0, 0))
         if self.rec.title:
             ImageDraw.Draw(img).text(((self.scene_w - 8 * u) * S, 6 * u * S), self.rec.title,
@@ -597,8 +607,8 @@ class Painter(Backdrop):
         box = self._moving_box(items, view)
         if box is not None:
             crop, corner, done = self.patch(img, box, SS)
-            self._draw_items(ImageDraw.Draw(crop), items, SS, view, corner,
-                             (crop.width / SS, crop.height / SS))
+            Pen(ImageDraw.Draw(crop), self.u, SS, view, corner,
+                (crop.width / SS, crop.height / SS)).draw(items)
             done()
         u = self.u
         crop, (cx, cy), done = self.patch(img, (4 * u, 2 * u, 150 * u, 24 * u), 1)

@@ -90,7 +90,7 @@ def _options_class() -> type:
                 self._ink[key] = len(self._ink) % len(BODY_INKS)
             return self._ink[key]
 
-        def number_of(self, body: Any) -> int:
+        def _number_of(self, body: Any) -> int:
             """The number of a moving (dynamic or kinematic) body, in the order first seen;
             -1 for a static body."""
             if body.body_type == pymunk.Body.STATIC:
@@ -101,7 +101,7 @@ def _options_class() -> type:
             body = shape.body
             static = body.body_type == pymunk.Body.STATIC
             self._sink = self.static if static else self.items
-            self._shape = (self.ink_of(body), self.number_of(body))
+            self._shape = (self.ink_of(body), self._number_of(body))
             return SpaceDebugColor(0, 0, 0, 255)
 
         def draw_circle(self, pos: Any, angle: float, radius: float, outline_color: Any,
@@ -135,7 +135,7 @@ def _options_class() -> type:
             for shape in space.shapes:
                 shape.cache_bb()
             space.debug_draw(self)
-            self.items += _constraint_items(space, self.number_of)
+            self.items += _constraint_items(space, self._number_of)
             return self.items
 
     return PaletteDrawOptions
@@ -509,7 +509,7 @@ class Recorder:
                          strip=self.strip, title=self.title, time_unit=self.units[2], **kw)
 
     def _shapes_of(self, body: Any) -> list[tuple]:
-        number = self.options.number_of(body)
+        number = self.options._number_of(body)
         return [it for frame in self.items[:1] for it in frame
                 if it[2] == number and it[0] in ("circle", "seg", "poly")]
 
