@@ -115,8 +115,7 @@ class Pygame:
         import pymunk
         import pymunk.pygame_util
 
-        self.pygame = pygame
-        pymunk.pygame_util.positive_y_is_up = False  # the transform below flips, if needed
+        self.pygame, self.util = pygame, pymunk.pygame_util
         self.surface = pygame.Surface((W, H))
         self.options = pymunk.pygame_util.DrawOptions(self.surface)
         self.options.flags = (pymunk.SpaceDebugDrawOptions.DRAW_SHAPES
@@ -133,6 +132,7 @@ class Pygame:
     def add(self, space: Any, draw: Callable[[Any, Any], None]) -> None:
         from PIL import Image
 
+        self.util.positive_y_is_up = False  # (a y-up program sets it): the transform flips
         self.surface.fill((255, 255, 255))
         draw(space, self.options)
         self.frames.append(Image.frombytes("RGB", (W, H),

@@ -529,3 +529,18 @@ def test_sigterm_while_writing_leaves_no_part_file(tmp_path):
                           capture_output=True, text=True, timeout=120, check=False)
     assert done.returncode == -signal.SIGTERM  # ended as SIGTERM ends a script ...
     assert "not reached" not in done.stdout and list(out.iterdir()) == []  # ... cleanly
+
+
+def test_the_gif_encoder_call_gives_the_bytes_of_a_one_frame_gif():
+    # animation/gif.py calls Pillow's LZW encoder as Pillow's GIF writer does, without
+    # writing a whole one-frame GIF per frame: the same bytes (render_gif's GIFs stay
+    # byte-identical), on random, few-colour, flat and odd-sized frames.
+    from dumbbell.animation import gif
+
+    rng = np.random.default_rng(1)
+    for shape in [(1, 1), (3, 5), (360, 640), (17, 255)]:
+        for frame in (rng.integers(0, 256, shape), rng.integers(0, 4, shape), np.zeros(shape)):
+            pixels = frame.astype(np.uint8)
+            im = Image.frombuffer("L", (shape[1], shape[0]), np.ascontiguousarray(pixels),
+                                  "raw", "L", 0, 1)
+            assert gif._lzw(pixels) == gif._lzw_of_a_gif(im)

@@ -111,3 +111,38 @@ def below(floor, bodies):
     f = (floor * rows).sum(axis=0)[both] / floor.sum(axis=0)[both]
     b = (bodies * rows).sum(axis=0)[both] / bodies.sum(axis=0)[both]
     return float(np.median(f - b))
+
+
+@pytest.mark.parametrize("name", ["constraints", "tank", "spiderweb", "flipper", "planet"])
+def test_captured_primitives_are_what_pymunk_draws(name):
+    # The recorder moves each shape's local geometry by its body's pose itself; pymunk's own
+    # debug drawing of the same space (its cached shape geometry brought up to date: the
+    # flipper program moves its flippers by hand after each step) hands the same circles,
+    # segments and polygons to the same draw options.
+    from dumbbell import spaces
+
+    from .pymunk_corpus import run_example
+
+    run = run_example(name, 20)
+    ours, theirs = spaces.draw_options(), spaces.draw_options()
+    moving = [it for it in ours.capture(run.space) if it[0] in ("circle", "seg", "poly")]
+    theirs.items, theirs.static = [], []
+    for shape in run.space.shapes:
+        shape.cache_bb()
+    run.space.debug_draw(theirs)
+    assert moving
+    for mine, pymunks in ((moving, theirs.items), (ours.static, theirs.static)):
+        assert len(mine) == len(pymunks)
+        for a, b in zip(sorted(mine, key=_order), sorted(pymunks, key=_order), strict=True):
+            assert a[0] == b[0] and (a[1] < 0) == (b[1] < 0) and (a[2] < 0) == (b[2] < 0)
+            assert _numbers(a) == pytest.approx(_numbers(b), abs=1e-9)
+
+
+def _numbers(it):
+    if it[0] == "poly":
+        return [*it[3], it[4]]
+    return list(it[3:])
+
+
+def _order(it):
+    return (it[0], [round(v, 6) for v in _numbers(it)])

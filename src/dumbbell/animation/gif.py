@@ -88,14 +88,29 @@ def encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, del
 
 
 def _lzw(pixels: np.ndarray) -> bytes:
-    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, taken
-    from a one-frame GIF that Pillow writes (its encoder is C and keeps indices as given)."""
-    from PIL import Image
+    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, by
+    Pillow's GIF encoder (C; it keeps indices as given): called as Pillow's GIF writer calls
+    it for a one-frame GIF (code size 8, not interlaced), which is what
+    :func:`_lzw_of_a_gif` takes from such a file, byte for byte, without the file's headers
+    and palette around it."""
+    from PIL import Image, ImageFile
 
     im = Image.frombuffer("L", (pixels.shape[1], pixels.shape[0]), np.ascontiguousarray(pixels),
                           "raw", "L", 0, 1)
+    tile = getattr(ImageFile, "_Tile", None)
+    if tile is None:  # an older Pillow: through a whole one-frame GIF
+        return _lzw_of_a_gif(im)
     buf = io.BytesIO()
-    im.save(buf, "GIF", optimize=False, interlace=False)
+    im.encoderconfig = (8, False)
+    ImageFile._save(im, buf, [tile("gif", (0, 0, *im.size), 0, "L")])
+    return b"\x08" + buf.getvalue() + b"\x00"
+
+
+def _lzw_of_a_gif(im: object) -> bytes:
+    """The first image's LZW data of a one-frame GIF that Pillow writes of the "L" image
+    ``im``."""
+    buf = io.BytesIO()
+    im.save(buf, "GIF", optimize=False, interlace=False)  # type: ignore[attr-defined]
     return _image_data(buf.getvalue())
 
 

@@ -15,7 +15,7 @@ for static)::
 
     ("circle", ink, body, x, y, r, angle)      ("spring", ink, body, ax, ay, bx, by)
     ("seg", ink, body, ax, ay, bx, by, r)      ("line", ink, body, ax, ay, bx, by)
-    ("poly", ink, body, ((x, y), ...), r)      ("dot", ink, body, x, y)
+    ("poly", ink, body, (x0, y0, x1, y1, ...), r)   ("dot", ink, body, x, y)
     ("rotary", ink, body, x, y, twist)
 
 **The camera.** ``"auto"`` chooses one view for the whole file, so nothing jitters. It pools
@@ -36,6 +36,7 @@ keeps one body at the centre of a view of fixed size.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import os
 import signal
@@ -82,6 +83,8 @@ TERM_INKS = {"K_trans": TERM_RGB["K_cm"], "K_rot": TERM_RGB["K_rot"], "U_g": TER
              "U_spring": TERM_RGB["U_spring"], "E": TERM_RGB["E"], "heat": TERM_RGB["E_lost"]}
 #: Fill of static shapes.
 STATIC_FILL = (232, 232, 232)
+#: Outline and fill of a shape by its ink (-1, the last: static and kinematic shapes).
+SHAPE_COLOURS = (*((rgb, blend(rgb, 0.33)) for rgb in BODY_INKS), (GREY, STATIC_FILL))
 #: Height of an energy bar's row at most (px at 640x360).
 ROW_MAX = 26
 #: The camera: a moving body's position counts unless it lies more than this many
@@ -149,8 +152,8 @@ def item_box(it: tuple) -> Box:
         _, _, _, ax, ay, bx, by, r = it
         return min(ax, bx) - r, max(ax, bx) + r, min(ay, by) - r, max(ay, by) + r
     if kind == "poly":
-        verts, r = it[3], it[4]
-        xs, ys = [v[0] for v in verts], [v[1] for v in verts]
+        flat, r = it[3], it[4]
+        xs, ys = flat[0::2], flat[1::2]
         if not xs:
             return (math.nan,) * 4
         return min(xs) - r, max(xs) + r, min(ys) - r, max(ys) + r
@@ -165,33 +168,94 @@ def _finite(boxes: np.ndarray) -> np.ndarray:
     return boxes[np.isfinite(boxes).all(axis=1)] if len(boxes) else boxes.reshape(0, 4)
 
 
-def element_boxes(frames: tuple[tuple[tuple, ...], ...]) -> tuple[np.ndarray, np.ndarray]:
+#: Kinds of primitive that are a body's shape (the others are constraints).
+SHAPES = ("circle", "seg", "poly")
+
+
+@dataclass(frozen=True)
+class Measured:
+    """One frame's primitives measured once: each one's world box (n x 4: x0, x1, y0, y1),
+    a point that turns with it (n x 2: a polygon's first corner, the end of a circle's radius
+    line, a segment's or constraint's first end; a rotary spring's twist and 0), and its
+    element: the number of the moving body whose shape it is, or ``-1 - j`` for the j-th
+    primitive (a constraint, or a shape on no moving body), alone."""
+
+    box: np.ndarray
+    turn: np.ndarray
+    key: np.ndarray
+    rotary: np.ndarray
+    #: Indices of the polygons, by their number of coordinates (twice their corners).
+    poly_groups: dict[int, list[int]]
+    polys: list[int]
+
+    @classmethod
+    def of(cls, items: tuple[tuple, ...]) -> Measured:
+        n = len(items)
+        box, turn = np.full((n, 4), math.nan), np.full((n, 2), math.nan)
+        groups: dict[Any, list[int]] = {}
+        for j, it in enumerate(items):
+            groups.setdefault(it[0] if it[0] != "poly" else len(it[3]), []).append(j)
+        for kind, idx in groups.items():
+            _measure(kind, [items[j] for j in idx], box, turn, np.array(idx))
+        keys = [it[2] if it[0] in SHAPES and it[2] >= 0 else -1 - j
+                for j, it in enumerate(items)]
+        polys = [j for kind, idx in groups.items() if not isinstance(kind, str) for j in idx]
+        return cls(box, turn, np.array(keys, dtype=int),
+                   np.array([it[0] == "rotary" for it in items], dtype=bool),
+                   {k: idx for k, idx in groups.items() if not isinstance(k, str)}, polys)
+
+    def elements(self) -> np.ndarray:
+        """World boxes of the elements (one per moving body, one per other primitive), finite
+        ones only."""
+        if not len(self.key):
+            return np.zeros((0, 4))
+        keys, inverse = np.unique(self.key, return_inverse=True)
+        out = np.empty((len(keys), 4))
+        out[:, [0, 2]], out[:, [1, 3]] = np.inf, -np.inf
+        np.minimum.at(out[:, 0], inverse, self.box[:, 0])
+        np.maximum.at(out[:, 1], inverse, self.box[:, 1])
+        np.minimum.at(out[:, 2], inverse, self.box[:, 2])
+        np.maximum.at(out[:, 3], inverse, self.box[:, 3])
+        return _finite(out)
+
+
+def _measure(kind: Any, items: list[tuple], box: np.ndarray, turn: np.ndarray,
+             idx: np.ndarray) -> None:
+    """Fill ``box`` and ``turn`` (see :class:`Measured`) at rows ``idx`` for ``items``, all
+    of one kind (a polygon's kind: its number of coordinates)."""
+    if not isinstance(kind, str):  # polygons with kind / 2 corners
+        if not kind:
+            return
+        flat = np.array([it[3] for it in items], dtype=float)
+        r = np.array([it[4] for it in items], dtype=float)
+        xs, ys = flat[:, 0::2], flat[:, 1::2]
+        box[idx] = np.stack([xs.min(1) - r, xs.max(1) + r, ys.min(1) - r, ys.max(1) + r], 1)
+        turn[idx] = flat[:, :2]
+        return
+    a = np.array([it[3:] for it in items], dtype=float)
+    if kind == "circle":  # x, y, r, angle
+        x, y, r, ang = a.T
+        box[idx] = np.stack([x - r, x + r, y - r, y + r], 1)
+        turn[idx] = np.stack([x + r * np.cos(ang), y + r * np.sin(ang)], 1)
+    elif kind in ("seg", "spring", "line"):  # ax, ay, bx, by (, r)
+        r = a[:, 4] if kind == "seg" else 0.0
+        box[idx] = np.stack([np.minimum(a[:, 0], a[:, 2]) - r, np.maximum(a[:, 0], a[:, 2]) + r,
+                             np.minimum(a[:, 1], a[:, 3]) - r, np.maximum(a[:, 1], a[:, 3]) + r],
+                            1)
+        turn[idx] = a[:, :2]
+    else:  # dot (x, y), rotary (x, y, twist)
+        box[idx] = a[:, [0, 0, 1, 1]]
+        turn[idx] = a[:, :2] if kind == "dot" else np.stack([a[:, 2], 0 * a[:, 2]], 1)
+
+
+def element_boxes(measured: list[Measured]) -> tuple[np.ndarray, np.ndarray]:
     """World boxes (n x 4: x0, x1, y0, y1) of the moving elements of every frame, finite
     ones only, and the frame of each: each moving body's shapes (one box per body and frame),
-    and each constraint that joins a moving body."""
-    out: list[Box] = []
-    where: list[int] = []
-    for k, items in enumerate(frames):
-        bodies: dict[int, list[float]] = {}
-        for it in items:
-            if it[2] < 0:
-                continue
-            b = item_box(it)
-            if it[0] in ("spring", "line", "dot", "rotary"):
-                out.append(b)
-                where.append(k)
-                continue
-            have = bodies.get(it[2])
-            if have is None:
-                bodies[it[2]] = list(b)
-            else:
-                have[0], have[1] = min(have[0], b[0]), max(have[1], b[1])
-                have[2], have[3] = min(have[2], b[2]), max(have[3], b[3])
-        out += [tuple(v) for v in bodies.values()]  # type: ignore[misc]
-        where += [k] * len(bodies)
-    boxes = np.array(out, dtype=float).reshape(-1, 4)
-    ok = np.isfinite(boxes).all(axis=1)
-    return boxes[ok], np.array(where, dtype=int)[ok]
+    and each constraint."""
+    parts = [m.elements() for m in measured]
+    where = np.concatenate([np.full(len(p), k, dtype=int) for k, p in enumerate(parts)]
+                           + [np.zeros(0, dtype=int)])
+    return np.concatenate([*parts, np.zeros((0, 4))]), where
 
 
 def _union(boxes: np.ndarray) -> Box | None:
@@ -207,8 +271,7 @@ def static_boxes(statics: tuple[tuple[tuple, ...], ...]) -> np.ndarray:
     return _finite(np.array(boxes, dtype=float).reshape(-1, 4))
 
 
-def auto_box(frames: tuple[tuple[tuple, ...], ...], statics: tuple[tuple[tuple, ...], ...]
-             ) -> Box:
+def auto_box(frames: list[Measured], statics: tuple[tuple[tuple, ...], ...]) -> Box:
     """The automatic camera's world box (see the module's docstring for the rule)."""
     moving, where = element_boxes(frames)
     fixed = static_boxes(statics)
@@ -246,8 +309,7 @@ def auto_box(frames: tuple[tuple[tuple, ...], ...], statics: tuple[tuple[tuple, 
     return bx0, bx1, by0, by1
 
 
-def all_box(frames: tuple[tuple[tuple, ...], ...], statics: tuple[tuple[tuple, ...], ...]
-            ) -> Box:
+def all_box(frames: list[Measured], statics: tuple[tuple[tuple, ...], ...]) -> Box:
     """Everything ever captured, static shapes included."""
     boxes = np.concatenate([element_boxes(frames)[0], static_boxes(statics)])
     return _union(boxes) or (-1.0, 1.0, -1.0, 1.0)
@@ -338,9 +400,16 @@ class Pen:
         self.sS = view.s * S
         self.lim_x, self.lim_y = size[0] * S, size[1] * S
 
-    def draw(self, items: tuple[tuple, ...] | list[tuple]) -> None:
-        for it in items:
-            getattr(self, it[0])(it)
+    def draw(self, items: tuple[tuple, ...] | list[tuple],
+             polys: dict[int, list[float]] | None = None,
+             index: list[int] | None = None) -> None:
+        """Draw ``items``; ``polys``: the corners of polygons in this image's pixels by
+        ``index`` (the items' indices in their frame), where known."""
+        for j, it in enumerate(items):
+            if polys is not None and it[0] == "poly":
+                self.poly(it, polys.get(index[j] if index is not None else j))
+            else:
+                getattr(self, it[0])(it)
 
     def P(self, x: float, y: float) -> tuple[float, float]:
         """The pixel (on this image) of world point (x, y), clipped."""
@@ -353,10 +422,7 @@ class Pen:
     @staticmethod
     def colours(ink: int) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
         """Outline and fill of a shape of ``ink`` (-1: static or kinematic, grey)."""
-        if ink < 0:
-            return GREY, STATIC_FILL
-        rgb = BODY_INKS[ink]
-        return rgb, blend(rgb, 0.33)
+        return SHAPE_COLOURS[ink]
 
     def circle(self, it: tuple) -> None:
         _, ink, _, x, y, r, angle = it
@@ -387,13 +453,24 @@ class Pen:
                 if ink_rgb == fill:
                     self.d.line(ends, fill=fill, width=width)
 
-    def poly(self, it: tuple) -> None:
-        _, ink, _, verts, _ = it
-        pts = [self.P(*v) for v in verts]
-        if len(pts) < 2 or self.outside([p[0] for p in pts], [p[1] for p in pts], self.width):
+    def poly(self, it: tuple, px: list[float] | None = None) -> None:
+        """A polygon; ``px``: its corners in this image's pixels (flat), if known."""
+        _, ink, _, flat, _ = it
+        if len(flat) < 4:
             return
-        out, fill = self.colours(ink)
-        self.d.polygon(pts, fill=fill, outline=out, width=self.width)
+        if px is None:
+            ox, oy, sS, fS = self.ox, self.oy, self.sS, self.flip * self.sS
+            px = [ox + v * sS if i % 2 == 0 else oy + v * fS for i, v in enumerate(flat)]
+        xs, ys = px[0::2], px[1::2]
+        if self.outside(xs, ys, self.width):
+            return
+        if not (-CLIP < min(xs) and max(xs) < CLIP and -CLIP < min(ys) and max(ys) < CLIP):
+            px = [_clip(v) for v in px]  # far off, or not a number
+        out, fill = SHAPE_COLOURS[ink]
+        # Filled, then outlined with a closed line: Pillow's wide polygon outline draws
+        # through a mask image per polygon, many times slower.
+        self.d.polygon(px, fill=fill)
+        self.d.line([*px, px[0], px[1]], fill=out, width=self.width, joint="curve")
 
     def spring(self, it: tuple) -> None:
         pa, pb = self.P(it[3], it[4]), self.P(it[5], it[6])
@@ -430,6 +507,132 @@ class Pen:
         self.d.line(pts, fill=SPRING, width=self.width, joint="curve")
 
 
+#: Redrawing: an element is drawn again once a coordinate crosses a grid of this many
+#: pixels (smaller shifts change no pixel's blend level); past this share of the moving
+#: elements changed, or this many separate boxes, the whole moving layer is drawn again.
+QUANTUM, REDRAW_SHARE, MAX_RECTS = 0.1, 0.4, 24
+#: Room (u) around each kind of primitive's box for what is drawn beyond it: outlines, the
+#: smallest circle, a spring's coils, a rotary spring's coil, a pivot's dot.
+ROOM = {"circle": 2.5, "seg": 2.0, "poly": 2.0, "spring": 6.0, "line": 2.0, "rotary": 13.0,
+        "dot": 4.0}
+
+
+class Layer:
+    """One frame's moving primitives seen through a view: each one's pixel box (with room
+    for what is drawn around it), and per element (a moving body's shapes, or one
+    constraint) its signature: its box and turning point in pixels on a grid of
+    :data:`QUANTUM` px (a rigid shape's pose to that grid). From the previous frame's layer,
+    :meth:`damage` finds the boxes to draw again."""
+
+    def __init__(self, items: tuple[tuple, ...], measured: Measured, view: View, u: float,
+                 panel: tuple[int, int]) -> None:
+        self.items = items
+        self.panel = panel
+        s, fs = view.s, view.flip * view.s
+        room = np.array([ROOM[it[0]] * u for it in items]).reshape(-1)
+        b = measured.box
+        xa, xb = view.ox + b[:, 0] * s, view.ox + b[:, 1] * s
+        ya, yb = view.oy + b[:, 2] * fs, view.oy + b[:, 3] * fs
+        px = np.stack([xa - room, np.minimum(ya, yb) - room, xb + room,
+                       np.maximum(ya, yb) + room], axis=1)
+        self.boxes = px.tolist()
+        inv = s / QUANTUM
+        grid = np.concatenate([b * inv, measured.turn * inv], axis=1)
+        # A rotary spring turns its coil, 12 u px out, by its twist.
+        grid[measured.rotary, 4] = measured.turn[measured.rotary, 0] * 12 * u / QUANTUM
+        with np.errstate(invalid="ignore"):
+            grid = np.floor(grid)  # a value that is not a number never equals itself
+        self.measured, self.view, self.corner = measured, view, None
+        self.keys = measured.key.tolist()
+        rows = map(tuple, grid.tolist())
+        if len(set(self.keys)) == len(self.keys):  # one primitive per element
+            self.sigs = dict(zip(self.keys, rows, strict=True))
+        else:
+            sigs: dict[int, list[tuple]] = {}
+            for key, row in zip(self.keys, rows, strict=True):
+                sigs.setdefault(key, []).append(row)
+            self.sigs = {key: tuple(v) for key, v in sigs.items()}
+        finite = px[np.isfinite(px).all(axis=1)]
+        self.box = self._clipped((float(finite[:, 0].min()), float(finite[:, 1].min()),
+                                  float(finite[:, 2].max()), float(finite[:, 3].max()))
+                                 ) if len(finite) else None
+
+    def _clipped(self, box: tuple[float, float, float, float]
+                 ) -> tuple[float, float, float, float] | None:
+        w, h = self.panel
+        out = (max(box[0], 0), max(box[1], 0), min(box[2], w - 1), min(box[3], h))
+        return out if out[2] > out[0] and out[3] > out[1] else None
+
+    @functools.cached_property
+    def element_boxes(self) -> dict[Any, tuple[float, float, float, float]]:
+        """The pixel box of each element."""
+        out: dict[Any, tuple[float, float, float, float]] = {}
+        for key, box in zip(self.keys, self.boxes, strict=True):
+            have = out.get(key)
+            out[key] = box if have is None else _union_px([have, box])
+        return out
+
+    def damage(self, before: Layer) -> list[tuple[float, float, float, float]] | None:
+        """The boxes (px) to draw again over the previous frame's picture: where an element
+        changed, appeared or went; None when the whole layer must be drawn again."""
+        changed = [k for k in self.sigs.keys() | before.sigs.keys()
+                   if self.sigs.get(k) != before.sigs.get(k)]
+        if len(changed) > REDRAW_SHARE * max(len(self.sigs), 1):
+            return None
+        now, then = self.element_boxes, before.element_boxes
+        rects = [b for k in changed for b in (now.get(k), then.get(k)) if b is not None]
+        if not all(math.isfinite(v) for b in rects for v in b):
+            return None
+        merged = _merge(rects)
+        if len(merged) > MAX_RECTS:
+            return None
+        return [c for c in (self._clipped(r) for r in merged) if c is not None]
+
+    def within(self, rect: tuple[float, float, float, float]) -> list[int]:
+        """The indices of the primitives whose boxes meet ``rect``, in drawing order."""
+        x0, y0, x1, y1 = rect
+        return [j for j, b in enumerate(self.boxes)
+                if not (b[2] < x0 or b[0] > x1 or b[3] < y0 or b[1] > y1)]
+
+    def draw(self, pen: Pen, rect: tuple[float, float, float, float]) -> None:
+        """Draw the primitives that meet ``rect`` with ``pen``: the polygons' corners placed
+        in the pen's pixels all at once."""
+        index = self.within(rect)
+        wanted = set(index)
+        polys: dict[int, list[float]] = {}
+        for count, group in self.measured.poly_groups.items():
+            idx = [j for j in group if j in wanted]
+            if not count or not idx:
+                continue
+            flat = np.array([self.items[j][3] for j in idx], dtype=float)
+            flat[:, 0::2] = pen.ox + flat[:, 0::2] * pen.sS
+            flat[:, 1::2] = pen.oy + flat[:, 1::2] * (pen.flip * pen.sS)
+            polys.update(zip(idx, flat.tolist(), strict=True))
+        pen.draw([self.items[j] for j in index], polys, index)
+
+
+def _union_px(boxes: list[tuple[float, float, float, float]]
+              ) -> tuple[float, float, float, float]:
+    return (min(b[0] for b in boxes), min(b[1] for b in boxes), max(b[2] for b in boxes),
+            max(b[3] for b in boxes))
+
+
+def _merge(rects: list[tuple[float, float, float, float]]
+           ) -> list[tuple[float, float, float, float]]:
+    """``rects`` (px: left, top, right, bottom) with every overlapping pair joined."""
+    out: list[tuple[float, float, float, float]] = []
+    for r in rects:
+        while True:
+            hit = next((o for o in out if not (o[2] < r[0] or o[0] > r[2] or o[3] < r[1]
+                                                or o[1] > r[3])), None)
+            if hit is None:
+                break
+            out.remove(hit)
+            r = _union_px([hit, r])
+        out.append(r)
+    return out
+
+
 class Painter(Backdrop):
     """Draws a :class:`Recording`'s frames in the fixed palette (see the module docstring)."""
 
@@ -453,12 +656,15 @@ class Painter(Backdrop):
         least = float(steps[steps > 0].min()) if (steps > 0).any() else 1.0
         self.t_decimals = max(2, min(6, math.ceil(-math.log10(least) - 1e-9)))
         self.t_end = max(float(span), 1e-300)
+        self.measured = [Measured.of(items) for items in rec.frames]
         self._layout()
         if self.energy:
             self._energy_scale()
         self.base = self._base()
         self._views()
         self._bg_key: tuple[int, int] | None = None
+        self._layer: Layer | None = None
+        self._scene: Image.Image | None = None
 
     # --- geometry -----------------------------------------------------------------------
 
@@ -489,9 +695,9 @@ class Painter(Backdrop):
         if rec.camera == "box" and rec.box is not None:
             box = fit(rec.box, aw, ah, 0.0)
         elif rec.camera == "all":
-            box = fit(all_box(rec.frames, rec.statics), aw, ah)
+            box = fit(all_box(self.measured, rec.statics), aw, ah)
         else:
-            box = fit(auto_box(rec.frames, rec.statics), aw, ah)
+            box = fit(auto_box(self.measured, rec.statics), aw, ah)
         self.views = [View.of(box, self.area, rec.y_up)] * self.n
 
     @property
@@ -545,13 +751,14 @@ class Painter(Backdrop):
                 self._strip_static(d, S)
         return img
 
-    def background(self, k: int) -> None:
+    def background(self, k: int) -> bool:
         """Make frame ``k``'s background current (``bg``, ``bg_rgb``, ``bg_ss``): the base
-        with the static shapes of its static set seen through its view, and the title."""
+        with the static shapes of its static set seen through its view, and the title.
+        Returns whether it changed."""
         version, view = self.rec.static_of[k], self.views[k]
         key = (version, id(view))
         if key == self._bg_key:
-            return
+            return False
         u, S = self.u, SS
         img = self.base.copy()
         scene = Image.new("RGB", (self.scene_w * S, self.H * S), WHITE)
@@ -565,6 +772,7 @@ class Painter(Backdrop):
         self.bg_rgb = self.bg.convert("RGB")
         self.bg_ss = self.bg_rgb.resize((self.W * S, self.H * S), Image.Resampling.NEAREST)
         self._bg_key = key
+        return True
 
     def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
         u = self.u
@@ -601,15 +809,22 @@ class Painter(Backdrop):
 
     def frame(self, k: int) -> Image.Image:
         """Frame ``k`` as a palette image."""
-        self.background(k)
+        fresh = self.background(k)
         img = self.bg.copy()
-        items, view = self.rec.frames[k], self.views[k]
-        box = self._moving_box(items, view)
-        if box is not None:
-            crop, corner, done = self.patch(img, box, SS)
-            Pen(ImageDraw.Draw(crop), self.u, SS, view, corner,
-                (crop.width / SS, crop.height / SS)).draw(items)
+        view = self.views[k]
+        layer = Layer(self.rec.frames[k], self.measured[k], view, self.u,
+                      (self.scene_w, self.H))
+        rects = None if fresh or self._layer is None else layer.damage(self._layer)
+        if rects is None:
+            rects = [layer.box] if layer.box is not None else []
+        else:
+            img.paste(self._scene, (0, 0))
+        for rect in rects:
+            crop, corner, done = self.patch(img, rect, SS)
+            layer.draw(Pen(ImageDraw.Draw(crop), self.u, SS, view, corner,
+                           (crop.width / SS, crop.height / SS)), rect)
             done()
+        self._layer, self._scene = layer, img.crop((0, 0, self.scene_w, self.H))
         u = self.u
         crop, (cx, cy), done = self.patch(img, (4 * u, 2 * u, 150 * u, 24 * u), 1)
         label = f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
@@ -623,19 +838,6 @@ class Painter(Backdrop):
                 ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
                                          width=max(1, round(1.2 * u)))
         return img
-
-    def _moving_box(self, items: tuple[tuple, ...], view: View
-                    ) -> tuple[float, float, float, float] | None:
-        """The pixel box (in the scene panel) that the moving primitives can touch."""
-        boxes = _finite(np.array([item_box(it) for it in items], dtype=float).reshape(-1, 4))
-        if not len(boxes):
-            return None
-        x0, x1, y0, y1 = _union(boxes)  # type: ignore[misc]
-        (px0, py0), (px1, py1) = view.px(x0, y0), view.px(x1, y1)
-        m = 16 * self.u
-        box = (max(min(px0, px1) - m, 0), max(min(py0, py1) - m, 0),
-               min(max(px0, px1) + m, self.scene_w - 1), min(max(py0, py1) + m, self.H))
-        return box if box[2] > box[0] and box[3] > box[1] else None
 
     def _bars(self, img: Image.Image, k: int) -> None:
         d = ImageDraw.Draw(img)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import functools
 import math
+import operator
 import os
 import tempfile
 from collections.abc import Mapping
@@ -61,6 +62,8 @@ def _options_class() -> type:
 
     from ..animation.recording import BODY_INKS
 
+    STATIC, DYNAMIC, BLACK = pymunk.Body.STATIC, pymunk.Body.DYNAMIC, SpaceDebugColor(0, 0, 0, 255)
+
     class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
         """Collects a space's shapes (through ``space.debug_draw``) and constraints as
         primitives in world coordinates for the recorder's painter: ``capture`` returns the
@@ -76,33 +79,36 @@ def _options_class() -> type:
             self._number: dict[int, int] = {}
             self._shape: tuple[int, int] = (-1, -1)
             self._sink: list[tuple] = self.items
+            self._geometry: _Geometry | None = None
 
         def ink_of(self, body: Any) -> int:
             """Index into the recorder's body colours of a dynamic body (in the order the
             bodies are first seen); -1 for static and kinematic ones (grey)."""
             from ..model import args
 
-            args.pymunk_object(body, "body", ("Body",))
-            if body.body_type != pymunk.Body.DYNAMIC:
+            return self._ink_of(args.pymunk_object(body, "body", ("Body",)))
+
+        def _ink_of(self, body: Any) -> int:
+            if body.body_type != DYNAMIC:
                 return -1
             key = id(body)
-            if key not in self._ink:
-                self._ink[key] = len(self._ink) % len(BODY_INKS)
-            return self._ink[key]
+            ink = self._ink.get(key)
+            if ink is None:
+                ink = self._ink[key] = len(self._ink) % len(BODY_INKS)
+            return ink
 
         def _number_of(self, body: Any) -> int:
             """The number of a moving (dynamic or kinematic) body, in the order first seen;
             -1 for a static body."""
-            if body.body_type == pymunk.Body.STATIC:
+            if body.body_type == STATIC:
                 return -1
             return self._number.setdefault(id(body), len(self._number))
 
         def color_for_shape(self, shape: Any) -> Any:
             body = shape.body
-            static = body.body_type == pymunk.Body.STATIC
-            self._sink = self.static if static else self.items
-            self._shape = (self.ink_of(body), self._number_of(body))
-            return SpaceDebugColor(0, 0, 0, 255)
+            self._sink = self.static if body.body_type == STATIC else self.items
+            self._shape = (self._ink_of(body), self._number_of(body))
+            return BLACK
 
         def draw_circle(self, pos: Any, angle: float, radius: float, outline_color: Any,
                         fill_color: Any) -> None:
@@ -117,28 +123,135 @@ def _options_class() -> type:
 
         def draw_polygon(self, verts: Any, radius: float, outline_color: Any,
                          fill_color: Any) -> None:
-            self._sink.append(("poly", *self._shape, tuple((v.x, v.y) for v in verts), radius))
+            flat = tuple(c for v in verts for c in (v.x, v.y))
+            self._sink.append(("poly", *self._shape, flat, radius))
 
         def draw_dot(self, size: float, pos: Any, color: Any) -> None:
             pass  # collision points are not drawn
 
         def capture(self, space: Any) -> list[tuple]:
             """The primitives of ``space`` now: the moving ones are returned (dynamic and
-            kinematic shapes, constraints), the static ones kept in ``static``."""
+            kinematic shapes, constraints), the static ones kept in ``static``. The same
+            primitives as ``space.debug_draw(self)`` collects, computed from each body's pose
+            and its shapes' local geometry (see :class:`_Geometry`)."""
             from ..model import args
 
             args.space(space)
-            self.items, self.static = [], []
-            # pymunk draws from each shape's cached world geometry, which only a step (or
-            # this) brings up to date: a body placed by hand before the first step, or
-            # between steps, is drawn where it is.
-            for shape in space.shapes:
-                shape.cache_bb()
-            space.debug_draw(self)
+            shapes = space.shapes
+            if self._geometry is None or not self._geometry.same(shapes):
+                self._geometry = _Geometry(list(shapes), self._ink_of, self._number_of)
+            self.items, self.static = self._geometry.items(space)
             self.items += _constraint_items(space, self._number_of)
             return self.items
 
     return PaletteDrawOptions
+
+
+class _Geometry:
+    """A space's shapes as local geometry on their bodies, made again when the shapes
+    change: a capture then reads every body's pose at once (``pymunk.batch``) and moves each
+    kind of shape with one numpy expression, instead of a Python call per shape from
+    ``space.debug_draw``. Always the bodies' present pose, so a body placed by hand before a
+    step is drawn where it is (pymunk's own drawing waits for the next step)."""
+
+    def __init__(self, shapes: list[Any], ink_of: Any, number_of: Any) -> None:
+        import pymunk
+
+        self.shapes = shapes
+        self.bodies: list[Any] = []
+        where: dict[int, int] = {}
+        kinds = {"circle": [], "seg": [], "poly": []}  # type: dict[str, list[int]]
+        for i, shape in enumerate(shapes):
+            body = shape.body
+            if id(body) not in where:
+                where[id(body)] = len(self.bodies)
+                self.bodies.append(body)
+            kind = ("circle" if isinstance(shape, pymunk.Circle) else
+                    "seg" if isinstance(shape, pymunk.Segment) else "poly")
+            kinds[kind].append(i)
+        self.static_shape = [s.body.body_type == pymunk.Body.STATIC for s in shapes]
+        self._ids = np.array([b.id for b in self.bodies], dtype=np.int64)
+        self._rows: np.ndarray | None = None
+        self._seen, self._found = -1, np.zeros(0, dtype=bool)
+        self.tags = [(ink_of(b), number_of(b)) for b in self.bodies]
+        self.body_of = {k: np.array([where[id(shapes[i].body)] for i in idx], dtype=int)
+                        for k, idx in kinds.items()}
+        self.index = kinds
+        c = [shapes[i] for i in kinds["circle"]]
+        self.circle = (np.array([tuple(s.offset) for s in c], dtype=float).reshape(-1, 2),
+                       [s.radius for s in c])
+        g = [shapes[i] for i in kinds["seg"]]
+        self.seg = (np.array([(*s.a, *s.b) for s in g], dtype=float).reshape(-1, 4),
+                    [s.radius for s in g])
+        p = [shapes[i] for i in kinds["poly"]]
+        verts = [s.get_vertices() for s in p]
+        self.poly_counts = [len(v) for v in verts]
+        self.poly_verts = np.array([tuple(v) for vs in verts for v in vs],
+                                   dtype=float).reshape(-1, 2)
+        self.poly_body = np.repeat(self.body_of["poly"], self.poly_counts)
+        self.poly_r = [s.radius for s in p]
+
+    def same(self, shapes: Any) -> bool:
+        """Whether ``shapes`` are the shapes this geometry was made of, in the same order."""
+        return len(shapes) == len(self.shapes) and all(map(operator.is_, shapes, self.shapes))
+
+    def poses(self, space: Any) -> np.ndarray:
+        """Every body's x, y and angle now (one row per body)."""
+        import pymunk.batch
+
+        fields = pymunk.batch.BodyFields
+        buf = pymunk.batch.Buffer()
+        pymunk.batch.get_space_bodies(space, fields.BODY_ID | fields.POSITION | fields.ANGLE,
+                                      buf)
+        ids = np.frombuffer(buf.int_buf(), dtype=np.int64)
+        data = np.frombuffer(buf.float_buf(), dtype=float).reshape(-1, 3)
+        if self._rows is None or len(ids) != self._seen or not np.array_equal(
+                ids[self._rows[self._found]], self._ids[self._found]):
+            # Which row holds which body (pymunk keeps the order while no body comes or
+            # goes); bodies the batch does not list (static ones) are read one by one.
+            row = {v: r for r, v in enumerate(ids.tolist())}
+            rows = [row.get(i, -1) for i in self._ids.tolist()]
+            self._rows, self._seen = np.array(rows, dtype=int), len(ids)
+            self._found = self._rows >= 0
+        out = np.empty((len(self.bodies), 3))
+        out[self._found] = data[self._rows[self._found]]
+        for i in np.flatnonzero(~self._found).tolist():
+            body = self.bodies[i]
+            out[i] = (*body.position, body.angle)
+        return out
+
+    def items(self, space: Any) -> tuple[list[tuple], list[tuple]]:
+        """The moving and the static primitives of the shapes now, in the shapes' order."""
+        pose = self.poses(space)
+        cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+
+        def world(local: np.ndarray, body: np.ndarray) -> np.ndarray:
+            c, s = cos[body], sin[body]
+            return np.stack([pose[body, 0] + c * local[:, 0] - s * local[:, 1],
+                             pose[body, 1] + s * local[:, 0] + c * local[:, 1]], axis=1)
+
+        out: list[tuple | None] = [None] * len(self.shapes)
+        tags, angle = self.tags, pose[:, 2].tolist()
+        body = self.body_of["circle"]
+        for i, b, (x, y), r in zip(self.index["circle"], body.tolist(),
+                                   world(self.circle[0], body).tolist(), self.circle[1],
+                                   strict=True):
+            out[i] = ("circle", *tags[b], x, y, r, angle[b])
+        body = self.body_of["seg"]
+        ends = np.concatenate([world(self.seg[0][:, :2], body), world(self.seg[0][:, 2:], body)],
+                              axis=1)
+        for i, b, (ax, ay, bx, by), r in zip(self.index["seg"], body.tolist(), ends.tolist(),
+                                             self.seg[1], strict=True):
+            out[i] = ("seg", *tags[b], ax, ay, bx, by, r)
+        flat = world(self.poly_verts, self.poly_body).ravel().tolist()
+        start = 0
+        for i, b, n, r in zip(self.index["poly"], self.body_of["poly"].tolist(),
+                              self.poly_counts, self.poly_r, strict=True):
+            out[i] = ("poly", *tags[b], tuple(flat[start:start + 2 * n]), r)
+            start += 2 * n
+        moving = [it for it, st in zip(out, self.static_shape, strict=True) if not st]
+        static = [it for it, st in zip(out, self.static_shape, strict=True) if st]
+        return moving, static  # type: ignore[return-value]
 
 
 def _constraint_items(space: Any, number_of: Any) -> list[tuple]:
