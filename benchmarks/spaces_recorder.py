@@ -209,20 +209,26 @@ def cradle_world(seconds: float) -> tuple[float, float, float, float]:
     return rec.view  # type: ignore[return-value]
 
 
-def _run(side: str, out: str, seconds: float, world: tuple[float, ...]) -> float:
+def _run(side: str, out: str, seconds: float, world: tuple[float, ...]) -> tuple[float, float]:
+    """One side as a whole process: its wall time and its CPU time (user + system), s."""
+    import resource
+
     # As on a user's machine: byte code cached (the first, untimed run writes it).
     env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
     env.pop("PYTHONDONTWRITEBYTECODE", None)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, __file__, "--side", side, "--out", out, "--seconds",
                     str(seconds), "--world=" + ",".join(repr(v) for v in world)], check=True,
                    env=env)
-    return time.perf_counter() - t0
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def whole_processes(seconds: float, repeat: int) -> None:
     world = cradle_world(seconds)
-    times: dict[str, list[float]] = {s: [] for s in SIDES}
+    times: dict[str, list[tuple[float, float]]] = {s: [] for s in SIDES}
     with tempfile.TemporaryDirectory() as tmp:
         outs = {s: str(Path(tmp) / f"{s}.gif") for s in SIDES}
         for s in SIDES:
@@ -234,17 +240,25 @@ def whole_processes(seconds: float, repeat: int) -> None:
     frames = round(seconds * FPS) + 1
     print(f"Newton's cradle (dumbbell.examples), {seconds:g} s at dt = {DT:g} s, {frames} frames "
           f"at {FPS} fps, {W}x{H}, whole processes after one untimed warm-up run each, "
-          f"{repeat} runs each, alternately (min / median s):")
+          f"{repeat} runs each, alternately:")
     _print(times, sizes)
 
 
-def _print(times: dict[str, list[float]], sizes: dict[str, int]) -> None:
-    best = {s: min(t) for s, t in times.items()}
+def _print(times: dict[str, list[tuple[float, float]]], sizes: dict[str, int]) -> None:
+    """Per side: wall and CPU time (min / median, s), the file's size, and the ratios of
+    the baselines' least times to the recorder's, by wall time and by CPU time."""
+    print(f"  {'side':16s} {'wall min / median':>18s} {'CPU min / median':>18s} {'GIF':>8s}"
+          "   faster than matplotlib, pygame (wall; CPU)")
+    best = {s: (min(w for w, _ in t), min(c for _, c in t)) for s, t in times.items()}
     for s, t in times.items():
-        line = f"  {s:16s} {min(t):7.3f} / {statistics.median(t):7.3f}   {sizes[s] / 1e3:8.0f} kB"
+        walls, cpus = [w for w, _ in t], [c for _, c in t]
+        line = (f"  {s:16s} {min(walls):8.3f} / {statistics.median(walls):7.3f} "
+                f"{min(cpus):8.3f} / {statistics.median(cpus):7.3f} {sizes[s] / 1e3:6.0f} kB")
         if s.startswith("recorder"):
-            line += (f"   {best['matplotlib'] / best[s]:5.1f}x faster than matplotlib, "
-                     f"{best['pygame'] / best[s]:5.1f}x than pygame")
+            r = {b: (best[b][0] / best[s][0], best[b][1] / best[s][1])
+                 for b in ("matplotlib", "pygame")}
+            line += (f"   {r['matplotlib'][0]:5.1f}x, {r['pygame'][0]:4.1f}x; "
+                     f"{r['matplotlib'][1]:5.1f}x, {r['pygame'][1]:4.1f}x")
         print(line)
 
 
@@ -258,22 +272,25 @@ def _corpus() -> Any:
     return pymunk_corpus, recorder_corpus
 
 
-def record_corpus(name: str, side: str, seconds: float, world: Any, out: str) -> float:
-    """Run corpus program ``name`` and draw it with ``side``: seconds spent by the side."""
+def record_corpus(name: str, side: str, seconds: float, world: Any, out: str
+                  ) -> tuple[float, float]:
+    """Run corpus program ``name`` and draw it with ``side``: the wall and CPU seconds
+    spent by the side."""
     import pymunk
 
     pymunk_corpus, _ = _corpus()
     real_draw = pymunk.Space.debug_draw  # the harness mutes the programs' own drawing
     drawer = make(side, world, out, units=("px", "kg", "s"))
-    state = {"t": 0.0, "next": 1, "spent": 0.0}
+    state = {"t": 0.0, "next": 1, "spent": 0.0, "cpu": 0.0}
 
     def timed(space: Any, t: float | None) -> None:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         if isinstance(drawer, Recorder):
             drawer.add(space, real_draw, t)
         else:
             drawer.add(space, real_draw)
         state["spent"] += time.perf_counter() - t0
+        state["cpu"] += time.process_time() - c0
 
     def on_step(space: Any, dt: float) -> None:
         state["t"] += dt
@@ -284,9 +301,10 @@ def record_corpus(name: str, side: str, seconds: float, world: Any, out: str) ->
     dt = pymunk_corpus.run_example(name, 1).dts[0]
     pymunk_corpus.run_example(name, math.ceil(seconds / dt - 1e-9),
                               on_start=lambda s: timed(s, None), on_step=on_step)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     drawer.save(out)
-    return state["spent"] + time.perf_counter() - t0
+    return (state["spent"] + time.perf_counter() - t0,
+            state["cpu"] + time.process_time() - c0)
 
 
 def corpus_world(name: str, seconds: float) -> tuple[float, float, float, float]:
@@ -302,10 +320,10 @@ def corpus(names: list[str], seconds: float, repeat: int) -> None:
     frames = round(seconds * FPS) + 1
     print(f"pymunk's examples, {seconds:g} s each, {frames} frames at {FPS} fps, {W}x{H}; each "
           f"side's own work in one process (capture, draw, write), {repeat} runs each, "
-          "alternately (min / median s):")
+          "alternately:")
     for name in names:
         world = corpus_world(name, seconds)
-        times: dict[str, list[float]] = {s: [] for s in SIDES}
+        times: dict[str, list[tuple[float, float]]] = {s: [] for s in SIDES}
         with tempfile.TemporaryDirectory() as tmp:
             outs = {s: str(Path(tmp) / f"{s}.gif") for s in SIDES}
             for _ in range(repeat):
@@ -320,7 +338,7 @@ def table(seconds: float) -> None:
     """The per-example table of docs/spaces.md."""
     _, rc = _corpus()
     print("| example | y | frame (px) | smallest body drawn, first / last frame (px) | "
-          "recorder, ms per frame | pygame_util + Pillow, ms per frame | ratio |")
+          "recorder, CPU ms per frame | pygame_util + Pillow, CPU ms per frame | ratio |")
     print("|---|---|---|---|---|---|---|")
     for name in rc.NAMES:
         with tempfile.TemporaryDirectory() as tmp:
@@ -332,9 +350,10 @@ def table(seconds: float) -> None:
                     min(rc.dynamic(space), key=lambda i: rc.body_size(list(space.bodies)[i]))]
                 sizes.append(min((rc.extent(rc.picture(space, r.rec, bodies=[i]))
                                   for i in visible), default=None))
-            plain = record_corpus(name, "recorder", seconds, r.rec.view,
-                                  str(Path(tmp) / "p.gif"))
-            base = record_corpus(name, "pygame", seconds, r.rec.view, str(Path(tmp) / "b.gif"))
+            _, plain = record_corpus(name, "recorder", seconds, r.rec.view,
+                                     str(Path(tmp) / "p.gif"))
+            _, base = record_corpus(name, "pygame", seconds, r.rec.view,
+                                    str(Path(tmp) / "b.gif"))
         n = r.rec.frames
         shown = " / ".join("-" if v is None else f"{v:.0f}" for v in sizes)
         print(f"| {name} | {'up' if r.rec.view[3] > r.rec.view[2] else 'down'} | {W}x{H} | "

@@ -544,3 +544,24 @@ def test_the_gif_encoder_call_gives_the_bytes_of_a_one_frame_gif():
             im = Image.frombuffer("L", (shape[1], shape[0]), np.ascontiguousarray(pixels),
                                   "raw", "L", 0, 1)
             assert gif._lzw(pixels) == gif._lzw_of_a_gif(im)
+
+
+@pytest.mark.parametrize("kw", [{}, {"energy": False}, {"camera": "follow"}])
+def test_comparing_only_where_a_frame_drew_gives_the_same_file(tmp_path, monkeypatch, kw):
+    # The painter tells the GIF writer where each frame drew (moving layer, time, bars,
+    # cursor); comparing frames only there must find every change: the same bytes as
+    # comparing whole frames. A static shape comes at the fourth frame.
+    from dumbbell.animation import recording
+
+    space = _space()
+    if kw.get("camera") == "follow":
+        kw = {"camera": next(b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC)}
+    with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
+        for k in range(12):
+            if k == 3:
+                space.add(pymunk.Segment(space.static_body, (-1, 0.5), (-0.5, 0.7), 0.02))
+            spaces.step(space, 1 / 25, substeps=10)
+            rec.capture()
+    monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
+    recording.write(tmp_path / "b.gif", rec.recording())
+    assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()

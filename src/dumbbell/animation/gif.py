@@ -28,12 +28,15 @@ TRAILER = b"\x3b"
 
 
 def write_frames(fh: BinaryIO, size: tuple[int, int], frame: Callable[[int], np.ndarray],
-                 delays: Sequence[int], on_frame: Callable[[], object] | None = None
+                 delays: Sequence[int], on_frame: Callable[[], object] | None = None,
+                 region: Callable[[int], tuple[int, int, int, int] | None] | None = None
                  ) -> tuple[float, float]:
     """Write a whole GIF of ``size`` (width, height px) to the binary file ``fh``: frame k is
     ``frame(k)`` (palette indices), shown for ``delays[k]`` x 10 ms, for every k in
-    ``delays``. ``on_frame`` is called after each frame (a progress bar). Returns the seconds
-    spent in ``frame`` (drawing) and in encoding."""
+    ``delays``. ``on_frame`` is called after each frame (a progress bar). ``region(k)``, if
+    given, is a box (px: left, top, right, bottom) outside which frame k is known to equal
+    frame k - 1 (None: anywhere), so only it is compared. Returns the seconds spent in
+    ``frame`` (drawing) and in encoding."""
     pal, clear = palette()
     fh.write(header(*size, pal))
     previous: np.ndarray | None = None
@@ -42,7 +45,8 @@ def write_frames(fh: BinaryIO, size: tuple[int, int], frame: Callable[[int], np.
         t1 = time.perf_counter()
         current = np.asarray(frame(k))
         t2 = time.perf_counter()
-        fh.write(encode_frame(*delta(previous, current, clear), delay, clear))
+        within = region(k) if region is not None else None
+        fh.write(encode_frame(*delta(previous, current, clear, within), delay, clear))
         draw += t2 - t1
         encode += time.perf_counter() - t2
         previous = current
@@ -59,12 +63,20 @@ def header(width: int, height: int, pal: bytes) -> bytes:
     return b"GIF89a" + lsd + pal + loop
 
 
-def delta(previous: np.ndarray | None, current: np.ndarray, clear: int
+def delta(previous: np.ndarray | None, current: np.ndarray, clear: int,
+          within: tuple[int, int, int, int] | None = None
           ) -> tuple[np.ndarray, int, int, bool]:
     """The rectangle of ``current`` that differs from ``previous``, unchanged pixels set to
-    ``clear``; with its left and top (px) and whether it uses transparency."""
+    ``clear``; with its left and top (px) and whether it uses transparency. ``within`` (px:
+    left, top, right, bottom): the frames are known to be equal outside it, so only it is
+    compared (the same result, sooner)."""
     if previous is None:
         return current, 0, 0, False
+    left = top = 0
+    if within is not None:
+        left, top = max(0, within[0]), max(0, within[1])
+        previous = previous[top:max(top, within[3]), left:max(left, within[2])]
+        current = current[top:max(top, within[3]), left:max(left, within[2])]
     changed = previous != current
     rows = np.flatnonzero(changed.any(axis=1))
     if len(rows) == 0:
@@ -73,7 +85,7 @@ def delta(previous: np.ndarray | None, current: np.ndarray, clear: int
     y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     sub = current[y0:y1, x0:x1].copy()
     sub[~changed[y0:y1, x0:x1]] = clear
-    return sub, int(x0), int(y0), True
+    return sub, int(x0) + left, int(y0) + top, True
 
 
 def encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, delay: int,

@@ -665,6 +665,8 @@ class Painter(Backdrop):
         self._bg_key: tuple[int, int] | None = None
         self._layer: Layer | None = None
         self._scene: Image.Image | None = None
+        self._touched: list[tuple[float, float, float, float]] | None = None
+        self.changed: tuple[float, float, float, float] | None = None
 
     # --- geometry -----------------------------------------------------------------------
 
@@ -819,6 +821,10 @@ class Painter(Backdrop):
             rects = [layer.box] if layer.box is not None else []
         else:
             img.paste(self._scene, (0, 0))
+        touched = [*rects, *self._panel_boxes(k)]
+        self.changed = None if fresh or self._touched is None else _union_px(
+            touched + self._touched)
+        self._touched = touched
         for rect in rects:
             crop, corner, done = self.patch(img, rect, SS)
             layer.draw(Pen(ImageDraw.Draw(crop), self.u, SS, view, corner,
@@ -838,6 +844,28 @@ class Painter(Backdrop):
                 ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
                                          width=max(1, round(1.2 * u)))
         return img
+
+    def _panel_boxes(self, k: int) -> list[tuple[float, float, float, float]]:
+        """The boxes (px) frame ``k`` draws outside the moving layer: the time label, and
+        the bars, their values and the strip's cursor."""
+        u = self.u
+        boxes = [(4 * u, 2 * u, 150 * u, 24 * u)]
+        if self.energy:
+            boxes.append((self.bars_box[0], self.rows[0][1] - 3, self.W,
+                          self.rows[-1][2] + 3))
+            if self.strip:
+                x = float(self.strip_x(self.t[k]))
+                boxes.append((x - 2 * u - 1, self.strip_box[1], x + 2 * u + 1,
+                              self.strip_box[3]))
+        return boxes
+
+    def region(self, k: int) -> tuple[int, int, int, int] | None:
+        """Where frame ``k`` (just drawn) can differ from frame k - 1 (px: left, top, right,
+        bottom), or None: anywhere."""
+        if self.changed is None:
+            return None
+        x0, y0, x1, y1 = self.changed
+        return math.floor(x0) - 1, math.floor(y0) - 1, math.ceil(x1) + 2, math.ceil(y1) + 2
 
     def _bars(self, img: Image.Image, k: int) -> None:
         d = ImageDraw.Draw(img)
@@ -910,7 +938,8 @@ def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) ->
         else:
             with atomic_output(path) as tmp, open(tmp, "wb") as fh:
                 stats["draw"], stats["encode"] = write_frames(
-                    fh, (painter.W, painter.H), painter.frame, delays_cs(painter.n, rec.fps))
+                    fh, (painter.W, painter.H), painter.frame, delays_cs(painter.n, rec.fps),
+                    region=painter.region)
     stats.update(frames=painter.n, total=time.perf_counter() - t0)
     if timing is not None:
         timing.update(stats)

@@ -483,6 +483,7 @@ class Recorder:
         self._key = ("dumbbell.spaces.Recorder", id(self))
         self._stepped = False
         self._captured = False
+        self._clock = (self.t0, 0)  # (the last time given, frames since)
         self._keep(self.t0)
 
     def __enter__(self) -> Self:
@@ -520,10 +521,13 @@ class Recorder:
                              f"{previous:g} {self.units[2]}", param="t")
         if first:
             self._drop_last()
-            t = self.t0 if t is None else t
-        elif t is None:
-            t = previous + (1.0 / self.fps if self._stepped else 0.0)
-        self._keep(t)
+        if t is not None:
+            self._clock = (t, 0)  # times counted on from here
+        elif not first and self._stepped:
+            # Counted in whole frames from the last time given, not summed: 50 frames at
+            # 25 fps end at 2.0 s, not 2.0000000000000004.
+            self._clock = (self._clock[0], self._clock[1] + 1)
+        self._keep(self._clock[0] + self._clock[1] / self.fps)
         self._captured = True
 
     def _keep(self, t: float) -> None:
