@@ -65,10 +65,12 @@ def _options_class() -> type:
     STATIC, DYNAMIC, BLACK = pymunk.Body.STATIC, pymunk.Body.DYNAMIC, SpaceDebugColor(0, 0, 0, 255)
 
     class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
-        """Collects a space's shapes (through ``space.debug_draw``) and constraints as
-        primitives in world coordinates for the recorder's painter: ``capture`` returns the
-        moving ones (dynamic and kinematic bodies, constraints) and keeps the static ones of
-        the same moment in ``static``."""
+        """Collects a space's shapes and constraints as primitives in world coordinates for
+        the recorder's painter (their format: :mod:`dumbbell.animation.recording`).
+        ``capture(space)`` returns the moving ones (dynamic and kinematic bodies'
+        shapes, constraints) and keeps the static ones of the same moment in ``static``;
+        ``space.debug_draw(options)`` collects the same shapes into ``items`` and
+        ``static``, through pymunk's callbacks."""
 
         def __init__(self) -> None:
             super().__init__()
@@ -615,7 +617,7 @@ class Recorder:
         else:
             span = self.span
             if span is None:
-                # 8 times the body's size: its shapes' box when the recorder was made.
+                # 8 times the body's size: its shapes' box when first seen.
                 boxes = [item_box(it) for it in self._shapes_of(self.camera)]
                 size = max((max(b[1] - b[0], b[3] - b[2]) for b in boxes), default=0.0)
                 span = 8 * size if size > 0 and math.isfinite(size) else 1.0
@@ -626,9 +628,14 @@ class Recorder:
                          strip=self.strip, title=self.title, time_unit=self.units[2], **kw)
 
     def _shapes_of(self, body: Any) -> list[tuple]:
+        """The followed body's shapes in the first frame that shows them."""
         number = self.options._number_of(body)
-        return [it for frame in self.items[:1] for it in frame
-                if it[2] == number and it[0] in ("circle", "seg", "poly")]
+        for frame in self.items:
+            shapes = [it for it in frame if it[2] == number and it[0] in ("circle", "seg",
+                                                                          "poly")]
+            if shapes:
+                return shapes
+        return []
 
     def write(self) -> Path:
         """Draw and write the file (called when the ``with`` block ends)."""
