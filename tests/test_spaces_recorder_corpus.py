@@ -26,7 +26,7 @@ from .recorder_corpus import (
 pytest.importorskip("pygame")
 
 #: Simulated time recorded per example (s).
-SECONDS = 1.2
+SECONDS = 1.0
 #: A body is readable when drawn at least this many pixels across (640 x 360 frame).
 MIN_PX = 4
 
