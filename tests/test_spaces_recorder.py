@@ -408,6 +408,13 @@ def test_bars_show_changes_from_the_start_in_the_spaces_units(tmp_path):
             vs.append(body.velocity.length)
     r = rec.recording()
     assert r.energy_title == "Energy (kg px²/s²)" and r.time_unit == "s"
+    for units, title in (("px", "Energy (kg px²/s²)"), (("cm", "g", "s"), "Energy (g cm²/s²)"),
+                         (("m", "kg", "s"), "Energy (J)")):
+        with spaces.Recorder(space, tmp_path / "u.gif", units=units) as one:
+            one.capture()
+        assert one.recording().energy_title == title
+    with pytest.raises(UsageError, match="^units"):
+        spaces.Recorder(space, tmp_path / "u.gif", units=("px", "kg"))
     assert r.labels["U_g"] == "ΔU_g" and r.labels["E"] == "K + ΔU"
     du = 2.0 * 900.0 * (np.array(ys) - ys[0])
     k = 0.5 * 2.0 * np.array(vs) ** 2

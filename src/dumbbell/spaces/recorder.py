@@ -369,12 +369,14 @@ def _check_world(world: Any) -> tuple[float, float, float, float]:
 def _check_units(units: Any) -> tuple[str, str, str]:
     from ..model import args
 
-    allowed = (f"must be three names (length, mass, time), each 1 to {UNIT_CHARS} characters, "
-               "e.g. ('m', 'kg', 's') or ('px', 'kg', 's')")
-    if not isinstance(units, tuple | list) or len(units) != 3 or not all(
-            isinstance(u, str) and 0 < len(u) <= UNIT_CHARS and u.isprintable() for u in units):
+    allowed = (f"must be the length unit ('px', as the guard takes it; mass in kg, time in s) "
+               f"or three names (length, mass, time), each 1 to {UNIT_CHARS} characters, e.g. "
+               "('m', 'kg', 's')")
+    names = (units, SI[1], SI[2]) if isinstance(units, str) else units
+    if not isinstance(names, tuple | list) or len(names) != 3 or not all(
+            isinstance(u, str) and 0 < len(u) <= UNIT_CHARS and u.isprintable() for u in names):
         raise UsageError(f"units = {args.show(units)}: {allowed}", param="units")
-    return tuple(units)  # type: ignore[return-value]
+    return tuple(names)  # type: ignore[return-value]
 
 
 def _energy_unit(units: tuple[str, str, str]) -> str:
@@ -414,8 +416,9 @@ class Recorder:
       ``"start"`` shows each potential energy as its change since frame 0 (ΔU_g, ΔU_spring)
       and E as K + ΔU, so the bars mean something whatever the space's origin; ``"space"``
       as :func:`~dumbbell.spaces.energy` reports them; a mapping (``{"U_g": -4.5e6}``) as the
-      change from energies you set. ``units`` = (length, mass, time) names the space's units
-      on every label (energy in mass·length²/time², J in SI).
+      change from energies you set. ``units`` = (length, mass, time), or the length unit
+      alone (mass in kg, time in s, as the guard's ``units``), names the space's units on
+      every label (energy in mass·length²/time², J in SI).
     - The view: ``camera="auto"`` frames the moving bodies (one fixed view for the file,
       robust to a body flying away; see :mod:`dumbbell.animation.recording`), ``"all"``
       everything captured, a ``pymunk.Body`` follows that body (a view ``span`` units across,
@@ -429,7 +432,8 @@ class Recorder:
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
                  camera: Any = "auto", span: float | None = None, y_up: bool | None = None,
-                 units: tuple[str, str, str] = SI, reference: Any = "start", t0: float = 0.0,
+                 units: str | tuple[str, str, str] = SI, reference: Any = "start",
+                 t0: float = 0.0,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
         import pymunk
 
