@@ -212,10 +212,11 @@ class Measured:
         keys, inverse = np.unique(self.key, return_inverse=True)
         out = np.empty((len(keys), 4))
         out[:, [0, 2]], out[:, [1, 3]] = np.inf, -np.inf
-        np.minimum.at(out[:, 0], inverse, self.box[:, 0])
-        np.maximum.at(out[:, 1], inverse, self.box[:, 1])
-        np.minimum.at(out[:, 2], inverse, self.box[:, 2])
-        np.maximum.at(out[:, 3], inverse, self.box[:, 3])
+        with np.errstate(invalid="ignore"):  # a body at nan is no element
+            np.minimum.at(out[:, 0], inverse, self.box[:, 0])
+            np.maximum.at(out[:, 1], inverse, self.box[:, 1])
+            np.minimum.at(out[:, 2], inverse, self.box[:, 2])
+            np.maximum.at(out[:, 3], inverse, self.box[:, 3])
         return _finite(out)
 
 

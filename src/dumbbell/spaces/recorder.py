@@ -154,7 +154,9 @@ class _Geometry:
     change: a capture then reads every body's pose at once (``pymunk.batch``) and moves each
     kind of shape with one numpy expression, instead of a Python call per shape from
     ``space.debug_draw``. Always the bodies' present pose, so a body placed by hand before a
-    step is drawn where it is (pymunk's own drawing waits for the next step)."""
+    step is drawn where it is (pymunk's own drawing waits for the next step). A shape changed
+    in place (pymunk's ``unsafe_set_radius``, ``unsafe_set_vertices``, ...) is seen once the
+    space's list of shapes changes."""
 
     def __init__(self, shapes: list[Any], ink_of: Any, number_of: Any) -> None:
         import pymunk
