@@ -10,7 +10,8 @@ Nothing of the programs is copied here; they are imported from the installed pym
 What the harness changes in a program, and only this:
 
 - ``pygame.time.Clock`` does not sleep, and the event queue is empty (no mouse, no keys);
-- ``Space.debug_draw`` draws nothing (the programs' own drawing is not under test);
+- ``Space.debug_draw`` draws nothing with the programs' own (pymunk's) draw options (their
+  drawing is not under test); other options, a recorder's, draw as usual;
 - ``random`` is seeded, so a program gives the same space every time;
 - for ``isolate``: a callback may remove parts of the space before the first step (the
   constraints demo, one constraint kind at a time).
@@ -202,6 +203,9 @@ def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
         return [e for e in real_get(*a, **k) if e.type not in user]
 
     def debug_draw(space: Any, options: Any) -> None:
+        if not type(options).__module__.startswith("pymunk."):
+            real_draw(space, options)  # not the program's drawing: a recorder's, say
+            return
         surface = getattr(options, "surface", None)
         if surface is not None:
             run.screen = tuple(surface.get_size())

@@ -695,7 +695,9 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.recorder.Recorder": lambda f: {
         "space": f.space(), "path": f.tmp / "r.gif", "fps": 10, "energy": True,
         "size": "64x64", "strip": False, "heat": f.heat(), "world": (-1.0, 1.0, -0.2, 1.0),
-        "title": "t", "about": (0.0, 0.0)},
+        "camera": "auto", "span": None, "y_up": None, "units": ("m", "kg", "s"),
+        "reference": "start", "t0": 0.0, "title": "t", "about": (0.0, 0.0)},
+    "dumbbell.spaces.recorder.Recorder.capture": lambda f: {"t": None},
     "dumbbell.spaces.recorder.PaletteDrawOptions": lambda f: {},
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of": lambda f: {
@@ -725,6 +727,7 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
     "dumbbell.io.files.OutputTransaction.claim":
         lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
+    "dumbbell.spaces.recorder.Recorder.capture": lambda f: f.recorder(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":

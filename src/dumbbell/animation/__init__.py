@@ -2,5 +2,6 @@
 
 #: :mod:`.render` holds the API (``render_gif``); :mod:`.drawing` the painter behind it, put
 #: together from :mod:`.layout`, :mod:`.world`, :mod:`.bars`, :mod:`.strip`, :mod:`.palette`,
-#: :mod:`.glyphs`, :mod:`.backdrop` and :mod:`.frames` (no public names of their own).
+#: :mod:`.glyphs`, :mod:`.backdrop` and :mod:`.frames`; :mod:`.recording` the painter behind
+#: ``dumbbell.spaces.Recorder``, from the same pieces (no public names of their own).
 __all__ = ["drawing", "render"]

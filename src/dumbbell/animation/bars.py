@@ -97,11 +97,13 @@ def bar_rows(names: Sequence[str], box: tuple[int, int, int, int], u: float,
 
 def draw_legend(d: ImageDraw.ImageDraw, S: int, u: float, box: tuple[int, int, int, int],
                 rows: Sequence[Row], colour: Callable[[str], tuple[int, int, int]],
-                zero_x: float) -> None:
-    """The panel's static parts on a background ``S`` times the size: its title, a swatch and
-    the name of each row, and the zero line at ``zero_x`` (px)."""
+                zero_x: float, title: str = "Energy (J)",
+                label: Callable[[str], str] | None = None) -> None:
+    """The panel's static parts on a background ``S`` times the size: its ``title``, a swatch
+    and the name of each row (``label(name)`` if given), and the zero line at ``zero_x``
+    (px)."""
     bx0, by0, _, _ = box
-    d.text((bx0 * S, by0 * S), "Energy (J)", font=font(round(TITLE_PX * u) * S, True),
+    d.text((bx0 * S, by0 * S), title, font=font(round(TITLE_PX * u) * S, True),
            fill=INK, anchor="lt")
     ft = font(round(TEXT_PX * u) * S)
     for name, top, bot in rows:
@@ -109,7 +111,8 @@ def draw_legend(d: ImageDraw.ImageDraw, S: int, u: float, box: tuple[int, int, i
         sw = round(SWATCH * u)
         d.rectangle([bx0 * S, (mid - sw / 2) * S, (bx0 + sw) * S, (mid + sw / 2) * S],
                     fill=colour(name))
-        d.text(((bx0 + sw + SWATCH_GAP * u) * S, mid * S), name, font=ft, fill=INK, anchor="lm")
+        d.text(((bx0 + sw + SWATCH_GAP * u) * S, mid * S), label(name) if label else name,
+               font=ft, fill=INK, anchor="lm")
     zx = zero_x * S
     d.line([(zx, (rows[0][1] - ZERO_OVERHANG) * S), (zx, (rows[-1][2] + ZERO_OVERHANG) * S)],
            fill=GREY, width=S)

@@ -28,12 +28,15 @@ TRAILER = b"\x3b"
 
 
 def write_frames(fh: BinaryIO, size: tuple[int, int], frame: Callable[[int], np.ndarray],
-                 delays: Sequence[int], on_frame: Callable[[], object] | None = None
+                 delays: Sequence[int], on_frame: Callable[[], object] | None = None,
+                 region: Callable[[int], tuple[int, int, int, int] | None] | None = None
                  ) -> tuple[float, float]:
     """Write a whole GIF of ``size`` (width, height px) to the binary file ``fh``: frame k is
     ``frame(k)`` (palette indices), shown for ``delays[k]`` x 10 ms, for every k in
-    ``delays``. ``on_frame`` is called after each frame (a progress bar). Returns the seconds
-    spent in ``frame`` (drawing) and in encoding."""
+    ``delays``. ``on_frame`` is called after each frame (a progress bar). ``region(k)``, if
+    given, is a box (px: left, top, right, bottom) outside which frame k is known to equal
+    frame k - 1 (None: anywhere), so only it is compared. Returns the seconds spent in
+    ``frame`` (drawing) and in encoding."""
     pal, clear = palette()
     fh.write(header(*size, pal))
     previous: np.ndarray | None = None
@@ -42,7 +45,8 @@ def write_frames(fh: BinaryIO, size: tuple[int, int], frame: Callable[[int], np.
         t1 = time.perf_counter()
         current = np.asarray(frame(k))
         t2 = time.perf_counter()
-        fh.write(encode_frame(*delta(previous, current, clear), delay, clear))
+        within = region(k) if region is not None else None
+        fh.write(encode_frame(*delta(previous, current, clear, within), delay, clear))
         draw += t2 - t1
         encode += time.perf_counter() - t2
         previous = current
@@ -59,12 +63,20 @@ def header(width: int, height: int, pal: bytes) -> bytes:
     return b"GIF89a" + lsd + pal + loop
 
 
-def delta(previous: np.ndarray | None, current: np.ndarray, clear: int
+def delta(previous: np.ndarray | None, current: np.ndarray, clear: int,
+          within: tuple[int, int, int, int] | None = None
           ) -> tuple[np.ndarray, int, int, bool]:
     """The rectangle of ``current`` that differs from ``previous``, unchanged pixels set to
-    ``clear``; with its left and top (px) and whether it uses transparency."""
+    ``clear``; with its left and top (px) and whether it uses transparency. ``within`` (px:
+    left, top, right, bottom): the frames are known to be equal outside it, so only it is
+    compared (the same result, sooner)."""
     if previous is None:
         return current, 0, 0, False
+    left = top = 0
+    if within is not None:
+        left, top = max(0, within[0]), max(0, within[1])
+        previous = previous[top:max(top, within[3]), left:max(left, within[2])]
+        current = current[top:max(top, within[3]), left:max(left, within[2])]
     changed = previous != current
     rows = np.flatnonzero(changed.any(axis=1))
     if len(rows) == 0:
@@ -73,7 +85,7 @@ def delta(previous: np.ndarray | None, current: np.ndarray, clear: int
     y0, y1, x0, x1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
     sub = current[y0:y1, x0:x1].copy()
     sub[~changed[y0:y1, x0:x1]] = clear
-    return sub, int(x0), int(y0), True
+    return sub, int(x0) + left, int(y0) + top, True
 
 
 def encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, delay: int,
@@ -88,14 +100,29 @@ def encode_frame(pixels: np.ndarray, left: int, top: int, transparent: bool, del
 
 
 def _lzw(pixels: np.ndarray) -> bytes:
-    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, taken
-    from a one-frame GIF that Pillow writes (its encoder is C and keeps indices as given)."""
-    from PIL import Image
+    """The LZW image data (code size byte, sub-blocks, terminator) of palette indices, by
+    Pillow's GIF encoder (C; it keeps indices as given): called as Pillow's GIF writer calls
+    it for a one-frame GIF (code size 8, not interlaced), which is what
+    :func:`_lzw_of_a_gif` takes from such a file, byte for byte, without the file's headers
+    and palette around it."""
+    from PIL import Image, ImageFile
 
     im = Image.frombuffer("L", (pixels.shape[1], pixels.shape[0]), np.ascontiguousarray(pixels),
                           "raw", "L", 0, 1)
+    tile = getattr(ImageFile, "_Tile", None)
+    if tile is None:  # an older Pillow: through a whole one-frame GIF
+        return _lzw_of_a_gif(im)
     buf = io.BytesIO()
-    im.save(buf, "GIF", optimize=False, interlace=False)
+    im.encoderconfig = (8, False)
+    ImageFile._save(im, buf, [tile("gif", (0, 0, *im.size), 0, "L")])
+    return b"\x08" + buf.getvalue() + b"\x00"
+
+
+def _lzw_of_a_gif(im: object) -> bytes:
+    """The first image's LZW data of a one-frame GIF that Pillow writes of the "L" image
+    ``im``."""
+    buf = io.BytesIO()
+    im.save(buf, "GIF", optimize=False, interlace=False)  # type: ignore[attr-defined]
     return _image_data(buf.getvalue())
 
 

@@ -241,9 +241,11 @@ class Gif(bytes):
 
     def save(self, path: str | Path) -> Path:
         """Write the GIF to ``path`` (atomically) and return the path."""
+        from ..io.files import check_writable
         from ..model import args
 
         path = args.path(path, "path")
+        check_writable(path, "path")
         with atomic_output(path) as tmp:
             Path(tmp).write_bytes(self)
         return path
@@ -283,6 +285,10 @@ def render_gif(
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
                          param="traj")
     path = None if path is None else args.path(path, "path")
+    if path is not None:
+        from ..io.files import check_writable
+
+        check_writable(path, "path")  # before the work: a folder, a file as a folder, ...
     quiet = args.flag(quiet, "quiet")
     fps = check_fps(fps)
     width, height = check_size(size)

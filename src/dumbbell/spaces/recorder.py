@@ -5,65 +5,52 @@
 ...         step(space, 1 / 25, substeps=20)
 ...         rec.capture()
 
+**Times.** The recorder keeps the space as it is when the recorder is made as frame 0, at
+``t0`` (0 by default); each :meth:`Recorder.capture` after the space has been stepped is the
+next frame, 1/fps later. So the loop above (step, then capture) gives 251 frames at t = 0,
+0.04, ..., 10 s, each label the time of its picture. A capture before any step replaces frame
+0 (the loop "capture, then step" gives frames at 0, 0.04, ... as well); a capture with no step
+since the previous one shows the same time again. ``capture(t=...)`` gives a frame's time
+yourself (in the space's time unit), when frames are not 1/fps of simulated time apart.
+Whether the space was stepped is learnt from a pymunk post-step callback, which touches
+nothing else of the space.
+
+**Orientation.** ``y_up=None`` puts the ground at the bottom: up is against gravity; with no
+vertical gravity, y is down when ``pymunk.pygame_util`` is imported and its
+``positive_y_is_up`` is False (what a pygame program shows), else up. ``y_up=True`` or False
+says it; a ``world`` box (left, right, bottom, top) with bottom > top is y down.
+
 :class:`PaletteDrawOptions` is a ``pymunk.SpaceDebugDrawOptions``: ``space.debug_draw`` hands it
-circles, segments and polygons, which it keeps as world-coordinate primitives; it adds the
-constraints itself (springs as zig-zags with a constant number of coils, rotary springs as a
-coil around the pivot, pins and grooves as lines, pivots as dots). Static shapes are drawn
-once, from the first capture.
-
-The recorder keeps primitives and energies per capture and draws the file when the ``with``
-block ends (nothing is written if it raises), with the discipline of ``dumbbell render``: one
-fixed palette (everything static drawn once, at twice the size then halved, and mapped to it
-once; per frame only the moving shapes are drawn, on a crop, and mapped through the palette
-that holds every ink's blends with white), a fixed world-to-pixel mapping and energy scale for
-the whole file, and each GIF frame after the first holding only the rectangle that changed.
-Same captures, same bytes. Frame k is shown at round(k * 100 / fps) x 10 ms; the GIF loops.
-
-MP4 goes through imageio's ffmpeg plugin (the optional extra ``dumbbell[mp4]``).
+circles, segments and polygons, which it keeps as primitives in world coordinates; it adds the
+constraints itself. The painting, framing and writing are
+:mod:`dumbbell.animation.recording`'s.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+import operator
+import os
+import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Self
 
 import numpy as np
-from PIL import Image, ImageDraw
 
-from ..animation.backdrop import SS, Backdrop
-from ..animation.bars import EnergyScale, bar_rows, draw_legend, draw_values
-from ..animation.gif import write_frames
-from ..animation.glyphs import Stamps, fmt_tick, font, nice_step
-from ..animation.layout import unit
-from ..animation.palette import (
-    GREY,
-    INK,
-    LIGHT,
-    SPRING,
-    TERM_RGB,
-    WHITE,
-    blend,
-    ink_index,
-    palette,
-    to_palette,
-)
-from ..animation.render import check_fps, check_size, delays_cs
-from ..animation.strip import GRID
-from ..animation.world import zigzag
 from ..errors import DumbbellError, UsageError
-from ..io.files import atomic_output
 
-#: Inks of dynamic bodies, by their order in the space (then again from the start).
-BODY_INKS = tuple(TERM_RGB[n] for n in ("A", "B", "K_rot", "K_spin", "U_g", "U_spring"))
-#: Energy terms shown, with the palette colour of each.
-TERMS = {"K_trans": TERM_RGB["K_cm"], "K_rot": TERM_RGB["K_rot"], "U_g": TERM_RGB["U_g"],
-         "U_spring": TERM_RGB["U_spring"], "E": TERM_RGB["E"]}
-HEAT_RGB = TERM_RGB["E_lost"]
-STATIC_FILL = (232, 232, 232)
-#: Height of an energy bar's row at most (px at 640x360): fewer terms than the animation's.
-ROW_MAX = 26
+#: Energy terms shown: the fields of :func:`dumbbell.spaces.energy` they come from.
+TERMS = ("K_trans", "K_rot", "U_g", "U_spring", "E")
+#: Potential terms, shown from a reference (their value at t0, or one you set).
+POTENTIALS = ("U_g", "U_spring")
+#: Labels of the rows when the potentials are shown from a reference.
+DELTA_LABELS = {"U_g": "ΔU_g", "U_spring": "ΔU_spring", "E": "K + ΔU"}
+#: Units of a space (length, mass, time) in SI, whose energy is the joule.
+SI = ("m", "kg", "s")
+#: Longest unit name.
+UNIT_CHARS = 12
 
 __all__ = ["PaletteDrawOptions", "Recorder", "draw_options"]  # noqa: F822 - see __getattr__
 
@@ -73,91 +60,218 @@ def _options_class() -> type:
     import pymunk
     from pymunk.space_debug_draw_options import SpaceDebugColor
 
+    from ..animation.recording import BODY_INKS
+
+    STATIC, DYNAMIC, BLACK = pymunk.Body.STATIC, pymunk.Body.DYNAMIC, SpaceDebugColor(0, 0, 0, 255)
+
     class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
-        """Collects a space's shapes (through ``space.debug_draw``) and constraints as
-        primitives in world coordinates (m) for the project's palette painter: ``capture``
-        returns the moving ones; ``static`` holds the static shapes of the first capture."""
+        """Collects a space's shapes and constraints as primitives in world coordinates for
+        the recorder's painter (their format: :mod:`dumbbell.animation.recording`).
+        ``capture(space)`` returns the moving ones (dynamic and kinematic bodies'
+        shapes, constraints) and keeps the static ones of the same moment in ``static``;
+        ``space.debug_draw(options)`` collects the same shapes into ``items`` and
+        ``static``, through pymunk's callbacks."""
 
         def __init__(self) -> None:
             super().__init__()
             self.flags = pymunk.SpaceDebugDrawOptions.DRAW_SHAPES
             self.items: list[tuple] = []
-            self.static: list[tuple] | None = None
+            self.static: list[tuple] = []
             self._ink: dict[int, int] = {}
-            self._shape_ink = 0
-            self._skip = False
+            self._number: dict[int, int] = {}
+            self._shape: tuple[int, int] = (-1, -1)
             self._sink: list[tuple] = self.items
+            self._geometry: _Geometry | None = None
 
         def ink_of(self, body: Any) -> int:
-            """Index into :data:`BODY_INKS` of a dynamic body; -1 for static/kinematic."""
+            """Index into the recorder's body colours of a dynamic body (in the order the
+            bodies are first seen); -1 for static and kinematic ones (grey)."""
             from ..model import args
 
-            args.pymunk_object(body, "body", ("Body",))
-            if body.body_type != pymunk.Body.DYNAMIC:
+            return self._ink_of(args.pymunk_object(body, "body", ("Body",)))
+
+        def _ink_of(self, body: Any) -> int:
+            if body.body_type != DYNAMIC:
                 return -1
             key = id(body)
-            if key not in self._ink:
-                self._ink[key] = len(self._ink) % len(BODY_INKS)
-            return self._ink[key]
+            ink = self._ink.get(key)
+            if ink is None:
+                ink = self._ink[key] = len(self._ink) % len(BODY_INKS)
+            return ink
+
+        def _number_of(self, body: Any) -> int:
+            """The number of a moving (dynamic or kinematic) body, in the order first seen;
+            -1 for a static body."""
+            if body.body_type == STATIC:
+                return -1
+            return self._number.setdefault(id(body), len(self._number))
 
         def color_for_shape(self, shape: Any) -> Any:
-            static = shape.body.body_type == pymunk.Body.STATIC
-            self._skip = static and self.static is not None
-            self._sink = self._static_sink if static else self.items
-            self._shape_ink = self.ink_of(shape.body)
-            return SpaceDebugColor(0, 0, 0, 255)
-
-        def _emit(self, item: tuple) -> None:
-            """Keep a shape's primitive, unless it is a static shape already kept."""
-            if not self._skip:
-                self._sink.append(item)
+            body = shape.body
+            self._sink = self.static if body.body_type == STATIC else self.items
+            self._shape = (self._ink_of(body), self._number_of(body))
+            return BLACK
 
         def draw_circle(self, pos: Any, angle: float, radius: float, outline_color: Any,
                         fill_color: Any) -> None:
-            self._emit(("circle", self._shape_ink, pos.x, pos.y, radius, angle))
+            self._sink.append(("circle", *self._shape, pos.x, pos.y, radius, angle))
 
         def draw_segment(self, a: Any, b: Any, color: Any) -> None:
-            self._emit(("seg", self._shape_ink, a.x, a.y, b.x, b.y, 0.0))
+            self._sink.append(("seg", *self._shape, a.x, a.y, b.x, b.y, 0.0))
 
         def draw_fat_segment(self, a: Any, b: Any, radius: float, outline_color: Any,
                              fill_color: Any) -> None:
-            self._emit(("seg", self._shape_ink, a.x, a.y, b.x, b.y, radius))
+            self._sink.append(("seg", *self._shape, a.x, a.y, b.x, b.y, radius))
 
         def draw_polygon(self, verts: Any, radius: float, outline_color: Any,
                          fill_color: Any) -> None:
-            self._emit(("poly", self._shape_ink, tuple((v.x, v.y) for v in verts), radius))
+            flat = tuple(c for v in verts for c in (v.x, v.y))
+            self._sink.append(("poly", *self._shape, flat, radius))
 
         def draw_dot(self, size: float, pos: Any, color: Any) -> None:
             pass  # collision points are not drawn
 
         def capture(self, space: Any) -> list[tuple]:
-            """The primitives of ``space`` now (dynamic and kinematic shapes, constraints)."""
+            """The primitives of ``space`` now: the moving ones are returned (dynamic and
+            kinematic shapes, constraints), the static ones kept in ``static``. The same
+            primitives as ``space.debug_draw(self)`` collects, computed from each body's pose
+            and its shapes' local geometry (see :class:`_Geometry`)."""
             from ..model import args
 
             args.space(space)
-            self.items = []
-            first = self.static is None
-            self._static_sink: list[tuple] = []
-            space.debug_draw(self)
-            if first:
-                self.static = self._static_sink
-            self.items += _constraint_items(space)
+            shapes = space.shapes
+            if self._geometry is None or not self._geometry.same(shapes):
+                self._geometry = _Geometry(list(shapes), self._ink_of, self._number_of)
+            self.items, self.static = self._geometry.items(space)
+            self.items += _constraint_items(space, self._number_of)
             return self.items
 
     return PaletteDrawOptions
 
 
-def _constraint_items(space: Any) -> list[tuple]:
+class _Geometry:
+    """A space's shapes as local geometry on their bodies, made again when the shapes
+    change: a capture then reads every body's pose at once (``pymunk.batch``) and moves each
+    kind of shape with one numpy expression, instead of a Python call per shape from
+    ``space.debug_draw``. Always the bodies' present pose, so a body placed by hand before a
+    step is drawn where it is (pymunk's own drawing waits for the next step). A shape changed
+    in place (pymunk's ``unsafe_set_radius``, ``unsafe_set_vertices``, ...) is seen once the
+    space's list of shapes changes."""
+
+    def __init__(self, shapes: list[Any], ink_of: Any, number_of: Any) -> None:
+        import pymunk
+
+        self.shapes = shapes
+        self.bodies: list[Any] = []
+        where: dict[int, int] = {}
+        kinds = {"circle": [], "seg": [], "poly": []}  # type: dict[str, list[int]]
+        for i, shape in enumerate(shapes):
+            body = shape.body
+            if id(body) not in where:
+                where[id(body)] = len(self.bodies)
+                self.bodies.append(body)
+            kind = ("circle" if isinstance(shape, pymunk.Circle) else
+                    "seg" if isinstance(shape, pymunk.Segment) else "poly")
+            kinds[kind].append(i)
+        self.static_shape = [s.body.body_type == pymunk.Body.STATIC for s in shapes]
+        self._ids = np.array([b.id for b in self.bodies], dtype=np.int64)
+        self._rows: np.ndarray | None = None
+        self._seen, self._found = -1, np.zeros(0, dtype=bool)
+        self.tags = [(ink_of(b), number_of(b)) for b in self.bodies]
+        self.body_of = {k: np.array([where[id(shapes[i].body)] for i in idx], dtype=int)
+                        for k, idx in kinds.items()}
+        self.index = kinds
+        c = [shapes[i] for i in kinds["circle"]]
+        self.circle = (np.array([tuple(s.offset) for s in c], dtype=float).reshape(-1, 2),
+                       [s.radius for s in c])
+        g = [shapes[i] for i in kinds["seg"]]
+        self.seg = (np.array([(*s.a, *s.b) for s in g], dtype=float).reshape(-1, 4),
+                    [s.radius for s in g])
+        p = [shapes[i] for i in kinds["poly"]]
+        verts = [s.get_vertices() for s in p]
+        self.poly_counts = [len(v) for v in verts]
+        self.poly_verts = np.array([tuple(v) for vs in verts for v in vs],
+                                   dtype=float).reshape(-1, 2)
+        self.poly_body = np.repeat(self.body_of["poly"], self.poly_counts)
+        self.poly_r = [s.radius for s in p]
+
+    def same(self, shapes: Any) -> bool:
+        """Whether ``shapes`` are the shapes this geometry was made of, in the same order."""
+        return len(shapes) == len(self.shapes) and all(map(operator.is_, shapes, self.shapes))
+
+    def poses(self, space: Any) -> np.ndarray:
+        """Every body's x, y and angle now (one row per body)."""
+        import pymunk.batch
+
+        fields = pymunk.batch.BodyFields
+        buf = pymunk.batch.Buffer()
+        pymunk.batch.get_space_bodies(space, fields.BODY_ID | fields.POSITION | fields.ANGLE,
+                                      buf)
+        ids = np.frombuffer(buf.int_buf(), dtype=np.int64)
+        data = np.frombuffer(buf.float_buf(), dtype=float).reshape(-1, 3)
+        if self._rows is None or len(ids) != self._seen or not np.array_equal(
+                ids[self._rows[self._found]], self._ids[self._found]):
+            # Which row holds which body (pymunk keeps the order while no body comes or
+            # goes); bodies the batch does not list (static ones) are read one by one.
+            row = {v: r for r, v in enumerate(ids.tolist())}
+            rows = [row.get(i, -1) for i in self._ids.tolist()]
+            self._rows, self._seen = np.array(rows, dtype=int), len(ids)
+            self._found = self._rows >= 0
+        out = np.empty((len(self.bodies), 3))
+        out[self._found] = data[self._rows[self._found]]
+        for i in np.flatnonzero(~self._found).tolist():
+            body = self.bodies[i]
+            out[i] = (*body.position, body.angle)
+        return out
+
+    def items(self, space: Any) -> tuple[list[tuple], list[tuple]]:
+        """The moving and the static primitives of the shapes now, in the shapes' order."""
+        pose = self.poses(space)
+        cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+
+        def world(local: np.ndarray, body: np.ndarray) -> np.ndarray:
+            c, s = cos[body], sin[body]
+            return np.stack([pose[body, 0] + c * local[:, 0] - s * local[:, 1],
+                             pose[body, 1] + s * local[:, 0] + c * local[:, 1]], axis=1)
+
+        out: list[tuple | None] = [None] * len(self.shapes)
+        tags, angle = self.tags, pose[:, 2].tolist()
+        body = self.body_of["circle"]
+        for i, b, (x, y), r in zip(self.index["circle"], body.tolist(),
+                                   world(self.circle[0], body).tolist(), self.circle[1],
+                                   strict=True):
+            out[i] = ("circle", *tags[b], x, y, r, angle[b])
+        body = self.body_of["seg"]
+        ends = np.concatenate([world(self.seg[0][:, :2], body), world(self.seg[0][:, 2:], body)],
+                              axis=1)
+        for i, b, (ax, ay, bx, by), r in zip(self.index["seg"], body.tolist(), ends.tolist(),
+                                             self.seg[1], strict=True):
+            out[i] = ("seg", *tags[b], ax, ay, bx, by, r)
+        flat = world(self.poly_verts, self.poly_body).ravel().tolist()
+        start = 0
+        for i, b, n, r in zip(self.index["poly"], self.body_of["poly"].tolist(),
+                              self.poly_counts, self.poly_r, strict=True):
+            out[i] = ("poly", *tags[b], tuple(flat[start:start + 2 * n]), r)
+            start += 2 * n
+        moving = [it for it, st in zip(out, self.static_shape, strict=True) if not st]
+        static = [it for it, st in zip(out, self.static_shape, strict=True) if st]
+        return moving, static  # type: ignore[return-value]
+
+
+def _constraint_items(space: Any, number_of: Any) -> list[tuple]:
     """The primitives of the constraints of ``space`` that have a picture: springs (linear
-    and rotary), pin and slide joints and grooves as lines, pivots as dots."""
+    and rotary), pin and slide joints and grooves as lines, pivots that hold a position as
+    dots; each tagged with
+    a moving body it joins (its ``number_of``), -1 when it joins none."""
     import pymunk
 
     items: list[tuple] = []
     for c in space.constraints:
         a, b = c.a, c.b
+        tag = number_of(b) if number_of(b) >= 0 else number_of(a)
         if isinstance(c, pymunk.DampedSpring):
             pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
-            items.append(("spring", pa.x, pa.y, pb.x, pb.y))
+            items.append(("spring", -1, tag, pa.x, pa.y, pb.x, pb.y))
         elif isinstance(c, pymunk.DampedRotarySpring):
             # At the pivot the two bodies share, if any; else at the moving body.
             pins = [j for j in space.constraints if isinstance(j, pymunk.PivotJoint)
@@ -167,16 +281,18 @@ def _constraint_items(space: Any) -> list[tuple]:
             else:
                 body = b if b.body_type == pymunk.Body.DYNAMIC else a
                 p = body.local_to_world(body.center_of_gravity)
-            items.append(("rotary", p.x, p.y, a.angle - b.angle - c.rest_angle))
+            items.append(("rotary", -1, tag, p.x, p.y, a.angle - b.angle - c.rest_angle))
         elif isinstance(c, pymunk.PinJoint | pymunk.SlideJoint):
             pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
-            items.append(("line", pa.x, pa.y, pb.x, pb.y))
-        elif isinstance(c, pymunk.PivotJoint):
+            items.append(("line", -1, tag, pa.x, pa.y, pb.x, pb.y))
+        elif isinstance(c, pymunk.PivotJoint) and c.max_bias > 0:
+            # (With max_bias 0 a pivot drives velocities only and holds no position: pymunk's
+            # idiom for top-down friction and control bodies. It is not drawn.)
             p = a.local_to_world(c.anchor_a)
-            items.append(("dot", p.x, p.y))
+            items.append(("dot", -1, tag, p.x, p.y))
         elif isinstance(c, pymunk.GrooveJoint):
             ga, gb = a.local_to_world(c.groove_a), a.local_to_world(c.groove_b)
-            items.append(("line", ga.x, ga.y, gb.x, gb.y))
+            items.append(("line", -1, tag, ga.x, ga.y, gb.x, gb.y))
     return items
 
 
@@ -192,82 +308,191 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def _bounds(items: list[tuple]) -> tuple[float, float, float, float]:
-    """World box (m) of primitives: x0, x1, y0, y1 (inf when there are none)."""
-    xs: list[float] = []
-    ys: list[float] = []
-    for it in items:
-        kind = it[0]
-        if kind == "circle":
-            _, _, x, y, r, _ = it
-            xs += [x - r, x + r]
-            ys += [y - r, y + r]
-        elif kind == "seg":
-            _, _, ax, ay, bx, by, r = it
-            xs += [ax - r, ax + r, bx - r, bx + r]
-            ys += [ay - r, ay + r, by - r, by + r]
-        elif kind == "poly":
-            r = it[3]
-            xs += [v[0] + s * r for v in it[2] for s in (-1, 1)]
-            ys += [v[1] + s * r for v in it[2] for s in (-1, 1)]
-        elif kind in ("spring", "line"):
-            xs += [it[1], it[3]]
-            ys += [it[2], it[4]]
-        elif kind in ("dot", "rotary"):
-            xs.append(it[1])
-            ys.append(it[2])
-    ok = [(x, y) for x, y in zip(xs, ys, strict=True) if math.isfinite(x) and math.isfinite(y)]
-    if not ok:
-        return (math.inf, -math.inf, math.inf, -math.inf)
-    return (min(p[0] for p in ok), max(p[0] for p in ok), min(p[1] for p in ok),
-            max(p[1] for p in ok))
+# --- arguments, checked when the recorder is made -------------------------------------------
+
+
+def _check_path(path: Any) -> Path:
+    """``path`` as a Path the recording can be written to, else a UsageError naming it and
+    what is wrong: checked before any capture, so a long run is not lost at the end."""
+    from ..animation.recording import mp4_problem
+    from ..io.files import check_writable, is_special
+    from ..model import args
+
+    shown = args.show(path) if isinstance(path, str | os.PathLike) else None
+    if shown is not None and "\0" in str(path):
+        raise UsageError(f"path = {shown}: a path cannot hold a NUL character", param="path")
+    path = args.path(path, "path")
+    suffix = path.suffix.lower()
+    if suffix not in (".gif", ".mp4"):
+        raise UsageError(f"path {args.show(str(path))}: must end in .gif or .mp4", param="path")
+    check_writable(path, "path")
+    if suffix == ".mp4" and (problem := mp4_problem()) is not None:
+        raise UsageError(f"path {args.show(str(path))}: {problem}", param="path")
+    if not is_special(path):
+        # The one sure test of a folder (read-only file systems, /proc, folders only root
+        # may write): make and remove a file in it, as the writer will.
+        here = path.parent
+        while not here.exists() and here != here.parent:
+            here = here.parent
+        try:
+            fd, probe = tempfile.mkstemp(prefix=f".{path.name[:40]}.", suffix=".probe", dir=here)
+        except OSError as exc:
+            raise UsageError(f"path {args.show(str(path))}: cannot write in {here} "
+                             f"({exc.strerror or exc})", param="path") from None
+        os.close(fd)
+        os.unlink(probe)
+    return path
+
+
+def _check_world(world: Any) -> tuple[float, float, float, float]:
+    """``world`` = (left, right, bottom, top) as floats that can be drawn, else a UsageError."""
+    from ..animation.recording import SPAN_MAX, SPAN_MIN
+    from ..model import args
+
+    allowed = ("must be four finite numbers (left, right, bottom, top) in the space's length "
+               "unit, right > left and bottom != top (bottom > top: y is down)")
+    if type(world).__name__ == "ndarray":
+        world = tuple(world.tolist()) if world.ndim == 1 else None
+    if not isinstance(world, tuple | list) or len(world) != 4:
+        raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
+    x0, x1, y0, y1 = (args.real(v, "world", "space units", positive=False) for v in world)
+    if not (x1 > x0 and y1 != y0):
+        raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
+    for lo, hi in ((x0, x1), (min(y0, y1), max(y0, y1))):
+        span = hi - lo
+        if not (SPAN_MIN <= span <= SPAN_MAX and span >= 1e-9 * max(abs(lo), abs(hi))):
+            raise UsageError(f"world = {args.show(world)}: each side must span between "
+                             f"{SPAN_MIN:g} and {SPAN_MAX:g} units, and at least 1e-9 of its "
+                             "coordinates (else no pixel can be told from the next)",
+                             param="world")
+    return x0, x1, y0, y1
+
+
+def _check_units(units: Any) -> tuple[str, str, str]:
+    from ..model import args
+
+    allowed = (f"must be the length unit ('px', as the guard takes it; mass in kg, time in s) "
+               f"or three names (length, mass, time), each 1 to {UNIT_CHARS} characters, e.g. "
+               "('m', 'kg', 's')")
+    names = (units, SI[1], SI[2]) if isinstance(units, str) else units
+    if not isinstance(names, tuple | list) or len(names) != 3 or not all(
+            isinstance(u, str) and 0 < len(u) <= UNIT_CHARS and u.isprintable() for u in names):
+        raise UsageError(f"units = {args.show(units)}: {allowed}", param="units")
+    return tuple(names)  # type: ignore[return-value]
+
+
+def _energy_unit(units: tuple[str, str, str]) -> str:
+    """The energy unit of a space in ``units`` (length, mass, time): J in SI."""
+    length, mass, t = units
+    return "J" if tuple(units) == SI else f"{mass} {length}²/{t}²"
+
+
+def _check_reference(reference: Any) -> str | dict[str, float]:
+    from ..model import args
+
+    allowed = ("must be 'start' (potential energies from their values at t0), 'space' (as "
+               "spaces.energy reports them) or a mapping of U_g and/or U_spring to the "
+               "energies to measure them from")
+    if isinstance(reference, str):
+        if reference not in ("start", "space"):
+            raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
+        return reference
+    if not isinstance(reference, Mapping) or not reference or not set(reference) <= set(
+            POTENTIALS):
+        raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
+    return {k: args.real(v, "reference", "energy units", positive=False)
+            for k, v in reference.items()}
 
 
 class Recorder:
     """Records ``space`` into ``path`` (.gif, or .mp4 with the ``[mp4]`` extra) at ``fps``
-    frames per second: call :meth:`capture` once per frame while stepping the space yourself;
-    the file is written when the ``with`` block ends.
+    frames per second: step the space yourself and call :meth:`capture` once per frame; the
+    file is written when the ``with`` block ends (nothing is written if it raises). The path
+    is checked when the recorder is made.
 
-    ``energy`` adds bars of K_trans, K_rot, U_g, U_spring and E (J, one fixed scale) and a
-    strip of them over the whole recording with a cursor (``strip``); a ``heat`` counter
-    (:class:`~dumbbell.spaces.HeatCounter`) adds its total and E + heat. ``world`` = (x0, x1,
-    y0, y1) in m fixes the view (default: everything captured); ``size`` 'WxH' px; ``title``
-    is written at the top."""
+    - Times (see the module docstring): frame 0 is the space when the recorder is made, at
+      ``t0``; each capture after stepping is 1/fps later, or at ``capture(t=...)``.
+    - ``energy``: bars of K_trans, K_rot, the potentials and E on one fixed scale, and a
+      ``strip`` of them over the whole recording with a cursor; a ``heat`` counter
+      (:class:`~dumbbell.spaces.HeatCounter`) adds its total and E + heat. ``reference``:
+      ``"start"`` shows each potential energy as its change since frame 0 (ΔU_g, ΔU_spring)
+      and E as K + ΔU, so the bars mean something whatever the space's origin; ``"space"``
+      as :func:`~dumbbell.spaces.energy` reports them; a mapping (``{"U_g": -4.5e6}``) as the
+      change from energies you set. ``units`` = (length, mass, time), or the length unit
+      alone (mass in kg, time in s, as the guard's ``units``), names the space's units on
+      every label (energy in mass·length²/time², J in SI).
+    - The view: ``camera="auto"`` frames the moving bodies (one fixed view for the file,
+      robust to a body flying away; see :mod:`dumbbell.animation.recording`), ``"all"``
+      everything captured, a ``pymunk.Body`` follows that body (a view ``span`` units across,
+      default 8 times the body's size); ``world`` = (left, right, bottom, top) fixes the box
+      (bottom > top: y is down). ``y_up``: None (ground at the bottom, see the module
+      docstring), True or False. ``size`` 'WxH' px; ``title`` is written at the top;
+      ``about`` is the point angular momentum is taken about.
+    """
 
     def __init__(self, space: Any, path: str | Path, fps: int = 25, energy: bool = True, *,
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
+                 camera: Any = "auto", span: float | None = None, y_up: bool | None = None,
+                 units: str | tuple[str, str, str] = SI, reference: Any = "start",
+                 t0: float = 0.0,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
+        import pymunk
+
+        from ..animation.render import check_fps, check_size
         from ..model import args
         from .heat import HeatCounter
 
         self.space = args.space(space)
-        self.path = args.path(path, "path")
-        if self.path.suffix.lower() not in (".gif", ".mp4"):
-            raise UsageError(f"path {self.path}: must end in .gif or .mp4", param="path")
+        self.path = _check_path(path)
         self.fps = check_fps(fps)
         self.W, self.H = check_size(size)
         self.energy = args.flag(energy, "energy")
         self.strip = args.flag(strip, "strip") and self.energy
         self.heat = None if heat is None else args.instance(
             heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
-        if world is not None:
-            allowed = "must be four finite numbers (x0, x1, y0, y1) with x1 > x0 and y1 > y0 (m)"
-            if type(world).__name__ == "ndarray":
-                world = tuple(world.tolist()) if world.ndim == 1 else None
-            if not isinstance(world, tuple | list) or len(world) != 4:
-                raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-            x0, x1, y0, y1 = (args.real(v, "world", "m", positive=False) for v in world)
-            if not (x1 > x0 and y1 > y0):
-                raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-            world = (x0, x1, y0, y1)
-        self.world = world
+        self.world = None if world is None else _check_world(world)
+        if isinstance(camera, pymunk.Body):
+            if camera.body_type == pymunk.Body.STATIC:
+                raise UsageError("camera: a static body cannot be followed; give a moving "
+                                 "body, 'auto' or 'all'", param="camera")
+        elif not (isinstance(camera, str) and camera in ("auto", "all")):
+            raise UsageError(f"camera = {args.show(camera)}: must be 'auto', 'all' or a "
+                             "pymunk.Body to follow", param="camera")
+        self.camera: Any = camera
+        if self.world is not None and self.camera != "auto":
+            raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
+                             "camera, not both", param="camera")
+        self.span = None if span is None else args.real(span, "span", "space units")
+        if self.span is not None and not isinstance(self.camera, pymunk.Body):
+            raise UsageError(f"span = {args.show(span)}: only for a followed body "
+                             "(camera=<a pymunk.Body>)", param="span")
+        self.y_up = None if y_up is None else args.flag(y_up, "y_up")
+        if self.world is not None and self.y_up is not None and self.y_up != (
+                self.world[3] > self.world[2]):
+            raise UsageError(f"y_up = {y_up}: the world box {args.show(world)} says y is "
+                             f"{'up' if self.world[3] > self.world[2] else 'down'}; give one "
+                             "of them", param="y_up")
+        self.units = _check_units(units)
+        self.reference = _check_reference(reference)
+        self.t0 = args.real(t0, "t0", self.units[2], positive=False)
         self.title = args.text(title, "title", "a str (written at the top)")
-        self.about = args.pair(about, "about", "m")
+        self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
         self.items: list[list[tuple]] = []
+        self.statics: list[tuple[tuple, ...]] = []
+        self.static_of: list[int] = []
+        self.t: list[float] = []
+        self.follow: list[tuple[float, float]] = []
         self.terms: dict[str, list[float]] = {n: [] for n in (*TERMS, "heat")}
         self.timing: dict[str, float] = {}
+        #: The world box shown (left, right, bottom, top, y up) once the file is written.
+        self.view: tuple[float, float, float, float] | None = None
+        self._key = ("dumbbell.spaces.Recorder", id(self))
+        self._stepped = False
+        self._captured = False
+        self._clock = (self.t0, 0)  # (the last time given, frames since)
+        self._keep(self.t0)
 
     def __enter__(self) -> Self:
         return self
@@ -278,306 +503,154 @@ class Recorder:
 
     @property
     def frames(self) -> int:
-        """Frames captured so far."""
+        """Frames so far (frame 0, the space when the recorder was made, included)."""
         return len(self.items)
 
-    def capture(self) -> None:
-        """Keep the space as it is now as the next frame."""
-        self.items.append(self.options.capture(self.space))
+    @property
+    def times(self) -> tuple[float, ...]:
+        """The time of each frame so far (the space's time unit)."""
+        return tuple(self.t)
+
+    def _on_step(self, space: Any, key: Any) -> None:
+        self._stepped = True
+
+    def capture(self, t: float | None = None) -> None:
+        """Keep the space as it is now as the next frame, at time ``t`` (the space's time
+        unit; default: 1/fps after the previous frame if the space was stepped since, else
+        the previous frame's time). Before any step, it replaces frame 0."""
+        from ..model import args
+
+        previous = self.t[-1]
+        if t is not None:
+            t = args.real(t, "t", self.units[2], positive=False)
+        first = not self._captured and not self._stepped
+        if t is not None and not first and not t >= previous:
+            raise UsageError(f"t = {t:g}: must be at least the previous frame's time "
+                             f"{previous:g} {self.units[2]}", param="t")
+        if first:
+            self._drop_last()
+        if t is not None:
+            self._clock = (t, 0)  # times counted on from here
+        elif not first and self._stepped:
+            # Counted in whole frames from the last time given, not summed: 50 frames at
+            # 25 fps end at 2.0 s, not 2.0000000000000004.
+            self._clock = (self._clock[0], self._clock[1] + 1)
+        self._keep(self._clock[0] + self._clock[1] / self.fps)
+        self._captured = True
+
+    def _keep(self, t: float) -> None:
+        """Keep the space now as a frame at time ``t``."""
+        items = self.options.capture(self.space)
+        static = tuple(self.options.static)
+        if not self.statics or static != self.statics[-1]:
+            self.statics.append(static)
+        self.items.append(items)
+        self.static_of.append(len(self.statics) - 1)
+        self.t.append(float(t))
+        if not isinstance(self.camera, str):
+            p = self.camera.local_to_world(self.camera.center_of_gravity)
+            self.follow.append((float(p.x), float(p.y)))
         if self.energy:
             from .accounting import energy
 
             e = energy(self.space, self.about)
             for name in TERMS:
-                self.terms[name].append(getattr(e, name))
+                self.terms[name].append(float(getattr(e, name)))
             self.terms["heat"].append(float(self.heat.total) if self.heat is not None else 0.0)
+        self._stepped = False
+        self.space.add_post_step_callback(self._on_step, self._key)
+
+    def _drop_last(self) -> None:
+        self.items.pop()
+        self.static_of.pop()
+        self.t.pop()
+        if self.follow:
+            self.follow.pop()
+        for values in self.terms.values():
+            if values:
+                values.pop()
+        if self.static_of.count(len(self.statics) - 1) == 0 and len(self.statics) > 1:
+            self.statics.pop()
+        elif not self.static_of:
+            self.statics.clear()
+
+    # --- writing -------------------------------------------------------------------------
+
+    def _y_up(self) -> bool:
+        """Whether y is up in the picture (see the module docstring)."""
+        import sys
+
+        if self.world is not None:
+            return self.world[3] > self.world[2]
+        if self.y_up is not None:
+            return self.y_up
+        gy = float(self.space.gravity.y)
+        if gy != 0 and math.isfinite(gy):
+            return gy < 0
+        util = sys.modules.get("pymunk.pygame_util")
+        return bool(util.positive_y_is_up) if util is not None else True
+
+    def _rows(self) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+        """The energy rows shown (name -> values) and their labels."""
+        e = {name: np.asarray(self.terms[name], dtype=float) for name in TERMS}
+        labels = {name: name for name in TERMS}
+        if self.reference != "space":
+            refs = ({n: float(e[n][0]) for n in POTENTIALS} if self.reference == "start"
+                    else {n: self.reference.get(n, 0.0) for n in POTENTIALS})
+            for name in POTENTIALS:
+                e[name] = e[name] - refs[name]
+            e["E"] = e["E"] - sum(refs.values())
+            labels.update(DELTA_LABELS)
+        if self.heat is not None:
+            e["heat"] = np.asarray(self.terms["heat"], dtype=float)
+            labels["heat"] = "heat"
+        return e, labels
+
+    def recording(self) -> Any:
+        """The frozen :class:`dumbbell.animation.recording.Recording` of what was captured."""
+        from ..animation.recording import Recording, item_box
+
+        kw: dict[str, Any] = {}
+        if self.energy:
+            rows, labels = self._rows()
+            kw.update(energy=rows, labels=labels, heat=self.heat is not None,
+                      energy_title=f"Energy ({_energy_unit(self.units)})")
+        if self.world is not None:
+            x0, x1, y0, y1 = self.world
+            kw.update(camera="box", box=(x0, x1, min(y0, y1), max(y0, y1)))
+        elif isinstance(self.camera, str):
+            kw.update(camera=self.camera)
+        else:
+            span = self.span
+            if span is None:
+                # 8 times the body's size: its shapes' box when first seen.
+                boxes = [item_box(it) for it in self._shapes_of(self.camera)]
+                size = max((max(b[1] - b[0], b[3] - b[2]) for b in boxes), default=0.0)
+                span = 8 * size if size > 0 and math.isfinite(size) else 1.0
+            kw.update(camera="follow", follow=tuple(self.follow), span=span)
+        return Recording(frames=tuple(tuple(f) for f in self.items), statics=tuple(self.statics),
+                         static_of=tuple(self.static_of), t=tuple(self.t),
+                         size=(self.W, self.H), fps=self.fps, y_up=self._y_up(),
+                         strip=self.strip, title=self.title, time_unit=self.units[2], **kw)
+
+    def _shapes_of(self, body: Any) -> list[tuple]:
+        """The followed body's shapes in the first frame that shows them."""
+        number = self.options._number_of(body)
+        for frame in self.items:
+            shapes = [it for it in frame if it[2] == number and it[0] in ("circle", "seg",
+                                                                          "poly")]
+            if shapes:
+                return shapes
+        return []
 
     def write(self) -> Path:
         """Draw and write the file (called when the ``with`` block ends)."""
-        import time
+        from ..animation import recording
 
-        if not self.items:
-            raise DumbbellError(f"{self.path}: no frames captured (call capture() per frame)")
-        t0 = time.perf_counter()
-        painter = _Painter(self)
-        self.timing["setup"] = time.perf_counter() - t0
-        if self.path.suffix.lower() == ".mp4":
-            _write_mp4(self.path, painter, self.fps)
-        else:
-            _write_gif(self.path, painter, self.fps, self.timing)
-        self.timing["total"] = time.perf_counter() - t0
+        if not self._captured:
+            raise DumbbellError(f"{self.path}: no frames captured (call capture() after each "
+                                "frame's steps)")
+        painter = recording.write(self.path, self.recording(), self.timing)
+        x0, x1, y0, y1 = painter.view
+        self.view = (x0, x1, y0, y1) if painter.rec.y_up else (x0, x1, y1, y0)
         return self.path
-
-
-def _write_gif(path: Path, painter: _Painter, fps: int, timing: dict[str, float]) -> None:
-    n = painter.n
-    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
-        draw, encode = write_frames(fh, (painter.W, painter.H), painter.frame, delays_cs(n, fps))
-    timing.update(draw=draw, encode=encode, frames=n)
-
-
-def _write_mp4(path: Path, painter: _Painter, fps: int) -> None:
-    try:
-        import imageio.v2 as imageio
-        import imageio_ffmpeg  # noqa: F401
-    except ImportError:
-        raise DumbbellError(f"{path}: MP4 needs the optional extra: pip install "
-                            "'dumbbell[mp4]' (imageio-ffmpeg)") from None
-    lut = np.frombuffer(palette()[0], dtype=np.uint8).reshape(256, 3)
-    with atomic_output(path) as tmp:
-        writer = imageio.get_writer(tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264",
-                                    pixelformat="yuv420p", macro_block_size=2,
-                                    ffmpeg_log_level="error")
-        try:
-            # yuv420p needs even sizes: an odd edge gets one more row or column of itself.
-            pad = ((0, painter.H % 2), (0, painter.W % 2), (0, 0))
-            for k in range(painter.n):
-                writer.append_data(np.pad(lut[np.asarray(painter.frame(k))], pad, mode="edge"))
-        finally:
-            writer.close()
-
-
-class _Painter(Backdrop):
-    """Draws the recorder's frames into the fixed palette (see the module docstring)."""
-
-    def __init__(self, rec: Recorder) -> None:
-        self.rec = rec
-        self.W, self.H = rec.W, rec.H
-        self.n = len(rec.items)
-        self.u = u = unit(self.W, self.H)
-        self.t = np.arange(self.n) / rec.fps
-        self.st_time = Stamps(font(max(9, round(14 * u)), bold=True))
-        self.st_text = Stamps(font(max(8, round(12 * u))))
-        self.st_note = Stamps(font(max(8, round(11 * u))))
-        self.inks = [ink_index(c) for c in BODY_INKS]
-        self.idx = {name: ink_index(rgb) for name, rgb in TERMS.items()}
-        self.idx["heat"] = ink_index(blend(HEAT_RGB, 0.6))
-        self.idx["ink"] = ink_index(INK)
-        self.heat = rec.heat is not None and rec.energy
-        self.names = [*TERMS, "heat"] if self.heat else list(TERMS)
-        self.e = {k: np.asarray(v, dtype=float) for k, v in rec.terms.items()}
-        self._layout()
-        if rec.energy:
-            self._energy_scale()
-        self.bg = self._background()
-        self.bg_rgb = self.bg.convert("RGB")
-        self.bg_ss = self.bg_rgb.resize((self.W * SS, self.H * SS), Image.Resampling.NEAREST)
-
-    # --- geometry -----------------------------------------------------------------------
-
-    def _layout(self) -> None:
-        rec, u, W, H = self.rec, self.u, self.W, self.H
-        self.scene_w = round(0.56 * W) if rec.energy else W
-        top = round(30 * u)
-        if rec.world is not None:
-            x0, x1, y0, y1 = rec.world
-        else:
-            allitems = [it for frame in rec.items for it in frame] + (rec.options.static or [])
-            x0, x1, y0, y1 = _bounds(allitems)
-            if not math.isfinite(x0):
-                x0, x1, y0, y1 = -1.0, 1.0, -1.0, 1.0
-            span = max(x1 - x0, y1 - y0, 1e-9)
-            pad = 0.04 * span
-            x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
-        aw, ah = self.scene_w - round(16 * u), H - top - round(8 * u)
-        self.s = min(aw / max(x1 - x0, 1e-12), ah / max(y1 - y0, 1e-12))
-        self.ox = round(8 * u) + aw / 2 - (x0 + x1) / 2 * self.s
-        self.oy = top + ah / 2 + (y0 + y1) / 2 * self.s
-        right = self.scene_w + round(10 * u)
-        self.bars_box = (right, round(8 * u), W - round(8 * u),
-                         round(0.55 * H) if rec.energy and self.rec.strip else H - round(8 * u))
-        self.strip_box = (right + round(34 * u), round(0.62 * H), W - round(12 * u),
-                          H - round(22 * u))
-
-    def px(self, x: float, y: float) -> tuple[float, float]:
-        return self.ox + x * self.s, self.oy - y * self.s
-
-    def _energy_scale(self) -> None:
-        vals = [self.e[n] for n in TERMS]
-        if self.heat:
-            vals += [self.e["heat"], self.e["E"] + self.e["heat"]]
-        self.scale = scale = EnergyScale.of(vals)
-        self.e_lo, self.e_hi, self.decimals = scale.lo, scale.hi, scale.decimals
-        span = scale.span
-        bx0, _, bx1, _ = self.bars_box
-        self.value_w = round(self.st_text.width(f"-{max(abs(self.e_lo), self.e_hi):.{self.decimals}f}")
-                             + 8 * self.u)
-        self.bar_left = bx0 + round(70 * self.u)
-        self.bar_right = bx1 - self.value_w
-        self.bar_scale = (self.bar_right - self.bar_left) / span
-        self.bar_zero = self.bar_left - self.e_lo * self.bar_scale
-        self.rows = bar_rows(self.names, self.bars_box, self.u, row_max=ROW_MAX)
-
-    def bar_px(self, v: float) -> float:
-        return self.bar_zero + v * self.bar_scale
-
-    def strip_y(self, v: Any) -> Any:
-        _, sy0, _, sy1 = self.strip_box
-        pad = 3 * self.u
-        return sy1 - pad - (sy1 - sy0 - 2 * pad) * (v - self.e_lo) / (self.e_hi - self.e_lo)
-
-    def strip_x(self, t: Any) -> Any:
-        sx0, _, sx1, _ = self.strip_box
-        end = max(float(self.t[-1]), 1e-9)
-        return sx0 + 1 + (sx1 - sx0 - 2) * t / end
-
-    # --- drawing primitives ---------------------------------------------------------------
-
-    def _draw_items(self, d: ImageDraw.ImageDraw, items: list[tuple], S: int,
-                    cx: float, cy: float) -> None:
-        u, s = self.u, self.s
-        line = max(1, round(1.5 * u * S))
-
-        def P(x: float, y: float) -> tuple[float, float]:
-            px, py = self.px(x, y)
-            return (px - cx) * S, (py - cy) * S
-
-        def colours(ink: int) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
-            if ink < 0:
-                return GREY, STATIC_FILL
-            rgb = BODY_INKS[ink]
-            return rgb, blend(rgb, 0.33)
-
-        for it in items:
-            kind = it[0]
-            if kind == "circle":
-                _, ink, x, y, r, angle = it
-                out, fill = colours(ink)
-                (X, Y), R = P(x, y), max(r * s, 1.5 * u) * S
-                d.ellipse([X - R, Y - R, X + R, Y + R], fill=fill, outline=out, width=line)
-                d.line([(X, Y), (X + R * math.cos(angle), Y - R * math.sin(angle))], fill=out,
-                       width=line)
-            elif kind == "seg":
-                _, ink, ax, ay, bx, by, r = it
-                out, fill = colours(ink)
-                w = max(line, round(2 * r * s * S))
-                d.line([P(ax, ay), P(bx, by)], fill=out if w <= 2 * line else fill, width=w)
-                if w > 2 * line:
-                    for x, y in ((ax, ay), (bx, by)):
-                        X, Y = P(x, y)
-                        d.ellipse([X - w / 2, Y - w / 2, X + w / 2, Y + w / 2], fill=fill)
-            elif kind == "poly":
-                _, ink, verts, r = it
-                out, fill = colours(ink)
-                d.polygon([P(*v) for v in verts], fill=fill, outline=out, width=line)
-            elif kind == "spring":
-                _, ax, ay, bx, by = it
-                pa, pb = P(ax, ay), P(bx, by)
-                d.line(zigzag(pa, pb, 5 * u * S, 9), fill=SPRING, width=line, joint="curve")
-            elif kind == "line":
-                _, ax, ay, bx, by = it
-                d.line([P(ax, ay), P(bx, by)], fill=SPRING, width=line)
-            elif kind == "dot":
-                X, Y = P(it[1], it[2])
-                R = 3 * u * S
-                d.ellipse([X - R, Y - R, X + R, Y + R], fill=INK)
-            elif kind == "rotary":
-                _, x, y, twist = it
-                X, Y = P(x, y)
-                pts = []
-                turns = 2.5
-                for i in range(61):
-                    f = i / 60
-                    a = f * turns * 2 * math.pi + twist
-                    rr = (4 + 8 * f) * u * S
-                    pts.append((X + rr * math.cos(a), Y - rr * math.sin(a)))
-                d.line(pts, fill=SPRING, width=line, joint="curve")
-
-    def _background(self) -> Image.Image:
-        W, H, u, S = self.W, self.H, self.u, SS
-        img = Image.new("RGB", (W * S, H * S), WHITE)
-        d = ImageDraw.Draw(img)
-        self._draw_items(d, self.rec.options.static or [], S, 0.0, 0.0)
-        if self.rec.title:
-            d.text(((self.scene_w - 8 * u) * S, 6 * u * S), self.rec.title,
-                   font=font(round(12 * u) * S, True), fill=INK, anchor="rt")
-        if self.rec.energy:
-            d.line([(self.scene_w * S, 8 * u * S), (self.scene_w * S, (H - 8 * u) * S)],
-                   fill=LIGHT, width=S)
-            draw_legend(d, S, u, self.bars_box, self.rows,
-                        lambda name: HEAT_RGB if name == "heat" else TERMS[name], self.bar_zero)
-            if self.rec.strip:
-                self._strip_static(d, S)
-        return to_palette(img.reduce(S))
-
-    def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
-        u = self.u
-        sx0, sy0, sx1, sy1 = self.strip_box
-        fs = font(round(10 * u) * S)
-        d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
-        for v in self.scale.ticks():
-            y = self.strip_y(v) * S
-            d.line([((sx0 + 1) * S, y), ((sx1 - 1) * S, y)], fill=GRID, width=S)
-            d.text(((sx0 - 4 * u) * S, y), fmt_tick(v), font=fs, fill=GREY, anchor="rm")
-        end = float(self.t[-1])
-        tstep = nice_step(end / 4) if end > 0 else 1.0
-        for k in range(math.floor(end / tstep + 1e-9) + 1):
-            x = self.strip_x(k * tstep) * S
-            d.line([(x, sy1 * S), (x, (sy1 + 3 * u) * S)], fill=GREY, width=S)
-            d.text((x, (sy1 + 5 * u) * S), fmt_tick(k * tstep), font=fs, fill=GREY, anchor="mt")
-        d.text(((sx0 - 4 * u) * S, (sy1 + 5 * u) * S), "t (s)", font=fs, fill=GREY, anchor="rt")
-        xs = self.strip_x(self.t) * S
-        width = max(1, round(1.5 * u * S))
-        series = [(n, self.e[n]) for n in TERMS if n != "E"]
-        if self.heat:
-            series.append(("heat", self.e["heat"]))
-            series.append(("E + heat", self.e["E"] + self.e["heat"]))
-        series.append(("E", self.e["E"]))
-        for name, v in series:
-            ys = self.strip_y(v) * S
-            ok = np.isfinite(ys)
-            if ok.sum() < 2:
-                continue
-            rgb = {"heat": HEAT_RGB, "E + heat": blend(HEAT_RGB, 0.6)}.get(name) or TERMS[name]
-            d.line(list(zip(xs[ok].tolist(), ys[ok].tolist(), strict=True)), fill=rgb,
-                   width=width, joint="curve")
-
-    # --- one frame --------------------------------------------------------------------------
-
-    def frame(self, k: int) -> Image.Image:
-        """Frame ``k`` as a palette image."""
-        img = self.bg.copy()
-        items = self.rec.items[k]
-        if items:
-            x0, x1, y0, y1 = _bounds(items)
-            if math.isfinite(x0):
-                (px0, py0), (px1, py1) = self.px(x0, y1), self.px(x1, y0)
-                m = 16 * self.u
-                box = (max(px0 - m, 0), max(py0 - m, 0), min(px1 + m, self.scene_w - 1),
-                       min(py1 + m, self.H))
-                if box[2] > box[0] and box[3] > box[1]:
-                    crop, (cx, cy), done = self.patch(img, box, SS)
-                    self._draw_items(ImageDraw.Draw(crop), items, SS, cx, cy)
-                    done()
-        u = self.u
-        crop, (cx, cy), done = self.patch(img, (4 * u, 2 * u, 130 * u, 24 * u), 1)
-        self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), f"t = {self.t[k]:.2f} s", INK, "lt")
-        done()
-        if self.rec.energy:
-            self._bars(img, k)
-            if self.rec.strip:
-                _, sy0, _, sy1 = self.strip_box
-                x = round(float(self.strip_x(self.t[k])))
-                ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
-                                         width=max(1, round(1.2 * u)))
-        return img
-
-    def _bars(self, img: Image.Image, k: int) -> None:
-        d = ImageDraw.Draw(img)
-        values = {n: float(self.e[n][k]) for n in self.names}
-        for name, top, bot in self.rows:
-            v = values[name]
-            if not math.isfinite(v):
-                continue
-            a, b = sorted((round(self.bar_px(0.0)), round(self.bar_px(v))))
-            if name == "E" and self.heat and values["heat"] > 0:
-                # E + heat: what E was, were no energy lost to the contacts.
-                h = round(self.bar_px(v + values["heat"]))
-                if h > b:
-                    d.rectangle([b, top, h - 1, bot - 1], fill=self.idx["heat"])
-            if b > a:
-                d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
-        bx1 = self.bars_box[2]
-        box = (self.bar_right + 2, self.rows[0][1] - 3, bx1, self.rows[-1][2] + 3)
-        draw_values(self.patch(img, box, 1), self.rows,
-                    lambda name: self.scale.text(values[name]), bx1, self.st_text)
