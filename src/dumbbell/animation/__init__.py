@@ -3,4 +3,6 @@
 #: :mod:`.render` holds the API (``render_gif``); :mod:`.drawing` the painter behind it, put
 #: together from :mod:`.layout`, :mod:`.world`, :mod:`.bars`, :mod:`.strip`, :mod:`.palette`,
 #: :mod:`.glyphs`, :mod:`.backdrop` and :mod:`.frames` (no public names of their own).
-__all__ = ["drawing", "render"]
+from .._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, ["drawing", "render"])

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..animation.render import MAX_FRAMES
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
+from .app import DEFAULT_OUT, EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--solver", metavar="NAME",
                    help="solver (default: the scene's run.solver)")
     p.add_argument("-o", "--output", metavar="FILE.gif",
-                   help="GIF to write (default: renders/<scene>.gif)")
+                   help=f"GIF to write (default: {DEFAULT_OUT}/<scene>.gif)")
     p.add_argument("--fps", metavar="N", type=_whole,
                    help="frames per second, 1 to 50 (default 25). GIF delays are whole "
                         "10 ms units: at 25 fps every frame lasts 40 ms; when 100/fps is not "
@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     size = check_size(args.size or gif.size, "--size" if args.size else "outputs.gif.size")
     strip = args.strip if args.strip is not None else gif.strip
     t_end = args.t_end or gif.t_end
-    out = Path(args.output) if args.output else Path("renders") / f"{scene.name}.gif"
+    out = Path(args.output) if args.output else Path(DEFAULT_OUT) / f"{scene.name}.gif"
     if out.suffix.lower() != ".gif":
         from ..errors import UsageError
 

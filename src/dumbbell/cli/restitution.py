@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float
+from .app import add_out, add_quiet, positive_float
 
 #: Largest number of tilts in one call: each costs several runs.
 MAX_TILTS = 91
@@ -80,8 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=[200.0, 2e3, 2e4],
                    help="spring constants of the spring dumbbells in N/m (default 200 2000 "
                         "20000)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the CSV and PNG (default: renders)")
+    add_out(p, "the CSV and PNG")
     add_quiet(p)
     p.set_defaults(func=run)
 

@@ -9,7 +9,7 @@ from typing import Any
 
 from ..animation.render import MAX_FRAMES
 from ..solvers import MAX_SAMPLES
-from .app import add_quiet, positive_int
+from .app import add_out, add_quiet, positive_int
 
 #: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
 SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d", "topple-2d")
@@ -24,8 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scene", metavar="SCENE", nargs="?",
                    help="scene file (TOML); default: the packaged textbook-1d scene")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the outputs (default: renders)")
+    add_out(p, "the outputs")
     p.add_argument("--all", action="store_true",
                    help="run every showcase scene (" + ", ".join(SHOWCASE) + ")")
     p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
@@ -54,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
     # Validate every scene, and its budgets, before any output is written.
     scenes = [load_scene(p) for p in paths]
     for scene in scenes:
-        _check_budgets(scene, args.max_samples, args.max_frames)
+        _check_budgets(scene, args.max_samples, args.max_frames,
+                       packaged=args.all or not args.scene)
     status = 0
     for scene in scenes:
         status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet,
@@ -63,15 +63,25 @@ def run(args: argparse.Namespace) -> int:
     return status
 
 
-def _check_budgets(scene, max_samples: int, max_frames: int) -> None:
+def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = False) -> None:
     """UsageError naming the scene and its keys when its run would keep more than
-    ``max_samples`` samples or its GIF have more than ``max_frames`` frames."""
+    ``max_samples`` samples or its GIF have more than ``max_frames`` frames. A ``packaged``
+    scene (installed with dumbbell, not the user's to edit) is named by its name, and the
+    message offers only the flags."""
+    import string
+
     from ..animation.render import check_frames
     from ..errors import UsageError
     from ..solvers import make_options
 
     def in_scene(exc: UsageError, keys: dict[str, str]) -> UsageError:
-        return UsageError(f"{scene.source}: {exc.reason}", fixes=exc.fixes).named(keys)
+        if not packaged:
+            return UsageError(f"{scene.source}: {exc.reason}", fixes=exc.fixes).named(keys)
+        # Only the budget flags: the scene's keys are in a file inside the installation.
+        flags = [f for f in exc.fixes
+                 if all(p in (None, "max_frames", "max_samples")
+                        for _, p, _, _ in string.Formatter().parse(f))]
+        return UsageError(f"the packaged scene {scene.name}: {exc.reason}", fixes=flags)
 
     try:
         make_options(scene, max_samples=max_samples)

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .app import add_quiet, positive_int
+from .app import add_out, add_quiet, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -25,8 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--solvers", nargs="+", metavar="NAME",
                    help="solvers to run (default: every solver that can run each case; the "
                         "2D reference only on 2D cases)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the report files (default: renders)")
+    add_out(p, "the report files")
     p.add_argument("--workers", type=positive_int("processes"), metavar="N",
                    help="local processes (default: the number of CPUs)")
     add_quiet(p)

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, positive_int
+from .app import add_out, add_quiet, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,8 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="solver (default: the scene's run.solver)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="end time of every run in s (default: the scene's run.t_end)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the CSV and PNG (default: renders)")
+    add_out(p, "the CSV and PNG")
     p.add_argument("--workers", type=positive_int("processes"), metavar="N",
                    help="local processes (default: the number of CPUs; 1 runs in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
