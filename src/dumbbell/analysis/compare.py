@@ -12,7 +12,10 @@ report says so). Each other run is measured against it:
   1 mm;
 - the energy error over the whole run (drift from E(0) relative to the energy scale; for a
   dissipative scene the distance from the truth's E);
-- the run time.
+- the run time, warm: a first run also pays numba's start-up and compile (or its load from
+  numba's cache), so a run shorter than :data:`TIME_AGAIN_BELOW` s is timed again and the
+  fastest later run is the run time; what the first run paid on top is reported apart as its
+  warm-up.
 
 The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` reports.
 
@@ -41,16 +44,34 @@ if TYPE_CHECKING:
 #: Default window (s) for position errors.
 WINDOW = 2.0
 
-__all__ = ["Comparison", "Row", "compare", "default_solvers"]
+__all__ = ["Comparison", "Row", "Timing", "compare", "default_solvers", "timed_run"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
+
+#: A run shorter than this (s) is timed again, until :data:`TIMED` s are timed in all (at most
+#: :data:`MAX_TIMED_RUNS` runs): the fastest later run is its warm run time.
+TIME_AGAIN_BELOW = 1.0
+TIMED = 0.2
+MAX_TIMED_RUNS = 5
 
 
 #: Columns of :meth:`Comparison.summary` and their units.
 SUMMARY_UNITS = {"solver": "", "dt": "s", "wall_time": "s", "steps_per_s": "1/s",
                  "window_error": "m", "diverged_at": "s", "energy_error": "1", "impacts": "",
-                 "verdict": ""}
+                 "verdict": "", "warm_up": "s"}
+
+
+@dataclass(frozen=True)
+class Timing:
+    """How long a run took on the solver's own clock (``Trajectory.wall_time``): ``seconds``
+    warm (the fastest of ``runs`` runs after the first, or the first when it was the only
+    one), and ``warm_up``, what the first run paid on top (numba's start-up and compile, or
+    the load from its cache; the solver's ``warm_up()`` included)."""
+
+    seconds: float
+    warm_up: float
+    runs: int = 1
 
 
 @dataclass(frozen=True)
@@ -66,6 +87,7 @@ class Row:
     window_error: float
     diverged_at: float | None
     energy_error: float
+    timing: Timing | None = None
 
 
 @dataclass(frozen=True)
@@ -78,27 +100,32 @@ class Comparison:
     rows: list[Row]
     window: float
     notes: list[str] = field(default_factory=list)
+    truth_timing: Timing | None = None
 
     def summary(self) -> list[dict[str, object]]:
         """One record per run, the truth first, keyed by label: solver, dt (s; None for the
-        step-free truths), run time (s), steps/s, the largest position error over the window
-        (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy error
-        (the truth's own drift; NaN for a dissipative truth, which has nothing to be measured
-        against), impacts and verdict (see :data:`SUMMARY_UNITS`)."""
+        step-free truths), warm run time (s), steps/s, the largest position error over the
+        window (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy
+        error (the truth's own drift; NaN for a dissipative truth, which has nothing to be
+        measured against), impacts, verdict and the first run's warm-up (s, :class:`Timing`;
+        see :data:`SUMMARY_UNITS`)."""
         out = []
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
+            timing = (self.truth_timing if row is None else row.timing) or Timing(
+                r.wall_time, math.nan)
             steps = r.info.get("steps")
+            seconds = timing.seconds
             out.append({
                 "label": r.solver if row is None else row.label, "solver": r.solver,
                 "dt": r.dt if r.dt and solver_class(r.solver).has_step else None,
-                "wall_time": r.wall_time,
-                "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
+                "wall_time": seconds,
+                "steps_per_s": steps / seconds if steps and seconds > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
                 "diverged_at": None if row is None else row.diverged_at,
                 "energy_error": energy_error(r, None) if row is None else row.energy_error,
                 "impacts": len(r.events),
-                "verdict": r.verdict})
+                "verdict": r.verdict, "warm_up": timing.warm_up})
         return out
 
     def to_pandas(self) -> pandas.DataFrame:
@@ -152,7 +179,7 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
     from ..model import args
-    from ..solvers import available, simulate
+    from ..solvers import available
 
     scene = args.scene(scene)
     solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
@@ -174,22 +201,41 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     truth_name = truth_solver(scene)
     for name in [*solvers, *([truth_name] if truth_name else [])]:
         solver_class(name).check_work(scene, make_options(scene, spacing, t_end))
-    truth, truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
+    (truth, truth_timing), truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
     rows = []
     for name in solvers:
         for dt in dts:
-            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
-                           quiet=quiet)
+            run, timing = timed_run(scene, name, dt=dt, t_end=t_end,
+                                    every=round(spacing / dt), quiet=quiet)
             err = position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
             label = name if len(dts) == 1 else f"{name} dt={dt:g}"
             rows.append(Row(label, run, err, position_error(run, truth, window),
                             float(run.t[over[0]]) if over.size else None,
-                            energy_error(run, truth)))
+                            energy_error(run, truth), timing))
     notes = []
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
-    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
+    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes, truth_timing)
+
+
+def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, Timing]:
+    """One run of solver ``name`` (``simulate``'s keywords) and its warm :class:`Timing`: the
+    solver's ``warm_up()`` first, then the run that is kept; a run shorter than
+    :data:`TIME_AGAIN_BELOW` s is timed again (the runs are deterministic) until
+    :data:`TIMED` s are timed, at most :data:`MAX_TIMED_RUNS` times."""
+    from ..solvers import simulate
+
+    compiled = solver_class(name).warm_up()
+    first = simulate(scene, name, **options)
+    again: list[float] = []
+    if first.wall_time < TIME_AGAIN_BELOW:
+        quiet = {**options, "quiet": True}
+        while sum(again) < TIMED and len(again) < MAX_TIMED_RUNS:
+            again.append(simulate(scene, name, **quiet).wall_time)
+    seconds = min(again) if again else first.wall_time
+    warm_up = max(0.0, first.wall_time - seconds) + (0.0 if math.isnan(compiled) else compiled)
+    return first, Timing(seconds, warm_up, 1 + len(again))
 
 
 
@@ -220,21 +266,20 @@ def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
 
 
 def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
-           quiet: bool) -> tuple[Trajectory, str]:
-    """The run every solver is measured against, sampled every ``spacing`` (s), and a note
-    saying what it is: the scene's truth solver, or pymunk at a tenth of the smallest step
-    ``dt_min`` (s) where there is none."""
-    from ..solvers import simulate
-
+           quiet: bool) -> tuple[tuple[Trajectory, Timing], str]:
+    """The run every solver is measured against, sampled every ``spacing`` (s), with its
+    timing, and a note saying what it is: the scene's truth solver, or pymunk at a tenth of
+    the smallest step ``dt_min`` (s) where there is none."""
     truth_name = truth_solver(scene)
     if truth_name is None:
         truth_dt = dt_min / 10
-        truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
-                         every=round(spacing / truth_dt), quiet=quiet)
+        timed = timed_run(scene, "pymunk", dt=truth_dt, t_end=t_end,
+                          every=round(spacing / truth_dt), quiet=quiet)
         why = no_truth_reason(scene)
-        return truth, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
+        return timed, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
                        f"{why}; so errors are against a ten times smaller step)")
-    truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
+    timed = truth, _ = timed_run(scene, truth_name, dt=spacing, t_end=t_end, every=1,
+                                 quiet=quiet)
     truth_note = truth_name
     est = truth.info.get("estimated_error")
     if est:
@@ -246,4 +291,4 @@ def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
     elif truth_name == "exact":
         truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
                        "chaotic map amplifies about 10x per impact)")
-    return truth, truth_note
+    return timed, truth_note
