@@ -55,9 +55,8 @@ def _whole(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..animation.render import check_fps, check_frames, check_size, render_gif, sample_every
+    from ..animation.render import check_fps, check_frames, check_size, render_gif
     from ..model.scene import GifSettings
-    from ..solvers import make_options, simulate
 
     scene = read_scene(args.scene)
     gif = scene.outputs.gif or GifSettings(scene.run.t_end)
@@ -75,9 +74,7 @@ def run(args: argparse.Namespace) -> int:
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")
-    options = make_options(scene, t_end=t_end)
-    every = sample_every(options.dt, fps, options.t_end)
-    traj = simulate(scene, args.solver, t_end=options.t_end, every=every, quiet=args.quiet)
+    traj = gif_trajectory(scene, fps, t_end, args.solver, quiet=args.quiet)
     render_gif(traj, out, quiet=args.quiet, fps=fps, size=size, strip=strip, t_end=t_end,
                max_frames=args.max_frames)
     if not args.quiet:
@@ -86,3 +83,24 @@ def run(args: argparse.Namespace) -> int:
         sys.stderr.write(f"dumbbell render: {scene.name}: {traj.solver}: {traj.verdict}\n")
         return EXIT_VERDICT
     return 0
+
+
+def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, quiet: bool = True,
+                   traj=None):
+    """The run a GIF of ``scene`` at ``fps`` over ``t_end`` s is drawn from: sampled as
+    :func:`dumbbell.animation.render.sample_every` says, which keeps the scene's own
+    ``run.every`` when it serves the GIF. ``traj``, a run already made (``dumbbell run``'s),
+    is used when it has those samples and lasts long enough; else the scene is run again.
+    So ``dumbbell render`` and ``dumbbell run`` draw one scene from the same samples and
+    write the same bytes."""
+    from ..animation.render import sample_every
+    from ..solvers import make_options, simulate
+
+    options = make_options(scene, t_end=t_end)
+    every = sample_every(options.dt, fps, options.t_end, scene.run.every)
+    if (traj is not None and traj.every == every and traj.dt == options.dt
+            and (solver is None or traj.solver == solver)
+            and (not traj.verdict.ok  # ended early: a new run would end there too
+                 or traj.t[-1] >= options.t_end - options.dt * every / 2)):
+        return traj
+    return simulate(scene, solver, t_end=options.t_end, every=every, quiet=quiet)

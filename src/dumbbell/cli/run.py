@@ -90,7 +90,8 @@ def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = Fa
     if scene.outputs.gif is not None:
         gif = scene.outputs.gif
         try:
-            check_frames(gif.t_end, gif.fps, max_frames, "outputs.gif.t_end")
+            check_frames(gif.t_end, gif.fps, max_frames,
+                         "the GIF's length" if packaged else "outputs.gif.t_end")
         except UsageError as exc:
             raise in_scene(exc, {"t_end": "outputs.gif.t_end",
                                  "fps": "outputs.gif.fps"}) from None
@@ -120,9 +121,12 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
             written.append(write_events(traj, out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
+        from .render import gif_trajectory
 
         gif = scene.outputs.gif
-        written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
+        # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
+        drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
+        written.append(render_gif(drawn, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
                                   size=gif.size, strip=gif.strip, t_end=gif.t_end,
                                   max_frames=max_frames))
     if not quiet:
