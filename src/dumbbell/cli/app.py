@@ -178,14 +178,17 @@ def _stop_signals() -> Iterator[None]:
 STDIN_SCENE = "stdin"
 
 
-def read_scene(path: str):
-    """The scene at ``path``, or read from standard input when ``path`` is ``-`` (at most
-    1 MB, the cap of a scene file; named :data:`STDIN_SCENE`, so ``render`` writes
-    ``renders/stdin.gif``)."""
+def read_scene(path, stdin: bool = True):
+    """The scene at ``path``, or read from standard input when ``path`` is ``-`` and the
+    command takes ``stdin`` (at most 1 MB, the cap of a scene file; named
+    :data:`STDIN_SCENE`, so ``render`` writes ``renders/stdin.gif``). A :class:`Scene`
+    already loaded (the showcase's shipped scenes) is taken as it is."""
     from ..errors import SceneError
-    from ..model.scene import MAX_SCENE_BYTES, load_scene, load_scene_bytes
+    from ..model.scene import MAX_SCENE_BYTES, Scene, load_scene, load_scene_bytes
 
-    if path != "-":
+    if isinstance(path, Scene):
+        return path
+    if path != "-" or not stdin:
         return load_scene(path)
     try:
         data = sys.stdin.buffer.read(MAX_SCENE_BYTES + 1)

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float, positive_int
+from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -66,9 +66,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.bench import run_bench
     from ..io.bench import write_all
-    from ..model.scene import load_scene
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
                        repeat=args.repeat, t_end=args.t_end, budget=args.budget,
                        spacing=args.sample_spacing, quiet=args.quiet)

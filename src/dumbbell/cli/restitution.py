@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float
+from .app import add_out, add_quiet, positive_float, read_scene
 
 #: Largest number of tilts in one call: each costs several runs.
 MAX_TILTS = 91
@@ -89,11 +89,10 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis.restitution import restitution
     from ..io.figures import save_figure
     from ..io.restitution import markdown, write_csv
-    from ..model.scene import load_scene
     from ..plot.rotation_chapter import restitution as draw
     from ..progress import bar
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     if args.elasticity is not None and scene.system.floor is not None:
         scene = scene.with_values({"floor.elasticity": args.elasticity})
     runs = len(args.theta) * (1 + len(args.stiffness))

@@ -10,10 +10,10 @@ from typing import Any
 from ..animation.render import MAX_FRAMES
 from ..solvers import MAX_SAMPLES
 from .app import add_out, add_quiet, positive_int
+from .showcase import PIECES
 
-#: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
-SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d", "topple-2d")
-
+#: The scenes ``dumbbell run --all`` runs (the other pieces of the showcase follow them).
+SHOWCASE = tuple(p.scene for p in PIECES if p.argv[0] == "run")
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -26,7 +26,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="scene file (TOML); default: the packaged textbook-1d scene")
     add_out(p, "the outputs")
     p.add_argument("--all", action="store_true",
-                   help="run every showcase scene (" + ", ".join(SHOWCASE) + ")")
+                   help="make the whole showcase, every file the repository tracks in "
+                        "renders/: the scenes " + ", ".join(SHOWCASE) + ", then "
+                        + "; ".join(p.command for p in PIECES if p.argv[0] != "run")
+                        + " (several minutes)")
     p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
                    default=MAX_SAMPLES,
                    help=f"refuse, before anything runs, a scene whose run would keep more than "
@@ -44,23 +47,24 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import UsageError
-    from ..model.scene import load_scene, packaged_scene
+    from .app import read_scene
+    from .showcase import load_packaged, run_pieces
 
     if args.all and args.scene:
         raise UsageError("give either SCENE or --all, not both")
-    paths = ([packaged_scene(n) for n in SHOWCASE] if args.all
-             else [Path(args.scene) if args.scene else packaged_scene()])
+    # A shipped scene (no SCENE, --all, the showcase's own) is not the user's file to edit.
+    packaged = args.all or not isinstance(args.scene, str)
+    scenes = ([load_packaged(n) for n in SHOWCASE] if args.all
+              else [read_scene(args.scene, stdin=False) if args.scene
+                    else load_packaged("textbook-1d")])
     # Validate every scene, and its budgets, before any output is written.
-    scenes = [load_scene(p) for p in paths]
     for scene in scenes:
-        _check_budgets(scene, args.max_samples, args.max_frames,
-                       packaged=args.all or not args.scene)
-    status = 0
-    for scene in scenes:
-        status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet,
-                                       max_samples=args.max_samples,
-                                       max_frames=args.max_frames))
-    return status
+        _check_budgets(scene, args.max_samples, args.max_frames, packaged=packaged)
+    if args.all:
+        return run_pieces(Path(args.out), quiet=args.quiet, max_samples=args.max_samples,
+                          max_frames=args.max_frames)
+    return run_scene(scenes[0], Path(args.out), quiet=args.quiet,
+                     max_samples=args.max_samples, max_frames=args.max_frames)
 
 
 def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = False) -> None:

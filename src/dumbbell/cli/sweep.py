@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float, positive_int
+from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -48,11 +48,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
-    from ..model.scene import load_scene
     from ..parallel import cap_note
     from ..solvers import solver_class
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     axes = [parse_axis(text) for text in args.grid]
     check_axes(axes)
     for axis in axes:
