@@ -10,8 +10,9 @@ import dumbbell
 
 ROOT = Path(dumbbell.__file__).parent
 
-#: Modules every layer may use (``_lazy``: the lazy loading of submodules by ``__getattr__``).
-SHARED = {"errors", "progress", "parallel", "io.frames", "_lazy"}
+#: Modules every layer may use (``_lazy``: the lazy loading of submodules by ``__getattr__``;
+#: ``_display``: how results show themselves, repr and notebook table).
+SHARED = {"errors", "progress", "parallel", "io.frames", "_lazy", "_display"}
 #: The one kind of upward import allowed: a convenience method that delegates to the layer
 #: above, imported inside the method (never at module level), as the brief allows for
 #: ``traj.to_csv(path)``. (importer, imported) pairs.

@@ -89,6 +89,21 @@ class Row:
     energy_error: float
     timing: Timing | None = None
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<Row {self.label}: largest position error {self.window_error:.3g} m "
+                        f"over the window, energy error {self.energy_error:.3g}, "
+                        f"{len(self.traj.events)} impacts, verdict {self.traj.verdict.status}>")
+
+    def _repr_html_(self) -> str:
+        from .._display import html_table
+
+        return html_table(repr(self), ["run", "largest position error (m)", "passes 1 mm at (s)",
+                                       "energy error", "impacts", "verdict"],
+                          [(self.label, self.window_error, self.diverged_at, self.energy_error,
+                            len(self.traj.events), self.traj.verdict.status)])
+
 
 @dataclass(frozen=True)
 class Comparison:
@@ -101,6 +116,28 @@ class Comparison:
     window: float
     notes: list[str] = field(default_factory=list)
     truth_timing: Timing | None = None
+
+    def __repr__(self) -> str:
+        """One line: the scene, the truth, and each run's largest position error."""
+        from .._display import one_line
+
+        runs = ", ".join(f"{r.label} {r.window_error:.3g} m" for r in self.rows)
+        return one_line(f"<Comparison {self.scene.name}: truth {self.truth.solver}; largest "
+                        f"position error over [0, {self.window:g}] s: {runs or 'no runs'}>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above the table ``dumbbell compare`` prints (times in s,
+        position errors in m)."""
+        from .._display import html_table
+
+        head = ["run", "dt (s)", "run time (s)", "warm-up (s)", "steps/s",
+                f"max |dr| over [0, {self.window:g}] s (m)", "|dr| > 1 mm at (s)",
+                "energy error", "impacts", "verdict"]
+        rows = [(r["label"], r["dt"], r["wall_time"], r["warm_up"], r["steps_per_s"],
+                 "(truth)" if i == 0 else r["window_error"], r["diverged_at"],
+                 r["energy_error"], r["impacts"], r["verdict"].status)
+                for i, r in enumerate(self.summary())]
+        return html_table(repr(self), head, rows, [f"truth: {self.truth_note}", *self.notes])
 
     def summary(self) -> list[dict[str, object]]:
         """One record per run, the truth first, keyed by label: solver, dt (s; None for the
@@ -224,8 +261,11 @@ def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, T
     solver's ``warm_up()`` first, then the run that is kept; a run shorter than
     :data:`TIME_AGAIN_BELOW` s is timed again (the runs are deterministic) until
     :data:`TIMED` s are timed, at most :data:`MAX_TIMED_RUNS` times."""
-    from ..solvers import simulate
+    from ..model import args
+    from ..solvers import available, simulate
 
+    scene = args.scene(scene)
+    name = args.choice(name, "name", available())
     compiled = solver_class(name).warm_up()
     first = simulate(scene, name, **options)
     again: list[float] = []
