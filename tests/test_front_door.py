@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import csv
 import importlib.metadata
+import math
 import re
 import subprocess
 import sys
@@ -105,7 +106,7 @@ def test_a_packaged_scene_is_refused_naming_only_flags(tmp_path, capsys, flags, 
     assert list(tmp_path.iterdir()) == []
 
 
-def test_compare_times_warm_runs_and_reports_the_warm_up_apart(tmp_path):
+def test_compare_times_warm_runs_and_reports_the_warm_up_apart(tmp_path, monkeypatch):
     from dumbbell.analysis.compare import MAX_TIMED_RUNS, timed_run
     from dumbbell.model.scene import load_scene
 
@@ -121,6 +122,15 @@ def test_compare_times_warm_runs_and_reports_the_warm_up_apart(tmp_path):
     assert list(rows[0])[-1] == "warm_up_s" and list(rows[0])[2] == "run_time_s"
     assert [r["solver"] for r in rows] == ["exact", "euler-cromer"]
     assert all(float(r["warm_up_s"]) >= 0 and float(r["run_time_s"]) > 0 for r in rows)
+    # A run not timed again (here: every run, as if each took long) has no measured warm-up
+    # unless its solver compiles something, which is timed by itself.
+    import dumbbell.analysis.compare
+
+    monkeypatch.setattr(dumbbell.analysis.compare, "TIME_AGAIN_BELOW", 0.0)
+    for solver, measured in (("pymunk", False), ("exact", False), ("euler-cromer", True)):
+        _, timing = timed_run(scene, solver, dt=1e-3, t_end=0.1, every=1)
+        assert timing.runs == 1 and (timing.warm_up >= 0 if measured
+                                     else math.isnan(timing.warm_up))
 
 
 def _scene_file(tmp_path, name: str, **lines: str) -> str:

@@ -4,14 +4,17 @@ tracked bytes again. The files that hold run times (the benchmark's table and it
 work-precision figure) are rewritten, and everything in them but the times is checked.
 
 The pieces run here one by one, in this process (``run --all`` runs the same pieces, in one
-go); the slowest are marked ``slow`` (``pytest -m "not slow"`` leaves them out; CI runs
-them)."""
+go), except those a code block of the docs runs as written: tests/test_docs_run.py checks
+what those leave in renders/ against the tracked bytes. The slowest are marked ``slow``
+(``pytest -m "not slow"`` leaves them out; CI runs them)."""
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import shutil
 import subprocess
+import sys
 
 import pytest
 
@@ -24,6 +27,34 @@ RENDERS = ROOT / "renders"
 UNTRACKED = (".csv", ".json", "stability.md")
 #: Pieces that take more than about 10 s on a 2-core machine.
 SLOW = {"bench"}
+
+
+def _docs_commands() -> set[str]:
+    spec = importlib.util.spec_from_file_location("docblocks", ROOT / "tools" / "docblocks.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module.commands(ROOT)
+
+
+def spellings(piece: Piece) -> set[str]:
+    """The command lines that make ``piece`` into renders/ (``dumbbell run`` with no scene is
+    the textbook's)."""
+    out = {piece.command}
+    if piece.argv == ("run", "textbook-1d"):
+        out.add("dumbbell run")
+    return out
+
+
+#: Pieces a runnable block of the docs makes into renders/, and the rest.
+IN_DOCS = [p for p in PIECES if spellings(p) & _docs_commands()]
+HERE = [p for p in PIECES if p not in IN_DOCS]
+
+
+def test_every_piece_is_checked_by_the_docs_or_here():
+    assert set(IN_DOCS) | set(HERE) == set(PIECES) and not set(IN_DOCS) & set(HERE)
+    # The README's first command is checked by the docs' run.
+    assert PIECES[0] in IN_DOCS
 
 
 def tracked_renders() -> set[str]:
@@ -103,7 +134,7 @@ def _run(piece: Piece, out, monkeypatch) -> int:
 @pytest.mark.parametrize("piece", [
     pytest.param(p, id=" ".join(p.argv[:2]),
                  marks=[pytest.mark.slow] if p.argv[0] in SLOW else [])
-    for p in PIECES])
+    for p in HERE])
 def test_each_piece_writes_the_tracked_bytes_again(tmp_path, piece, monkeypatch):
     assert _run(piece, tmp_path, monkeypatch) == 0
     written = {p.name for p in tmp_path.iterdir()}

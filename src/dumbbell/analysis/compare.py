@@ -67,7 +67,8 @@ class Timing:
     """How long a run took on the solver's own clock (``Trajectory.wall_time``): ``seconds``
     warm (the fastest of ``runs`` runs after the first, or the first when it was the only
     one), and ``warm_up``, what the first run paid on top (numba's start-up and compile, or
-    the load from its cache; the solver's ``warm_up()`` included)."""
+    the load from its cache; the solver's ``warm_up()`` included): NaN when nothing was
+    measured (one run of a solver with nothing to compile)."""
 
     seconds: float
     warm_up: float
@@ -274,8 +275,10 @@ def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, T
         while sum(again) < TIMED and len(again) < MAX_TIMED_RUNS:
             again.append(simulate(scene, name, **quiet).wall_time)
     seconds = min(again) if again else first.wall_time
-    warm_up = max(0.0, first.wall_time - seconds) + (0.0 if math.isnan(compiled) else compiled)
-    return first, Timing(seconds, warm_up, 1 + len(again))
+    # Measured only: the first run's excess when there were later runs, plus the compile.
+    parts = [p for p in (max(0.0, first.wall_time - seconds) if again else math.nan, compiled)
+             if not math.isnan(p)]
+    return first, Timing(seconds, sum(parts) if parts else math.nan, 1 + len(again))
 
 
 

@@ -40,7 +40,7 @@ def summary_csv(result: Comparison) -> str:
                      None if row is None else row.window_error, result.window,
                      None if row is None else row.diverged_at,
                      rec["energy_error"], len(r.events), r.verdict.status,
-                     f"{rec['warm_up']:.3g}"))
+                     "" if math.isnan(rec["warm_up"]) else f"{rec['warm_up']:.3g}"))
     return csv_text(SUMMARY_COLUMNS, rows)
 
 
