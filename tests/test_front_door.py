@@ -127,10 +127,13 @@ def test_compare_times_warm_runs_and_reports_the_warm_up_apart(tmp_path, monkeyp
     import dumbbell.analysis.compare
 
     monkeypatch.setattr(dumbbell.analysis.compare, "TIME_AGAIN_BELOW", 0.0)
-    for solver, measured in (("pymunk", False), ("exact", False), ("euler-cromer", True)):
+    for solver, measured in (("pymunk", False), ("euler-cromer", True)):
         _, timing = timed_run(scene, solver, dt=1e-3, t_end=0.1, every=1)
         assert timing.runs == 1 and (timing.warm_up >= 0 if measured
                                      else math.isnan(timing.warm_up))
+    # A step-free solver's first run may load its compiled code: it is timed again anyway.
+    _, timing = timed_run(scene, "exact", dt=1e-3, t_end=0.1, every=1)
+    assert timing.runs >= 2 and timing.warm_up >= 0
 
 
 def _scene_file(tmp_path, name: str, **lines: str) -> str:

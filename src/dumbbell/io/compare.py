@@ -102,9 +102,9 @@ def text(result: Comparison) -> str:
             f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
             f"{rec['impacts']:>9}  {rec['verdict']}")
     lines += [("run time: warm, on the solver's own clock (a run under "
-              f"{TIME_AGAIN_BELOW:g} s is timed again, the fastest of up to "
-              f"{MAX_TIMED_RUNS} later runs); warm-up: what the first run paid on top (numba's "
-              "start-up and compile, or its load from numba's cache)"),
+              f"{TIME_AGAIN_BELOW:g} s, or of exact or reference, is timed again: the fastest "
+              f"of up to {MAX_TIMED_RUNS} later runs); warm-up: what the first run paid on top "
+              "(numba's start-up and compile, or its load from numba's cache)"),
               "", *_impact_lines(result), *result.notes]
     return "\n".join(lines)
 
