@@ -110,6 +110,15 @@ def frame_energies() -> tuple[float, float, float]:
     return float(traj["K_cm"][i]), float(traj["K_cm"][j]), float(traj["K_int"][i:j + 1].max())
 
 
+def _ec_error(window: float) -> float:
+    """Euler-Cromer at the textbook's dt against exact: the largest position error over
+    [0, window] s."""
+    from dumbbell.analysis.metrics import position_error
+
+    return position_error(run("textbook-1d", "euler-cromer", dt=1e-5, every=100), truth(),
+                          window)
+
+
 @dataclass(frozen=True)
 class Claim:
     page: str
@@ -192,6 +201,16 @@ CLAIMS = [
           lambda: __import__("dumbbell.solvers.exact_rigid", fromlist=["x"])
           .first_impact_state(30.0, 1.0)[1].omega),
     # docs/physics.md
+    Claim("docs/physics.md", "(for the textbook values ω = 63.25 rad/s, a period of 0.0993 s)",
+          "63.25", lambda: scene("textbook-1d").system.omega),
+    Claim("docs/physics.md", "(for the textbook values ω = 63.25 rad/s, a period of 0.0993 s)",
+          "0.0993", lambda: 2 * math.pi / scene("textbook-1d").system.omega),
+    Claim("docs/physics.md", "The textbook scene has about 22 impacts in 10 s.", "22",
+          lambda: len(truth().events)),
+    *[Claim("docs/physics.md", "at most 3e-5 m off up to 0.5 s, 1e-4 m up to 1 s,\n2e-3 m up to "
+            "2 s and 0.3 m by 3 s", quoted, fn) for quoted, fn in [
+                ("3e-5", lambda: _ec_error(0.5)), ("1e-4", lambda: _ec_error(1.0)),
+                ("2e-3", lambda: _ec_error(2.0)), ("0.3", lambda: _ec_error(3.0))]],
     Claim("docs/physics.md", "J = 2v / (1/M + r_x²/I) (1.254 J)", "1.254", _rigid_first_k_rot),
     Claim("docs/physics.md", "# J: 0.4976, 0.4939, 0.4903", "0.4976",
           lambda: k_rot_between(1e4)),
@@ -215,10 +234,16 @@ CLAIMS = [
            lambda: window_error("euler-cromer", 1e-4)),
           ("euler-cromer", "1e-4", "1.99e-2", "1.27e-2", "1.27e-2",
            lambda: energy_error("euler-cromer", 1e-4))]],
-    Claim("docs/measurements.md", "| 1e-3 | 10,000 | 2.65e-1 |", "2.65e-1",
+    Claim("docs/measurements.md", "| 2.65e-1 | 1.28e-1 | 8.53e-3 |", "2.65e-1",
           lambda: window_error("euler-cromer", 1e-3)),
-    Claim("docs/measurements.md", "| verlet | 1e-4 | 100,000 | 5.69e-5 |", "5.69e-5",
+    Claim("docs/measurements.md", "| 2.65e-1 | 1.28e-1 | 8.53e-3 |", "1.28e-1",
+          lambda: energy_error("euler-cromer", 1e-3)),
+    Claim("docs/measurements.md", "| 5.69e-5 | 9.68e-6 | 6.09e-7 |", "5.69e-5",
           lambda: window_error("verlet", 1e-4)),
+    Claim("docs/measurements.md", "| 5.69e-5 | 9.68e-6 | 6.09e-7 |", "9.68e-6",
+          lambda: energy_error("verlet", 1e-4)),
+    Claim("docs/measurements.md", "| 1.34e-2 | 3.00e-2 | 1.25e-3 |", "1.34e-2",
+          lambda: window_error("pymunk", 1e-3)),
     # docs/stability.md
     Claim("docs/stability.md", "rest expected at 4.07 s", "4.07",
           lambda: math.sqrt(2 * 1.0 / G) * (1 + 0.8) / (1 - 0.8)),
