@@ -15,8 +15,6 @@ their own.
 
 from __future__ import annotations
 
-import typing as _typing
-
 from ._lazy import attach as _attach
 
 #: Public name -> the module that defines it.
@@ -43,7 +41,7 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> _typing.Any:
+def __getattr__(name: str) -> object:
     if name == "available_solvers":
         # Not bound to the name ``solvers``: that is the package (dumbbell.solvers.exact, ...).
         from .solvers import available
@@ -66,7 +64,9 @@ def __dir__() -> list[str]:
     return sorted(set(__all__) | set(SUBMODULES) | {"__version__"})
 
 
-if _typing.TYPE_CHECKING:
+# typing is not imported here (it costs more than the rest of `import dumbbell`).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
     from .analysis.api import bench, compare, stability, sweep
     from .animation.render import Gif, render_gif
     from .errors import ColumnError, DumbbellError, MissingExtraError, SceneError, UsageError

@@ -6,8 +6,11 @@ and ``__dir__`` lists them (and only them), so ``import dumbbell`` stays cheap a
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Iterable, Mapping
-from typing import Any
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:  # typing and collections.abc are not imported at run time: import cost
+    from collections.abc import Callable, Iterable, Mapping
+    from typing import Any
 
 
 def attach(package: str, submodules: Iterable[str] = (),
