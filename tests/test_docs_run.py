@@ -30,11 +30,17 @@ FILES = docblocks.doc_files(ROOT)
 MAX_ILLUSTRATIVE = 3
 
 
+@pytest.fixture(scope="module")
+def ran():
+    """Every page's blocks run, the pages shared between two processes."""
+    return docblocks.run_files(FILES, ROOT)
+
+
 @pytest.mark.parametrize("path", FILES, ids=[p.name for p in FILES])
-def test_every_block_runs_as_written(path):
+def test_every_block_runs_as_written(path, ran):
     from tests.test_showcase import IN_DOCS, spellings
 
-    results, left, written = docblocks.run_file(path, ROOT)
+    results, left, written = ran[path]
     failures = [f"{r.block}: {r.error}" for r in results if r.error]
     assert failures == [], "\n\n".join(failures)
     assert left == []

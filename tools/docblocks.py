@@ -5,7 +5,8 @@ fail.
     python tools/docblocks.py docs/api.md  # one file; exit 1 when a block fails
     python tools/docblocks.py -v           # also each block's time
 
-Each Markdown file is one session, in a fresh temporary folder holding a copy of the
+The pages are shared between two processes (forked); each Markdown file is one session, in
+a fresh temporary folder holding a copy of the
 repository's ``scenes/`` (what a reader who cloned the repository has beside them), run
 against the installed ``dumbbell``:
 
@@ -355,13 +356,55 @@ def run_file(path: Path, root: Path = ROOT) -> tuple[list[Result], list[str], se
     return results, left, written
 
 
+#: Rough seconds each page's blocks take on 2 cores, to share the pages between processes.
+COST = {"README.md": 10, "physics.md": 7, "rotation.md": 5, "solvers.md": 4,
+        "measurements.md": 3, "api.md": 2, "stability.md": 2, "rendering.md": 1.5}
+
+
+def run_files(paths: list[Path], root: Path = ROOT, processes: int = 2
+              ) -> dict[Path, tuple[list[Result], list[str], set[str]]]:
+    """:func:`run_file` for every path, the pages shared between this process and
+    ``processes - 1`` forked ones (each page a session of its own either way); where fork
+    is not available, one after another here."""
+    import multiprocessing
+
+    if processes < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return {path: run_file(path, root) for path in paths}
+    groups: list[list[Path]] = [[] for _ in range(processes)]
+    loads = [0.0] * processes
+    for path in sorted(paths, key=lambda q: -COST.get(q.name, 0.5)):
+        i = loads.index(min(loads))
+        groups[i].append(path)
+        loads[i] += COST.get(path.name, 0.5)
+    context = multiprocessing.get_context("fork")
+    children = []
+    for group in groups[1:]:
+        receive, send = context.Pipe(duplex=False)
+        child = context.Process(target=_run_group, args=(send, group, root))
+        child.start()
+        send.close()
+        children.append((child, receive, group))
+    out = {path: run_file(path, root) for path in groups[0]}
+    for child, receive, group in children:
+        try:
+            out.update(receive.recv())
+        except EOFError:  # the child died: run its pages here
+            out.update({path: run_file(path, root) for path in group})
+        child.join()
+    return {path: out[path] for path in paths}
+
+
+def _run_group(send, paths: list[Path], root: Path) -> None:
+    send.send({path: run_file(path, root) for path in paths})
+    send.close()
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     verbose = "-v" in argv
     paths = [Path(a).resolve() for a in argv if a != "-v"] or doc_files()
     ran = skipped = failed = 0
-    for path in paths:
-        results, left, _ = run_file(path)
+    for path, (results, left, _) in run_files(paths).items():
         for r in results:
             if r.block.illustrative is not None and r.block.lang in RUN:
                 skipped += 1
