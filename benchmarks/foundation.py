@@ -2,7 +2,9 @@
 
 1. The textbook run (10 s, dt = 1e-5, 1e6 steps): the listing of section 13.5.1 as printed
    (numpy arrays indexed element by element in plain Python) against ``dumbbell.simulate``,
-   in the same process. The JIT warm-up is excluded from the ratio and reported separately.
+   in the same process, alternating (one of each per round): a ratio is the median of the
+   per-round ratios, with their range, and the load average is printed beside them. The JIT
+   warm-up is excluded from the ratio and reported separately.
 2. Memory: dt = 1e-7 (1e8 steps) with every = 10000, peak resident memory of a fresh process.
 3. The exact solution over 10 s against the 1e6-step Euler-Cromer run, at the same sampling.
 
@@ -64,14 +66,29 @@ def listing_as_printed(time_end: float = 10.0, dt: float = 0.00001) -> tuple[np.
     return xA, vA, xB, vB, E
 
 
-def timed(fn, repeat: int) -> tuple[float, float, object]:
-    """(min, median, last result) of ``repeat`` calls, in s."""
-    times, result = [], None
+def rounds(fns: dict[str, object], repeat: int) -> tuple[dict[str, list[float]], dict]:
+    """Run every function once per round, ``repeat`` rounds, alternating, so that a busy
+    moment of a shared machine hits both sides of a ratio alike; returns each one's times (s)
+    and last result."""
+    times: dict[str, list[float]] = {name: [] for name in fns}
+    last: dict[str, object] = {}
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), float(np.median(times)), result
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            last[name] = fn()
+            times[name].append(time.perf_counter() - t0)
+    return times, last
+
+
+def paired(times: dict[str, list[float]], slow: str, fast: str) -> str:
+    """Median, and range, of the per-round ratios slow / fast."""
+    ratios = sorted(a / b for a, b in zip(times[slow], times[fast], strict=True))
+    return (f"{float(np.median(ratios)):.3g}x (median of {len(ratios)} paired rounds; "
+            f"{ratios[0]:.3g}x to {ratios[-1]:.3g}x)")
+
+
+def best(times: list[float], unit: float = 1e3, label: str = "ms") -> str:
+    return f"{min(times) * unit:.3g} {label} (median {float(np.median(times)) * unit:.3g} {label})"
 
 
 def fresh_process(code: str, env: dict[str, str] | None = None) -> str:
@@ -82,7 +99,8 @@ def fresh_process(code: str, env: dict[str, str] | None = None) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5, help="runs per timing (default 5)")
+    parser.add_argument("--repeat", type=int, default=5,
+                        help="rounds, one run of each per round (default 5)")
     parser.add_argument("--skip-listing", action="store_true",
                         help="skip the plain-Python listing (it takes several seconds)")
     args = parser.parse_args()
@@ -104,7 +122,7 @@ def main() -> None:
     rows.append(("JIT load from numba's cache, fresh process", f"{float(cached):.3f} s"))
     euler_cromer.warm_up()
 
-    def ours():
+    def every_step():
         traj = dumbbell.simulate(scene, "euler-cromer", every=1)
         traj["E"]
         return traj
@@ -114,32 +132,41 @@ def main() -> None:
         traj["E"]
         return traj
 
-    ec_min, ec_med, traj = timed(ours, args.repeat)
-    sh_min, sh_med, _ = timed(shipped, args.repeat)
-    rows.append((("dumbbell.simulate(textbook scene), 1e6 steps, 1e4 samples (every=100), "
-                 "with energies"), f"{sh_min * 1e3:.1f} ms (median {sh_med * 1e3:.1f} ms)"))
-    rows.append(("dumbbell.simulate, 1e6 steps, all 1e6 samples (every=1), with energies",
-                 f"{ec_min * 1e3:.1f} ms (median {ec_med * 1e3:.1f} ms)"))
+    def exact():
+        return dumbbell.simulate(scene, "exact", every=100)
+
+    exact()  # load exact's compiled code before timing
+    load = os.getloadavg()[0]
+    fns = {"shipped": shipped, "every_step": every_step, "exact": exact}
     if not args.skip_listing:
-        lst_min, lst_med, listing = timed(listing_as_printed, max(1, min(args.repeat, 2)))
+        fns["listing"] = listing_as_printed
+    times, last = rounds(fns, args.repeat)
+    rows.append((("dumbbell.simulate(textbook scene), 1e6 steps, 1e4 samples (every=100), "
+                 "with energies"), best(times["shipped"])))
+    rows.append(("dumbbell.simulate, 1e6 steps, all 1e6 samples (every=1), with energies",
+                 best(times["every_step"])))
+    rows.append(("exact, 10 s, 1e4 samples (every=100), with energies", best(times["exact"])))
+    rows.append(("exact against euler-cromer, both 1e4 samples over 10 s",
+                 "cheaper by " + paired(times, "shipped", "exact")))
+    if not args.skip_listing:
+        listing, traj = last["listing"], last["every_step"]
         same = all(np.array_equal(a[:-1], traj[c][:-2]) for a, c in
                    zip(listing[:4], ("xA", "vA", "xB", "vB"), strict=True))
         rows.append(("textbook listing as printed, plain Python",
-                     f"{lst_min:.2f} s (median {lst_med:.2f} s)"))
+                     best(times["listing"], 1, "s")))
         rows.append(("speed-up, textbook scene as shipped (every=100)",
-                     f"{lst_min / sh_min:.0f}x"))
-        rows.append(("speed-up, every step kept (every=1)", f"{lst_min / ec_min:.0f}x"))
+                     paired(times, "listing", "shipped")))
+        rows.append(("speed-up, every step kept (every=1)",
+                     paired(times, "listing", "every_step")))
         rows.append(("listing and dumbbell agree bit for bit over 10 s", str(same)))
-
-    ex1_min, _, _ = timed(lambda: dumbbell.simulate(scene, "exact", every=1)["E"], args.repeat)
-    ex100_min, _, ex = timed(lambda: dumbbell.simulate(scene, "exact", every=100), args.repeat)
-    ec100_min, _, _ = timed(lambda: dumbbell.simulate(scene, "euler-cromer", every=100),
-                            args.repeat)
-    E = ex["E"]
-    rows.append(("exact, 10 s, 1e4 samples (every=100)", f"{ex100_min * 1e3:.1f} ms"))
-    rows.append(("euler-cromer, 1e6 steps, 1e4 samples (every=100)", f"{ec100_min * 1e3:.1f} ms"))
-    rows.append(("exact, 10 s, 1e6 samples (every=1), with energies", f"{ex1_min * 1e3:.1f} ms"))
+    t0 = time.perf_counter()
+    ex1 = dumbbell.simulate(scene, "exact", every=1)
+    rows.append(("exact, 10 s, 1e6 samples (every=1), with energies",
+                 f"{(time.perf_counter() - t0) * 1e3:.3g} ms"))
+    E = ex1["E"]
     rows.append(("exact: largest |E - E0| / E0 over 10 s", f"{np.abs(E - E[0]).max() / E[0]:.1e}"))
+    rows.append((("load average (1 min) before / after the timed rounds, on "
+                 f"{os.cpu_count()} CPUs"), f"{load:.1f} / {os.getloadavg()[0]:.1f}"))
 
     mem = fresh_process("""
         import time, dumbbell

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import functools
 from pathlib import Path
 
 import pytest
@@ -38,3 +39,24 @@ def make_scene(changes: dict | None = None, drop: tuple[str, ...] = (), base: di
 def textbook() -> Scene:
     """The shipped scenes/textbook-1d.toml."""
     return load_scene(SCENES / "textbook-1d.toml")
+
+
+#: Tilts (degrees) at which the rotation chapter drops its rigid dumbbell.
+DROP_ANGLES = (0.0, 30.0, 45.0, 60.0, 80.0)
+
+
+@functools.cache
+def rigid_pymunk_drops(e: float) -> dict[float, object]:
+    """The rigid dumbbell of scenes/tilted-2d.toml dropped on a floor of restitution ``e`` at
+    each of :data:`DROP_ANGLES` in pymunk at dt = 1e-5 s, every step kept, as ``dumbbell
+    restitution`` drops it: tilt -> Trajectory. Shared by the tests that read the first
+    bounce (the runs take seconds)."""
+    from dumbbell.analysis.restitution import drop_duration, tilted
+    from dumbbell.solvers import simulate
+
+    scene = load_scene(SCENES / "tilted-2d.toml").with_values({"floor.elasticity": e})
+    out = {}
+    for theta in DROP_ANGLES:
+        s = tilted(scene, theta)
+        out[theta] = simulate(s, "pymunk", t_end=drop_duration(s), every=1, dt=1e-5)
+    return out

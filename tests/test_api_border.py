@@ -434,6 +434,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.solvers.base.RunOptions.sample_times": lambda f: {"count": 3},
     "dumbbell.model.trajectory.Trajectory": lambda f: fields(f.traj),
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: {"body": "B"},
+    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: {"path": f.tmp / "traj.csv"},
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: {"name": "E"},
     "dumbbell.model.trajectory.Impact": lambda f: fields(f.traj.events[0]),
     "dumbbell.model.trajectory.Verdict": lambda f: fields(f.traj.verdict),
@@ -477,6 +478,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
         "t_end": 0.02, "quiet": True},
     "dumbbell.analysis.compare.default_solvers": lambda f: {"scene": f.scene},
+    "dumbbell.analysis.compare.Timing": lambda f: {"seconds": 0.01, "warm_up": 0.5, "runs": 3},
+    "dumbbell.analysis.compare.timed_run": lambda f: {"scene": f.scene, "name": "exact"},
 
     # dumbbell.analysis.contact, extended, metrics
     "dumbbell.analysis.contact.ContactMomentum": lambda f: fields(f.contact),
@@ -733,6 +736,7 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
+    "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
     "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,

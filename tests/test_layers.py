@@ -10,8 +10,13 @@ import dumbbell
 
 ROOT = Path(dumbbell.__file__).parent
 
-#: Modules every layer may use.
-SHARED = {"errors", "progress", "parallel", "io.frames"}
+#: Modules every layer may use (``_lazy``: the lazy loading of submodules by ``__getattr__``;
+#: ``_display``: how results show themselves, repr and notebook table).
+SHARED = {"errors", "progress", "parallel", "io.frames", "_lazy", "_display"}
+#: The one kind of upward import allowed: a convenience method that delegates to the layer
+#: above, imported inside the method (never at module level), as the brief allows for
+#: ``traj.to_csv(path)``. (importer, imported) pairs.
+DELEGATES = {("dumbbell.model.trajectory", "dumbbell.io.trajectory")}
 #: Layer of each package: ``spaces`` (any pymunk space: energy, heat, step guard) sits with
 #: the model; its recorder is the user's API above the animation that paints the recording
 #: (``animation/recording.py``), as the commands are.
@@ -31,26 +36,51 @@ def layer(module: str) -> int:
     return 5  # the package's own __init__ re-exports the public API
 
 
-def imports(path: Path) -> tuple[str, list[str]]:
-    """The module's dotted name and the dumbbell modules it imports (relative imports)."""
-    parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+def imports(path: Path, local: bool = True, root: Path = ROOT) -> tuple[str, list[str]]:
+    """The module's dotted name and the dumbbell modules it imports (relative imports);
+    with ``local`` False, only those at module level (not inside a function)."""
+    parts = list(path.relative_to(root.parent).with_suffix("").parts)
     package = parts[:-1]  # the package a relative import starts from
     module = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+    tree = ast.parse(path.read_text())
+    inside = {id(n) for f in ast.walk(tree)
+              if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)) for n in ast.walk(f)}
     found = []
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.level:
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level and (local or id(node) not in inside):
             base = package[: len(package) - node.level + 1]
             target = ".".join(base + ([node.module] if node.module else []))
             found += [target] if node.module else [f"{target}.{a.name}" for a in node.names]
     return module, found
 
 
-def test_every_module_imports_only_its_layer_and_the_ones_below():
+def upward_imports(root: Path = ROOT) -> list[str]:
+    """Every import that reaches up a layer, but a listed delegate's import inside a function."""
     upward = []
-    for path in sorted(ROOT.rglob("*.py")):
-        module, targets = imports(path)
-        upward += [f"{module} -> {t}" for t in targets if layer(t) > layer(module)]
-    assert upward == []
+    for path in sorted(root.rglob("*.py")):
+        module, targets = imports(path, root=root)
+        _, top = imports(path, local=False, root=root)
+        upward += [f"{module} -> {t}" for t in targets if layer(t) > layer(module)
+                   and ((module, t) not in DELEGATES or t in top)]
+    return upward
+
+
+def test_every_module_imports_only_its_layer_and_the_ones_below():
+    assert upward_imports() == []
+
+
+def test_a_delegate_may_import_up_only_inside_a_function(tmp_path):
+    model = tmp_path / "dumbbell" / "model"
+    model.mkdir(parents=True)
+    (model / "trajectory.py").write_text(
+        "def to_csv(self, path):\n    from ..io.trajectory import write_csv\n")
+    assert upward_imports(tmp_path / "dumbbell") == []
+    (model / "trajectory.py").write_text("from ..io.trajectory import write_csv\n")
+    assert upward_imports(tmp_path / "dumbbell") == [
+        "dumbbell.model.trajectory -> dumbbell.io.trajectory"]
+    (model / "scene.py").write_text("def f():\n    from ..io.trajectory import write_csv\n")
+    assert "dumbbell.model.scene -> dumbbell.io.trajectory" in upward_imports(
+        tmp_path / "dumbbell")
 
 
 def test_the_layer_rule_sees_an_upward_import():

@@ -24,9 +24,9 @@ from dumbbell.analysis.topple import closed_form, measure
 from dumbbell.model.scene import load_scene, scene_from_dict
 from dumbbell.solvers import simulate
 
-from .conftest import ROOT, SCENES
+from .conftest import DROP_ANGLES, ROOT, SCENES, rigid_pymunk_drops
 
-ANGLES = (0.0, 30.0, 45.0, 60.0, 80.0)
+ANGLES = DROP_ANGLES
 
 
 @pytest.fixture(scope="module")
@@ -65,10 +65,9 @@ def test_rigid_truth_against_impulse_law(tilted_scene, e):
 
 @pytest.mark.parametrize("e", [1.0, 0.5])
 def test_rigid_pymunk_against_impulse_law(tilted_scene, e):
-    for theta in ANGLES:
-        s, traj = drop(tilted_scene, theta, e, "pymunk", dt=1e-5)
-        assert bounce(traj).e_first == pytest.approx(float(e_eff_rigid(theta, e, rigid_q(s))),
-                                                     abs=1e-3)
+    for theta, traj in rigid_pymunk_drops(e).items():  # drop(tilted_scene, theta, e, "pymunk")
+        assert bounce(traj).e_first == pytest.approx(
+            float(e_eff_rigid(theta, e, rigid_q(traj.scene))), abs=1e-3)
 
 
 def test_unequal_masses_use_q(tilted_scene):

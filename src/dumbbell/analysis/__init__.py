@@ -1,6 +1,10 @@
 """Layer 3, analysis: computations over trajectories (compare, bench, sweep, stability,
 rotation). Imports model and solvers; draws and writes through plot and io."""
 
-#: The analyses, one module each; the functions :mod:`dumbbell` exports are in :mod:`.api`.
-__all__ = ["api", "bench", "compare", "contact", "extended", "metrics", "restitution",
-           "rotation", "stability", "sweep", "topple"]
+from .._lazy import attach
+
+#: The analyses, one module each, imported when first read; the functions :mod:`dumbbell`
+#: exports are in :mod:`.api`.
+__getattr__, __dir__, __all__ = attach(__name__, [
+    "api", "bench", "compare", "contact", "extended", "metrics", "restitution", "rotation",
+    "stability", "sweep", "topple"])

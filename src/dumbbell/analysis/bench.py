@@ -178,6 +178,32 @@ class BenchResult:
     notes: list[str] = field(default_factory=list)
     spacing: float = SAMPLE_SPACING
 
+    def __repr__(self) -> str:
+        """One line: the scene, the points and how many ran ok, and the speed-ups at the
+        textbook's accuracy."""
+        from .._display import one_line
+
+        ok = sum(p.ok for p in self.points)
+        solvers = list(dict.fromkeys(p.solver for p in self.points))
+        speed = self.speedups().get("speedup", {})
+        fast = ", ".join(f"{n} {v:.3g}x" for n, v in speed.items() if n != self.baseline)
+        return one_line(f"<BenchResult {self.scene}: {len(self.points)} points of "
+                        f"{len(solvers)} solvers ({ok} ok), truth {self.truth or '-'}, error "
+                        f"over [0, {self.window:g}] s"
+                        + (f"; speed-up at {self.baseline}'s error: {fast}" if fast else "")
+                        + ">")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above one row per point (times in s, errors in m)."""
+        from .._display import html_table
+
+        head = ["solver", "dt (s)", "steps", "run time min (s)", "median (s)",
+                "position error (m)", "energy error", "impact time error (s)", "verdict"]
+        rows = [(p.solver, p.dt, p.steps, p.seconds, p.seconds_median, p.error,
+                 p.energy_error, p.impact_time_error, p.status) for p in self.points]
+        fits = [f"fitted order: {n} {f.order:.2f}" for n, f in self.fits.items()]
+        return html_table(repr(self), head, rows, [*fits, *self.notes])
+
     def speedups(self, target: float | None = None) -> dict[str, Any]:
         """Run time each solver needs for the error ``target`` (m; default: Euler-Cromer's at
         the textbook's dt), read off its work-precision line by log-log interpolation, and the

@@ -12,7 +12,10 @@ report says so). Each other run is measured against it:
   1 mm;
 - the energy error over the whole run (drift from E(0) relative to the energy scale; for a
   dissipative scene the distance from the truth's E);
-- the run time.
+- the run time, warm: a first run also pays numba's start-up and compile (or its load from
+  numba's cache), so a run shorter than :data:`TIME_AGAIN_BELOW` s, or of a step-free solver,
+  is timed again and the fastest later run is the run time; what the first run paid on top
+  is reported apart as its warm-up.
 
 The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` reports.
 
@@ -41,16 +44,35 @@ if TYPE_CHECKING:
 #: Default window (s) for position errors.
 WINDOW = 2.0
 
-__all__ = ["Comparison", "Row", "compare", "default_solvers"]
+__all__ = ["Comparison", "Row", "Timing", "compare", "default_solvers", "timed_run"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
+
+#: A run shorter than this (s) is timed again, until :data:`TIMED` s are timed in all (at most
+#: :data:`MAX_TIMED_RUNS` runs): the fastest later run is its warm run time.
+TIME_AGAIN_BELOW = 1.0
+TIMED = 0.2
+MAX_TIMED_RUNS = 5
 
 
 #: Columns of :meth:`Comparison.summary` and their units.
 SUMMARY_UNITS = {"solver": "", "dt": "s", "wall_time": "s", "steps_per_s": "1/s",
                  "window_error": "m", "diverged_at": "s", "energy_error": "1", "impacts": "",
-                 "verdict": ""}
+                 "verdict": "", "warm_up": "s"}
+
+
+@dataclass(frozen=True)
+class Timing:
+    """How long a run took on the solver's own clock (``Trajectory.wall_time``): ``seconds``
+    warm (the fastest of ``runs`` runs after the first, or the first when it was the only
+    one), and ``warm_up``, what the first run paid on top (numba's start-up and compile, or
+    the load from its cache; the solver's ``warm_up()`` included): NaN when nothing was
+    measured (one run of a solver with nothing to compile)."""
+
+    seconds: float
+    warm_up: float
+    runs: int = 1
 
 
 @dataclass(frozen=True)
@@ -66,6 +88,22 @@ class Row:
     window_error: float
     diverged_at: float | None
     energy_error: float
+    timing: Timing | None = None
+
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<Row {self.label}: largest position error {self.window_error:.3g} m "
+                        f"over the window, energy error {self.energy_error:.3g}, "
+                        f"{len(self.traj.events)} impacts, verdict {self.traj.verdict.status}>")
+
+    def _repr_html_(self) -> str:
+        from .._display import html_table
+
+        return html_table(repr(self), ["run", "largest position error (m)", "passes 1 mm at (s)",
+                                       "energy error", "impacts", "verdict"],
+                          [(self.label, self.window_error, self.diverged_at, self.energy_error,
+                            len(self.traj.events), self.traj.verdict.status)])
 
 
 @dataclass(frozen=True)
@@ -78,27 +116,54 @@ class Comparison:
     rows: list[Row]
     window: float
     notes: list[str] = field(default_factory=list)
+    truth_timing: Timing | None = None
+
+    def __repr__(self) -> str:
+        """One line: the scene, the truth, and each run's largest position error."""
+        from .._display import one_line
+
+        runs = ", ".join(f"{r.label} {r.window_error:.3g} m" for r in self.rows)
+        return one_line(f"<Comparison {self.scene.name}: truth {self.truth.solver}; largest "
+                        f"position error over [0, {self.window:g}] s: {runs or 'no runs'}>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above the table ``dumbbell compare`` prints (times in s,
+        position errors in m)."""
+        from .._display import html_table
+
+        head = ["run", "dt (s)", "run time (s)", "warm-up (s)", "steps/s",
+                f"max |dr| over [0, {self.window:g}] s (m)", "|dr| > 1 mm at (s)",
+                "energy error", "impacts", "verdict"]
+        rows = [(r["label"], r["dt"], r["wall_time"], r["warm_up"], r["steps_per_s"],
+                 "(truth)" if i == 0 else r["window_error"], r["diverged_at"],
+                 r["energy_error"], r["impacts"], r["verdict"].status)
+                for i, r in enumerate(self.summary())]
+        return html_table(repr(self), head, rows, [f"truth: {self.truth_note}", *self.notes])
 
     def summary(self) -> list[dict[str, object]]:
         """One record per run, the truth first, keyed by label: solver, dt (s; None for the
-        step-free truths), run time (s), steps/s, the largest position error over the window
-        (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy error
-        (the truth's own drift; NaN for a dissipative truth, which has nothing to be measured
-        against), impacts and verdict (see :data:`SUMMARY_UNITS`)."""
+        step-free truths), warm run time (s), steps/s, the largest position error over the
+        window (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy
+        error (the truth's own drift; NaN for a dissipative truth, which has nothing to be
+        measured against), impacts, verdict and the first run's warm-up (s, :class:`Timing`;
+        see :data:`SUMMARY_UNITS`)."""
         out = []
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
+            timing = (self.truth_timing if row is None else row.timing) or Timing(
+                r.wall_time, math.nan)
             steps = r.info.get("steps")
+            seconds = timing.seconds
             out.append({
                 "label": r.solver if row is None else row.label, "solver": r.solver,
                 "dt": r.dt if r.dt and solver_class(r.solver).has_step else None,
-                "wall_time": r.wall_time,
-                "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
+                "wall_time": seconds,
+                "steps_per_s": steps / seconds if steps and seconds > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
                 "diverged_at": None if row is None else row.diverged_at,
                 "energy_error": energy_error(r, None) if row is None else row.energy_error,
                 "impacts": len(r.events),
-                "verdict": r.verdict})
+                "verdict": r.verdict, "warm_up": timing.warm_up})
         return out
 
     def to_pandas(self) -> pandas.DataFrame:
@@ -152,7 +217,7 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     the scene's) and the truth, sampled at the same times, and measure them. Raises
     UsageError before running anything if a solver cannot run the scene."""
     from ..model import args
-    from ..solvers import available, simulate
+    from ..solvers import available
 
     scene = args.scene(scene)
     solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
@@ -174,22 +239,50 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
     truth_name = truth_solver(scene)
     for name in [*solvers, *([truth_name] if truth_name else [])]:
         solver_class(name).check_work(scene, make_options(scene, spacing, t_end))
-    truth, truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
+    (truth, truth_timing), truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
     rows = []
     for name in solvers:
         for dt in dts:
-            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
-                           quiet=quiet)
+            run, timing = timed_run(scene, name, dt=dt, t_end=t_end,
+                                    every=round(spacing / dt), quiet=quiet)
             err = position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
             label = name if len(dts) == 1 else f"{name} dt={dt:g}"
             rows.append(Row(label, run, err, position_error(run, truth, window),
                             float(run.t[over[0]]) if over.size else None,
-                            energy_error(run, truth)))
+                            energy_error(run, truth), timing))
     notes = []
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
-    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
+    return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes, truth_timing)
+
+
+def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, Timing]:
+    """One run of solver ``name`` (``simulate``'s keywords) and its warm :class:`Timing`: the
+    solver's ``warm_up()`` first, then the run that is kept; a run shorter than
+    :data:`TIME_AGAIN_BELOW` s, and any run of a solver without a step, is timed again (the
+    runs are deterministic) until :data:`TIMED` s are timed, at most :data:`MAX_TIMED_RUNS`
+    times."""
+    from ..model import args
+    from ..solvers import available, simulate
+
+    scene = args.scene(scene)
+    name = args.choice(name, "name", available())
+    cls = solver_class(name)
+    compiled = cls.warm_up()
+    first = simulate(scene, name, **options)
+    again: list[float] = []
+    # A step-free solver (exact, reference) may compile or load its code in its first run,
+    # however long that took on a busy machine: it is always timed again.
+    if first.wall_time < TIME_AGAIN_BELOW or not cls.has_step:
+        quiet = {**options, "quiet": True}
+        while sum(again) < TIMED and len(again) < MAX_TIMED_RUNS:
+            again.append(simulate(scene, name, **quiet).wall_time)
+    seconds = min(again) if again else first.wall_time
+    # Measured only: the first run's excess when there were later runs, plus the compile.
+    parts = [p for p in (max(0.0, first.wall_time - seconds) if again else math.nan, compiled)
+             if not math.isnan(p)]
+    return first, Timing(seconds, sum(parts) if parts else math.nan, 1 + len(again))
 
 
 
@@ -220,21 +313,20 @@ def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
 
 
 def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
-           quiet: bool) -> tuple[Trajectory, str]:
-    """The run every solver is measured against, sampled every ``spacing`` (s), and a note
-    saying what it is: the scene's truth solver, or pymunk at a tenth of the smallest step
-    ``dt_min`` (s) where there is none."""
-    from ..solvers import simulate
-
+           quiet: bool) -> tuple[tuple[Trajectory, Timing], str]:
+    """The run every solver is measured against, sampled every ``spacing`` (s), with its
+    timing, and a note saying what it is: the scene's truth solver, or pymunk at a tenth of
+    the smallest step ``dt_min`` (s) where there is none."""
     truth_name = truth_solver(scene)
     if truth_name is None:
         truth_dt = dt_min / 10
-        truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
-                         every=round(spacing / truth_dt), quiet=quiet)
+        timed = timed_run(scene, "pymunk", dt=truth_dt, t_end=t_end,
+                          every=round(spacing / truth_dt), quiet=quiet)
         why = no_truth_reason(scene)
-        return truth, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
+        return timed, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
                        f"{why}; so errors are against a ten times smaller step)")
-    truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
+    timed = truth, _ = timed_run(scene, truth_name, dt=spacing, t_end=t_end, every=1,
+                                 quiet=quiet)
     truth_note = truth_name
     est = truth.info.get("estimated_error")
     if est:
@@ -246,4 +338,4 @@ def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
     elif truth_name == "exact":
         truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
                        "chaotic map amplifies about 10x per impact)")
-    return truth, truth_note
+    return timed, truth_note

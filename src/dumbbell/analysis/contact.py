@@ -45,6 +45,23 @@ class ContactMomentum:
         """L_P after minus before (kg m^2/s): zero for a frictionless impact."""
         return self.after - self.before
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<ContactMomentum {self.impact.body}'s impact at t = "
+                        f"{self.impact.t:.6g} s, P = ({self.px:.4g}, 0) m: L_P "
+                        f"{self.before:.7g} -> {self.after:.7g} (change {self.change:.2g}), "
+                        f"L_cm {self.L_cm_before:.7g} -> {self.L_cm_after:.7g} kg m^2/s>")
+
+    def _repr_html_(self) -> str:
+        from .._display import html_table
+
+        return html_table(repr(self), ["", "before (kg m^2/s)", "after (kg m^2/s)",
+                                       "change (kg m^2/s)"],
+                          [("L_P", self.before, self.after, self.change),
+                           ("L_cm", self.L_cm_before, self.L_cm_after,
+                            self.L_cm_after - self.L_cm_before)])
+
 
 def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> ContactMomentum:
     """Angular momentum about the contact point of impact ``index`` (0: the first) of a 2D

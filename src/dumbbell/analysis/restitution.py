@@ -91,6 +91,21 @@ class Bounce:
     share_first: float
     share_cluster: float
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<Bounce e_first={self.e_first:.6g}, e_cluster={self.e_cluster:.6g} "
+                        f"after {self.impacts} impacts, K_rot share {self.share_first:.3g} "
+                        f"after the first, {self.share_cluster:.3g} after the cluster>")
+
+    def _repr_html_(self) -> str:
+        from .._display import html_table
+
+        return html_table(repr(self), ["", "e_eff", "K_rot / K before"],
+                          [("first impact", self.e_first, self.share_first),
+                           (f"first cluster ({self.impacts} impacts)", self.e_cluster,
+                            self.share_cluster)])
+
 
 def _cm_vy(traj: Trajectory) -> np.ndarray:
     s = traj.scene
@@ -209,6 +224,25 @@ class RestitutionResult:
     springs: dict[float, dict[str, np.ndarray]] = field(default_factory=dict)
     rigid_k_rot_share: np.ndarray | None = None
     rigid_impacts: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        """One line: e, q, the tilts, the truth against the formula, the springs."""
+        from .._display import one_line
+
+        n = len(self.theta)
+        tilts = f"{n} tilts {self.theta[0]:g}..{self.theta[-1]:g} deg" if n else "no tilts"
+        gap = float(np.max(np.abs(self.truth - self.formula))) if n else math.nan
+        springs = ", ".join(f"{k:g}" for k in self.springs)
+        return one_line(f"<RestitutionResult e={self.e:g}, q={self.q:.4g}: {tilts}; "
+                        f"{self.truth_solver} within {gap:.2g} of the formula"
+                        + (f"; springs k = {springs} N/m" if springs else "") + ">")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above one row per tilt: the CSV's columns."""
+        from .._display import html_table
+
+        cols = self.columns()
+        return html_table(repr(self), list(cols), zip(*cols.values(), strict=True))
 
     @property
     def sign_change(self) -> float:

@@ -96,6 +96,19 @@ class Series:
     dt: float
     scene: Scene
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<Series {self.scene.name}: {len(self.runs)} runs "
+                        f"({', '.join(self.runs)}), {self.solver} at dt = {self.dt:g} s>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above each run's summary line."""
+        from .._display import html_table
+
+        return html_table(repr(self), ["run", "trajectory"],
+                          [(label, repr(traj)) for label, traj in self.runs.items()])
+
 
 def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float = 2.0,
            stiffnesses: tuple[float, ...] = STIFFNESSES) -> Series:

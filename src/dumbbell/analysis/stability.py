@@ -101,6 +101,27 @@ class StabilityResult:
     skipped: tuple[str, ...] = ()
     guard: tuple[str, ...] = ()
 
+    def __repr__(self) -> str:
+        """One line: runs, cases, and which runs disagree with the theory."""
+        from .._display import one_line
+
+        bad = self.disagreements
+        which = "; ".join(f"{r.case} {r.solver}" for r in bad)
+        return one_line(f"<StabilityResult: {len(self.rows)} runs of "
+                        f"{len({r.case for r in self.rows})} cases, "
+                        f"{len(self.rows) - len(bad)} agree with the theory, {len(bad)} "
+                        f"disagree{' (' + which + ')' if bad else ''}>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above one row per run (dt in s)."""
+        from .._display import html_table
+
+        head = ["case", "solver", "dt (s)", "w*dt", "verdict", "t_fail (s)",
+                "largest rel. energy error", "theory expects", "agreement"]
+        rows = [(r.case, r.solver, r.dt, r.w_dt, r.verdict, r.t_fail, r.max_rel_energy_error,
+                 r.predicted, r.agreement) for r in self.rows]
+        return html_table(repr(self), head, rows, [f"not run: {s}" for s in self.skipped])
+
     @property
     def disagreements(self) -> list[StabilityRow]:
         """The runs whose verdict is not the one the theory expects."""

@@ -315,6 +315,27 @@ class SweepResult:
     def columns(self) -> list[str]:
         return [a.key for a in self.axes] + list(RESULT_COLUMNS)
 
+    def __repr__(self) -> str:
+        """One line: the scene, the grid, the solver, and how many points ended each way."""
+        from .._display import one_line
+
+        grid = " x ".join(f"{a.key} ({len(a.values)})" for a in self.axes)
+        counts = ", ".join(f"{n:,} {v}" for v, n in sorted(self.counts().items()))
+        took = f"; {self.wall_time:.3g} s on {self.backend}" if self.backend else ""
+        return one_line(f"<SweepResult {self.scene.name}: {len(self.rows):,} points over "
+                        f"{grid}, solver {self.solver}, t_end {self.t_end:g} s: "
+                        f"{counts or 'none'}{took}>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above the points that did not end ok (all points when every
+        one did), a table row each."""
+        from .._display import html_table
+
+        bad = [r for r in self.rows if r.verdict != "ok"]
+        shown = bad or self.rows
+        note = (f"the {len(bad):,} points that did not end ok" if bad else "every point ended ok")
+        return html_table(repr(self), self.columns, (r.cells for r in shown), [note])
+
     def to_pandas(self) -> pandas.DataFrame:
         """One row per grid point in grid order, the CSV's columns, units in
         ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).

@@ -45,6 +45,22 @@ class ToppleClosedForm:
     g: float
     theta0: float
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<ToppleClosedForm mA={self.mA:g} kg, mB={self.mB:g} kg, "
+                        f"L={self.L:g} m, I={self.I:.4g} kg m^2, g={self.g:g} m/s^2, released "
+                        f"at {math.degrees(self.theta0):g} deg>")
+
+    def _repr_html_(self) -> str:
+        """The one-line summary above the fall time and the landing speeds."""
+        from .._display import html_table
+
+        v_cm, v_top = self.landing_speeds()
+        return html_table(repr(self), ["fall time (s)", "centre of mass at landing (m/s)",
+                                       "top particle at landing (m/s)"],
+                          [(self.fall_time(), v_cm, v_top)])
+
     @property
     def M(self) -> float:
         """Total mass (kg)."""
@@ -184,6 +200,20 @@ class ToppleMeasure:
     theta: np.ndarray
     cm_x: np.ndarray
     v_top_curve: np.ndarray
+
+    def __repr__(self) -> str:
+        from .._display import one_line
+
+        return one_line(f"<ToppleMeasure lands at {self.fall_time:.6g} s: top particle "
+                        f"{self.v_top:.6g} m/s, centre of mass {self.v_cm:.6g} m/s, "
+                        f"horizontal drift {self.cm_drift:.2g} m; {len(self.t)} samples>")
+
+    def _repr_html_(self) -> str:
+        from .._display import html_table
+
+        return html_table(repr(self), ["fall time (s)", "top particle (m/s)",
+                                       "centre of mass (m/s)", "horizontal drift (m)"],
+                          [(self.fall_time, self.v_top, self.v_cm, self.cm_drift)])
 
 
 def measure(traj: Trajectory) -> ToppleMeasure:

@@ -4,4 +4,6 @@
 #: together from :mod:`.layout`, :mod:`.world`, :mod:`.bars`, :mod:`.strip`, :mod:`.palette`,
 #: :mod:`.glyphs`, :mod:`.backdrop` and :mod:`.frames`; :mod:`.recording` the painter behind
 #: ``dumbbell.spaces.Recorder``, from the same pieces (no public names of their own).
-__all__ = ["drawing", "render"]
+from .._lazy import attach
+
+__getattr__, __dir__, __all__ = attach(__name__, ["drawing", "render"])

@@ -127,20 +127,30 @@ def delays_cs(n: int, fps: int) -> list[int]:
 MAX_DIVISOR_SEARCH = 10**7
 
 
-def sample_every(dt: float, fps: int, t_end: float) -> int:
+def sample_every(dt: float, fps: int, t_end: float, every: int | None = None) -> int:
     """Steps between kept samples so that samples fall on frame times when 1/fps is a whole
     number of steps ``dt`` (s), about :data:`STRIP_RATE` samples per second for the strip and
     at most about :data:`STRIP_SAMPLES` over ``t_end`` (s). Never fewer than half the steps
-    that target asks for, so a render keeps at most 2 * STRIP_SAMPLES + 1 samples."""
+    that target asks for, so a render keeps at most 2 * STRIP_SAMPLES + 1 samples.
+
+    ``every``, the scene's own ``run.every``, is kept when it does all that at least as well
+    (samples as dense or denser, on the frame times, within the bound): then ``dumbbell
+    render`` draws from the same samples as ``dumbbell run``, and the two GIFs are the same
+    bytes."""
     from ..model import args
 
     dt = args.real(dt, "dt", "s")
     fps = check_fps(fps)
     t_end = args.real(t_end, "t_end", "s")
+    every = None if every is None else args.whole(every, "every", "steps")
     steps = max(1.0, t_end / dt)  # inf only past the step cap, which a run checks first
     # At most the run's steps, so that a subnormal dt cannot make it overflow.
     target = min(steps, max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES))
     frame_steps = 1.0 / (fps * dt)
+    if every is not None and every <= target and steps / every <= 2 * STRIP_SAMPLES:
+        whole = abs(frame_steps - round(frame_steps)) <= 1e-9 * frame_steps
+        if not whole or round(frame_steps) % every == 0:
+            return every
     if not (frame_steps <= MAX_DIVISOR_SEARCH and math.isfinite(target)):
         return math.floor(target) if math.isfinite(target) else 1
     per_frame = max(1, round(frame_steps))

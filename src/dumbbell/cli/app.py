@@ -88,6 +88,17 @@ def positive_int(what: str, hi: int = MAX_COUNT):
     return parse
 
 
+#: The one default output folder of every command (``--out``; ``render -o`` and ``simulate``'s
+#: CSV, which goes to standard output, name files).
+DEFAULT_OUT = "renders"
+
+
+def add_out(parser: argparse.ArgumentParser, what: str) -> None:
+    """The ``--out DIR`` flag: the folder for ``what``, :data:`DEFAULT_OUT` by default."""
+    parser.add_argument("--out", metavar="DIR", default=DEFAULT_OUT,
+                        help=f"folder for {what} (default: {DEFAULT_OUT}, for every command)")
+
+
 def add_quiet(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-q", "--quiet", action="store_true",
                         help="no progress bar (it is also off when stderr is not a terminal "
@@ -101,6 +112,10 @@ def build_parser() -> Parser:
                     "internal motion: the bouncing dumbbell of textbook section 13.5.1.",
         epilog="Exit status: 0 done, 2 bad input, 3 a run ended with a verdict other than ok.",
     )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"dumbbell {__version__}",
+                        help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
     for name in COMMANDS:
@@ -163,14 +178,17 @@ def _stop_signals() -> Iterator[None]:
 STDIN_SCENE = "stdin"
 
 
-def read_scene(path: str):
-    """The scene at ``path``, or read from standard input when ``path`` is ``-`` (at most
-    1 MB, the cap of a scene file; named :data:`STDIN_SCENE`, so ``render`` writes
-    ``renders/stdin.gif``)."""
+def read_scene(path, stdin: bool = True):
+    """The scene at ``path``, or read from standard input when ``path`` is ``-`` and the
+    command takes ``stdin`` (at most 1 MB, the cap of a scene file; named
+    :data:`STDIN_SCENE`, so ``render`` writes ``renders/stdin.gif``). A :class:`Scene`
+    already loaded (the showcase's shipped scenes) is taken as it is."""
     from ..errors import SceneError
-    from ..model.scene import MAX_SCENE_BYTES, load_scene, load_scene_bytes
+    from ..model.scene import MAX_SCENE_BYTES, Scene, load_scene, load_scene_bytes
 
-    if path != "-":
+    if isinstance(path, Scene):
+        return path
+    if path != "-" or not stdin:
         return load_scene(path)
     try:
         data = sys.stdin.buffer.read(MAX_SCENE_BYTES + 1)

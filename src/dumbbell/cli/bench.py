@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, positive_int
+from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,8 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "when some runs fail: failures are results here.",
     )
     p.add_argument("scene", metavar="SCENE", help="scene file (TOML)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the outputs (default: renders)")
+    add_out(p, "the outputs")
     p.add_argument("--solvers", nargs="+", metavar="NAME",
                    help="solvers to compare (default: every solver the scene supports, "
                         "except the truth, which is always added as a point of its own)")
@@ -67,9 +66,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.bench import run_bench
     from ..io.bench import write_all
-    from ..model.scene import load_scene
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
                        repeat=args.repeat, t_end=args.t_end, budget=args.budget,
                        spacing=args.sample_spacing, quiet=args.quiet)

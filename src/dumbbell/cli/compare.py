@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, read_scene
+from .app import add_out, add_quiet, positive_float, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,8 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scene", metavar="SCENE",
                    help="scene file (TOML); - reads it from standard input")
-    p.add_argument("--out", metavar="DIR", default="compare",
-                   help="folder for the outputs (default: compare)")
+    add_out(p, "the outputs")
     p.add_argument("--dt", type=positive_float("s"), nargs="+", metavar="DT",
                    help="time step(s) in s for the compared solvers (default: the scene's "
                         "run.dt); several give one run each")

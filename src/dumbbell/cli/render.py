@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..animation.render import MAX_FRAMES
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
+from .app import DEFAULT_OUT, EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--solver", metavar="NAME",
                    help="solver (default: the scene's run.solver)")
     p.add_argument("-o", "--output", metavar="FILE.gif",
-                   help="GIF to write (default: renders/<scene>.gif)")
+                   help=f"GIF to write (default: {DEFAULT_OUT}/<scene>.gif)")
     p.add_argument("--fps", metavar="N", type=_whole,
                    help="frames per second, 1 to 50 (default 25). GIF delays are whole "
                         "10 ms units: at 25 fps every frame lasts 40 ms; when 100/fps is not "
@@ -55,9 +55,8 @@ def _whole(text: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..animation.render import check_fps, check_frames, check_size, render_gif, sample_every
+    from ..animation.render import check_fps, check_frames, check_size, render_gif
     from ..model.scene import GifSettings
-    from ..solvers import make_options, simulate
 
     scene = read_scene(args.scene)
     gif = scene.outputs.gif or GifSettings(scene.run.t_end)
@@ -67,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     size = check_size(args.size or gif.size, "--size" if args.size else "outputs.gif.size")
     strip = args.strip if args.strip is not None else gif.strip
     t_end = args.t_end or gif.t_end
-    out = Path(args.output) if args.output else Path("renders") / f"{scene.name}.gif"
+    out = Path(args.output) if args.output else Path(DEFAULT_OUT) / f"{scene.name}.gif"
     if out.suffix.lower() != ".gif":
         from ..errors import UsageError
 
@@ -75,9 +74,7 @@ def run(args: argparse.Namespace) -> int:
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")
-    options = make_options(scene, t_end=t_end)
-    every = sample_every(options.dt, fps, options.t_end)
-    traj = simulate(scene, args.solver, t_end=options.t_end, every=every, quiet=args.quiet)
+    traj = gif_trajectory(scene, fps, t_end, args.solver, quiet=args.quiet)
     render_gif(traj, out, quiet=args.quiet, fps=fps, size=size, strip=strip, t_end=t_end,
                max_frames=args.max_frames)
     if not args.quiet:
@@ -86,3 +83,24 @@ def run(args: argparse.Namespace) -> int:
         sys.stderr.write(f"dumbbell render: {scene.name}: {traj.solver}: {traj.verdict}\n")
         return EXIT_VERDICT
     return 0
+
+
+def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, quiet: bool = True,
+                   traj=None):
+    """The run a GIF of ``scene`` at ``fps`` over ``t_end`` s is drawn from: sampled as
+    :func:`dumbbell.animation.render.sample_every` says, which keeps the scene's own
+    ``run.every`` when it serves the GIF. ``traj``, a run already made (``dumbbell run``'s),
+    is used when it has those samples and lasts long enough; else the scene is run again.
+    So ``dumbbell render`` and ``dumbbell run`` draw one scene from the same samples and
+    write the same bytes."""
+    from ..animation.render import sample_every
+    from ..solvers import make_options, simulate
+
+    options = make_options(scene, t_end=t_end)
+    every = sample_every(options.dt, fps, options.t_end, scene.run.every)
+    if (traj is not None and traj.every == every and traj.dt == options.dt
+            and (solver is None or traj.solver == solver)
+            and (not traj.verdict.ok  # ended early: a new run would end there too
+                 or traj.t[-1] >= options.t_end - options.dt * every / 2)):
+        return traj
+    return simulate(scene, solver, t_end=options.t_end, every=every, quiet=quiet)

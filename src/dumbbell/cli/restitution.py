@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float
+from .app import add_out, add_quiet, positive_float, read_scene
 
 #: Largest number of tilts in one call: each costs several runs.
 MAX_TILTS = 91
@@ -80,8 +80,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=[200.0, 2e3, 2e4],
                    help="spring constants of the spring dumbbells in N/m (default 200 2000 "
                         "20000)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the CSV and PNG (default: renders)")
+    add_out(p, "the CSV and PNG")
     add_quiet(p)
     p.set_defaults(func=run)
 
@@ -90,11 +89,10 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis.restitution import restitution
     from ..io.figures import save_figure
     from ..io.restitution import markdown, write_csv
-    from ..model.scene import load_scene
     from ..plot.rotation_chapter import restitution as draw
     from ..progress import bar
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     if args.elasticity is not None and scene.system.floor is not None:
         scene = scene.with_values({"floor.elasticity": args.elasticity})
     runs = len(args.theta) * (1 + len(args.stiffness))

@@ -9,11 +9,11 @@ from typing import Any
 
 from ..animation.render import MAX_FRAMES
 from ..solvers import MAX_SAMPLES
-from .app import add_quiet, positive_int
+from .app import add_out, add_quiet, positive_int
+from .showcase import PIECES
 
-#: Scenes whose outputs the README shows; ``dumbbell run --all`` regenerates them all.
-SHOWCASE = ("textbook-1d", "tilted-2d", "rigid-2d", "topple-2d")
-
+#: The scenes ``dumbbell run --all`` runs (the other pieces of the showcase follow them).
+SHOWCASE = tuple(p.scene for p in PIECES if p.argv[0] == "run")
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -24,10 +24,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scene", metavar="SCENE", nargs="?",
                    help="scene file (TOML); default: the packaged textbook-1d scene")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the outputs (default: renders)")
+    add_out(p, "the outputs")
     p.add_argument("--all", action="store_true",
-                   help="run every showcase scene (" + ", ".join(SHOWCASE) + ")")
+                   help="make the whole showcase, every file the repository tracks in "
+                        "renders/: the scenes " + ", ".join(SHOWCASE) + ", then "
+                        + "; ".join(p.command for p in PIECES if p.argv[0] != "run")
+                        + " (several minutes)")
     p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
                    default=MAX_SAMPLES,
                    help=f"refuse, before anything runs, a scene whose run would keep more than "
@@ -45,33 +47,45 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import UsageError
-    from ..model.scene import load_scene, packaged_scene
+    from .app import read_scene
+    from .showcase import load_packaged, run_pieces
 
     if args.all and args.scene:
         raise UsageError("give either SCENE or --all, not both")
-    paths = ([packaged_scene(n) for n in SHOWCASE] if args.all
-             else [Path(args.scene) if args.scene else packaged_scene()])
+    # A shipped scene (no SCENE, --all, the showcase's own) is not the user's file to edit.
+    packaged = args.all or not isinstance(args.scene, str)
+    scenes = ([load_packaged(n) for n in SHOWCASE] if args.all
+              else [read_scene(args.scene, stdin=False) if args.scene
+                    else load_packaged("textbook-1d")])
     # Validate every scene, and its budgets, before any output is written.
-    scenes = [load_scene(p) for p in paths]
     for scene in scenes:
-        _check_budgets(scene, args.max_samples, args.max_frames)
-    status = 0
-    for scene in scenes:
-        status = max(status, run_scene(scene, Path(args.out), quiet=args.quiet,
-                                       max_samples=args.max_samples,
-                                       max_frames=args.max_frames))
-    return status
+        _check_budgets(scene, args.max_samples, args.max_frames, packaged=packaged)
+    if args.all:
+        return run_pieces(Path(args.out), quiet=args.quiet, max_samples=args.max_samples,
+                          max_frames=args.max_frames)
+    return run_scene(scenes[0], Path(args.out), quiet=args.quiet,
+                     max_samples=args.max_samples, max_frames=args.max_frames)
 
 
-def _check_budgets(scene, max_samples: int, max_frames: int) -> None:
+def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = False) -> None:
     """UsageError naming the scene and its keys when its run would keep more than
-    ``max_samples`` samples or its GIF have more than ``max_frames`` frames."""
+    ``max_samples`` samples or its GIF have more than ``max_frames`` frames. A ``packaged``
+    scene (installed with dumbbell, not the user's to edit) is named by its name, and the
+    message offers only the flags."""
+    import string
+
     from ..animation.render import check_frames
     from ..errors import UsageError
     from ..solvers import make_options
 
     def in_scene(exc: UsageError, keys: dict[str, str]) -> UsageError:
-        return UsageError(f"{scene.source}: {exc.reason}", fixes=exc.fixes).named(keys)
+        if not packaged:
+            return UsageError(f"{scene.source}: {exc.reason}", fixes=exc.fixes).named(keys)
+        # Only the budget flags: the scene's keys are in a file inside the installation.
+        flags = [f for f in exc.fixes
+                 if all(p in (None, "max_frames", "max_samples")
+                        for _, p, _, _ in string.Formatter().parse(f))]
+        return UsageError(f"the packaged scene {scene.name}: {exc.reason}", fixes=flags)
 
     try:
         make_options(scene, max_samples=max_samples)
@@ -80,7 +94,8 @@ def _check_budgets(scene, max_samples: int, max_frames: int) -> None:
     if scene.outputs.gif is not None:
         gif = scene.outputs.gif
         try:
-            check_frames(gif.t_end, gif.fps, max_frames, "outputs.gif.t_end")
+            check_frames(gif.t_end, gif.fps, max_frames,
+                         "the GIF's length" if packaged else "outputs.gif.t_end")
         except UsageError as exc:
             raise in_scene(exc, {"t_end": "outputs.gif.t_end",
                                  "fps": "outputs.gif.fps"}) from None
@@ -110,9 +125,12 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
             written.append(write_events(traj, out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
+        from .render import gif_trajectory
 
         gif = scene.outputs.gif
-        written.append(render_gif(traj, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
+        # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
+        drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
+        written.append(render_gif(drawn, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
                                   size=gif.size, strip=gif.strip, t_end=gif.t_end,
                                   max_frames=max_frames))
     if not quiet:

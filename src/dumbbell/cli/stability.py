@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .app import add_quiet, positive_int
+from .app import add_out, add_quiet, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -25,8 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--solvers", nargs="+", metavar="NAME",
                    help="solvers to run (default: every solver that can run each case; the "
                         "2D reference only on 2D cases)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the report files (default: renders)")
+    add_out(p, "the report files")
     p.add_argument("--workers", type=positive_int("processes"), metavar="N",
                    help="local processes (default: the number of CPUs)")
     add_quiet(p)
@@ -40,18 +39,9 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     Everything is validated before anything runs, and only then is ``note`` (a line about
     the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
     runs."""
-    from ..analysis.stability import (
-        StabilityResult,
-        guard_lines,
-        map_rows,
-        map_solvers,
-        plan_runs,
-        run_cases,
-    )
+    from ..analysis.stability import StabilityResult, guard_lines, plan_runs, run_cases
     from ..errors import UsageError
-    from ..io.figures import save_figure
     from ..io.stability import write
-    from ..plot.maps import stability_map
 
     runs, skipped = plan_runs(cases, solvers)
     out = Path(out)
@@ -62,12 +52,25 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
     written = write(result, out)
-    steppers = map_solvers(solvers)
-    if steppers:
-        maps = {name: map_rows(name, workers, quiet) for name in steppers}
-        panels = stability_map(maps)
-        written.append(save_figure(panels[0].figure, out / "stability-map.png", dpi=90))
+    path = write_map(solvers, out, workers, quiet)
+    if path is not None:
+        written.append(path)
     return {"rows": list(result.rows), "skipped": skipped, "written": written}
+
+
+def write_map(solvers: list[str] | None, out: str | Path, workers: int | None = None,
+              quiet: bool = True) -> Path | None:
+    """OUT/stability-map.png for the time-stepping ``solvers`` among those asked for (all by
+    default); None when there is none."""
+    from ..analysis.stability import map_rows, map_solvers
+    from ..io.figures import save_figure
+    from ..plot.maps import stability_map
+
+    steppers = map_solvers(solvers)
+    if not steppers:
+        return None
+    panels = stability_map({name: map_rows(name, workers, quiet) for name in steppers})
+    return save_figure(panels[0].figure, Path(out) / "stability-map.png", dpi=90)
 
 
 def run(args: argparse.Namespace) -> int:

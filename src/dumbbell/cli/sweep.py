@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, positive_int
+from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,8 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="solver (default: the scene's run.solver)")
     p.add_argument("--t-end", type=positive_float("s"), metavar="T",
                    help="end time of every run in s (default: the scene's run.t_end)")
-    p.add_argument("--out", metavar="DIR", default="renders",
-                   help="folder for the CSV and PNG (default: renders)")
+    add_out(p, "the CSV and PNG")
     p.add_argument("--workers", type=positive_int("processes"), metavar="N",
                    help="local processes (default: the number of CPUs; 1 runs in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
@@ -49,11 +48,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
-    from ..model.scene import load_scene
     from ..parallel import cap_note
     from ..solvers import solver_class
 
-    scene = load_scene(args.scene)
+    scene = read_scene(args.scene, stdin=False)
     axes = [parse_axis(text) for text in args.grid]
     check_axes(axes)
     for axis in axes:

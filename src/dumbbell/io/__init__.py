@@ -1,5 +1,9 @@
 """Layer 4, files: every output is written atomically, through :mod:`dumbbell.io.files`."""
 
-#: The writers, one module per result, and what they share.
-__all__ = ["bench", "compare", "figures", "files", "frames", "restitution", "stability", "sweep",
-           "tables", "trajectory"]
+from .._lazy import attach
+
+#: The writers, one module per result, and what they share; each is imported when first
+#: read (``dumbbell.io.trajectory.write_csv``).
+__getattr__, __dir__, __all__ = attach(__name__, [
+    "bench", "compare", "figures", "files", "frames", "restitution", "stability", "sweep",
+    "tables", "trajectory"])

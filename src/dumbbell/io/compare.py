@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.compare import Comparison
+from ..analysis.compare import MAX_TIMED_RUNS, TIME_AGAIN_BELOW, Comparison
 from ..model import args
 from .files import atomic_output
 from .tables import csv_text, write_text
@@ -23,9 +23,10 @@ def _checked(result: Any) -> Comparison:
 
 
 #: Columns of SCENE-compare.csv (times in s, position errors in m, the energy error
-#: dimensionless; the measures of :mod:`dumbbell.analysis.metrics`).
+#: dimensionless; the measures of :mod:`dumbbell.analysis.metrics`). ``run_time_s`` is warm;
+#: ``warm_up_s`` what the first run paid on top (numba start-up, compile or cache load).
 SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m", "window_s",
-                   "error_passes_1mm_at_s", "energy_error", "impacts", "verdict")
+                   "error_passes_1mm_at_s", "energy_error", "impacts", "verdict", "warm_up_s")
 
 
 def summary_csv(result: Comparison) -> str:
@@ -35,10 +36,11 @@ def summary_csv(result: Comparison) -> str:
     for row, rec in zip([None, *result.rows], result.summary(), strict=True):
         r = result.truth if row is None else row.traj
         rows.append((r.solver if row is None else row.label, r.dt if r.dt else "",
-                     f"{r.wall_time:.6g}", r.info.get("steps", ""),
+                     f"{rec['wall_time']:.6g}", r.info.get("steps", ""),
                      None if row is None else row.window_error, result.window,
                      None if row is None else row.diverged_at,
-                     rec["energy_error"], len(r.events), r.verdict.status))
+                     rec["energy_error"], len(r.events), r.verdict.status,
+                     "" if math.isnan(rec["warm_up"]) else f"{rec['warm_up']:.3g}"))
     return csv_text(SUMMARY_COLUMNS, rows)
 
 
@@ -79,9 +81,9 @@ def text(result: Comparison) -> str:
     """The summary as a fixed-width text table (times in s, position errors in m, steps/s),
     then the impacts inside the window and the notes: what ``dumbbell compare`` prints."""
     result = _checked(result)
-    head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'steps/s':>10}"
-            f"{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}{'impacts':>9}"
-            "  verdict")
+    head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'warm-up [s]':>13}"
+            f"{'steps/s':>10}{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}"
+            f"{'impacts':>9}  verdict")
     lines = [f"{result.scene.title}  ({result.scene.source})",
              f"truth: {result.truth_note}",
              (f"position error: largest distance of either particle from its true place over "
@@ -94,11 +96,16 @@ def text(result: Comparison) -> str:
         err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
         div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
         energy = "-" if math.isnan(rec["energy_error"]) else f"{rec['energy_error']:.2e}"
+        warm = "-" if math.isnan(rec["warm_up"]) else f"{rec['warm_up']:.3g}"
         lines.append(
-            f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}"
+            f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}{warm:>13}"
             f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
             f"{rec['impacts']:>9}  {rec['verdict']}")
-    lines += ["", *_impact_lines(result), *result.notes]
+    lines += [("run time: warm, on the solver's own clock (a run under "
+              f"{TIME_AGAIN_BELOW:g} s, or of exact or reference, is timed again: the fastest "
+              f"of up to {MAX_TIMED_RUNS} later runs); warm-up: what the first run paid on top "
+              "(numba's start-up and compile, or its load from numba's cache)"),
+              "", *_impact_lines(result), *result.notes]
     return "\n".join(lines)
 
 

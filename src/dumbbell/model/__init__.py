@@ -1,5 +1,7 @@
 """Layer 1, the model: a scene (TOML -> :class:`Scene`), the energy formulas and the
 :class:`Trajectory` a solver returns. Imports nothing else from the package but errors."""
 
-#: The package's own names: none; the API is in its modules (scene, energy, trajectory).
-__all__: list[str] = []
+from .._lazy import attach
+
+#: The package's own names: none; the API is in its modules, imported when first read.
+__getattr__, __dir__, __all__ = attach(__name__, ["args", "energy", "scene", "trajectory"])

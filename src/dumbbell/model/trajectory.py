@@ -18,6 +18,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -279,11 +280,13 @@ class Trajectory:
         any), verdict."""
         dt = "-" if self.dt is None else f"{self.dt:g} s"
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
+        from .._display import one_line
+
         verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
         contacts = f", {len(self.contacts)} contacts" if self.contacts else ""
-        return (f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, t={span}, "
-                f"{len(self.t)} samples, {len(self.events)} impacts{contacts}, "
-                f"verdict: {verdict}>")
+        return one_line(f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, "
+                        f"t={span}, {len(self.t)} samples, {len(self.events)} impacts"
+                        f"{contacts}, verdict: {verdict}>")
 
     def _repr_html_(self) -> str:
         """A small table for notebooks: the one-line summary, the energy terms (J) at the start
@@ -310,6 +313,15 @@ class Trajectory:
             f"{''.join(rows)}</table>"
             f"<table><tr><th>impact t (s)</th><th>body</th><th>v before (m/s)</th>"
             f"<th>v after (m/s)</th></tr>{impacts}</table>{contacts}</div>")
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the samples as ``dumbbell simulate -o FILE`` does (the :attr:`columns`,
+        atomically) and return the path: a convenience over
+        :func:`dumbbell.io.trajectory.write_csv`, which writes it (a trajectory itself writes
+        no file)."""
+        from ..io.trajectory import write_csv
+
+        return write_csv(self, path)
 
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every

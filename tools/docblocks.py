@@ -1,0 +1,427 @@
+"""Run every code block of README.md and docs/*.md as a reader would, and report the ones that
+fail.
+
+    python tools/docblocks.py              # from the repository's root: every file
+    python tools/docblocks.py docs/api.md  # one file; exit 1 when a block fails
+    python tools/docblocks.py -v           # also each block's time
+
+The pages are shared between two processes (forked); each Markdown file is one session, in
+a fresh temporary folder holding a copy of the
+repository's ``scenes/`` (what a reader who cloned the repository has beside them), run
+against the installed ``dumbbell``:
+
+- ```` ```python ```` blocks run in order in one namespace per file, as in a notebook;
+- ```` ```sh ```` and ```` ```bash ```` blocks run line by line (``\\`` continues a line,
+  ``#`` starts a comment, ``&&`` and ``;`` join commands); ``dumbbell ARGS`` runs in this
+  process (``dumbbell.cli.main``, exit status 0 expected), ``python ...`` with this Python,
+  anything else in ``bash``;
+- ```` ```console ```` blocks are transcripts: ``$ COMMAND`` lines run as above and the lines
+  after one are the output it must print (doctest's rules: ``...`` stands for any text,
+  white space is normalised; ``$ echo $?`` prints the last exit status);
+- ```` ```toml ```` and ```` ```text ```` blocks are data and output listings, not run; a
+  fence without a language is an error, so that nothing is left unlabelled.
+
+A block that is not meant to run says so on the line before its fence:
+``<!-- illustrative: why -->``. Those are counted and listed, with their reasons.
+
+After a file's blocks, whatever they left in ``renders/`` must be a file the repository
+tracks there, with the same bytes (the showcase's timed files excepted), or one that git
+ignores: the docs' commands write outside ``renders/`` unless they are the showcase's.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import doctest
+import io
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+#: Languages that run, and those that are data or output listings.
+RUN = {"python", "sh", "bash", "console"}
+DATA = {"toml", "text"}
+_FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>```+|~~~+)\s*(?P<lang>[\w+-]*)\s*$")
+_MARK = re.compile(r"^\s*<!--\s*illustrative\b:?\s*(?P<why>.*?)\s*-->\s*$")
+#: Shell syntax this runner leaves to bash (pipes, redirections, background jobs).
+_SHELL = {"|", "||", ">", ">>", "<", "&", "2>", "2>&1", "(", ")"}
+#: Seconds a command run in a subprocess may take.
+TIMEOUT = 300
+
+
+@dataclass
+class Block:
+    """One fenced code block: the file (relative to the root), the line of its opening
+    fence, its language, its text, and why it is illustrative (None: it runs)."""
+
+    path: str
+    line: int
+    lang: str
+    code: str
+    illustrative: str | None = None
+
+    @property
+    def runs(self) -> bool:
+        return self.lang in RUN and self.illustrative is None
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line} ({self.lang or 'no language'})"
+
+
+@dataclass
+class Result:
+    """What running one block gave: its time (s) and the error, if any."""
+
+    block: Block
+    seconds: float = 0.0
+    error: str | None = None
+
+
+def doc_files(root: Path = ROOT) -> list[Path]:
+    """README.md and every Markdown file directly under docs/."""
+    files = [root / "README.md"] if (root / "README.md").exists() else []
+    return files + sorted((root / "docs").glob("*.md"))
+
+
+def blocks(path: Path, root: Path = ROOT) -> list[Block]:
+    """The fenced code blocks of one Markdown file, in order."""
+    out: list[Block] = []
+    lines = path.read_text(encoding="utf-8").splitlines()
+    name = str(path.relative_to(root)) if path.is_relative_to(root) else str(path)
+    i = 0
+    while i < len(lines):
+        m = _FENCE.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        fence, start = m.group("fence"), i
+        i += 1
+        body = []
+        while i < len(lines) and not lines[i].strip().startswith(fence):
+            body.append(lines[i])
+            i += 1
+        prev = next((lines[j] for j in range(start - 1, -1, -1) if lines[j].strip()), "")
+        mark = _MARK.match(prev)
+        out.append(Block(name, start + 1, m.group("lang"), "\n".join(body) + "\n",
+                         (mark.group("why") or "illustrative") if mark else None))
+        i += 1
+    return out
+
+
+class Failed(Exception):
+    """A block did not do what it says; the message says where and why."""
+
+
+@dataclass
+class Session:
+    """One Markdown file's blocks, run in ``folder`` (which holds a copy of scenes/)."""
+
+    folder: Path
+    namespace: dict = field(default_factory=lambda: {"__name__": "__docs__"})
+    status: int = 0
+
+    # -- Python ---------------------------------------------------------------------------
+
+    def python(self, block: Block) -> None:
+        code = compile(block.code, f"{block.path}:{block.line}", "exec")
+        printed = io.StringIO()
+        with _in(self.folder), contextlib.redirect_stdout(printed), \
+                contextlib.redirect_stderr(printed):
+            try:
+                exec(code, self.namespace)  # noqa: S102 - running the docs is the point
+            except Exception as exc:
+                raise Failed(f"{type(exc).__name__}: {exc}\n(it printed: "
+                             f"{printed.getvalue()[-2000:]})") from exc
+            finally:
+                _close_figures()
+
+    # -- shell ----------------------------------------------------------------------------
+
+    def command(self, line: str) -> tuple[int, str]:
+        """Run one shell line; returns its exit status and what it printed."""
+        if line.strip() == "echo $?":
+            return 0, f"{self.status}\n"
+        try:
+            tokens = list(_lexer(line))
+        except ValueError as exc:
+            raise Failed(f"cannot read the shell line {line!r}: {exc}") from None
+        if not tokens:
+            return self.status, ""
+        if any(t in _SHELL for t in tokens) or "$" in line:
+            return self._bash(line)
+        printed, status = "", 0
+        for argv in _split(tokens, {"&&", ";"}):
+            status, text = self._one(argv)
+            printed += text
+            if status != 0 and "&&" in tokens:
+                break
+        return status, printed
+
+    def _one(self, argv: list[str]) -> tuple[int, str]:
+        if argv[0] == "dumbbell":
+            from dumbbell.cli import main
+
+            out, err = io.StringIO(), io.StringIO()
+            with _in(self.folder), contextlib.redirect_stdout(out), \
+                    contextlib.redirect_stderr(err):
+                try:
+                    status = main(argv[1:])
+                except SystemExit as exc:  # --help, --version and argparse's errors
+                    status = exc.code if isinstance(exc.code, int) else 1
+                finally:
+                    _close_figures()
+            return status, out.getvalue() + err.getvalue()
+        if argv[0] in ("python", "python3", "python3.11"):
+            argv = [sys.executable, *argv[1:]]
+        return self._process(argv)
+
+    def _bash(self, line: str) -> tuple[int, str]:
+        return self._process(["bash", "-c", line])
+
+    def _process(self, argv: list[str]) -> tuple[int, str]:
+        env = dict(os.environ, MPLBACKEND="Agg",
+                   PATH=os.pathsep.join([str(Path(sys.executable).parent),
+                                         os.environ.get("PATH", "")]))
+        done = subprocess.run(argv, cwd=self.folder, capture_output=True, text=True, env=env,
+                              timeout=TIMEOUT, check=False)
+        return done.returncode, done.stdout + done.stderr
+
+    def shell(self, block: Block) -> None:
+        for line in _lines(block.code):
+            self.status, printed = self.command(line)
+            if self.status != 0:
+                raise Failed(f"`{line}` exited {self.status}:\n{printed[-2000:]}")
+
+    def console(self, block: Block) -> None:
+        checker = doctest.OutputChecker()
+        flags = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+        for line, want in _transcript(block.code):
+            self.status, got = self.command(line)
+            if not checker.check_output(want, got, flags):
+                raise Failed(f"`{line}` printed (exit {self.status}):\n{got}\nnot:\n{want}")
+
+    def run(self, block: Block) -> None:
+        {"python": self.python, "sh": self.shell, "bash": self.shell,
+         "console": self.console}[block.lang](block)
+
+
+@contextlib.contextmanager
+def _in(folder: Path):
+    before = Path.cwd()
+    os.chdir(folder)
+    try:
+        yield
+    finally:
+        os.chdir(before)
+
+
+def _close_figures() -> None:
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
+
+
+def _lexer(line: str):
+    lexer = shlex.shlex(line, posix=True, punctuation_chars=True)
+    lexer.whitespace_split = True
+    lexer.commenters = "#"
+    return lexer
+
+
+def _split(tokens: list[str], separators: set[str]) -> list[list[str]]:
+    out: list[list[str]] = [[]]
+    for token in tokens:
+        if token in separators:
+            out.append([])
+        else:
+            out[-1].append(token)
+    return [argv for argv in out if argv]
+
+
+def _lines(code: str) -> list[str]:
+    """Shell lines, a trailing backslash joining a line to the next."""
+    out, held = [], ""
+    for raw in code.splitlines():
+        if raw.rstrip().endswith("\\"):
+            held += raw.rstrip()[:-1] + " "
+            continue
+        out.append(held + raw)
+        held = ""
+    if held:
+        out.append(held)
+    return [line for line in out if line.strip()]
+
+
+def _transcript(code: str) -> list[tuple[str, str]]:
+    """(command, expected output) pairs of a console block."""
+    pairs: list[tuple[str, str]] = []
+    for raw in code.splitlines():
+        if raw.startswith("$ "):
+            pairs.append((raw[2:], ""))
+        elif pairs:
+            pairs[-1] = (pairs[-1][0], pairs[-1][1] + raw + "\n")
+    return pairs
+
+
+def check_renders(folder: Path, root: Path = ROOT) -> list[str]:
+    """What the blocks left in ``folder/renders`` that they should not have: a file the
+    repository neither tracks nor ignores there, or a tracked one with other bytes."""
+    out = folder / "renders"
+    if not out.is_dir():
+        return []
+    from dumbbell.cli.showcase import measured, tracked
+
+    problems = []
+    for path in sorted(out.iterdir()):
+        name = path.name
+        if name in tracked():
+            if name not in measured() and path.read_bytes() != (root / "renders" /
+                                                                name).read_bytes():
+                problems.append(f"renders/{name}: written with other bytes than the tracked "
+                                "file (only the showcase's own command may write it)")
+        elif not _ignored(name, root):
+            problems.append(f"renders/{name}: not a showcase file, and git would see it")
+    return problems
+
+
+def _ignored(name: str, root: Path) -> bool:
+    """Whether .gitignore keeps renders/NAME out of git (its renders/ rules only)."""
+    ignored = False
+    for line in (root / ".gitignore").read_text(encoding="utf-8").splitlines():
+        line = line.strip()
+        negate = line.startswith("!")
+        pattern = line[1:] if negate else line
+        if not pattern.startswith("renders/"):
+            continue
+        regex = re.escape(pattern[len("renders/"):]).replace(r"\*", "[^/]*")
+        if re.fullmatch(regex, name):
+            ignored = not negate
+    return ignored
+
+
+def commands(root: Path = ROOT, paths: list[Path] | None = None) -> set[str]:
+    """Every command line the runnable shell and console blocks of ``paths`` (default: every
+    doc file) run, comments dropped and white space normalised (what the showcase's test
+    leaves to the docs' run)."""
+    out = set()
+    for path in doc_files(root) if paths is None else paths:
+        for block in blocks(path, root):
+            if not block.runs or block.lang == "python":
+                continue
+            lines = (_lines(block.code) if block.lang != "console"
+                     else [c for c, _ in _transcript(block.code)])
+            for line in lines:
+                try:
+                    tokens = list(_lexer(line))
+                except ValueError:
+                    continue
+                out.update(" ".join(argv) for argv in _split(tokens, {"&&", ";"}))
+    return out
+
+
+def run_file(path: Path, root: Path = ROOT) -> tuple[list[Result], list[str], set[str]]:
+    """Run one file's blocks in a fresh folder; the results, what they left in renders/ that
+    they should not have, and the names of every file they left there."""
+    results = []
+    with tempfile.TemporaryDirectory(prefix="docblocks-") as tmp:
+        folder = Path(tmp)
+        shutil.copytree(root / "scenes", folder / "scenes")
+        session = Session(folder)
+        for block in blocks(path, root):
+            result = Result(block)
+            if block.lang not in RUN | DATA:
+                result.error = (f"a fence without a known language ({block.lang!r}): label it "
+                                f"with one of {', '.join(sorted(RUN | DATA))}")
+            elif block.runs:
+                t0 = time.perf_counter()
+                try:
+                    session.run(block)
+                except Failed as exc:
+                    result.error = str(exc)
+                except Exception as exc:  # noqa: BLE001 - report it as the block's failure
+                    result.error = f"{type(exc).__name__}: {exc}"
+                result.seconds = time.perf_counter() - t0
+            results.append(result)
+        left = check_renders(folder, root)
+        renders = folder / "renders"
+        written = {p.name for p in renders.iterdir()} if renders.is_dir() else set()
+    return results, left, written
+
+
+#: Rough seconds each page's blocks take on 2 cores, to share the pages between processes.
+COST = {"README.md": 10, "physics.md": 7, "rotation.md": 5, "solvers.md": 4,
+        "measurements.md": 3, "api.md": 2, "stability.md": 2, "rendering.md": 1.5}
+
+
+def run_files(paths: list[Path], root: Path = ROOT, processes: int = 2
+              ) -> dict[Path, tuple[list[Result], list[str], set[str]]]:
+    """:func:`run_file` for every path, the pages shared between this process and
+    ``processes - 1`` forked ones (each page a session of its own either way); where fork
+    is not available, one after another here."""
+    import multiprocessing
+
+    if processes < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return {path: run_file(path, root) for path in paths}
+    groups: list[list[Path]] = [[] for _ in range(processes)]
+    loads = [0.0] * processes
+    for path in sorted(paths, key=lambda q: -COST.get(q.name, 0.5)):
+        i = loads.index(min(loads))
+        groups[i].append(path)
+        loads[i] += COST.get(path.name, 0.5)
+    context = multiprocessing.get_context("fork")
+    children = []
+    for group in groups[1:]:
+        receive, send = context.Pipe(duplex=False)
+        child = context.Process(target=_run_group, args=(send, group, root))
+        child.start()
+        send.close()
+        children.append((child, receive, group))
+    out = {path: run_file(path, root) for path in groups[0]}
+    for child, receive, group in children:
+        try:
+            out.update(receive.recv())
+        except EOFError:  # the child died: run its pages here
+            out.update({path: run_file(path, root) for path in group})
+        child.join()
+    return {path: out[path] for path in paths}
+
+
+def _run_group(send, paths: list[Path], root: Path) -> None:
+    send.send({path: run_file(path, root) for path in paths})
+    send.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    verbose = "-v" in argv
+    paths = [Path(a).resolve() for a in argv if a != "-v"] or doc_files()
+    ran = skipped = failed = 0
+    for path, (results, left, _) in run_files(paths).items():
+        for r in results:
+            if r.block.illustrative is not None and r.block.lang in RUN:
+                skipped += 1
+                print(f"illustrative {r.block}: {r.block.illustrative}")
+            elif r.block.runs:
+                ran += 1
+                if verbose:
+                    print(f"{r.seconds:6.1f} s  {r.block}")
+            if r.error:
+                failed += 1
+                print(f"FAILED {r.block} after {r.seconds:.1f} s: {r.error}")
+        for problem in left:
+            failed += 1
+            print(f"FAILED {path.name}: {problem}")
+    print(f"{ran} blocks run, {skipped} illustrative, {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
