@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import copy
 import functools
+import importlib.util
+import sys
 from pathlib import Path
 
 import pytest
@@ -11,6 +13,17 @@ import pytest
 from dumbbell.model.scene import Scene, load_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parent.parent
+
+
+def load_tool(name: str):
+    """The module ``tools/NAME.py``, loaded once per session: its dataclasses look their
+    module up in ``sys.modules`` (a second load would give classes that do not pickle)."""
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
 SCENES = ROOT / "scenes"
 
 #: The textbook's scene as a dict, for tests that vary it.

@@ -6,23 +6,11 @@ renders/ unless they are the showcase's."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-
 import pytest
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, load_tool
 
-
-def _docblocks():
-    spec = importlib.util.spec_from_file_location("docblocks", ROOT / "tools" / "docblocks.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
-
-
-docblocks = _docblocks()
+docblocks = load_tool("docblocks")
 FILES = docblocks.doc_files(ROOT)
 #: Most blocks that may be marked illustrative (each with its reason): the README's install
 #: commands (CI runs command 2 verbatim), the development page's whole suite and ruff, and

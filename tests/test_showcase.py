@@ -10,17 +10,15 @@ what those leave in renders/ against the tracked bytes. The slowest are marked `
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import shutil
 import subprocess
-import sys
 
 import pytest
 
 from dumbbell.cli import main
 from dumbbell.cli.showcase import PIECES, Piece, measured, parse, tracked
-from tests.conftest import ROOT
+from tests.conftest import ROOT, load_tool
 
 RENDERS = ROOT / "renders"
 #: What the commands also write beside the tracked files; .gitignore keeps them out of git.
@@ -30,11 +28,7 @@ SLOW = {"bench"}
 
 
 def _docs_commands() -> set[str]:
-    spec = importlib.util.spec_from_file_location("docblocks", ROOT / "tools" / "docblocks.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module.commands(ROOT)
+    return load_tool("docblocks").commands(ROOT)
 
 
 def spellings(piece: Piece) -> set[str]:
