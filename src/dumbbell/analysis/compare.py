@@ -23,6 +23,7 @@ The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` report
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -30,10 +31,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from ..solvers import no_truth_reason, solver_class, truth_solver
-from .metrics import energy_error, position_error, position_error_series
+from ..solvers import METHODS, Solver, solver_classes, truth_class
+from ..solvers.base import run_options
+from .metrics import _energy_error, _position_error, _position_error_series
 
 if TYPE_CHECKING:
     import pandas
@@ -41,7 +44,7 @@ if TYPE_CHECKING:
 #: Default window (s) for position errors.
 WINDOW = 2.0
 
-__all__ = ["Comparison", "Row", "compare", "default_solvers"]
+__all__ = ["CompareOptions", "Comparison", "Row", "compare", "default_solvers"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
@@ -80,8 +83,8 @@ class Comparison:
     notes: list[str] = field(default_factory=list)
 
     def summary(self) -> list[dict[str, object]]:
-        """One record per run, the truth first, keyed by label: solver, dt (s; None for the
-        step-free truths), run time (s), steps/s, the largest position error over the window
+        """One record per run, the truth first, keyed by label: solver, dt (s; None for a
+        run without steps, such as the step-free truths), run time (s), steps/s, the largest position error over the window
         (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy error
         (the truth's own drift; NaN for a dissipative truth, which has nothing to be measured
         against), impacts and verdict (see :data:`SUMMARY_UNITS`)."""
@@ -91,12 +94,12 @@ class Comparison:
             steps = r.info.get("steps")
             out.append({
                 "label": r.solver if row is None else row.label, "solver": r.solver,
-                "dt": r.dt if r.dt and solver_class(r.solver).has_step else None,
+                "dt": r.dt if r.dt and steps is not None else None,
                 "wall_time": r.wall_time,
                 "steps_per_s": steps / r.wall_time if steps and r.wall_time > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
                 "diverged_at": None if row is None else row.diverged_at,
-                "energy_error": energy_error(r, None) if row is None else row.energy_error,
+                "energy_error": _energy_error(r, None) if row is None else row.energy_error,
                 "impacts": len(r.events),
                 "verdict": r.verdict})
         return out
@@ -138,71 +141,95 @@ class Comparison:
 
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
-    from ..model import args
+    return [cls.name for cls in _default_solvers(args.scene(scene))]
 
-    scene = args.scene(scene)
+
+def _default_solvers(scene: Scene) -> list[type[Solver]]:
     names = ["pymunk", "euler-cromer" if scene.system.dimensions == 1 else "euler-cromer-2d"]
-    return [n for n in names if solver_class(n).supports(scene) is None]
+    return [METHODS[n] for n in names if METHODS[n]._supports(scene) is None]
 
 
-def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
-            dts: list[float] | None = None, window: float = WINDOW, t_end: float | None = None, quiet: bool = True
-            ) -> Comparison:
-    """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
-    the scene's) and the truth, sampled at the same times, and measure them. Raises
-    UsageError before running anything if a solver cannot run the scene."""
-    from ..model import args
-    from ..solvers import available, simulate
+@dataclass(frozen=True)
+class CompareOptions:
+    """What :func:`compare` runs: ``solvers`` (names or Solver classes; None:
+    :func:`default_solvers`) at each step in ``dts`` (s; None: the scene's) over ``t_end``
+    (s; None: the scene's), the position error over [0, ``window``] s, quietly or with
+    progress bars. Built once, checked once."""
 
+    solvers: tuple[type[Solver], ...] | None = None
+    dts: tuple[float, ...] | None = None
+    window: float = WINDOW
+    t_end: float | None = None
+    quiet: bool = True
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__
+        classes = solver_classes(self.solvers)
+        put(self, "solvers", None if classes is None else tuple(classes))
+        dts = self.dts
+        if isinstance(dts, numbers.Real) and not isinstance(dts, bool):
+            dts = [dts]
+        if dts is not None and not (isinstance(dts, tuple) and dts and all(
+                type(dt) is float and 0 < dt < math.inf for dt in dts)):
+            dts = args.positives(list(dts) if isinstance(dts, tuple) else dts, "dts", "s")
+        put(self, "dts", None if dts is None else tuple(dts))
+        for name in ("window", "t_end"):
+            value = getattr(self, name)
+            if not (value is None and name == "t_end"
+                    or type(value) is float and 0 < value < math.inf):
+                put(self, name, args.real(value, name, "s"))
+        if type(self.quiet) is not bool:
+            put(self, "quiet", args.flag(self.quiet, "quiet"))
+
+
+def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
+    """Run the solvers of ``options`` (:class:`CompareOptions`) at each of its steps, and
+    the truth, sampled at the same times, and measure them. Raises UsageError before running
+    anything if a solver cannot run the scene."""
     scene = args.scene(scene)
-    solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
-                                                                         available())
-    dts = [scene.run.dt] if dts is None else args.positives(dts, "dts", "s")
-    t_end = scene.run.t_end if t_end is None else args.real(t_end, "t_end", "s")
-    window = args.real(window, "window", "s")
-    quiet = args.flag(quiet, "quiet")
-    for name in solvers:
-        reason = solver_class(name).supports(scene)
+    options = args.instance(options, "options", CompareOptions, "CompareOptions")
+    solvers = options.solvers or tuple(_default_solvers(scene))
+    dts = list(options.dts or (scene.run.dt,))
+    t_end = scene.run.t_end if options.t_end is None else options.t_end
+    window = options.window
+    for cls in solvers:
+        reason = cls._supports(scene)
         if reason is not None:
-            raise UsageError(f"solvers: {name!r} cannot run {scene.source}: {reason}", param="solvers")
-    if not (window > 0 and math.isfinite(window)):
-        raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
+            raise UsageError(f"solvers: {cls.name!r} cannot run {scene.source}: {reason}",
+                             param="solvers")
     spacing = _spacing(scene, dts, t_end)
     # Every run's own work budget (the exact truth's impacts), before the first run.
-    from ..solvers import make_options
-
-    truth_name = truth_solver(scene)
-    for name in [*solvers, *([truth_name] if truth_name else [])]:
-        solver_class(name).check_work(scene, make_options(scene, spacing, t_end))
-    truth, truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
+    truth_cls = truth_class(scene)
+    for cls in [*solvers, *([truth_cls] if truth_cls else [])]:
+        cls._check_work(scene, run_options(scene, spacing, t_end))
+    truth, truth_note = _truth(scene, truth_cls, min(dts), (spacing, t_end), options.quiet)
     rows = []
-    for name in solvers:
+    for cls in solvers:
         for dt in dts:
-            run = simulate(scene, name, dt=dt, t_end=t_end, every=round(spacing / dt),
-                           quiet=quiet)
-            err = position_error_series(run, truth)
+            run = cls._solve(scene, run_options(scene, dt, t_end, round(spacing / dt),
+                                                options.quiet))
+            err = _position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
-            label = name if len(dts) == 1 else f"{name} dt={dt:g}"
-            rows.append(Row(label, run, err, position_error(run, truth, window),
+            label = cls.name if len(dts) == 1 else f"{cls.name} dt={dt:g}"
+            rows.append(Row(label, run, err, _position_error(run, truth, window),
                             float(run.t[over[0]]) if over.size else None,
-                            energy_error(run, truth)))
+                            _energy_error(run, truth)))
     notes = []
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
     return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
 
 
-
 def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
     """The one sample spacing (s) of every run, so that they compare point by point: the
     largest dt or the scene's dt * every, which each dt must divide. UsageError before
     anything runs if a dt does not fit or the samples would pass the budget."""
-    from ..solvers import MAX_SAMPLES, make_options
+    from ..solvers import MAX_SAMPLES
 
     spacing = max(max(dts), scene.run.dt * scene.run.every)
     for dt in dts:
         try:
-            make_options(scene, dt, t_end)  # validates dt against t_end
+            run_options(scene, dt, t_end)  # validates dt against t_end
         except UsageError as exc:
             raise UsageError(f"dts: {exc.reason}", param="dts", fixes=exc.fixes) from None
         ratio = spacing / dt
@@ -219,23 +246,23 @@ def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
     return spacing
 
 
-def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
-           quiet: bool) -> tuple[Trajectory, str]:
-    """The run every solver is measured against, sampled every ``spacing`` (s), and a note
-    saying what it is: the scene's truth solver, or pymunk at a tenth of the smallest step
-    ``dt_min`` (s) where there is none."""
-    from ..solvers import simulate
+def _truth(scene: Scene, cls: type[Solver] | None, dt_min: float,
+           samples: tuple[float, float], quiet: bool) -> tuple[Trajectory, str]:
+    """The run every solver is measured against, with samples = (spacing, t_end) in s, and a
+    note saying what it is: the scene's truth solver ``cls``, or pymunk at a tenth of the
+    smallest step ``dt_min`` (s) where there is none."""
+    from ..solvers import no_truth_reason
 
-    truth_name = truth_solver(scene)
-    if truth_name is None:
+    spacing, t_end = samples
+    if cls is None:
         truth_dt = dt_min / 10
-        truth = simulate(scene, "pymunk", dt=truth_dt, t_end=t_end,
-                         every=round(spacing / truth_dt), quiet=quiet)
+        truth = METHODS["pymunk"]._solve(scene, run_options(
+            scene, truth_dt, t_end, round(spacing / truth_dt), quiet))
         why = no_truth_reason(scene)
         return truth, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
                        f"{why}; so errors are against a ten times smaller step)")
-    truth = simulate(scene, truth_name, dt=spacing, t_end=t_end, every=1, quiet=quiet)
-    truth_note = truth_name
+    truth = cls._solve(scene, run_options(scene, spacing, t_end, 1, quiet))
+    truth_note = cls.name
     est = truth.info.get("estimated_error")
     if est:
         method = ("RK8 on d = rA - rB, no impact missed" if truth.info.get("rk_steps")
@@ -243,7 +270,7 @@ def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
         truth_note += (f" ({method}; its own estimated error: "
                        f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
                        f"energy {est['energy_relative']:.1e})")
-    elif truth_name == "exact":
+    elif cls.name == "exact":
         truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
                        "chaotic map amplifies about 10x per impact)")
     return truth, truth_note

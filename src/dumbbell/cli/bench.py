@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, positive_int
+from .app import add_quiet, options, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -65,14 +65,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.bench import run_bench
+    from ..analysis.bench import BenchOptions, run_bench
     from ..io.bench import write_all
     from ..model.scene import load_scene
 
     scene = load_scene(args.scene)
-    result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
-                       repeat=args.repeat, t_end=args.t_end, budget=args.budget,
-                       spacing=args.sample_spacing, quiet=args.quiet)
+    result = run_bench(scene, options(BenchOptions, args, spacing="sample_spacing"))
     written = write_all(result, Path(args.out))
     from ..io.figures import save_figure
     from ..plot.bench import convergence, work_precision

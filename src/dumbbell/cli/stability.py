@@ -5,9 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .app import add_quiet, positive_int
+from .app import add_quiet, options, positive_int
+
+if TYPE_CHECKING:
+    from ..analysis.stability import StabilityOptions
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,9 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
-           workers: int | None = None, quiet: bool = True,
-           note: str | None = None) -> dict[str, Any]:
+def report(options: StabilityOptions, out: str | Path, note: str | None = None
+           ) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
     Everything is validated before anything runs, and only then is ``note`` (a line about
     the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
@@ -53,7 +55,8 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     from ..io.stability import write
     from ..plot.maps import stability_map
 
-    runs, skipped = plan_runs(cases, solvers)
+    runs, skipped = plan_runs(options)
+    workers, quiet = options.workers, options.quiet
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
@@ -62,20 +65,21 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
     written = write(result, out)
-    steppers = map_solvers(solvers)
+    steppers = map_solvers(options.solvers)
     if steppers:
-        maps = {name: map_rows(name, workers, quiet) for name in steppers}
+        maps = {cls.name: map_rows(cls, workers, quiet) for cls in steppers}
         panels = stability_map(maps)
         written.append(save_figure(panels[0].figure, out / "stability-map.png", dpi=90))
     return {"rows": list(result.rows), "skipped": skipped, "written": written}
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis.stability import StabilityOptions
     from ..parallel import cap_note
 
     # Jobs are many (cases x solvers); the CPUs are the cap that binds.
     note = cap_note("--workers", args.workers, 1 << 30)
-    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note)
+    result = report(options(StabilityOptions, args), args.out, note)
     if not args.quiet:
         rows = result["rows"]
         bad = sum(not r.agrees for r in rows)

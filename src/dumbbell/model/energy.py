@@ -73,7 +73,8 @@ def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
     from .trajectory import _columns
 
     args.mapping(state, name, "a dict of state columns by name")
-    needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if spins(scene) else [])
+    needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if scene.system.discs
+                                      else [])
     missing = [c for c in needed if c not in state]
     if missing:
         raise UsageError(f"{name} has no column {missing[0]!r}: needs {', '.join(needed)}",
@@ -84,10 +85,17 @@ def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
                     n, name)
 
 
+def _scene(scene: Any) -> Scene:
+    """``scene`` as a Scene: a Scene passes as it is (it was checked when it was made),
+    anything else is checked (a path is loaded)."""
+    from .scene import Scene
+
+    return scene if isinstance(scene, Scene) else args.scene(scene)
+
+
 def state_columns(scene: Scene) -> list[str]:
     """Position and velocity columns of a scene (m, m/s), in CSV order."""
-    scene = args.scene(scene)
-    if scene.system.dimensions == 1:
+    if _scene(scene).system.dimensions == 1:
         return ["xA", "vA", "xB", "vB"]
     return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
 
@@ -116,17 +124,17 @@ def column_unit(name: str) -> str:
 def spins(scene: Scene) -> bool:
     """True when the particles are spinning discs (:attr:`System.discs
     <dumbbell.model.scene.System.discs>`, 2D only)."""
-    return args.scene(scene).system.discs
+    return _scene(scene).system.discs
 
 
 def energy_columns(scene: Scene) -> list[str]:
     """The energy terms (J) a scene can have, in CSV order; those it cannot have are left out."""
-    scene = args.scene(scene)
+    scene = _scene(scene)
     if scene.system.dimensions == 1:
         cols = ["K_cm", "K_int", "U_g", "U_spring", "E"]
     else:
         cols = ["K_cm", "K_rot", "K_vib"]
-        if spins(scene):
+        if scene.system.discs:
             cols.append("K_spin")
         cols.append("U_g")
         if scene.system.spring is not None:
@@ -144,8 +152,7 @@ BOOKKEEPING = ("E", "E_lost", "E_heat", "E_err")
 def momentum_columns(scene: Scene) -> list[str]:
     """The angular-momentum columns (kg m^2/s) of a scene, after the energy terms in the CSV:
     ``L_cm`` in 2D, none in 1D."""
-    scene = args.scene(scene)
-    return ["L_cm"] if scene.system.dimensions == 2 else []
+    return ["L_cm"] if _scene(scene).system.dimensions == 2 else []
 
 
 def partition_1d(
@@ -266,8 +273,10 @@ def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) 
     each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
     scene = args.scene(scene)
     t = np.asarray(args.array(t, "t", "s"))
-    state = _state(scene, state, t.size)
-    events = _impacts(events)
+    return _heat(scene, t, _state(scene, state, t.size), _impacts(events))
+
+
+def _heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) -> np.ndarray:
     if "heat" in state:
         return np.asarray(state["heat"], dtype=float)
     mass = {"A": scene.system.A.mass, "B": scene.system.B.mass}
@@ -291,8 +300,10 @@ def _impacts(events: Any) -> list[Impact]:
 
 def disc_inertia(mass: float, radius: float) -> float:
     """Moment of inertia of a uniform disc about its centre, 1/2 m r^2 (kg m^2)."""
-    mass = args.real(mass, "mass", "kg")
-    radius = args.real(radius, "radius", "m", lo=0.0)
+    return _disc(args.real(mass, "mass", "kg"), args.real(radius, "radius", "m", lo=0.0))
+
+
+def _disc(mass: float, radius: float) -> float:
     return 0.5 * mass * radius**2
 
 
@@ -319,7 +330,7 @@ def _positions_velocities(state: Columns) -> tuple[np.ndarray, ...]:
 
 def _disc_spin(scene: Scene, state: Columns) -> np.ndarray:
     """K_spin, the discs' own 1/2 I omega^2 summed (J)."""
-    return sum(rotational_ke(disc_inertia(p.mass, p.radius), state[f"omega{p.name}"])
+    return sum(rotational_ke(_disc(p.mass, p.radius), state[f"omega{p.name}"])
                for p in (scene.system.A, scene.system.B))
 
 
@@ -333,8 +344,11 @@ def partition(
     t = args.array(t, "t", "s")
     if t.ndim != 1:
         raise UsageError(f"t = {args.show(t)}: must be a 1-d array of times (s)", param="t")
-    state = _state(scene, state, t.size)
-    events = _impacts(events)
+    return _partition(scene, t, _state(scene, state, t.size), _impacts(events))
+
+
+def _partition(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact] = (),
+               ) -> dict[str, np.ndarray]:
     k, b = scene.system.k, scene.system.b
     if scene.system.dimensions == 1:
         parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
@@ -343,7 +357,7 @@ def partition(
         rA, vA, rB, vB = _positions_velocities(state)
         parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
                              rA, vA, rB, vB)
-        if spins(scene):
+        if scene.system.discs:
             parts["K_spin"] = _disc_spin(scene, state)
             parts["E"] = parts["E"] + parts["K_spin"]
     return _with_losses(scene, t, state, events, parts)
@@ -379,7 +393,7 @@ def _with_losses(
     and E_err = E_lost - E_heat added where the scene is dissipative (J)."""
     if scene.system.dissipative:
         parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
-        parts["E_heat"] = heat(scene, t, state, events)
+        parts["E_heat"] = _heat(scene, t, state, events)
         parts["E_err"] = parts["E_lost"] - parts["E_heat"]
     return {name: parts[name] for name in energy_columns(scene)}
 
@@ -406,7 +420,7 @@ def partition_from_terms(
         axis = partition_2d(system.A.mass, system.B.mass, system.k, system.b, system.g,
                             *_positions_velocities(state))
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
-        if spins(scene):
+        if system.discs:
             parts["K_spin"] = (terms["K_rot"] if system.rigid is None
                                else _disc_spin(scene, state))
     return _with_losses(scene, t, state, events, parts)
@@ -420,6 +434,10 @@ def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> f
         args.mapping(terms_at_start, "terms_at_start", "a dict of energy terms (J) or None")
         terms_at_start = {key: args.real(v, "terms_at_start", "J", positive=False)
                           for key, v in terms_at_start.items()}
+    return _energy_scale(E0, terms_at_start)
+
+
+def _energy_scale(E0: float, terms_at_start: Mapping[str, float] | None) -> float:
     scale = abs(E0)
     if terms_at_start:
         largest = max(abs(v) for v in terms_at_start.values())
@@ -437,9 +455,17 @@ def relative_energy_error(energy: Columns) -> np.ndarray:
     if "E" not in energy:
         raise UsageError("energy has no column 'E': must hold the total energy E (J)",
                          param="energy")
-    energy = _columns(energy, _length(energy["E"]), "energy")
+    return _relative_energy_error(_columns(energy, _length(energy["E"]), "energy"))
+
+
+def _relative_energy_error(energy: Columns) -> np.ndarray:
     E = energy["E"]
     if len(E) == 0:
         return E
+    return np.abs(E - E[0]) / _start_scale(energy)
+
+
+def _start_scale(energy: Columns) -> float:
+    """The :func:`energy_scale` of energy columns (J) at their first sample."""
     terms = {name: float(v[0]) for name, v in energy.items() if name not in BOOKKEEPING}
-    return np.abs(E - E[0]) / energy_scale(float(E[0]), terms)
+    return _energy_scale(float(energy["E"][0]), terms)

@@ -55,8 +55,8 @@ import numpy as np
 from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
 from ..model.scene import Particle, Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from .base import RunOptions, Solver
-from .verdicts import conclude, nonfinite_reason, tunnel_reason
+from .base import ExplicitSpring, RunOptions, Solver
+from .verdicts import RawRun, conclude, nonfinite_reason, tunnel_reason
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Pymunk"]
@@ -324,7 +324,7 @@ class _Watch:
         """The verdict of the sample ``row`` at ``t`` (s) of a run at step ``dt`` (s), or
         None when the run goes on."""
         if not all(abs(v) < _BIG for v in row):
-            return Verdict("unstable", t, nonfinite_reason(self.scene, dt))
+            return Verdict("unstable", t, nonfinite_reason(self.scene, dt, Pymunk.step_limit))
         if not self.floors:
             return None
         for name in "AB":
@@ -401,17 +401,17 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         info["moment"] = world.rigid_body.moment
     t = options.sample_times(kept)
     events = [e for e in events if verdict is None or e.t <= verdict.t]
-    return conclude(scene, NAME, t, state, events, verdict or Verdict(), dt=dt, every=every,
-                    wall_time=wall, info=info, energy=_energy(scene, world, t, state, events))
+    return conclude(Pymunk, scene, options, RawRun(
+        t, state, events, verdict or Verdict(), wall, info,
+        energy=_energy(scene, world, t, state, events)))
 
 
-class Pymunk(Solver):
+class Pymunk(ExplicitSpring, Solver):
     """The pymunk (Chipmunk) engine (see the module docstring)."""
 
     name = NAME
     order = 1
     has_step = True
-    explicit_spring = True
     flip_floor = False
     relative_cost = 30.0
     is_truth = False

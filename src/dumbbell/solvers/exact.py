@@ -27,7 +27,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
 from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
-from .verdicts import conclude
+from .verdicts import RawRun, conclude
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Exact"]
@@ -294,9 +294,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
             for name, value in zip(cols, motion.state(seg, t[lo:hi] - seg.t0), strict=True):
                 cols[name][lo:hi] = value
     wall = time.perf_counter() - t0
-    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
-                    wall_time=wall, info={"segments": len(segs), "root_xtol": ROOT_XTOL},
-                    truth=True)
+    return conclude(Exact, scene, options, RawRun(t, cols, events, verdict, wall,
+                                                  {"segments": len(segs), "root_xtol": ROOT_XTOL}))
 
 
 def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
@@ -312,10 +311,9 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
         t = t[t <= verdict.t]
     cols = sample(scene, segs, t)
     wall = time.perf_counter() - t0
-    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
-                    wall_time=wall, truth=True,
-                    info={"segments": len(segs), "root_xtol": RIGID_XTOL,
-                          "moment": rigid_moment(scene)})
+    return conclude(Exact, scene, options, RawRun(t, cols, events, verdict, wall,
+                                                  {"segments": len(segs), "root_xtol": RIGID_XTOL,
+                                                   "moment": rigid_moment(scene)}))
 
 
 class Exact(Solver):
@@ -325,7 +323,7 @@ class Exact(Solver):
     name = NAME
     order = None
     has_step = False
-    explicit_spring = False
+    step_limit = None
     flip_floor = True
     relative_cost = 0.01
     is_truth = True

@@ -56,7 +56,7 @@ from ..model.energy import (
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
-from .verdicts import head, judge
+from .verdicts import RawRun, head, judge
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Reference"]
@@ -317,7 +317,8 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
     from ..model import args
     from ..progress import bar
 
-    estimate_error = args.flag(estimate_error, "estimate_error")
+    if not isinstance(estimate_error, bool):
+        estimate_error = args.flag(estimate_error, "estimate_error")
     times = options.sample_times()
     if scene.system.dimensions == 2 and scene.system.rigid is None:
         warm_up()  # numba compiles (or loads) the kernel outside the solver's clock
@@ -336,12 +337,11 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
         info = {"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev}
     if scene.system.rigid is not None:
         info["moment"] = rigid_moment(scene)
-    verdict, keep, energy = judge(scene, NAME, t, cols, impacts, verdict, options.dt,
-                                  truth=True)
+    verdict, keep, energy = judge(Reference, scene, options, RawRun(t, cols, impacts, verdict))
     t, cols = t[:keep], head(cols, keep)
     if estimate_error and len(t):
         info["estimated_error"] = _estimate_error(scene, t, cols, impacts, energy)
-    return Trajectory(scene=scene, solver=NAME, t=t, state=cols, events=impacts,
+    return Trajectory._made(scene=scene, solver=NAME, t=t, state=cols, events=impacts,
                       verdict=verdict, dt=options.dt, every=options.every, wall_time=wall,
                       info=info, energy=energy)
 
@@ -377,7 +377,7 @@ class Reference(Solver):
     name = NAME
     order = None
     has_step = False
-    explicit_spring = False
+    step_limit = None
     flip_floor = True
     relative_cost = 100.0
     is_truth = True
