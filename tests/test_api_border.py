@@ -37,7 +37,7 @@ TOP = ("dumbbell", "dumbbell.parallel", "dumbbell.progress")
 INTERNAL = ("dumbbell.solvers.kernels",)
 #: Classes whose methods are a contract only (they raise NotImplementedError); every
 #: registered subclass's are covered (:func:`_solver_rows`).
-CONTRACTS = ("dumbbell.solvers.base.Solver",)
+CONTRACTS = ("dumbbell.solvers.base.Solver", "dumbbell.solvers.stepping.Stepper")
 #: The methods of the solver contract a registered solver has, its own or its family's.
 SOLVER_METHODS = ("supports", "solve", "check_work", "truth_for", "catch_depth", "kernel",
                   "swing")
@@ -392,6 +392,10 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.model.scene.scenes_dir": lambda f: {},
     "dumbbell.model.trajectory.read_only": lambda f: {"values": np.zeros(3)},
     # dumbbell.solvers: the registered classes are found (:func:`_solver_rows`), their modules
+    "dumbbell.solvers.kernels.Kernel": lambda f: {
+        "step": _module("dumbbell.solvers.kernels.euler_cromer").step,
+        "floor": "flip", "start": None, "through_at_radius": False},
+    "dumbbell.solvers.stepping.Stepper": lambda f: {},
     "dumbbell.solvers.exact_rigid.first_impact_state": lambda f: {
         "tilt": 30.0, "elasticity": 0.5, "mA": 0.1, "mB": 0.2, "length": 0.2, "height": 1.0,
         "g": 9.8},

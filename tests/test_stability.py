@@ -15,8 +15,7 @@ import pytest
 from dumbbell.analysis.stability import find_cases, plan_cases, predict, rest_time
 from dumbbell.cli import main
 from dumbbell.model.scene import load_scene, scene_from_dict
-from dumbbell.solvers import REGISTRY, simulate
-from dumbbell.solvers import METHODS
+from dumbbell.solvers import METHODS, REGISTRY, simulate
 from dumbbell.solvers.verdicts import seconds
 from tests.conftest import SCENES, make_scene
 
@@ -216,3 +215,24 @@ def test_every_report_column_has_a_unit():
     from dumbbell.analysis.stability import COLUMNS, UNITS
 
     assert set(UNITS) == set(COLUMNS)
+
+
+@pytest.mark.parametrize("solver,scene", [
+    ("euler-cromer", "textbook-1d"), ("verlet", "textbook-1d"), ("euler-cromer-2d", "tilted-2d"),
+    ("verlet", "tilted-2d")])
+def test_a_verdict_is_dated_at_its_step_whatever_the_sampling(solver, scene):
+    """dt = 0.1 s is far past the step limit (w*dt = 6.3): the energy passes the scene's
+    threshold within a few steps, long before the state overflows. Sampled every step, every
+    7th, every 100th, or so sparsely that the state overflows before the first sample is
+    kept, the verdict names the same step: the first whose energy error passes, computed
+    here from the every-step run's own columns."""
+    base = load_scene(SCENES / f"{scene}.toml").with_values({"run.dt": 0.1, "run.t_end": 30.0})
+    full = simulate(base, solver, every=1)
+    E = full["E"]
+    err = np.abs(E - E[0]) / abs(E[0])
+    first = int(np.flatnonzero(err > base.run.unstable_energy)[0])
+    assert full.verdict.status == "unstable" and full.verdict.t == full.t[first]
+    for every in (7, 100, 250):
+        v = simulate(base, solver, every=every).verdict
+        assert v.status == "unstable" and v.t == full.verdict.t, (every, v)
+        assert v.reason == full.verdict.reason

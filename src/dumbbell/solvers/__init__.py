@@ -3,10 +3,12 @@
 >>> traj = simulate(load_scene("scenes/textbook-1d.toml"), "exact", every=100)  # doctest: +SKIP
 
 A solver is a :class:`Solver` subclass (the contract is in :mod:`dumbbell.solvers.base`): its
-facts (order, step, floor, cost, ...) are class attributes, and ``supports(scene)`` and
-``solve(scene, options)`` are class methods. :data:`METHODS` is the registry. Adding a solver
-is one module with one subclass and one line in :data:`METHODS`; the heavy parts (numba
-kernels, pymunk, scipy) load only when that solver runs.
+facts (order, step limit, floor, cost, ...) are class attributes, and ``supports(scene)`` and
+``solve(scene, options)`` are class methods. A stepping solver subclasses :class:`Stepper` and
+writes only its step (a :class:`Kernel`). :func:`simulate` and the analyses take such a class
+as it is, like scipy's ``method=``; :data:`METHODS` is the registry of the names scenes and
+the command line know. The heavy parts (numba kernels, pymunk, scipy) load only when a solver
+runs.
 """
 
 from __future__ import annotations
@@ -31,7 +33,9 @@ from .engine import Pymunk
 from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
 from .exact import Exact
+from .kernels import Kernel
 from .reference import Reference
+from .stepping import Stepper
 from .verlet import Verlet
 
 #: Solver name -> class, in the order listings show them.
@@ -46,8 +50,10 @@ __all__ = [
     "MAX_STEPS",
     "METHODS",
     "REGISTRY",
+    "Kernel",
     "RunOptions",
     "Solver",
+    "Stepper",
     "available",
     "make_options",
     "no_truth_reason",

@@ -6,11 +6,12 @@ A stepping solver writes one thing: its step, a plain Python function in the sub
 that numba compiles, described by a :class:`Kernel`. The driver compiles it into
 ``advance(st, i, i_stop, p, every, out, j0, ev)``, which advances the state ``st`` in place
 from step ``i`` towards ``i_stop`` with the scalars of the record ``p`` (:class:`Params`);
-applies the floor's flip where the step leaves it to the driver; records impacts as rows
-``(time, body 0/1, v_before, v_after)`` of ``ev``; writes every ``every``-th step into the
-columns of ``out`` (its column 0 is sample ``j0``); stops at the step where the state blows
-up or a particle is through the floor; and returns ``(step reached, status, impacts
-recorded)`` with a status code below.
+applies the floor's rule the kernel names; records impacts as rows ``(time, body 0/1,
+v_before, v_after)`` of ``ev``; writes every ``every``-th step into the columns of ``out`` (its
+column 0 is sample ``j0``); stops at the step where the state blows up, a particle is through
+the floor or comes to rest on it; and returns ``(step reached, status, impacts recorded)`` with
+a status code below. A step takes and returns plain values, never an array, so that the
+compiled loop keeps the state in registers.
 
 The state is a tuple of floats: 1D ``(xA, vA, xB, vB)``, 2D ``(xA, yA, vxA, vyA, xB, yB, vxB,
 vyB)`` (heights and vertical velocities: 1D columns 0, 1 and 2, 3; 2D 1, 3 and 5, 7), which a
@@ -30,6 +31,12 @@ BIG = 1e150
 EVENT_BUFFER = 4096
 #: Kernel status codes.
 OK, BLOWUP, TUNNEL_A, TUNNEL_B, REST = 0, 1, 2, 3, 4
+#: An impact slower than this (m/s), or more impacts than MAX_HITS within one step, means a
+#: particle has come to rest on the floor (the exact and reference solvers use the same speed).
+REST_SPEED = 1e-9
+MAX_HITS = 64
+#: The floor rules a kernel may name (:attr:`Kernel.floor`).
+FLOOR_RULES = ("flip", "end", "locate")
 
 
 class Params(NamedTuple):
@@ -51,26 +58,30 @@ class Params(NamedTuple):
 
 class Kernel(NamedTuple):
     """A stepping solver's compiled part. Each function is plain Python that numba compiles
-    (undecorated, or ``numba.njit``); the driver inlines it into its loop.
+    (undecorated, or ``numba.njit``; what it calls must be ``numba.njit`` or
+    ``numba.extending.register_jitable``); the driver inlines it into its loop.
 
-    - ``step``: one step of length ``p.dt``. Unless ``finds_impacts``, ``step(s, p) -> s``:
-      the state after the step, the floor left to the driver, which then applies the
-      textbook's rule (a particle below the floor that was not before the step has its
-      vertical velocity reversed, times the elasticity; it is not moved);
-    - ``finds_impacts``: the step handles the floor itself: ``step(s, p, i, hits) -> (s,
-      n_hits, status)`` for the step from step index ``i``, with its impacts in the first
-      ``n_hits`` rows of ``hits`` (time in s, body 0/1, v_before, v_after; at most
-      :data:`~.driver.HITS`) and ``status`` OK, or REST when a particle has come to rest
-      (the step is then not counted);
-    - ``start``: ``start(s, p) -> s`` extends the sampled state with what the step carries
-      (None: nothing). It is called whenever the driver resumes, so what it computes must
-      follow from the sampled state alone;
-    - ``through_at_radius``: a particle is through the floor once its centre is more than its
-      radius below it and moving down (a circle that the floor catches while they overlap);
-      otherwise at any depth.
+    ``floor`` names the rule at the floor, which the driver applies or records:
+
+    - ``"flip"`` (the textbook's): ``step(s, p) -> s``, one step of length ``p.dt``; then a
+      particle below the floor that was not before the step has its vertical velocity
+      reversed, times the elasticity; it is not moved;
+    - ``"end"`` (pymunk's order): ``step(s, p) -> (s, hits)``, the step with its contacts
+      applied at its end, ``hits = (hitA, vA_before, vA_after, hitB, vB_before, vB_after)``
+      (``hitX`` True when X met the floor in this step);
+    - ``"locate"`` (impacts inside the step): ``step(s, p, rem) -> (s, h, body)`` advances
+      by ``h`` <= ``rem`` s, stopping early (``body`` 0 for A, 1 for B; else -1) where a
+      particle meets the floor; the driver places it there, reflects its vertical velocity
+      (times the elasticity), counts the impact and steps on over the rest of the step.
+
+    ``start(s, p) -> s`` extends the sampled state with what the step carries (None:
+    nothing); it is called whenever the driver resumes and after a located impact, so what it
+    computes must follow from the sampled state alone. ``through_at_radius``: a particle is
+    through the floor once its centre is more than its radius below it and moving down (a
+    circle that the floor catches while they overlap); otherwise at any depth.
     """
 
     step: Callable[..., Any]
-    finds_impacts: bool = False
+    floor: str = "flip"
     start: Callable[..., Any] | None = None
     through_at_radius: bool = False

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import math
 
-from . import OK, Kernel
-from .driver import record
+from . import Kernel
 
 
-def step(s, p, i, hits):  # pragma: no cover - compiled
+def step(s, p):  # pragma: no cover - compiled
     dt, mA, mB, k, b, g, e, floor = p.dt, p.mA, p.mB, p.k, p.b, p.g, p.e, p.floor
     xA, yA, vxA, vyA, xB, yB, vxB, vyB = s
     invA = 1.0 / mA
@@ -46,16 +45,14 @@ def step(s, p, i, hits):  # pragma: no cover - compiled
     vxB = vxB + 0.0 * dt
     vyB = vyB + (-g) * dt
     # 5. contact impulses, at the end of the step
-    n_hits = 0
     if hitA:
         vyA = -e * vyA_pre
-        n_hits = record(hits, n_hits, (i + 1) * dt, 0.0, vyA_pre, vyA)
     if hitB:
         vyB = -e * vyB_pre
-        n_hits = record(hits, n_hits, (i + 1) * dt, 1.0, vyB_pre, vyB)
-    return (xA, yA, vxA, vyA, xB, yB, vxB, vyB), n_hits, OK
+    return ((xA, yA, vxA, vyA, xB, yB, vxB, vyB),
+            (hitA, vyA_pre, vyA, hitB, vyB_pre, vyB))
 
 
 #: pymunk's order: contacts found at the new positions, their impulse applied last; a
 #: circle is caught while it overlaps the floor, so it is through only a radius below it.
-KERNEL = Kernel(step, finds_impacts=True, through_at_radius=True)
+KERNEL = Kernel(step, floor="end", through_at_radius=True)

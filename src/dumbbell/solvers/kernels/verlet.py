@@ -11,15 +11,8 @@ from __future__ import annotations
 import math
 
 from numba import njit
-from numba.extending import register_jitable
 
-from . import OK, REST, Kernel
-from .driver import record
-
-#: An impact slower than this (m/s), or more impacts than MAX_HITS in one step, means a
-#: particle has come to rest on the floor (the exact solver uses the same speed).
-REST_SPEED = 1e-9
-MAX_HITS = 64
+from . import Kernel
 
 
 @njit(cache=True, nogil=True)
@@ -66,7 +59,7 @@ def _first_root(c, b, a, h):  # pragma: no cover
     return tau
 
 
-@register_jitable
+@njit(cache=True, nogil=True)
 def _accel_1d(xA, xB, p):  # pragma: no cover - compiled
     """Accelerations (m/s^2) of A and B from the spring and gravity, with the masses, spring
     and gravity of the record ``p``."""
@@ -79,54 +72,31 @@ def start_1d(s, p):  # pragma: no cover - compiled
     return (s[0], s[1], s[2], s[3], aA, aB)
 
 
-def step_1d(s, p, i, hits):  # pragma: no cover - compiled
-    dt, e, floor = p.dt, p.e, p.floor
+def step_1d(s, p, rem):  # pragma: no cover - compiled
+    """Velocity Verlet over ``rem`` s, or up to the first root in (0, rem] of either
+    particle's height (returns the state, the time advanced and the body, -1 for none)."""
     xA, vA, xB, vB, aA, aB = s
-    n_hits = 0
-    status = OK
-    rem = dt
-    while True:
-        tau = rem + 1.0
-        body = -1
-        if floor:
-            tA = _first_root(xA, vA, aA, rem)
-            tB = _first_root(xB, vB, aB, rem)
-            if tB >= 0.0:
-                tau = tB
-                body = 1
-            if tA >= 0.0 and tA < tau:
-                tau = tA
-                body = 0
-        h = rem if body < 0 else tau
-        xA = xA + h * (vA + 0.5 * aA * h)
-        xB = xB + h * (vB + 0.5 * aB * h)
-        aA_new, aB_new = _accel_1d(xA, xB, p)
-        vA = vA + 0.5 * (aA + aA_new) * h
-        vB = vB + 0.5 * (aB + aB_new) * h
-        aA = aA_new
-        aB = aB_new
-        if body < 0:
-            break
-        rem = rem - h
-        # The root is where the step's own quadratic meets the floor: place it there
-        # exactly, so rounding cannot leave it a hair below.
-        v_in = vA if body == 0 else vB
-        v_out = e * abs(v_in) if v_in < 0.0 else v_in
-        n_hits = record(hits, n_hits, i * dt + (dt - rem), body, v_in, v_out)
-        if body == 0:
-            xA = 0.0
-            vA = v_out
-        else:
-            xB = 0.0
-            vB = v_out
-        aA, aB = _accel_1d(xA, xB, p)
-        if abs(v_in) < REST_SPEED or n_hits > MAX_HITS:
-            status = REST
-            break
-    return (xA, vA, xB, vB, aA, aB), n_hits, status
+    tau = rem + 1.0
+    body = -1
+    if p.floor:
+        tA = _first_root(xA, vA, aA, rem)
+        tB = _first_root(xB, vB, aB, rem)
+        if tB >= 0.0:
+            tau = tB
+            body = 1
+        if tA >= 0.0 and tA < tau:
+            tau = tA
+            body = 0
+    h = rem if body < 0 else tau
+    xA = xA + h * (vA + 0.5 * aA * h)
+    xB = xB + h * (vB + 0.5 * aB * h)
+    aA_new, aB_new = _accel_1d(xA, xB, p)
+    vA = vA + 0.5 * (aA + aA_new) * h
+    vB = vB + 0.5 * (aB + aB_new) * h
+    return (xA, vA, xB, vB, aA_new, aB_new), h, body
 
 
-@register_jitable
+@njit(cache=True, nogil=True)
 def _accel_2d(xA, yA, xB, yB, p):  # pragma: no cover - compiled
     """Accelerations (m/s^2) of A and B from the spring along their axis and gravity, with
     the masses, spring and gravity of the record ``p``."""
@@ -148,55 +118,33 @@ def start_2d(s, p):  # pragma: no cover - compiled
     return (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], axA, ayA, axB, ayB)
 
 
-def step_2d(s, p, i, hits):  # pragma: no cover - compiled
-    dt, e, floor = p.dt, p.e, p.floor
+def step_2d(s, p, rem):  # pragma: no cover - compiled
+    """:func:`step_1d` in 2D: the roots of the heights; the spring along the axis."""
     xA, yA, vxA, vyA, xB, yB, vxB, vyB, axA, ayA, axB, ayB = s
-    n_hits = 0
-    status = OK
-    rem = dt
-    while True:
-        tau = rem + 1.0
-        body = -1
-        if floor:
-            tA = _first_root(yA, vyA, ayA, rem)
-            tB = _first_root(yB, vyB, ayB, rem)
-            if tB >= 0.0:
-                tau = tB
-                body = 1
-            if tA >= 0.0 and tA < tau:
-                tau = tA
-                body = 0
-        h = rem if body < 0 else tau
-        xA = xA + h * (vxA + 0.5 * axA * h)
-        yA = yA + h * (vyA + 0.5 * ayA * h)
-        xB = xB + h * (vxB + 0.5 * axB * h)
-        yB = yB + h * (vyB + 0.5 * ayB * h)
-        nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, p)
-        vxA = vxA + 0.5 * (axA + nxA) * h
-        vyA = vyA + 0.5 * (ayA + nyA) * h
-        vxB = vxB + 0.5 * (axB + nxB) * h
-        vyB = vyB + 0.5 * (ayB + nyB) * h
-        axA, ayA, axB, ayB = nxA, nyA, nxB, nyB
-        if body < 0:
-            break
-        rem = rem - h
-        # A frictionless floor reverses only the vertical velocity.
-        v_in = vyA if body == 0 else vyB
-        v_out = e * abs(v_in) if v_in < 0.0 else v_in
-        n_hits = record(hits, n_hits, i * dt + (dt - rem), body, v_in, v_out)
-        if body == 0:
-            yA = 0.0
-            vyA = v_out
-        else:
-            yB = 0.0
-            vyB = v_out
-        axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, p)
-        if abs(v_in) < REST_SPEED or n_hits > MAX_HITS:
-            status = REST
-            break
-    return (xA, yA, vxA, vyA, xB, yB, vxB, vyB, axA, ayA, axB, ayB), n_hits, status
+    tau = rem + 1.0
+    body = -1
+    if p.floor:
+        tA = _first_root(yA, vyA, ayA, rem)
+        tB = _first_root(yB, vyB, ayB, rem)
+        if tB >= 0.0:
+            tau = tB
+            body = 1
+        if tA >= 0.0 and tA < tau:
+            tau = tA
+            body = 0
+    h = rem if body < 0 else tau
+    xA = xA + h * (vxA + 0.5 * axA * h)
+    yA = yA + h * (vyA + 0.5 * ayA * h)
+    xB = xB + h * (vxB + 0.5 * axB * h)
+    yB = yB + h * (vyB + 0.5 * ayB * h)
+    nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, p)
+    vxA = vxA + 0.5 * (axA + nxA) * h
+    vyA = vyA + 0.5 * (ayA + nyA) * h
+    vxB = vxB + 0.5 * (axB + nxB) * h
+    vyB = vyB + 0.5 * (ayB + nyB) * h
+    return (xA, yA, vxA, vyA, xB, yB, vxB, vyB, nxA, nyA, nxB, nyB), h, body
 
 
-#: The steps in 1D and 2D: each finds its own impacts, at the roots of its quadratic.
-KERNELS = {1: Kernel(step_1d, finds_impacts=True, start=start_1d),
-           2: Kernel(step_2d, finds_impacts=True, start=start_2d)}
+#: The steps in 1D and 2D: each stops at the impacts it locates, the roots of its quadratic.
+KERNELS = {1: Kernel(step_1d, floor="locate", start=start_1d),
+           2: Kernel(step_2d, floor="locate", start=start_2d)}
