@@ -60,7 +60,7 @@ from ..solvers import (
     truth_class,
 )
 from ..solvers.base import run_options
-from .extended import extended_precision_exact, extended_precision_rigid
+from .extended import _exact_error, _rigid_error
 from .metrics import _energy_error, _impact_time_error, _position_error
 
 if TYPE_CHECKING:
@@ -511,7 +511,7 @@ def _single_point(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any) -
     point.energy_error = _energy_error(traj, None)
     if not cls.estimates_error:
         rigid = scene.system.rigid is not None
-        check = extended_precision_rigid if rigid else extended_precision_exact
+        check = _rigid_error if rigid else _exact_error
         point.error, point.impact_time_error = check(traj, window)
         point.reason = "errors against the same closed form in extended precision"
     else:

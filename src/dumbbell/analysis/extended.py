@@ -40,7 +40,10 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
     with each impact time refined by Newton's method in that precision. It checks the
     rounding of the double-precision solution, given its sequence of impacts."""
-    traj, window = _checked(traj, window, rigid=False)
+    return _exact_error(*_checked(traj, window, rigid=False))
+
+
+def _exact_error(traj: Trajectory, window: float) -> tuple[float, float]:
     L = np.longdouble
     scene = traj.scene
     mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
@@ -101,7 +104,10 @@ def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, fl
     """:func:`extended_precision_exact` for the rigid 2D dumbbell: the parabola-and-rotation
     closed form and the impulse law in numpy's extended precision, each impact time refined
     by Newton's method there; largest position error (m) and impact time error (s)."""
-    traj, window = _checked(traj, window, rigid=True)
+    return _rigid_error(*_checked(traj, window, rigid=True))
+
+
+def _rigid_error(traj: Trajectory, window: float) -> tuple[float, float]:
     from ..model.energy import rigid_moment
 
     L = np.longdouble

@@ -310,15 +310,14 @@ def _disc(mass: float, radius: float) -> float:
 def rigid_moment(scene: Scene) -> float:
     """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
     two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
-    scene = args.scene(scene)
+    scene = _scene(scene)
     if scene.system.rigid is None:
         raise UsageError(f"scene = {scene.name}: must be a rigid dumbbell (a [rigid] table)",
                          param="scene")
     system = scene.system
     moment = system.mu * system.rigid.length**2
-    if spins(scene):
-        moment += (disc_inertia(system.A.mass, system.A.radius)
-                   + disc_inertia(system.B.mass, system.B.radius))
+    if system.discs:
+        moment += _disc(system.A.mass, system.A.radius) + _disc(system.B.mass, system.B.radius)
     return moment
 
 

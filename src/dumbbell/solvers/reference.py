@@ -47,8 +47,8 @@ from typing import Any
 import numpy as np
 
 from ..model.energy import (
+    _relative_energy_error,
     impact_heat,
-    relative_energy_error,
     rigid_moment,
     spins,
     state_columns,
@@ -361,7 +361,7 @@ def _estimate_error(
         "position_m_window": float(diff[window].max()),
         "window_s": float(min(ERROR_WINDOW, t[n - 1])),
         "position_m_whole_run": float(diff.max()),
-        "energy_relative": float(relative_energy_error(energy).max()),
+        "energy_relative": float(_relative_energy_error(energy).max()),
     }
     early = [(a, b) for a, b in zip(impacts, events, strict=False)
              if max(a.t, b.t) <= ERROR_WINDOW and a.body == b.body]
