@@ -31,7 +31,7 @@ from dumbbell import DumbbellError
 PACKAGES = ("dumbbell.model", "dumbbell.solvers", "dumbbell.spaces", "dumbbell.examples",
             "dumbbell.plot", "dumbbell.analysis", "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
-TOP = ("dumbbell", "dumbbell.parallel", "dumbbell.progress")
+TOP = ("dumbbell", "dumbbell.frames", "dumbbell.parallel", "dumbbell.progress")
 #: Packages not walked: the compiled loops, which import numba and are called by the solver
 #: classes only (which check the arguments first).
 INTERNAL = ("dumbbell.solvers.kernels",)
@@ -378,7 +378,6 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                    "strip": True},
     "dumbbell.model.scene.OutputSettings": lambda f: fields(f.scene.outputs),
     "dumbbell.model.scene.Particle": lambda f: fields(f.scene.system.A),
-    "dumbbell.model.scene.PymunkSettings": lambda f: fields(f.scene.pymunk),
     "dumbbell.model.scene.Rigid": lambda f: {"length": 0.3},
     "dumbbell.model.scene.RunSettings": lambda f: fields(f.scene.run),
     "dumbbell.model.scene.Spring": lambda f: {"stiffness": 200.0, "rest_length": 0.2},
@@ -396,6 +395,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "step": _module("dumbbell.solvers.kernels.euler_cromer").step,
         "floor": "flip", "start": None, "through_at_radius": False},
     "dumbbell.solvers.stepping.Stepper": lambda f: {},
+    "dumbbell.solvers.pymunk_settings.PymunkSettings": lambda f: fields(f.scene.pymunk),
     "dumbbell.solvers.exact_rigid.first_impact_state": lambda f: {
         "tilt": 30.0, "elasticity": 0.5, "mA": 0.1, "mB": 0.2, "length": 0.2, "height": 1.0,
         "g": 9.8},
@@ -610,9 +610,9 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                    "folder": False},
     "dumbbell.io.files.is_special": lambda f: {"path": "/dev/null"},
     "dumbbell.io.files.output_transaction": lambda f: {"inputs": [(f.scene_file, "scene")]},
-    "dumbbell.io.frames.data_frame": lambda f: {"columns": {"t": [0.0, 1.0], "x": [1.0, 2.0]},
+    "dumbbell.frames.data_frame": lambda f: {"columns": {"t": [0.0, 1.0], "x": [1.0, 2.0]},
                                                 "index": "t", "units": {"t": "s", "x": "m"}},
-    "dumbbell.io.frames.pandas_module": lambda f: {"what": "to_pandas()"},
+    "dumbbell.frames.pandas_module": lambda f: {"what": "to_pandas()"},
     "dumbbell.io.restitution.markdown": lambda f: {"result": f.restitution},
     "dumbbell.io.restitution.write_csv": lambda f: {"result": f.restitution,
                                                     "path": f.tmp / "r.csv"},

@@ -54,7 +54,7 @@ def test_a_simulation_checks_its_arguments_once(textbook, call, most):
     found = checks(lambda: call(textbook))
     assert sum(found.values()) <= most, found
     # Each is the border's own: simulate's, and the run options' it was given.
-    assert {caller for _, caller in found} <= {"simulate", "checked_options"}, found
+    assert {caller for _, caller in found} <= {"simulate", "make_options"}, found
 
 
 def test_a_comparison_checks_its_arguments_once(textbook):

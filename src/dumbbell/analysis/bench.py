@@ -55,11 +55,11 @@ from ..solvers import (
     MAX_SAMPLES,
     RunOptions,
     Solver,
-    solver_classes,
     supporting,
     truth_class,
 )
 from ..solvers.base import run_options
+from ._fields import check
 from .extended import _exact_error, _rigid_error
 from .metrics import _energy_error, _impact_time_error, _position_error
 
@@ -211,7 +211,7 @@ class BenchResult:
     def to_pandas(self) -> pandas.DataFrame:
         """One row per point with the CSV's columns (numbered from 0), units in
         ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         rows = [asdict(p) for p in self.points]
         return data_frame({c: [r[c] for r in rows] for c in CSV_COLUMNS}, units=CSV_UNITS)
@@ -262,11 +262,6 @@ def _default_solvers(scene: Scene) -> list[type[Solver]]:
     return [cls for cls in supporting(scene) if cls is not truth]
 
 
-def _positive(value: Any) -> bool:
-    """Whether ``value`` is already a float > 0 and finite (what needs no further check)."""
-    return type(value) is float and 0 < value < math.inf
-
-
 @dataclass(frozen=True)
 class BenchOptions:
     """What :func:`run_bench` measures: ``solvers`` (names or Solver classes; None: every
@@ -286,23 +281,13 @@ class BenchOptions:
     quiet: bool = True
 
     def __post_init__(self) -> None:
-        put = object.__setattr__
-        classes = solver_classes(self.solvers)
-        put(self, "solvers", None if classes is None else tuple(classes))
-        dts = self.dts
-        if isinstance(dts, numbers.Real) and not isinstance(dts, bool):
-            dts = [dts]
-        if not (isinstance(dts, tuple) and dts and all(_positive(dt) for dt in dts)):
-            dts = args.positives(list(dts) if isinstance(dts, tuple) else dts, "dts", "s")
-        put(self, "dts", tuple(sorted(dts, reverse=True)))
-        for name in ("window", "budget", "t_end", "spacing"):
-            value = getattr(self, name)
-            if not (value is None and name in ("t_end", "spacing") or _positive(value)):
-                put(self, name, args.real(value, name, "s"))
+        check(self, {"solvers": "solvers", "dts": "steps", "window": "seconds",
+                     "t_end": "seconds?", "budget": "seconds", "spacing": "seconds?",
+                     "quiet": "flag"})
+        object.__setattr__(self, "dts", tuple(sorted(self.dts, reverse=True)))
         if not (type(self.repeat) is int and 1 <= self.repeat <= MAX_REPEAT):
-            put(self, "repeat", args.whole(self.repeat, "repeat", "runs", hi=MAX_REPEAT))
-        if type(self.quiet) is not bool:
-            put(self, "quiet", args.flag(self.quiet, "quiet"))
+            object.__setattr__(self, "repeat", args.whole(self.repeat, "repeat", "runs",
+                                                          hi=MAX_REPEAT))
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,7 @@ The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` report
 from __future__ import annotations
 
 import math
-import numbers
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,8 +33,9 @@ from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from ..solvers import METHODS, Solver, solver_classes, truth_class
+from ..solvers import METHODS, Solver, truth_class
 from ..solvers.base import run_options
+from ._fields import check
 from .metrics import _energy_error, _position_error, _position_error_series
 
 if TYPE_CHECKING:
@@ -107,7 +107,7 @@ class Comparison:
     def to_pandas(self) -> pandas.DataFrame:
         """:meth:`summary` as a DataFrame indexed by label, the verdict as text, units in
         ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         records = self.summary()
         columns = {name: [rec[name] for rec in records] for name in ["label", *SUMMARY_UNITS]}
@@ -117,7 +117,7 @@ class Comparison:
 
     def impacts_to_pandas(self) -> pandas.DataFrame:
         """:meth:`impacts` as a DataFrame indexed by impact number (times in s)."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         records = self.impacts()
         names = list(records[0]) if records else ["n", "body", "truth_t"]
@@ -163,23 +163,8 @@ class CompareOptions:
     quiet: bool = True
 
     def __post_init__(self) -> None:
-        put = object.__setattr__
-        classes = solver_classes(self.solvers)
-        put(self, "solvers", None if classes is None else tuple(classes))
-        dts = self.dts
-        if isinstance(dts, numbers.Real) and not isinstance(dts, bool):
-            dts = [dts]
-        if dts is not None and not (isinstance(dts, tuple) and dts and all(
-                type(dt) is float and 0 < dt < math.inf for dt in dts)):
-            dts = args.positives(list(dts) if isinstance(dts, tuple) else dts, "dts", "s")
-        put(self, "dts", None if dts is None else tuple(dts))
-        for name in ("window", "t_end"):
-            value = getattr(self, name)
-            if not (value is None and name == "t_end"
-                    or type(value) is float and 0 < value < math.inf):
-                put(self, name, args.real(value, name, "s"))
-        if type(self.quiet) is not bool:
-            put(self, "quiet", args.flag(self.quiet, "quiet"))
+        check(self, {"solvers": "solvers", "dts": "steps?", "window": "seconds",
+                     "t_end": "seconds?", "quiet": "flag"})
 
 
 def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
@@ -206,8 +191,8 @@ def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
     rows = []
     for cls in solvers:
         for dt in dts:
-            run = cls._solve(scene, run_options(scene, dt, t_end, round(spacing / dt),
-                                                options.quiet))
+            run = cls._solve(scene, replace(run_options(scene, dt, t_end, round(spacing / dt)),
+                                            quiet=options.quiet))
             err = _position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
             label = cls.name if len(dts) == 1 else f"{cls.name} dt={dt:g}"
@@ -256,12 +241,12 @@ def _truth(scene: Scene, cls: type[Solver] | None, dt_min: float,
     spacing, t_end = samples
     if cls is None:
         truth_dt = dt_min / 10
-        truth = METHODS["pymunk"]._solve(scene, run_options(
-            scene, truth_dt, t_end, round(spacing / truth_dt), quiet))
+        truth = METHODS["pymunk"]._solve(scene, replace(run_options(
+            scene, truth_dt, t_end, round(spacing / truth_dt)), quiet=quiet))
         why = no_truth_reason(scene)
         return truth, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
                        f"{why}; so errors are against a ten times smaller step)")
-    truth = cls._solve(scene, run_options(scene, spacing, t_end, 1, quiet))
+    truth = cls._solve(scene, replace(run_options(scene, spacing, t_end, 1), quiet=quiet))
     truth_note = cls.name
     est = truth.info.get("estimated_error")
     if est:

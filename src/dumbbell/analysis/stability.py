@@ -37,6 +37,7 @@ from ..model import args
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
 from ..parallel import Backend, ordered_map
 from ..solvers import Solver, solver_class, solver_classes
+from ._fields import check
 
 if TYPE_CHECKING:
     import pandas
@@ -112,7 +113,7 @@ class StabilityResult:
     def to_pandas(self) -> pandas.DataFrame:
         """One row per run with the CSV's columns, units in ``df.attrs["units"]``. Needs
         pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         return data_frame({c: [getattr(r, c) for r in self.rows] for c in COLUMNS},
                           units=UNITS)
@@ -375,15 +376,8 @@ class StabilityOptions:
     quiet: bool = True
 
     def __post_init__(self) -> None:
-        put = object.__setattr__
-        if self.cases is not None:
-            put(self, "cases", args.path(self.cases, "cases"))
-        classes = solver_classes(self.solvers)
-        put(self, "solvers", None if classes is None else tuple(classes))
-        if self.workers is not None and not (type(self.workers) is int and self.workers >= 1):
-            put(self, "workers", args.whole(self.workers, "workers", "processes"))
-        if type(self.quiet) is not bool:
-            put(self, "quiet", args.flag(self.quiet, "quiet"))
+        check(self, {"cases": "path?", "solvers": "solvers", "workers": "workers?",
+                     "quiet": "flag"})
 
 
 def run_stability(options: StabilityOptions) -> StabilityResult:

@@ -33,6 +33,7 @@ from ..model import args
 from ..model.scene import Scene
 from ..parallel import Backend, ordered_map
 from ..solvers import Solver, scene_class, solver_class
+from ._fields import check
 
 if TYPE_CHECKING:
     import pandas
@@ -315,7 +316,7 @@ class SweepResult:
         """One row per grid point in grid order, the CSV's columns, units in
         ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).
         Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         units = {a.key: "" for a in self.axes} | RESULT_UNITS
         cells = list(zip(*(row.cells for row in self.rows))) or [()] * len(self.columns)
@@ -377,21 +378,9 @@ class SweepOptions:
     connect_timeout: float = 10.0
 
     def __post_init__(self) -> None:
-        put = object.__setattr__
-        if self.solver is not None:
-            put(self, "solver", solver_class(self.solver))
-        if self.t_end is not None and not (type(self.t_end) is float and 0 < self.t_end < math.inf):
-            put(self, "t_end", args.real(self.t_end, "t_end", "s"))
-        if self.workers is not None and not (type(self.workers) is int and self.workers >= 1):
-            put(self, "workers", args.whole(self.workers, "workers", "processes"))
-        if self.scheduler is not None:
-            args.text(self.scheduler, "scheduler", "a Dask scheduler address "
-                      "('tcp://HOST:PORT', or 'local') or None")
-        for name in ("quiet", "processes"):
-            if type(getattr(self, name)) is not bool:
-                put(self, name, args.flag(getattr(self, name), name))
-        if not (type(self.connect_timeout) is float and 0 < self.connect_timeout < math.inf):
-            put(self, "connect_timeout", args.real(self.connect_timeout, "connect_timeout", "s"))
+        check(self, {"solver": "solver?", "t_end": "seconds?", "workers": "workers?",
+                     "scheduler": "text?", "quiet": "flag", "processes": "flag",
+                     "connect_timeout": "seconds"})
 
 
 def run_sweep(scene: Scene, axes: Sequence[Axis], options: SweepOptions,

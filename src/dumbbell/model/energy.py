@@ -36,8 +36,11 @@ from ..errors import UsageError
 from . import args
 
 if TYPE_CHECKING:
-    from .scene import Scene
-    from .trajectory import Impact
+    from .scene import Scene, System
+
+#: Impacts with the floor (:class:`dumbbell.model.trajectory.Impact`: t, body, v_before,
+#: v_after, heat), which this module reads by their fields.
+Impacts = Iterable[Any]
 
 #: State columns by name (m, m/s, rad/s), one value per sample.
 Columns = Mapping[str, np.ndarray]
@@ -70,8 +73,6 @@ def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
            ) -> dict[str, np.ndarray]:
     """``state`` checked to be a dict of 1-d columns holding every state column of ``scene``
     (and the spins where the particles spin), all as long as the first (or ``n``)."""
-    from .trajectory import _columns
-
     args.mapping(state, name, "a dict of state columns by name")
     needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if scene.system.discs
                                       else [])
@@ -81,8 +82,8 @@ def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
                          param=name)
     if n is None:
         n = _length(state[needed[0]])
-    return _columns({c: state[c] for c in [*needed, *(["heat"] if "heat" in state else [])]},
-                    n, name)
+    return args.columns({c: state[c] for c in [*needed, *(["heat"] if "heat" in state else [])]},
+                        n, name)
 
 
 def _scene(scene: Any) -> Scene:
@@ -155,19 +156,18 @@ def momentum_columns(scene: Scene) -> list[str]:
     return ["L_cm"] if _scene(scene).system.dimensions == 2 else []
 
 
-def partition_1d(
-    mA: float, mB: float, k: float, b: float, g: float,
-    xA: np.ndarray, vA: np.ndarray, xB: np.ndarray, vB: np.ndarray,
-) -> dict[str, np.ndarray]:
-    """1D partition from masses (kg), stiffness (N/m), rest length (m), gravity (m/s^2) and
-    positions/velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J.
+def partition_1d(system: System, xA: np.ndarray, vA: np.ndarray, xB: np.ndarray,
+                 vB: np.ndarray) -> dict[str, np.ndarray]:
+    """1D partition of ``system`` (its masses in kg, spring in N/m and m, gravity in m/s^2)
+    from positions and velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J.
 
-    >>> partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *np.array([[1.2], [0.0], [1.0], [0.0]]))["E"]
+    >>> partition_1d(scene.system, *np.array([[1.2], [0.0], [1.0], [0.0]]))["E"]  # doctest: +SKIP
     array([2.156])
     """
     arrays = [np.ascontiguousarray(np.atleast_1d(a), dtype=np.float64) for a in (xA, vA, xB, vB)]
-    out = np.empty((5, arrays[0].size))
-    _loop_1d()(float(mA), float(mB), float(k), float(b), float(g), *arrays, out)
+    constants = (float(system.A.mass), float(system.B.mass), float(system.k), float(system.b),
+                 float(system.g))
+    out = _loop_1d()(constants, *arrays)
     return dict(zip(("K_cm", "K_int", "U_g", "U_spring", "E"), out, strict=True))
 
 
@@ -178,8 +178,10 @@ def _loop_1d():
     from numba import njit
 
     @njit(cache=True, nogil=True)
-    def loop(mA, mB, k, b, g, xA, vA, xB, vB, out):  # pragma: no cover
+    def loop(constants, xA, vA, xB, vB):  # pragma: no cover
+        mA, mB, k, b, g = constants
         M = mA + mB
+        out = np.empty((5, xA.size))
         for i in range(xA.size):
             X = (mA * xA[i] + mB * xB[i]) / M
             V = (mA * vA[i] + mB * vB[i]) / M
@@ -193,16 +195,17 @@ def _loop_1d():
             out[2, i] = U_g
             out[3, i] = U_spring
             out[4, i] = K_cm + K_int + U_g + U_spring
+        return out
 
     return loop
 
 
-def partition_2d(
-    mA: float, mB: float, k: float, b: float, g: float,
-    rA: np.ndarray, vA: np.ndarray, rB: np.ndarray, vB: np.ndarray,
-) -> dict[str, np.ndarray]:
-    """2D partition; positions and velocities are (n, 2) arrays (m, m/s), y vertical.
-    Returns K_cm, K_rot, K_vib, U_g, U_spring, E in J (K_spin is added by :func:`partition`)."""
+def partition_2d(system: System, rA: np.ndarray, vA: np.ndarray, rB: np.ndarray,
+                 vB: np.ndarray) -> dict[str, np.ndarray]:
+    """2D partition of ``system``; positions and velocities are (n, 2) arrays (m, m/s), y
+    vertical. Returns K_cm, K_rot, K_vib, U_g, U_spring, E in J (K_spin is added by
+    :func:`partition`)."""
+    mA, mB, k, b, g = system.A.mass, system.B.mass, system.k, system.b, system.g
     M = mA + mB
     mu = mA * mB / M
     V = (mA * vA + mB * vB) / M
@@ -267,16 +270,16 @@ def impact_heat(mass: float, v_before: float, v_after: float) -> float:
     return 0.5 * mass * (v_before * v_before - v_after * v_after)
 
 
-def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) -> np.ndarray:
+def heat(scene: Scene, t: np.ndarray, state: Columns, events: Impacts) -> np.ndarray:
     """Energy the contacts dissipated up to each sample time ``t`` (s), in J: counted by the
     solver where the state has a ``heat`` column (pymunk), else summed over the impacts up to
     each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
     scene = args.scene(scene)
     t = np.asarray(args.array(t, "t", "s"))
-    return _heat(scene, t, _state(scene, state, t.size), _impacts(events))
+    return _heat(scene, t, _state(scene, state, t.size), args.impacts(events))
 
 
-def _heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) -> np.ndarray:
+def _heat(scene: Scene, t: np.ndarray, state: Columns, events: Impacts) -> np.ndarray:
     if "heat" in state:
         return np.asarray(state["heat"], dtype=float)
     mass = {"A": scene.system.A.mass, "B": scene.system.B.mass}
@@ -286,16 +289,6 @@ def _heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact])
                         for e in events])
     total = np.concatenate([[0.0], np.cumsum(amounts)])
     return total[np.searchsorted(times, t, side="right")] if len(times) else np.zeros(len(t))
-
-
-def _impacts(events: Any) -> list[Impact]:
-    """``events`` (a list or tuple of Impact) as a list; UsageError naming ``events``."""
-    from .trajectory import Impact
-
-    if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
-        raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
-                         param="events")
-    return list(events)
 
 
 def disc_inertia(mass: float, radius: float) -> float:
@@ -334,7 +327,7 @@ def _disc_spin(scene: Scene, state: Columns) -> np.ndarray:
 
 
 def partition(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact] = (),
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts = (),
 ) -> dict[str, np.ndarray]:
     """All energy columns (J, :func:`energy_columns` order) of ``scene`` at the sample times
     ``t`` (s) with the state columns ``state`` (m, m/s, rad/s) and the impacts ``events``
@@ -343,19 +336,15 @@ def partition(
     t = args.array(t, "t", "s")
     if t.ndim != 1:
         raise UsageError(f"t = {args.show(t)}: must be a 1-d array of times (s)", param="t")
-    return _partition(scene, t, _state(scene, state, t.size), _impacts(events))
+    return _partition(scene, t, _state(scene, state, t.size), args.impacts(events))
 
 
-def _partition(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact] = (),
+def _partition(scene: Scene, t: np.ndarray, state: Columns, events: Impacts = (),
                ) -> dict[str, np.ndarray]:
-    k, b = scene.system.k, scene.system.b
     if scene.system.dimensions == 1:
-        parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
-                             state["xA"], state["vA"], state["xB"], state["vB"])
+        parts = partition_1d(scene.system, state["xA"], state["vA"], state["xB"], state["vB"])
     else:
-        rA, vA, rB, vB = _positions_velocities(state)
-        parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
-                             rA, vA, rB, vB)
+        parts = partition_2d(scene.system, *_positions_velocities(state))
         if scene.system.discs:
             parts["K_spin"] = _disc_spin(scene, state)
             parts["E"] = parts["E"] + parts["K_spin"]
@@ -385,7 +374,7 @@ def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
 
 
 def _with_losses(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts,
     parts: dict[str, np.ndarray],
 ) -> dict[str, np.ndarray]:
     """``parts`` in :func:`energy_columns` order, with E_lost = E(0) - E, E_heat (:func:`heat`)
@@ -398,7 +387,7 @@ def _with_losses(
 
 
 def partition_from_terms(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts,
     terms: Columns,
 ) -> dict[str, np.ndarray]:
     """The dumbbell's energy columns (J, :func:`energy_columns` order) from the general
@@ -416,8 +405,7 @@ def partition_from_terms(
         parts["K_int"] = terms["K_int"]
     else:
         system = scene.system
-        axis = partition_2d(system.A.mass, system.B.mass, system.k, system.b, system.g,
-                            *_positions_velocities(state))
+        axis = partition_2d(system, *_positions_velocities(state))
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
         if system.discs:
             parts["K_spin"] = (terms["K_rot"] if system.rigid is None
@@ -448,13 +436,11 @@ def _energy_scale(E0: float, terms_at_start: Mapping[str, float] | None) -> floa
 def relative_energy_error(energy: Columns) -> np.ndarray:
     """|E(t) - E(0)| / scale for every sample (dimensionless) of the energy columns ``energy``
     (J, as :func:`partition` gives them), scale from :func:`energy_scale`."""
-    from .trajectory import _columns
-
     args.mapping(energy, "energy", "a dict of energy columns (J) by name")
     if "E" not in energy:
         raise UsageError("energy has no column 'E': must hold the total energy E (J)",
                          param="energy")
-    return _relative_energy_error(_columns(energy, _length(energy["E"]), "energy"))
+    return _relative_energy_error(args.columns(energy, _length(energy["E"]), "energy"))
 
 
 def _relative_energy_error(energy: Columns) -> np.ndarray:

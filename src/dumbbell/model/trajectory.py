@@ -125,27 +125,6 @@ def _view(values: np.ndarray) -> np.ndarray:
     return view
 
 
-def _samples(values: Any, name: str) -> np.ndarray:
-    """``values`` (a 1-d array of numbers) as a read-only view; UsageError naming ``name``."""
-    array = np.asarray(values) if isinstance(values, np.ndarray | list | tuple) else None
-    if array is None or array.ndim != 1 or array.dtype.kind not in "fiu":
-        raise UsageError(f"{name} = {args.show(values)}: must be a 1-d array of numbers",
-                         param=name)
-    return _view(array)
-
-
-def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
-    """Read-only views of the columns by name ``columns``, each checked to hold ``n``
-    samples (as many as ``t``); UsageError naming ``name``."""
-    args.mapping(columns, name, "a dict of columns by name")
-    out = {key: _samples(col, f"{name}[{key!r}]") for key, col in columns.items()}
-    for key, col in out.items():
-        if len(col) != n:
-            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
-                             f"t ({n})", param=name)
-    return out
-
-
 @dataclass(frozen=True, eq=False)
 class Trajectory:
     """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
@@ -180,17 +159,13 @@ class Trajectory:
             args.real(self.dt, "dt", "s")
         args.whole(self.every, "every", "steps")
         args.real(self.wall_time, "wall_time", "s", lo=0.0)
-        t = _samples(self.t, "t")
+        t = args.samples(self.t, "t")
         put(self, "t", t)
-        put(self, "state", _columns(self.state, len(t), "state"))
-        events = self.events
-        if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
-            raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
-                             param="events")
-        put(self, "events", tuple(events))
+        put(self, "state", args.columns(self.state, len(t), "state"))
+        put(self, "events", tuple(args.impacts(self.events)))
         args.mapping(self.info, "info", "a dict")
         if self.energy is not None:
-            put(self, "energy", _columns(self.energy, len(t), "energy"))
+            put(self, "energy", args.columns(self.energy, len(t), "energy"))
         else:
             from .energy import _state
 
@@ -302,7 +277,7 @@ class Trajectory:
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every
         column's unit in ``df.attrs["units"]``. Needs the extra: pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
         from .energy import column_unit
 
         return data_frame({name: self[name] for name in self.columns}, index="t",

@@ -18,14 +18,13 @@ from typing import Any
 
 from ..errors import SceneError, UsageError
 from ..model import args
-from ..model.scene import Scene
+from ..model.scene import OWNED_TABLES, Scene
 from ..model.trajectory import Trajectory
 from .base import (
     MAX_SAMPLES,
     MAX_STEPS,
     RunOptions,
     Solver,
-    checked_options,
     contract_problems,
     make_options,
 )
@@ -34,6 +33,7 @@ from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
 from .exact import Exact
 from .kernels import Kernel
+from .pymunk_settings import PymunkSettings
 from .reference import Reference
 from .stepping import Stepper
 from .verlet import Verlet
@@ -44,6 +44,8 @@ METHODS: dict[str, type[Solver]] = {
 }
 #: Another name for :data:`METHODS`.
 REGISTRY = METHODS
+# The scene's [pymunk] table belongs to the pymunk solver: its settings, on their owner.
+OWNED_TABLES["pymunk"] = PymunkSettings
 
 __all__ = [
     "MAX_SAMPLES",
@@ -179,7 +181,7 @@ def simulate(
     scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)
-    return cls._solve(scene, checked_options(scene, dt, t_end, every, quiet, max_samples))
+    return cls._solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))
 
 
 def runnable(cls: type[Solver], scene: Scene) -> None:

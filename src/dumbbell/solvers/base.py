@@ -13,7 +13,7 @@ import functools
 import inspect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -151,14 +151,6 @@ class Solver:
                 setattr(cls, name, _checked(name, fn.__func__, isinstance(fn, staticmethod)))
 
     @classmethod
-    def _supports(cls, scene: Scene) -> str | None:
-        raise NotImplementedError
-
-    @classmethod
-    def _solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
-        raise NotImplementedError
-
-    @classmethod
     def supports(cls, scene: Scene) -> str | None:
         """None if this solver can run ``scene``, else why not (one sentence)."""
         raise NotImplementedError
@@ -220,8 +212,8 @@ class ExplicitSpring:
 
 def contract_problems(cls: Any) -> list[str]:
     """What keeps ``cls`` from being a solver: not a :class:`Solver` subclass, a fact left out
-    or of the wrong type (:attr:`Solver.CAPABILITIES`), ``supports`` or ``solve`` not written,
-    a step limit without a step. Empty for a solver that keeps the contract."""
+    or of the wrong type (:attr:`Solver.CAPABILITIES`) or out of its range, ``supports`` or
+    ``solve`` not written. Empty for a solver that keeps the contract."""
     if not (isinstance(cls, type) and issubclass(cls, Solver)) or cls is Solver:
         return ["not a subclass of dumbbell.solvers.Solver"]
     problems = []
@@ -231,21 +223,24 @@ def contract_problems(cls: Any) -> list[str]:
             problems.append(f"{fact} is not declared")
         elif isinstance(value, bool) and bool not in kinds or not isinstance(value, kinds):
             problems.append(f"{fact} = {value!r} must be {' or '.join(k.__name__ for k in kinds)}")
-    if not problems:
-        if not cls.name:
-            problems.append("name is empty")
-        if cls.order is not None and cls.order < 1:
-            problems.append(f"order = {cls.order} must be >= 1 or None")
-        if cls.step_limit is not None and not 0 < cls.step_limit < math.inf:
-            problems.append(f"step_limit = {cls.step_limit} must be > 0 and finite, or None")
-        if not cls.has_step and (cls.order is not None or cls.step_limit is not None):
-            problems.append("a solver without a step has no order and no step limit")
-        if not cls.relative_cost > 0:
-            problems.append(f"relative_cost = {cls.relative_cost} must be > 0")
-    for method in ("_supports", "_solve"):
-        if next(c for c in cls.__mro__ if method in vars(c)) is Solver:
-            problems.append(f"{method[1:]} is not written")
+    problems += [] if problems else _range_problems(cls)
+    problems += [f"{method[1:]} is not written" for method in ("_supports", "_solve")
+                 if not hasattr(cls, method)]
     return problems
+
+
+def _range_problems(cls: type[Solver]) -> list[str]:
+    """The facts of ``cls`` (each of the right type) that are out of their range."""
+    checks = [
+        (bool(cls.name), "name is empty"),
+        (cls.order is None or cls.order >= 1, f"order = {cls.order} must be >= 1 or None"),
+        (cls.step_limit is None or 0 < cls.step_limit < math.inf,
+         f"step_limit = {cls.step_limit} must be > 0 and finite, or None"),
+        (cls.has_step or (cls.order is None and cls.step_limit is None),
+         "a solver without a step has no order and no step limit"),
+        (cls.relative_cost > 0, f"relative_cost = {cls.relative_cost} must be > 0"),
+    ]
+    return [problem for fine, problem in checks if not fine]
 
 
 _MISSING = object()
@@ -389,44 +384,34 @@ def make_options(
     quiet: bool = True, max_samples: int | None = None,
 ) -> RunOptions:
     """Fill run options from the scene's ``[run]`` table and check them (UsageError): ``dt``
-    and ``t_end`` in s, ``every`` in steps. The step count is checked against
-    :data:`MAX_STEPS` and, when ``max_samples`` is given, the samples kept against it, both as
-    exact integers before anything is allocated."""
+    and ``t_end`` in s, ``every`` in steps (each checked if given; None: the scene's). The
+    step count is checked against :data:`MAX_STEPS` and, when ``max_samples`` is given, the
+    samples kept against it, both as exact integers before anything is allocated."""
     from ..model import args
 
-    return checked_options(args.scene(scene), dt, t_end, every, quiet, max_samples)
-
-
-def checked_options(
-    scene: Scene, dt: float | None = None, t_end: float | None = None, every: int | None = None,
-    quiet: bool = True, max_samples: int | None = None,
-) -> RunOptions:
-    """:func:`make_options` for a ``scene`` that is a Scene: each argument a caller gave is
-    checked (None, and the defaults ``quiet`` True and ``max_samples`` :data:`MAX_SAMPLES`,
-    need no check), then :func:`run_options`."""
-    from ..model import args
-
+    scene = args.scene(scene)
     if dt is not None:
         dt = args.real(dt, "dt", "s")
     if t_end is not None:
         t_end = args.real(t_end, "t_end", "s")
     if every is not None:
         every = args.whole(every, "every", "steps", hi=MAX_STEPS)
+    options = run_options(scene, dt, t_end, every)
     if quiet is not True:
-        quiet = args.flag(quiet, "quiet")
-    if max_samples is not None and max_samples is not MAX_SAMPLES:
-        max_samples = args.whole(max_samples, "max_samples", "samples")
-    return run_options(scene, dt, t_end, every, quiet, max_samples)
+        options = replace(options, quiet=args.flag(quiet, "quiet"))
+    if max_samples is not None:
+        # The default needs no check (simulate's budget, MAX_SAMPLES).
+        budget = (max_samples if max_samples is MAX_SAMPLES
+                  else args.whole(max_samples, "max_samples", "samples"))
+        check_samples(scene, options, budget)
+    return options
 
 
-def run_options(
-    scene: Scene, dt: float | None = None, t_end: float | None = None, every: int | None = None,
-    quiet: bool = True, max_samples: int | None = None,
-) -> RunOptions:
-    """The run options of ``scene`` with the values given (checked already; None: the
-    scene's ``[run]``): UsageError when ``dt`` passes ``t_end``, when the run would take more
-    than :data:`MAX_STEPS` steps or keep more than ``max_samples`` samples, counted as exact
-    integers before anything is allocated."""
+def run_options(scene: Scene, dt: float | None = None, t_end: float | None = None,
+                every: int | None = None) -> RunOptions:
+    """The (quiet) run options of ``scene`` with the values given, checked already (None:
+    the scene's ``[run]``): UsageError when ``dt`` passes ``t_end`` or the run would take
+    more than :data:`MAX_STEPS` steps, counted before anything is allocated."""
     dt = scene.run.dt if dt is None else float(dt)
     t_end = scene.run.t_end if t_end is None else float(t_end)
     every = scene.run.every if every is None else int(every)
@@ -440,10 +425,7 @@ def run_options(
         count = f"{round(ratio):,} steps" if math.isfinite(ratio) else "more than 1e308 steps"
         raise UsageError(f"t_end / dt = {t_end:g} s / {dt:g} s = {count}: a run may take at "
                          f"most {MAX_STEPS:,} steps", fixes=("raise {dt}", "lower {t_end}"))
-    options = RunOptions(dt, t_end, every, bool(quiet))
-    if max_samples is not None:
-        check_samples(scene, options, max_samples)
-    return options
+    return RunOptions(dt, t_end, every, True)
 
 
 def check_samples(scene: Scene, options: RunOptions, max_samples: int) -> None:

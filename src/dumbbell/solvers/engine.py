@@ -56,7 +56,7 @@ from ..model.energy import disc_inertia, partition_from_terms, spins, state_colu
 from ..model.scene import Particle, Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import ExplicitSpring, RunOptions, Solver
-from .verdicts import RawRun, conclude, nonfinite_reason, tunnel_reason
+from .verdicts import RawRun, Sinking, conclude, nonfinite_reason, tunnel_reason
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Pymunk"]
@@ -76,7 +76,7 @@ _PARTICLE_TYPE = {"A": 2, "B": 3}
 
 def settings(scene: Scene) -> dict[str, Any]:
     """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else the
-    defaults declared on :class:`~dumbbell.model.scene.PymunkSettings`."""
+    defaults declared on :class:`~dumbbell.solvers.pymunk_settings.PymunkSettings`."""
     return scene.pymunk.resolved()
 
 
@@ -330,9 +330,8 @@ class _Watch:
         for name in "AB":
             y, vy = row[self.columns[name][0]], row[self.columns[name][1]]
             if y < -self.radius[name] and vy < 0:
-                return Verdict("tunnelled", t, tunnel_reason(
-                    self.scene, name, y, vy, dt,
-                    depth=self.radius[name] + FLOOR_THICKNESS / 2))
+                return Verdict("tunnelled", t, tunnel_reason(self.scene, Sinking(
+                    name, y, vy, depth=self.radius[name] + FLOOR_THICKNESS / 2), dt))
         return None
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -67,31 +68,26 @@ class Stepper(Solver):
     def solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
         """Run ``scene`` at step ``options.dt`` (s). ``wall_time`` covers the kernel calls
         and the impact list, not the compiling, the array set-up, the verdict or the energy."""
-        loop = _loop(cls, scene.system.dimensions)
-        params = kernel_params(scene.system, options.dt)
+        run = _Steps.of(cls, scene, options.dt)
         columns = state_columns(scene)
-        st = initial_state(scene)
         # One contiguous row per column, so the Trajectory's columns are views, not copies.
         out = np.empty((len(columns), options.n_samples))
-        out[:, 0] = st
-        _ready(loop, params, len(columns))  # compiling is not part of the run time
-        events: list[Impact] = []
+        out[:, 0] = run.st
         t0 = time.perf_counter()
         with bar(options.n_steps, f"{cls.name} {scene.name}", "step",
                  quiet=options.quiet or options.n_steps < 5 * cls.chunk) as pb:
-            steps, status = drive(loop, params, st, (0, options.n_steps), options.every,
-                                  (out, 0), events, cls.chunk, pb.update)
+            steps, status = run.drive((0, options.n_steps), (out, 0, options.every),
+                                      cls.chunk, pb.update)
         wall = time.perf_counter() - t0
         kept = steps // options.every + 1
         state = {name: out[c, :kept] for c, name in enumerate(columns)}
         t = options.sample_times(kept)
-        verdict = kernel_verdict(cls, scene, options.dt, (steps, status), st, events,
-                                 (t, state))
+        verdict = kernel_verdict(cls, scene, run, (steps, status), (t, state))
 
         def replay(last: int) -> Iterator[tuple[np.ndarray, dict[str, np.ndarray]]]:
-            return _replay(loop, params, initial_state(scene), columns, last)
+            return _Steps.of(cls, scene, options.dt).replay(columns, last)
 
-        return conclude(cls, scene, options, RawRun(t, state, events, verdict, wall,
+        return conclude(cls, scene, options, RawRun(t, state, run.events, verdict, wall,
                                                     {"steps": steps}, replay=replay))
 
     @classmethod
@@ -104,9 +100,9 @@ class Stepper(Solver):
             if cls.kernel(dimensions) is not None:
                 _ready(_loop(cls, dimensions), params, width)
         if cls.kernel(1) is not None:
-            from ..model.energy import partition_1d
+            from ..model.energy import _loop_1d
 
-            partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *np.ones((4, 1)))
+            _loop_1d()((0.1, 0.1, 200.0, 0.2, 9.8), *np.ones((4, 1)))
         return time.perf_counter() - t0
 
 
@@ -130,61 +126,78 @@ def initial_state(scene: Scene) -> np.ndarray:
     return np.array([A.x, A.height, A.vx, A.vy, B.x, B.height, B.vx, B.vy], dtype=np.float64)
 
 
-def drive(loop: Callable[..., Any], params: Params, st: np.ndarray, span: tuple[int, int],
-          every: int, out: tuple[np.ndarray, int], events: list[Impact], chunk: int,
-          progress: Callable[[int], Any] | None = None) -> tuple[int, int]:
-    """Run ``loop`` from ``st`` over the steps ``span`` = (first, stop) in calls of at most
-    ``chunk`` steps, keeping every ``every``-th step in ``out`` = (array, index of the sample
-    in its column 0) and the impacts in ``events``, until the stop step or a bad status.
-    Returns (step reached, status)."""
-    i, stop = span
-    array, j0 = out
-    ev = np.empty((EVENT_BUFFER, 4))
-    status = OK
-    while i < stop and status == OK:
-        i_new, status, n_ev = loop(st, i, min(stop, i + chunk), params, every, array, j0, ev)
-        events.extend(Impact(float(r[0]), "AB"[int(r[1])], float(r[2]), float(r[3]))
-                      for r in ev[:n_ev])
-        if progress is not None:
-            progress(i_new - i)
-        i = i_new
-    return i, status
+@dataclass
+class _Steps:
+    """A stepping solver's compiled loop, the run's scalars (``params``), its state (changed
+    in place) and the impacts recorded so far."""
+
+    loop: Callable[..., Any]
+    params: Params
+    st: np.ndarray
+    events: list[Impact] = field(default_factory=list)
+
+    @classmethod
+    def of(cls, solver: type[Stepper], scene: Scene, dt: float) -> _Steps:
+        """The loop of ``solver`` for ``scene`` at step ``dt`` (s), compiled or loaded (not
+        part of a run's time), from the scene's starting state."""
+        loop = _loop(solver, scene.system.dimensions)
+        st = initial_state(scene)
+        params = kernel_params(scene.system, dt)
+        _ready(loop, params, len(st))
+        return cls(loop, params, st)
+
+    def drive(self, span: tuple[int, int], samples: tuple[np.ndarray, int, int], chunk: int,
+              progress: Callable[[int], Any] | None = None) -> tuple[int, int]:
+        """Steps ``span`` = (first, stop) in calls of at most ``chunk`` steps, keeping every
+        ``every``-th step in ``samples`` = (array, index of the sample in its column 0,
+        every), until the stop step or a bad status. Returns (step reached, status)."""
+        (i, stop), (array, j0, every) = span, samples
+        ev = np.empty((EVENT_BUFFER, 4))
+        status = OK
+        while i < stop and status == OK:
+            i_new, status, n_ev = self.loop(self.st, i, min(stop, i + chunk), self.params,
+                                            every, array, j0, ev)
+            self.events.extend(Impact(float(r[0]), "AB"[int(r[1])], float(r[2]), float(r[3]))
+                               for r in ev[:n_ev])
+            if progress is not None:
+                progress(i_new - i)
+            i = i_new
+        return i, status
+
+    def replay(self, columns: list[str], last: int
+               ) -> Iterator[tuple[np.ndarray, dict[str, np.ndarray]]]:
+        """Steps 1..``last`` of a run from the starting state, in blocks of
+        :data:`REPLAY_BLOCK`: each block's step indices and states (the kernel is
+        deterministic, so they are the run's own floats)."""
+        i = 0
+        block = np.empty((len(columns), REPLAY_BLOCK))
+        while i < last:
+            stop = min(last, i + REPLAY_BLOCK)
+            reached, _ = self.drive((i, stop), (block, i + 1, 1), REPLAY_BLOCK)
+            steps = np.arange(i + 1, reached + 1)
+            yield steps, {name: block[c, : len(steps)] for c, name in enumerate(columns)}
+            if reached < stop:
+                return
+            i = stop
 
 
-def _replay(loop: Callable[..., Any], params: Params, st: np.ndarray, columns: list[str],
-            last: int) -> Iterator[tuple[np.ndarray, dict[str, np.ndarray]]]:
-    """Steps 1..``last`` of the run again, from ``st``, in blocks of :data:`REPLAY_BLOCK`:
-    each block's step indices and states (the kernel is deterministic, so they are the run's
-    own floats)."""
-    i = 0
-    block = np.empty((len(columns), REPLAY_BLOCK))
-    while i < last:
-        stop = min(last, i + REPLAY_BLOCK)
-        reached, _ = drive(loop, params, st, (i, stop), 1, (block, i + 1), [], REPLAY_BLOCK)
-        steps = np.arange(i + 1, reached + 1)
-        yield steps, {name: block[c, : len(steps)] for c, name in enumerate(columns)}
-        if reached < stop:
-            return
-        i = stop
-
-
-def kernel_verdict(cls: type[Solver], scene: Scene, dt: float, end: tuple[int, int],
-                   st: np.ndarray, events: list[Impact],
+def kernel_verdict(cls: type[Solver], scene: Scene, run: _Steps, end: tuple[int, int],
                    samples: tuple[np.ndarray, dict[str, np.ndarray]]) -> Verdict:
-    """The solver's own verdict on a run at step ``dt`` (s) that stopped at ``end`` = (step,
-    status) in the state ``st``, with ``events`` and the ``samples`` (times, state) it kept:
-    blown up (``unstable`` at that step, :func:`~.verdicts.judge` then looks for an earlier
-    energy failure), a particle below the floor (:func:`~.verdicts.below_floor_verdict`), at
-    rest on the floor (``failed`` at its last impact), else ok."""
+    """The solver's own verdict on a ``run`` that stopped at ``end`` = (step, status), with
+    the ``samples`` (times, state) it kept: blown up (``unstable`` at that step,
+    :func:`~.verdicts.judge` then looks for an earlier energy failure), a particle below the
+    floor (:func:`~.verdicts.below_floor_verdict`), at rest on the floor (``failed`` at its
+    last impact), else ok."""
     steps, status = end
+    dt = run.params.dt
     if status == BLOWUP:
         return Verdict("unstable", steps * dt, nonfinite_reason(scene, dt, cls.step_limit))
     if status in (TUNNEL_A, TUNNEL_B):
         t, state = samples
         E = _partition(scene, t[[0, -1]], {k: v[[0, -1]] for k, v in state.items()})["E"]
-        return below_floor_verdict(scene, steps * dt, dt, sinking(scene, st, status), E=E)
+        return below_floor_verdict(scene, steps * dt, dt, sinking(scene, run.st, status), E=E)
     if status == REST:
-        last = events[-1] if events else None
+        last = run.events[-1] if run.events else None
         return Verdict(
             "failed", last.t if last else steps * dt,
             f"{last.body if last else 'a particle'} came to rest on the floor (impact speed "

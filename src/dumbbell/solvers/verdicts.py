@@ -73,26 +73,6 @@ def nonfinite_reason(scene: Scene, dt: float, limit: float | None) -> str:
             f"{limit:.3g} (w = {w:.4g} rad/s)")
 
 
-def tunnel_reason(
-    scene: Scene, body: str, height: float, speed: float, dt: float | None,
-    depth: float | None = None,
-) -> str:
-    """Why ``body`` went through the floor: it is ``height`` (m, < 0) below it moving down at
-    ``speed`` (m/s). ``depth`` (m) is how far past the floor a contact can still be caught in
-    one step (2r for a circle on a thin floor); with it, the message gives the step to use."""
-    text = f"{body} is {abs(height):.3g} m below the floor, still moving down at {abs(speed):.3g} m/s"
-    if dt is None:
-        return text
-    travel = abs(speed) * dt
-    if depth is not None and depth > 0:
-        text += (f": it moves {travel:.3g} m per step, more than the {depth:.3g} m in which "
-                 f"a contact is caught; use dt < {seconds(depth / abs(speed))} s or a larger "
-                 "radius")
-    else:
-        text += f" ({travel:.3g} m per step): the velocity flip came too late to stop it"
-    return text
-
-
 @dataclass(frozen=True)
 class Sinking:
     """A particle found below the floor although the floor should have turned it back:
@@ -105,6 +85,25 @@ class Sinking:
     speed: float
     push: float = 0.0
     depth: float | None = None
+
+
+def tunnel_reason(scene: Scene, sinking: Sinking, dt: float | None) -> str:
+    """Why a particle went through the floor (``sinking``: where it is, how fast it moves,
+    and how far past the floor a contact can still be caught in one step, 2r for a circle on
+    a thin floor; with that depth the message gives the step to use) at step ``dt`` (s)."""
+    speed, depth = abs(sinking.speed), sinking.depth
+    text = (f"{sinking.body} is {abs(sinking.height):.3g} m below the floor, still moving "
+            f"down at {speed:.3g} m/s")
+    if dt is None:
+        return text
+    travel = speed * dt
+    if depth is not None and depth > 0:
+        text += (f": it moves {travel:.3g} m per step, more than the {depth:.3g} m in which "
+                 f"a contact is caught; use dt < {seconds(depth / speed)} s or a larger "
+                 "radius")
+    else:
+        text += f" ({travel:.3g} m per step): the velocity flip came too late to stop it"
+    return text
 
 
 def below_floor_verdict(scene: Scene, t: float, dt: float, sinking: Sinking,
@@ -131,7 +130,7 @@ def below_floor_verdict(scene: Scene, t: float, dt: float, sinking: Sinking,
                 reason += (f"; the floor is elastic, so the step's impact errors drained the "
                            f"energy to {left:.0%} of its start: use a smaller dt")
         return Verdict("failed", t, reason)
-    reason = tunnel_reason(scene, body, height, speed, dt, sinking.depth)
+    reason = tunnel_reason(scene, sinking, dt)
     if push > scene.system.g:
         reason += (f"; the spring pushed it back down (at {push:.3g} m/s^2) before it climbed "
                    f"out, with w*dt = {step_ratio(scene, dt):.2f}: use a smaller dt")
@@ -283,20 +282,21 @@ def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
                 judged.ok and verdict.ok):
             # The last step to look at: the first bad sample's, else the explosion's.
             last = round(judged.t / dt) if not judged.ok else round(verdict.t / dt)  # type: ignore[operator]
-            judged = _first_bad_step(cls, scene, dt, energy, raw.replay, last) or judged
+            judged = _first_bad_step(cls, scene, dt, energy, raw.replay(last)) or judged
         if not (judged.ok and verdict.status == "unstable"):
             verdict = judged
     return verdict, keep, head(energy, keep)
 
 
 def _first_bad_step(cls: type[Solver], scene: Scene, dt: float,
-                    energy: Mapping[str, np.ndarray], replay: Replay, last: int
+                    energy: Mapping[str, np.ndarray],
+                    blocks: Iterator[tuple[np.ndarray, Mapping[str, np.ndarray]]]
                     ) -> Verdict | None:
-    """``unstable`` at the first of steps 1..``last`` (of step ``dt``, s) whose energy error
-    (against the run's first sample, ``energy``) passes the scene's threshold; None if none
-    does."""
+    """``unstable`` at the first of the replayed steps (``blocks`` of step indices and states;
+    step ``dt`` in s) whose energy error (against the run's first sample, ``energy``) passes
+    the scene's threshold; None if none does."""
     E0, scale = float(energy["E"][0]), _start_scale(energy)
-    for steps, state in replay(last):
+    for steps, state in blocks:
         E = _partition(scene, steps * dt, state)["E"]
         err = _energy_errors(scene, E, E0, scale)
         bad = np.flatnonzero(~(err <= scene.run.unstable_energy))

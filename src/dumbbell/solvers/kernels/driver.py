@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from numba import njit
+from numba import literal_unroll, njit
 from numba.cpython.unsafe.tuple import tuple_setitem
 from numba.extending import register_jitable
 from numba.np.unsafe.ndarray import to_fixed_tuple
@@ -73,52 +73,37 @@ def _fingerprint(*functions: Callable[..., Any]) -> str:
     return digest.hexdigest()
 
 
+def _layout(dimensions: int) -> tuple[int, tuple[int, ...], Callable[..., Any],
+                                      Callable[..., Any]]:
+    """For a state in ``dimensions``: its sampled size, where the heights and vertical
+    velocities of A and B are, and the compiled check and sampling of it."""
+    if dimensions == 1:
+        return 4, (0, 1, 2, 3), _finite_1d, _keep_1d
+    return 8, (1, 3, 5, 7), _finite_2d, _keep_2d
+
+
 def _loop(kernel: Kernel, dimensions: int) -> Callable[..., Any]:
     if kernel.floor not in FLOOR_RULES:
         raise ValueError(f"Kernel.floor = {kernel.floor!r}: must be one of {FLOOR_RULES}")
-    step = _jitable(kernel.step)
-    start = _jitable(kernel.start or _same)
-    flip, end = kernel.floor == "flip", kernel.floor == "end"
+    step, start = _jitable(kernel.step), _jitable(kernel.start or _same)
+    flip, locate = kernel.floor == "flip", kernel.floor == "locate"
     at_radius = kernel.through_at_radius
-    one = dimensions == 1
-    n = 4 if one else 8
-    hA, vA, hB, vB = (0, 1, 2, 3) if one else (1, 3, 5, 7)
+    n, vert, finite, keep = _layout(dimensions)
     fingerprint = _fingerprint(kernel.step, kernel.start or _same)
 
     @njit(cache=True, nogil=True)
     def loop(st, i, i_stop, p, every, out, j0, ev):  # pragma: no cover - compiled
         fingerprint  # noqa: B018 - part of the cache key (see the module docstring)
         s = start(to_fixed_tuple(st, n), p)
-        dt, e, floor = p.dt, p.e, p.floor
-        dA = p.rA if at_radius else 0.0
-        dB = p.rB if at_radius else 0.0
         n_ev = 0
         status = OK
         # A countdown to the next kept step: an integer modulo every step costs more than
         # the textbook's step.
         until_sample = every - i % every
         while i < i_stop:
-            if flip:
-                old = s
-                s = step(s, p)
-                if floor:
-                    # The textbook's rule, B first as in its listing.
-                    t = (i + 1) * dt
-                    if s[hB] < 0.0 and old[hB] >= 0.0:
-                        s, n_ev = _flip(s, vB, 1.0, e, t, ev, n_ev)
-                    if s[hA] < 0.0 and old[hA] >= 0.0:
-                        s, n_ev = _flip(s, vA, 0.0, e, t, ev, n_ev)
-            elif end:
-                s, hits = step(s, p)
-                t = (i + 1) * dt
-                if hits[0]:
-                    n_ev = record(ev, n_ev, t, 0.0, hits[1], hits[2])
-                if hits[3]:
-                    n_ev = record(ev, n_ev, t, 1.0, hits[4], hits[5])
-            else:
-                rem = dt
-                count = 0
-                while True:
+            if locate:
+                rem, count = p.dt, 0
+                while status == OK:
                     s, h, body = step(s, p, rem)
                     if body < 0:
                         break
@@ -126,94 +111,123 @@ def _loop(kernel: Kernel, dimensions: int) -> Callable[..., Any]:
                     count += 1
                     # Placed on the floor where the step's own path meets it, so that
                     # rounding cannot leave it a hair below; its velocity reflected.
-                    v_in = s[vA] if body == 0 else s[vB]
-                    v_out = e * abs(v_in) if v_in < 0.0 else v_in
-                    n_ev = record(ev, n_ev, i * dt + (dt - rem), body, v_in, v_out)
-                    if body == 0:
-                        s = start(tuple_setitem(tuple_setitem(s, hA, 0.0), vA, v_out), p)
-                    else:
-                        s = start(tuple_setitem(tuple_setitem(s, hB, 0.0), vB, v_out), p)
-                    if abs(v_in) < REST_SPEED or count > MAX_HITS:
+                    s, hit = _landed(s, body, p.e, vert)
+                    n_ev = record(ev, n_ev, i * p.dt + (p.dt - rem), hit)
+                    s = start(s, p)
+                    if abs(hit[1]) < REST_SPEED or count > MAX_HITS:
                         status = REST
-                        break
                 if status != OK:
                     break  # at rest: the step is not counted
+            else:
+                if flip:
+                    old = s
+                    s = step(s, p)
+                    s, first, second = _textbook(old, s, p, vert)
+                else:
+                    s, first, second = _at_end(step(s, p))
+                n_ev = record(ev, n_ev, (i + 1) * p.dt, first)
+                n_ev = record(ev, n_ev, (i + 1) * p.dt, second)
             i += 1
-            if floor:
-                if s[hB] < -dB and s[vB] < 0.0:
-                    status = TUNNEL_B
-                if s[hA] < -dA and s[vA] < 0.0:
-                    status = TUNNEL_A
-            # Each component named (not indexed in a loop), so the state stays in registers.
-            if not (_finite(s) if one else _finite_2d(s)):
-                status = BLOWUP
+            status = _status(s, p, at_radius, vert) if finite(s) else BLOWUP
             until_sample -= 1
             if until_sample == 0:
                 until_sample = every
-                j = i // every - j0
-                if one:
-                    _keep(out, j, s)
-                else:
-                    _keep_2d(out, j, s)
+                keep(out, i // every - j0, s)
             if status != OK or n_ev > ev.shape[0] - MAX_HITS - 4:
                 break
-        for c in range(n):
-            st[c] = s[c]
+        keep(st[:, None], 0, s)  # the state reached, for the next call
         return i, status, n_ev
 
     return loop
 
 
-@njit(cache=True, nogil=True)
-def _finite(s):  # pragma: no cover - compiled
-    """Whether the 1D state's four components are below :data:`BIG` in size (not NaN)."""
+@register_jitable
+def _textbook(old, s, p, vert):  # pragma: no cover - compiled
+    """The textbook's rule after a step from ``old`` to ``s``: a particle below the floor
+    that was not before has its vertical velocity reversed, times the elasticity; B first,
+    as in its listing. ``vert``: where A's and B's heights and vertical velocities are in the
+    state. Returns the state and the two impacts (B's, then A's; ``(-1.0, ...)`` where there
+    is none)."""
+    hA, vA, hB, vB = vert
+    first = second = (-1.0, 0.0, 0.0)
+    if p.floor and s[hB] < 0.0 and old[hB] >= 0.0:
+        first = (1.0, s[vB], p.e * abs(s[vB]))
+        s = tuple_setitem(s, vB, first[2])
+    if p.floor and s[hA] < 0.0 and old[hA] >= 0.0:
+        second = (0.0, s[vA], p.e * abs(s[vA]))
+        s = tuple_setitem(s, vA, second[2])
+    return s, first, second
+
+
+@register_jitable
+def _at_end(result):  # pragma: no cover - compiled
+    """A step's state and its contacts at its end (``"end"`` rule) as the two impacts, A's
+    then B's (``(-1.0, ...)`` where there is none)."""
+    s, hits = result
+    first = (0.0, hits[1], hits[2]) if hits[0] else (-1.0, 0.0, 0.0)
+    second = (1.0, hits[4], hits[5]) if hits[3] else (-1.0, 0.0, 0.0)
+    return s, first, second
+
+
+@register_jitable
+def _landed(s, body, e, vert):  # pragma: no cover - compiled
+    """``s`` with ``body`` (0 A, 1 B) placed on the floor and its vertical velocity
+    reflected, times the elasticity ``e``; and the impact (body, v_before, v_after)."""
+    hA, vA, hB, vB = vert
+    h, v = (hA, vA) if body == 0 else (hB, vB)
+    v_in = s[v]
+    v_out = e * abs(v_in) if v_in < 0.0 else v_in
+    return tuple_setitem(tuple_setitem(s, h, 0.0), v, v_out), (float(body), v_in, v_out)
+
+
+@register_jitable
+def _status(s, p, at_radius, vert):  # pragma: no cover - compiled
+    """TUNNEL_A or TUNNEL_B after a step when that particle is below the floor (by more than
+    its radius if ``at_radius``) and still moving down, else OK."""
+    hA, vA, hB, vB = vert
+    if p.floor and s[hA] < (-p.rA if at_radius else 0.0) and s[vA] < 0.0:
+        return TUNNEL_A
+    if p.floor and s[hB] < (-p.rB if at_radius else 0.0) and s[vB] < 0.0:
+        return TUNNEL_B
+    return OK
+
+
+@register_jitable
+def _finite_1d(s):  # pragma: no cover - compiled
+    """Whether no component of the 1D state passed :data:`BIG` (nor is NaN); each component
+    named, so the state stays in registers."""
     return abs(s[0]) < BIG and abs(s[1]) < BIG and abs(s[2]) < BIG and abs(s[3]) < BIG
 
 
-@njit(cache=True, nogil=True)
+@register_jitable
 def _finite_2d(s):  # pragma: no cover - compiled
-    """Whether the 2D state's eight components are below :data:`BIG` in size (not NaN)."""
+    """:func:`_finite_1d` of the 2D state."""
     return (abs(s[0]) < BIG and abs(s[1]) < BIG and abs(s[2]) < BIG and abs(s[3]) < BIG
             and abs(s[4]) < BIG and abs(s[5]) < BIG and abs(s[6]) < BIG and abs(s[7]) < BIG)
 
 
-@njit(cache=True, nogil=True)
-def _keep(out, j, s):  # pragma: no cover - compiled
+@register_jitable
+def _keep_1d(out, j, s):  # pragma: no cover - compiled
     """The 1D state as sample ``j`` of the columns ``out``."""
-    out[0, j] = s[0]
-    out[1, j] = s[1]
-    out[2, j] = s[2]
-    out[3, j] = s[3]
+    for c in literal_unroll((0, 1, 2, 3)):
+        out[c, j] = s[c]
 
 
-@njit(cache=True, nogil=True)
+@register_jitable
 def _keep_2d(out, j, s):  # pragma: no cover - compiled
     """The 2D state as sample ``j`` of the columns ``out``."""
-    out[0, j] = s[0]
-    out[1, j] = s[1]
-    out[2, j] = s[2]
-    out[3, j] = s[3]
-    out[4, j] = s[4]
-    out[5, j] = s[5]
-    out[6, j] = s[6]
-    out[7, j] = s[7]
+    for c in literal_unroll((0, 1, 2, 3, 4, 5, 6, 7)):
+        out[c, j] = s[c]
 
 
-@njit(cache=True, nogil=True)
-def record(rows, n, t, body, before, after):  # pragma: no cover - compiled
-    """Row ``n`` of the impact table ``rows``: ``body`` (0 A, 1 B) met the floor at ``t``
-    (s) with vertical velocity ``before`` and left with ``after`` (m/s); returns ``n + 1``."""
+@register_jitable
+def record(rows, n, t, hit):  # pragma: no cover - compiled
+    """The impact ``hit`` = (body 0 A / 1 B, v_before, v_after in m/s; body -1: none) at
+    ``t`` (s) as row ``n`` of the impact table ``rows``; returns the next free row."""
+    if hit[0] < 0.0:
+        return n
     rows[n, 0] = t
-    rows[n, 1] = body
-    rows[n, 2] = before
-    rows[n, 3] = after
+    rows[n, 1] = hit[0]
+    rows[n, 2] = hit[1]
+    rows[n, 3] = hit[2]
     return n + 1
-
-
-@njit(cache=True, nogil=True)
-def _flip(s, v, body, e, t, ev, n_ev):  # pragma: no cover - compiled
-    """``s`` with its velocity component ``v`` reversed and scaled by ``e`` (the floor's
-    elasticity), the impact of ``body`` recorded as row ``n_ev`` of ``ev`` at ``t`` (s);
-    and the next free row."""
-    after = e * abs(s[v])
-    return tuple_setitem(s, v, after), record(ev, n_ev, t, body, s[v], after)

@@ -60,6 +60,25 @@ def _first_root(c, b, a, h):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
+def _first_impact(a, b, rem, floor):  # pragma: no cover - compiled
+    """How long a step may go (s) and which particle meets the floor at its end: the first
+    root in (0, ``rem``] of either particle's height (``a``, ``b``: height, vertical
+    velocity, vertical acceleration of A and B), or the whole ``rem`` and -1 (none)."""
+    tau = rem + 1.0
+    body = -1
+    if floor:
+        tA = _first_root(a[0], a[1], a[2], rem)
+        tB = _first_root(b[0], b[1], b[2], rem)
+        if tB >= 0.0:
+            tau = tB
+            body = 1
+        if tA >= 0.0 and tA < tau:
+            tau = tA
+            body = 0
+    return (rem if body < 0 else tau), body
+
+
+@njit(cache=True, nogil=True)
 def _accel_1d(xA, xB, p):  # pragma: no cover - compiled
     """Accelerations (m/s^2) of A and B from the spring and gravity, with the masses, spring
     and gravity of the record ``p``."""
@@ -76,18 +95,7 @@ def step_1d(s, p, rem):  # pragma: no cover - compiled
     """Velocity Verlet over ``rem`` s, or up to the first root in (0, rem] of either
     particle's height (returns the state, the time advanced and the body, -1 for none)."""
     xA, vA, xB, vB, aA, aB = s
-    tau = rem + 1.0
-    body = -1
-    if p.floor:
-        tA = _first_root(xA, vA, aA, rem)
-        tB = _first_root(xB, vB, aB, rem)
-        if tB >= 0.0:
-            tau = tB
-            body = 1
-        if tA >= 0.0 and tA < tau:
-            tau = tA
-            body = 0
-    h = rem if body < 0 else tau
+    h, body = _first_impact((xA, vA, aA), (xB, vB, aB), rem, p.floor)
     xA = xA + h * (vA + 0.5 * aA * h)
     xB = xB + h * (vB + 0.5 * aB * h)
     aA_new, aB_new = _accel_1d(xA, xB, p)
@@ -121,18 +129,7 @@ def start_2d(s, p):  # pragma: no cover - compiled
 def step_2d(s, p, rem):  # pragma: no cover - compiled
     """:func:`step_1d` in 2D: the roots of the heights; the spring along the axis."""
     xA, yA, vxA, vyA, xB, yB, vxB, vyB, axA, ayA, axB, ayB = s
-    tau = rem + 1.0
-    body = -1
-    if p.floor:
-        tA = _first_root(yA, vyA, ayA, rem)
-        tB = _first_root(yB, vyB, ayB, rem)
-        if tB >= 0.0:
-            tau = tB
-            body = 1
-        if tA >= 0.0 and tA < tau:
-            tau = tA
-            body = 0
-    h = rem if body < 0 else tau
+    h, body = _first_impact((yA, vyA, ayA), (yB, vyB, ayB), rem, p.floor)
     xA = xA + h * (vxA + 0.5 * axA * h)
     yA = yA + h * (vyA + 0.5 * ayA * h)
     xB = xB + h * (vxB + 0.5 * axB * h)
