@@ -56,6 +56,7 @@ from ..model.energy import (
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
+from .kernels import REST_SPEED
 from .verdicts import RawRun, head, judge
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
@@ -67,8 +68,6 @@ RTOL = 1e-12
 ATOL = 1e-12
 #: The window (s) over which the error estimate is stated separately (chaos: see docs/physics.md).
 ERROR_WINDOW = 2.0
-#: An impact slower than this (m/s) means the particle has come to rest on the floor.
-REST_SPEED = 1e-9
 MAX_IMPACTS = 100_000
 
 

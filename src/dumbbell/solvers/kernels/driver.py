@@ -28,6 +28,7 @@ from numba.cpython.unsafe.tuple import tuple_setitem
 from numba.extending import register_jitable
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
+from ...errors import UsageError
 from . import BIG, BLOWUP, FLOOR_RULES, MAX_HITS, OK, REST, REST_SPEED, TUNNEL_A, TUNNEL_B, Kernel
 
 #: (kernel, dimensions) -> its compiled loop.
@@ -84,7 +85,8 @@ def _layout(dimensions: int) -> tuple[int, tuple[int, ...], Callable[..., Any],
 
 def _loop(kernel: Kernel, dimensions: int) -> Callable[..., Any]:
     if kernel.floor not in FLOOR_RULES:
-        raise ValueError(f"Kernel.floor = {kernel.floor!r}: must be one of {FLOOR_RULES}")
+        raise UsageError(f"kernel.floor = {kernel.floor!r}: must be one of "
+                         f"{', '.join(FLOOR_RULES)}", param="kernel")
     step, start = _jitable(kernel.step), _jitable(kernel.start or _same)
     flip, locate = kernel.floor == "flip", kernel.floor == "locate"
     at_radius = kernel.through_at_radius
