@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from numba import literal_unroll, njit
+from numba import njit
 from numba.cpython.unsafe.tuple import tuple_setitem
 from numba.extending import register_jitable
 from numba.np.unsafe.ndarray import to_fixed_tuple
@@ -211,15 +211,14 @@ def _finite_2d(s):  # pragma: no cover - compiled
 @register_jitable
 def _keep_1d(out, j, s):  # pragma: no cover - compiled
     """The 1D state as sample ``j`` of the columns ``out``."""
-    for c in literal_unroll((0, 1, 2, 3)):
-        out[c, j] = s[c]
+    out[0, j], out[1, j], out[2, j], out[3, j] = s[0], s[1], s[2], s[3]
 
 
 @register_jitable
 def _keep_2d(out, j, s):  # pragma: no cover - compiled
     """The 2D state as sample ``j`` of the columns ``out``."""
-    for c in literal_unroll((0, 1, 2, 3, 4, 5, 6, 7)):
-        out[c, j] = s[c]
+    out[0, j], out[1, j], out[2, j], out[3, j] = s[0], s[1], s[2], s[3]
+    out[4, j], out[5, j], out[6, j], out[7, j] = s[4], s[5], s[6], s[7]
 
 
 @register_jitable
