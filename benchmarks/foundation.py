@@ -115,12 +115,12 @@ def main() -> None:
     # JIT: compile from scratch in a fresh process with an empty cache, and load from the cache.
     with tempfile.TemporaryDirectory() as cache:
         cold = fresh_process("from dumbbell.solvers import euler_cromer;"
-                             "print(euler_cromer.warm_up())", {"NUMBA_CACHE_DIR": cache})
+                             "print(euler_cromer.EulerCromer.warm_up())", {"NUMBA_CACHE_DIR": cache})
         cached = fresh_process("from dumbbell.solvers import euler_cromer;"
-                               "print(euler_cromer.warm_up())", {"NUMBA_CACHE_DIR": cache})
+                               "print(euler_cromer.EulerCromer.warm_up())", {"NUMBA_CACHE_DIR": cache})
     rows.append(("JIT compile, fresh process, empty cache", f"{float(cold):.2f} s"))
     rows.append(("JIT load from numba's cache, fresh process", f"{float(cached):.3f} s"))
-    euler_cromer.warm_up()
+    euler_cromer.EulerCromer.warm_up()
 
     def every_step():
         traj = dumbbell.simulate(scene, "euler-cromer", every=1)
@@ -172,7 +172,7 @@ def main() -> None:
         import time, dumbbell
         from dumbbell.model.scene import packaged_scene
         from dumbbell.solvers import euler_cromer
-        euler_cromer.warm_up()
+        euler_cromer.EulerCromer.warm_up()
         scene = dumbbell.load_scene(packaged_scene())
         t0 = time.perf_counter()
         traj = dumbbell.simulate(scene, "euler-cromer", dt=1e-7, every=10000)

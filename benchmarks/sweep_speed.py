@@ -30,11 +30,11 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _sweep(scene, n: int, workers: int, t_end: float = 1.0):
     """Run the n x n sweep; returns (wall s, CPU s of this process and its children, result)."""
-    from dumbbell.analysis.sweep import parse_axis, run_sweep
+    from dumbbell.analysis.sweep import SweepOptions, parse_axis, run_sweep
 
     axes = [parse_axis(f"k=log:1e2:1e7:{n}"), parse_axis(f"dt=log:1e-6:1e-2:{n}")]
     c0, t0 = os.times(), time.perf_counter()
-    result = run_sweep(scene, axes, "euler-cromer", t_end, workers=workers, quiet=True)
+    result = run_sweep(scene, axes, SweepOptions("euler-cromer", t_end, workers))
     wall, c1 = time.perf_counter() - t0, os.times()
     cpu = sum(c1[:4]) - sum(c0[:4])
     return wall, cpu, result
@@ -43,10 +43,10 @@ def _sweep(scene, n: int, workers: int, t_end: float = 1.0):
 def speed(n: int, workers: int, repeat: int) -> None:
     from dumbbell.io.sweep import csv_text
     from dumbbell.model.scene import load_scene
-    from dumbbell.solvers.euler_cromer import warm_up
+    from dumbbell.solvers.euler_cromer import EulerCromer
 
     scene = load_scene(ROOT / "scenes" / "textbook-1d.toml")
-    warm_up()
+    EulerCromer.warm_up()
     serial, pooled, cpu_s, cpu_p, texts = [], [], [], [], set()
     for _ in range(repeat):
         t, cpu, res = _sweep(scene, n, 1)

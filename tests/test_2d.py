@@ -54,7 +54,9 @@ def test_partition_identity_on_random_states():
     n = 1000
     rA, rB, vA, vB = (rng.normal(size=(n, 2)) for _ in range(4))
     mA, mB = 0.3, 0.07
-    parts = partition_2d(mA, mB, 50.0, 0.2, G, rA, vA, rB, vB)
+    system = make_scene({"bodies.A.mass": mA, "bodies.B.mass": mB, "spring.stiffness": 50.0,
+                         "spring.rest_length": 0.2, "gravity.g": G}).system
+    parts = partition_2d(system, rA, vA, rB, vB)
     K = parts["K_cm"] + parts["K_rot"] + parts["K_vib"]
     expected = 0.5 * mA * (vA**2).sum(axis=1) + 0.5 * mB * (vB**2).sum(axis=1)
     np.testing.assert_allclose(K, expected, rtol=1e-12)

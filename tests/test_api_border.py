@@ -31,13 +31,16 @@ from dumbbell import DumbbellError
 PACKAGES = ("dumbbell.model", "dumbbell.solvers", "dumbbell.spaces", "dumbbell.examples",
             "dumbbell.plot", "dumbbell.analysis", "dumbbell.io", "dumbbell.animation")
 #: Packages whose own ``__all__`` counts, but not their submodules'.
-TOP = ("dumbbell", "dumbbell.parallel", "dumbbell.progress")
+TOP = ("dumbbell", "dumbbell.frames", "dumbbell.parallel", "dumbbell.progress")
 #: Packages not walked: the compiled loops, which import numba and are called by the solver
 #: classes only (which check the arguments first).
 INTERNAL = ("dumbbell.solvers.kernels",)
 #: Classes whose methods are a contract only (they raise NotImplementedError); every
-#: registered subclass's own are covered.
-CONTRACTS = ("dumbbell.solvers.base.Solver",)
+#: registered subclass's are covered (:func:`_solver_rows`).
+CONTRACTS = ("dumbbell.solvers.base.Solver", "dumbbell.solvers.stepping.Stepper")
+#: The methods of the solver contract a registered solver has, its own or its family's.
+SOLVER_METHODS = ("supports", "solve", "check_work", "truth_for", "catch_depth", "kernel",
+                  "swing")
 
 #: Values that are wrong for nearly every argument.
 HOSTILE = (None, "text", [1, 2], float("nan"), -1, object())
@@ -96,7 +99,18 @@ def public() -> dict[str, Any]:
                 for method, (fn, bound) in _own_methods(obj).items():
                     if _parameters(fn)[1 if bound else 0:]:
                         found.setdefault(f"{key}.{method}", fn)
+    for cls in _solvers():
+        # A solver's contract methods, inherited from its family or not (called on the class).
+        key = f"{cls.__module__}.{cls.__qualname__}"
+        for method in SOLVER_METHODS:
+            if hasattr(cls, method):
+                found.setdefault(f"{key}.{method}", getattr(cls, method))
     return found
+
+
+def _solvers() -> list[type]:
+    """The registered solver classes, found in the registry, not listed here."""
+    return list(importlib.import_module("dumbbell.solvers").METHODS.values())
 
 
 def _parameters(fn: Any) -> list[str]:
@@ -180,13 +194,15 @@ class Fixtures:
     def comparison(self) -> Any:
         import dumbbell
 
-        return dumbbell.compare(self.scene, ["euler-cromer"], [1e-3], window=0.02, t_end=0.05)
+        return dumbbell.compare(self.scene, solvers=["euler-cromer"], dts=[1e-3], window=0.02,
+                                t_end=0.05)
 
     @functools.cached_property
     def bench_result(self) -> Any:
         import dumbbell
 
-        return dumbbell.bench(self.scene, ["euler-cromer"], [1e-3, 5e-4, 2.5e-4], window=0.02,
+        return dumbbell.bench(self.scene, solvers=["euler-cromer"], dts=[1e-3, 5e-4, 2.5e-4],
+                              window=0.02,
                               repeat=1, t_end=0.05)
 
     @functools.cached_property
@@ -256,7 +272,7 @@ class Fixtures:
     def stability_result(self) -> Any:
         import dumbbell
 
-        return dumbbell.stability(self.scene_file.parent, ["euler-cromer"], workers=1)
+        return dumbbell.stability(self.scene_file.parent, solvers=["euler-cromer"], workers=1)
 
     @functools.cache  # noqa: B019 - one figure per count for the whole test: hostile calls
     def ax(self, count: int = 1) -> Any:  # stop before drawing, valid ones draw over it
@@ -362,7 +378,6 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                    "strip": True},
     "dumbbell.model.scene.OutputSettings": lambda f: fields(f.scene.outputs),
     "dumbbell.model.scene.Particle": lambda f: fields(f.scene.system.A),
-    "dumbbell.model.scene.PymunkSettings": lambda f: fields(f.scene.pymunk),
     "dumbbell.model.scene.Rigid": lambda f: {"length": 0.3},
     "dumbbell.model.scene.RunSettings": lambda f: fields(f.scene.run),
     "dumbbell.model.scene.Spring": lambda f: {"stiffness": 200.0, "rest_length": 0.2},
@@ -375,45 +390,25 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                       "source": "x.toml"},
     "dumbbell.model.scene.scenes_dir": lambda f: {},
     "dumbbell.model.trajectory.read_only": lambda f: {"values": np.zeros(3)},
-    # dumbbell.solvers: the registered classes (called on the class) and their modules
-    "dumbbell.solvers.engine.Pymunk": lambda f: {},
-    "dumbbell.solvers.engine.Pymunk.catch_depth": lambda f: {"scene": f.scene},
-    "dumbbell.solvers.engine.Pymunk.solve": lambda f: {"scene": f.scene, "options": f.options},
-    "dumbbell.solvers.engine.Pymunk.supports": lambda f: {"scene": f.scene},
-    "dumbbell.solvers.euler_cromer.EulerCromer": lambda f: {},
-    "dumbbell.solvers.euler_cromer.EulerCromer.solve": lambda f: {"scene": f.scene,
-                                                                  "options": f.options},
-    "dumbbell.solvers.euler_cromer.EulerCromer.supports": lambda f: {"scene": f.scene},
-    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D": lambda f: {},
-    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D.solve": lambda f: {
-        "scene": f.scene_2d, "options": f.options},
-    "dumbbell.solvers.euler_cromer_2d.EulerCromer2D.supports": lambda f: {"scene": f.scene_2d},
-    "dumbbell.solvers.exact.Exact": lambda f: {},
-    "dumbbell.solvers.exact.Exact.check_work": lambda f: {"scene": f.scene,
-                                                         "options": f.options},
-    "dumbbell.solvers.exact.Exact.solve": lambda f: {"scene": f.scene, "options": f.options},
-    "dumbbell.solvers.exact.Exact.supports": lambda f: {"scene": f.rigid_2d},
-    "dumbbell.solvers.exact.Exact.truth_for": lambda f: {"scene": f.scene},
+    # dumbbell.solvers: the registered classes are found (:func:`_solver_rows`), their modules
+    "dumbbell.solvers.kernels.Kernel": lambda f: {
+        "step": _module("dumbbell.solvers.kernels.euler_cromer").step,
+        "floor": "flip", "start": None, "through_at_radius": False},
+    "dumbbell.solvers.stepping.Stepper": lambda f: {},
+    "dumbbell.solvers.pymunk_settings.PymunkSettings": lambda f: fields(f.scene.pymunk),
     "dumbbell.solvers.exact_rigid.first_impact_state": lambda f: {
         "tilt": 30.0, "elasticity": 0.5, "mA": 0.1, "mB": 0.2, "length": 0.2, "height": 1.0,
         "g": 9.8},
-    "dumbbell.solvers.reference.Reference": lambda f: {},
-    "dumbbell.solvers.reference.Reference.solve": lambda f: {
-        "scene": f.scene, "options": f.options, "estimate_error": False},
-    "dumbbell.solvers.reference.Reference.supports": lambda f: {"scene": f.scene_2d},
-    "dumbbell.solvers.reference.Reference.truth_for": lambda f: {"scene": f.scene_2d},
-    "dumbbell.solvers.verlet.Verlet": lambda f: {},
-    "dumbbell.solvers.verlet.Verlet.solve": lambda f: {"scene": f.scene, "options": f.options},
-    "dumbbell.solvers.verlet.Verlet.supports": lambda f: {"scene": f.scene},
     # dumbbell.parallel, dumbbell.progress
     "dumbbell.parallel.batches": lambda f: {"n": 10, "workers": 2},
     "dumbbell.parallel.cap_note": lambda f: {"flag": "--workers", "workers": 4, "jobs": 3,
                                              "what": "runs"},
     "dumbbell.parallel.cap_workers": lambda f: {"workers": 2, "jobs": 3},
+    "dumbbell.parallel.Backend": lambda f: {
+        "workers": 1, "scheduler": None, "processes": True, "initializer": None, "initargs": (),
+        "quiet": True, "desc": "", "unit": "run", "connect_timeout": 1.0},
     "dumbbell.parallel.ordered_map": lambda f: {
-        "func": _arity, "jobs": [(1,), (2, 3)], "shared": 0, "workers": 1, "scheduler": None,
-        "processes": True, "initializer": None, "initargs": (), "quiet": True, "desc": "",
-        "unit": "run", "connect_timeout": 1.0},
+        "func": _arity, "jobs": [(1,), (2, 3)], "backend": None, "shared": 0},
     "dumbbell.progress.bar": lambda f: {"total": 10, "desc": "d", "unit": "it", "quiet": True},
     "dumbbell.progress.progress_wanted": lambda f: {"quiet": True},
     "dumbbell.solvers.simulate": lambda f: {
@@ -466,17 +461,23 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.bench.default_spacing": lambda f: {"scene": f.scene},
     "dumbbell.analysis.bench.dt_label": lambda f: {"dt": 3.2e-6},
     "dumbbell.analysis.bench.fit_order": lambda f: {"points": f.bench_result.points},
+    "dumbbell.analysis.bench.BenchOptions": lambda f: {
+        "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02, "repeat": 1,
+        "t_end": 0.02, "budget": 10.0, "spacing": None, "quiet": True},
     "dumbbell.analysis.bench.run_bench": lambda f: {
-        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
-        "repeat": 1, "t_end": 0.02, "budget": 10.0, "spacing": None, "quiet": True},
+        "scene": f.scene, "options": _module("dumbbell.analysis.bench").BenchOptions(
+            solvers=["euler-cromer"], dts=[1e-3], window=0.02, repeat=1, t_end=0.02)},
     "dumbbell.analysis.bench.time_for_error": lambda f: {
         "line": [(0.1, 1e-3), (1.0, 1e-5)], "target": 1e-4},
     # dumbbell.analysis.compare
     "dumbbell.analysis.compare.Comparison": lambda f: fields(f.comparison),
     "dumbbell.analysis.compare.Row": lambda f: fields(f.comparison.rows[0]),
+    "dumbbell.analysis.compare.CompareOptions": lambda f: {
+        "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02, "t_end": 0.02,
+        "quiet": True},
     "dumbbell.analysis.compare.compare": lambda f: {
-        "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
-        "t_end": 0.02, "quiet": True},
+        "scene": f.scene, "options": _module("dumbbell.analysis.compare").CompareOptions(
+            ["euler-cromer"], [1e-3], 0.02, 0.02)},
     "dumbbell.analysis.compare.default_solvers": lambda f: {"scene": f.scene},
     "dumbbell.analysis.compare.Timing": lambda f: {"seconds": 0.01, "warm_up": 0.5, "runs": 3},
     "dumbbell.analysis.compare.timed_run": lambda f: {"scene": f.scene, "name": "exact"},
@@ -541,9 +542,12 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.stability.predict": lambda f: {
         "scene": f.scene, "solver": "verlet", "dt": 1e-3, "t_end": 1.0},
     "dumbbell.analysis.stability.rest_time": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.stability.run_stability": lambda f: {
+    "dumbbell.analysis.stability.StabilityOptions": lambda f: {
         "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
         "quiet": True},
+    "dumbbell.analysis.stability.run_stability": lambda f: {
+        "options": _module("dumbbell.analysis.stability").StabilityOptions(
+            f.scene_file.parent, ["euler-cromer"], 1)},
     # dumbbell.analysis.sweep
     "dumbbell.analysis.sweep.Axis": lambda f: fields(f.sweep_result.axes[0]),
     "dumbbell.analysis.sweep.Point": lambda f: {"index": 0, "values": {"run.dt": 1e-3}},
@@ -557,10 +561,13 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.sweep.plan": lambda f: {
         "scene": f.scene, "axes": f.sweep_result.axes, "solver": "euler-cromer",
         "t_end": 0.02},
+    "dumbbell.analysis.sweep.SweepOptions": lambda f: {
+        "solver": "euler-cromer", "t_end": 0.02, "workers": 1, "scheduler": None,
+        "quiet": True, "processes": False, "connect_timeout": 1.0},
     "dumbbell.analysis.sweep.run_sweep": lambda f: {
-        "scene": f.scene, "axes": f.sweep_result.axes[:1], "solver": "euler-cromer",
-        "t_end": 0.02, "workers": 1, "scheduler": None, "quiet": True, "processes": False,
-        "points": None, "connect_timeout": 1.0},
+        "scene": f.scene, "axes": f.sweep_result.axes[:1],
+        "options": _module("dumbbell.analysis.sweep").SweepOptions("euler-cromer", 0.02),
+        "points": None},
     "dumbbell.analysis.sweep.warm_up": lambda f: {"solver": "euler-cromer"},
     # dumbbell.analysis.topple
     "dumbbell.analysis.topple.ToppleClosedForm": lambda f: fields(f.topple_cf),
@@ -607,9 +614,9 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                    "folder": False},
     "dumbbell.io.files.is_special": lambda f: {"path": "/dev/null"},
     "dumbbell.io.files.output_transaction": lambda f: {"inputs": [(f.scene_file, "scene")]},
-    "dumbbell.io.frames.data_frame": lambda f: {"columns": {"t": [0.0, 1.0], "x": [1.0, 2.0]},
+    "dumbbell.frames.data_frame": lambda f: {"columns": {"t": [0.0, 1.0], "x": [1.0, 2.0]},
                                                 "index": "t", "units": {"t": "s", "x": "m"}},
-    "dumbbell.io.frames.pandas_module": lambda f: {"what": "to_pandas()"},
+    "dumbbell.frames.pandas_module": lambda f: {"what": "to_pandas()"},
     "dumbbell.io.restitution.markdown": lambda f: {"result": f.restitution},
     "dumbbell.io.restitution.write_csv": lambda f: {"result": f.restitution,
                                                     "path": f.tmp / "r.csv"},
@@ -720,6 +727,37 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder(),
         "heat": None},
 }
+
+def _solver_rows() -> dict[str, Callable[[Fixtures], dict[str, Any]]]:
+    """Valid arguments of every registered solver class and of its contract methods: a
+    scene it can run (the first of a 1D, a 2D spring and a rigid 2D scene), the run options,
+    and for one that estimates its own error, no second run."""
+
+    def scene_for(cls: type) -> Callable[[Fixtures], Any]:
+        def scene(f: Fixtures) -> Any:
+            return next(s for s in (f.scene, f.scene_2d, f.rigid_2d)
+                        if cls._supports(s) is None)
+        return scene
+
+    rows: dict[str, Callable[[Fixtures], dict[str, Any]]] = {}
+    for cls in _solvers():
+        key, scene = f"{cls.__module__}.{cls.__qualname__}", scene_for(cls)
+        extra = {"estimate_error": False} if cls.estimates_error else {}
+        rows[key] = lambda f: {}
+        for method in ("supports", "truth_for", "catch_depth"):
+            rows[f"{key}.{method}"] = lambda f, scene=scene: {"scene": scene(f)}
+        rows[f"{key}.solve"] = (lambda f, scene=scene, extra=extra:
+                                {"scene": scene(f), "options": f.options, **extra})
+        rows[f"{key}.check_work"] = lambda f, scene=scene: {"scene": scene(f),
+                                                            "options": f.options}
+        if hasattr(cls, "kernel"):
+            rows[f"{key}.kernel"] = (lambda f, scene=scene:
+                                     {"dimensions": scene(f).system.dimensions})
+        rows[f"{key}.swing"] = lambda f: {"ratio": 1.5}
+    return rows
+
+
+VALID.update(_solver_rows())
 
 #: Method case -> f -> the object whose method it is (fresh at each call).
 OWNER: dict[str, Callable[[Fixtures], Any]] = {

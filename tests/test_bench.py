@@ -13,6 +13,7 @@ import pytest
 from dumbbell.analysis.bench import (
     CSV_COLUMNS,
     DEFAULT_DTS,
+    BenchOptions,
     default_solvers,
     default_spacing,
     fit_order,
@@ -34,8 +35,8 @@ FIT_DTS = [1e-3, 3.16e-4, 1e-4, 3.16e-5, 1e-5]
 def one_second():
     """Euler-Cromer and verlet on the fit grid, 1 s simulated, window [0, 1 s]."""
     scene = make_scene({"run.t_end": 1.0})
-    return run_bench(scene, solvers=["euler-cromer", "verlet"], dts=FIT_DTS, window=1.0,
-                     repeat=1)
+    return run_bench(scene, BenchOptions(solvers=["euler-cromer", "verlet"], dts=FIT_DTS,
+                                         window=1.0, repeat=1))
 
 
 def test_defaults():
@@ -82,8 +83,8 @@ def test_sample_spacing_follows_the_spring():
 
 def test_textbook_accuracy_over_two_seconds():
     # docs/physics.md: Euler-Cromer at dt = 1e-5 is about 2e-3 m off the exact solution by 2 s.
-    result = run_bench(make_scene({"run.t_end": 2.0}), solvers=["euler-cromer"], dts=[1e-5],
-                       repeat=1)
+    result = run_bench(make_scene({"run.t_end": 2.0}),
+                       BenchOptions(solvers=["euler-cromer"], dts=[1e-5], repeat=1))
     point = result.points[0]
     assert point.every == 100 and point.window == 2.0
     assert 1e-3 < point.error < 4e-3
@@ -106,8 +107,8 @@ def test_extended_precision_check_sees_a_wrong_solution():
 def test_failed_runs_are_kept_and_slow_steps_skipped(tmp_path):
     # k = 2e4 N/m: w = 632 rad/s, so dt = 4e-3 s is past w*dt = 2 and blows up.
     scene = make_scene({"spring.stiffness": 2e4, "run.t_end": 0.5})
-    result = run_bench(scene, solvers=["euler-cromer"], dts=[4e-3, 1e-3, 1e-4], window=0.5,
-                       repeat=1, budget=1e-9)
+    result = run_bench(scene, BenchOptions(solvers=["euler-cromer"], dts=[4e-3, 1e-3, 1e-4],
+                                           window=0.5, repeat=1, budget=1e-9))
     rows = {p.dt: p for p in result.points if p.dt is not None}
     assert rows[4e-3].verdict == "unstable" and math.isinf(rows[4e-3].error)
     assert rows[1e-3].verdict == "ok"  # the first point that ran sets the cost per step
@@ -177,8 +178,8 @@ def test_time_for_an_error_interpolates_in_log_log():
 @pytest.mark.skipif("reference" not in REGISTRY, reason="needs the 2D reference solver")
 def test_2d_scene_uses_the_reference_as_truth():
     scene = load_scene(SCENES / "tilted-2d.toml")
-    result = run_bench(scene, solvers=["verlet"], dts=[1e-3, 1e-4], window=0.5, t_end=0.5,
-                       repeat=1)
+    result = run_bench(scene, BenchOptions(solvers=["verlet"], dts=[1e-3, 1e-4], window=0.5,
+                                           t_end=0.5, repeat=1))
     assert result.truth == "reference"
     coarse, fine, truth = result.points
     assert truth.solver == "reference" and truth.truth == "self"

@@ -59,7 +59,7 @@ def exit_code(argv: list[str]) -> int:
     (["--t-end", "nan"], "--t-end"),
     (["--every", "0"], "--every"),
     (["--every", "1.5"], "--every"),
-    (["--solver", "rk4"], "rk4"),
+    (["--solver", "no-such-solver"], "no-such-solver"),
     (["--dt", "20"], "dt"),
     (["--bogus"], "--bogus"),
 ])

@@ -207,7 +207,8 @@ def test_bench_truth_point_checks_rigid_against_extended_precision(rigid_run):
 
 
 def test_a_truth_that_misses_an_impact_ends_failed(rigid, textbook):
-    from dumbbell.solvers.verdicts import judge
+    from dumbbell.solvers import METHODS, RunOptions
+    from dumbbell.solvers.verdicts import RawRun, judge
 
     # The DOP853 reference steps over the grazing swing of B at 2.68 s on the rigid scene.
     ref = simulate(rigid, "reference", every=100)
@@ -219,13 +220,14 @@ def test_a_truth_that_misses_an_impact_ends_failed(rigid, textbook):
                 simulate(rigid, "exact", every=100, t_end=2.0)):
         key = "x" if run.scene.system.dimensions == 1 else "y"
         j = len(run.t) // 3
-        verdict, keep, energy = judge(run.scene, "exact", run.t, run.state, run.events,
-                                      run.verdict, None, truth=True)
+        options = RunOptions(run.dt, 2.0, run.every)
+        verdict, keep, energy = judge(METHODS["exact"], run.scene, options,
+                                      RawRun(run.t, run.state, run.events, run.verdict))
         assert verdict.ok and keep == len(run.t)
         state = dict(run.state, **{f"{key}B": run.state[f"{key}B"].copy()})
         state[f"{key}B"][j] = -2e-9
-        verdict, keep, energy = judge(run.scene, "exact", run.t, state, run.events,
-                                      run.verdict, None, truth=True)
+        verdict, keep, energy = judge(METHODS["exact"], run.scene, options,
+                                      RawRun(run.t, state, run.events, run.verdict))
         assert verdict.status == "failed" and verdict.t == run.t[j] and keep == j + 1
         assert all(len(col) == keep for col in energy.values())
 

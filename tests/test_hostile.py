@@ -781,18 +781,20 @@ def test_wrong_types_raise_a_dumbbell_error_naming_the_argument(call, argument):
 
 
 def test_analysis_functions_check_their_arguments():
-    from dumbbell.analysis.compare import compare
-    from dumbbell.analysis.sweep import run_sweep
+    from dumbbell.analysis.compare import CompareOptions, compare
+    from dumbbell.analysis.sweep import SweepOptions, run_sweep
 
     scene = load_scene(SCENES / "textbook-1d.toml")
     with pytest.raises(DumbbellError, match="solvers"):
-        compare(scene, solvers="exact")
+        compare(scene, CompareOptions(solvers="nope"))
+    with pytest.raises(DumbbellError, match="options"):
+        compare(scene, {"solvers": ["exact"]})
     with pytest.raises(DumbbellError, match="scene"):
-        compare(None)
+        compare(None, CompareOptions())
     with pytest.raises(DumbbellError, match="axes"):
-        run_sweep(scene, None, "euler-cromer")
+        run_sweep(scene, None, SweepOptions("euler-cromer"))
     with pytest.raises(DumbbellError, match="solver"):
-        run_sweep(scene, [], None)
+        run_sweep(scene, [], SweepOptions(3))
 
 
 def test_trajectory_outputs_check_their_path(tmp_path):

@@ -18,8 +18,8 @@ SCENES = Path(__file__).parent.parent / "scenes"
 
 
 def test_the_compare_text_holds_every_run_and_every_impact_in_the_window():
-    result = compare(SCENES / "textbook-1d.toml", ["euler-cromer", "verlet"], [1e-4],
-                     window=0.8, t_end=1.0)
+    result = compare(SCENES / "textbook-1d.toml", solvers=["euler-cromer", "verlet"],
+                     dts=[1e-4], window=0.8, t_end=1.0)
     lines = text(result).splitlines()
     rule = next(i for i, line in enumerate(lines) if set(line) == {"-"})
     table = lines[rule + 1: rule + 2 + len(result.rows)]

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from dumbbell.analysis.bench import run_bench
-from dumbbell.analysis.compare import compare
+import dumbbell
+from dumbbell import compare
 from dumbbell.analysis.metrics import energy_error, position_error, position_error_series
 from dumbbell.model.scene import load_scene
 from dumbbell.model.trajectory import Trajectory
@@ -71,7 +71,7 @@ def test_1d_position_error_is_the_height_difference():
 
 def test_compare_reports_the_measures_bench_reports():
     scene = load_scene(TILTED)
-    result = compare(scene, ["euler-cromer-2d"], [1e-4], window=0.5, t_end=0.5)
+    result = compare(scene, solvers=["euler-cromer-2d"], dts=[1e-4], window=0.5, t_end=0.5)
     row, truth = result.rows[0], result.truth
     # Independent: A's and B's distances from the truth, and E's drift from E(0).
     dist = np.maximum(np.hypot(row.traj["xA"] - truth["xA"], row.traj["yA"] - truth["yA"]),
@@ -80,8 +80,8 @@ def test_compare_reports_the_measures_bench_reports():
     assert row.window_error == pytest.approx(float(dist.max()), rel=1e-12)
     E = row.traj["E"]
     assert row.energy_error == pytest.approx(np.abs(E - E[0]).max() / abs(E[0]), rel=1e-12)
-    bench = run_bench(scene, solvers=["euler-cromer-2d"], dts=[1e-4], window=0.5, t_end=0.5,
-                      repeat=1, spacing=result.truth.t[1])
+    bench = dumbbell.bench(scene, solvers=["euler-cromer-2d"], dts=[1e-4], window=0.5,
+                           t_end=0.5, repeat=1, spacing=result.truth.t[1])
     point = bench.points[0]
     assert point.error == pytest.approx(row.window_error, rel=1e-9)
     assert point.energy_error == pytest.approx(row.energy_error, rel=1e-12)

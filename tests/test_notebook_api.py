@@ -121,6 +121,7 @@ def _frozen(result, field_name):
 
 
 def test_compare_from_python(textbook):
+    from dumbbell.analysis.compare import CompareOptions
     from dumbbell.analysis.compare import compare as analysis_compare
 
     result = dumbbell.compare(SCENES / "textbook-1d.toml", solvers=["euler-cromer", "verlet"],
@@ -139,8 +140,8 @@ def test_compare_from_python(textbook):
     assert df.loc["exact", "verdict"] == "ok"
     impacts = result.impacts_to_pandas()
     assert list(impacts["truth_t"]) == [e.t for e in result.truth.events]
-    # The old call signature still works and gives the same table.
-    old = analysis_compare(textbook, ["euler-cromer", "verlet"], [1e-4], 1.0, 1.2)
+    # The analysis function takes the options as one record, and gives the same table.
+    old = analysis_compare(textbook, CompareOptions(["euler-cromer", "verlet"], [1e-4], 1.0, 1.2))
     timing = ["wall_time", "steps_per_s", "warm_up"]
     assert old.to_pandas().drop(columns=timing).equals(df.drop(columns=timing))
 

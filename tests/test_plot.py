@@ -8,10 +8,10 @@ import matplotlib.figure
 import pytest
 
 from dumbbell import load_scene, plot, simulate
-from dumbbell.analysis.bench import run_bench
-from dumbbell.analysis.compare import compare
+from dumbbell.analysis.bench import BenchOptions, run_bench
+from dumbbell.analysis.compare import CompareOptions, compare
 from dumbbell.analysis.rotation import series
-from dumbbell.analysis.sweep import parse_axis, run_sweep
+from dumbbell.analysis.sweep import SweepOptions, parse_axis, run_sweep
 from tests.conftest import SCENES
 
 plt = pytest.importorskip("matplotlib.pyplot")
@@ -37,13 +37,14 @@ def results():
     return {
         "traj1": simulate(one_d, "euler-cromer", t_end=0.5, every=10),
         "traj2": simulate(two_d, "verlet", t_end=0.5, dt=1e-4, every=10),
-        "compare": compare(one_d, ["euler-cromer", "verlet"], dts=[1e-4], t_end=0.5,
-                           window=0.3),
-        "bench": run_bench(one_d, solvers=["euler-cromer", "verlet"], dts=[1e-3, 1e-4],
-                           window=0.3, t_end=0.3, repeat=1),
+        "compare": compare(one_d, CompareOptions(["euler-cromer", "verlet"], dts=[1e-4],
+                                                 t_end=0.5, window=0.3)),
+        "bench": run_bench(one_d, BenchOptions(solvers=["euler-cromer", "verlet"],
+                                               dts=[1e-3, 1e-4], window=0.3, t_end=0.3,
+                                               repeat=1)),
         "sweep": run_sweep(one_d, [parse_axis("k=log:100:1000:2"),
-                                   parse_axis("dt=lin:1e-4:2e-4:2")], "euler-cromer", 0.2,
-                           workers=1, processes=False),
+                                   parse_axis("dt=lin:1e-4:2e-4:2")],
+                           SweepOptions("euler-cromer", 0.2, workers=1, processes=False)),
         "rotation": series(two_d, solver="verlet", dt=1e-4, t_end=0.3),
     }
 

@@ -50,7 +50,7 @@ BAD = [
     ("below the floor", "height = 1.0", "height = -0.1", "bodies.B.height", ">= 0"),
     ("A below B", "height = 1.2", "height = 0.9", "bodies.A.height", "bodies.B.height"),
     ("elasticity above 1", "elasticity = 1.0", "elasticity = 1.5", "floor.elasticity", "<= 1"),
-    ("unknown solver", "dt = 1e-5", "dt = 1e-5\nsolver = 'rk4'", "run.solver", "one of"),
+    ("unknown solver", "dt = 1e-5", "dt = 1e-5\nsolver = 'no-such-solver'", "run.solver", "one of"),
     ("bad dimensions", 'dimensions = 1', 'dimensions = 3', "dimensions", "<= 2"),
     ("missing mass", "mass = 0.1\nheight = 1.2", "height = 1.2", "bodies.A.mass", "missing"),
     ("not TOML", "[run]", "[run", "", "not valid TOML"),

@@ -1,5 +1,5 @@
-"""The solver registry: every solver declares its facts, and one class plus one registry line
-is all a new solver needs."""
+"""The solver registry: every solver declares its facts, and one class is all a new solver
+needs (a registry line gives it a name the scenes and the CLI know)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from dumbbell import load_scene, simulate
+from dumbbell import DumbbellError, UsageError, load_scene, simulate
 from dumbbell.analysis.stability import predict
 from dumbbell.model.trajectory import Trajectory
 from dumbbell.solvers import (
@@ -20,10 +20,12 @@ from dumbbell.solvers import (
     supported,
     truth_solver,
 )
+from dumbbell.solvers.base import contract_problems
 from tests.conftest import SCENES
 
-TYPES = {"name": str, "order": (int, type(None)), "has_step": bool, "explicit_spring": bool,
-         "flip_floor": bool, "relative_cost": float, "is_truth": bool, "estimates_error": bool}
+TYPES = {"name": str, "order": (int, type(None)), "has_step": bool,
+         "step_limit": (float, type(None)), "flip_floor": bool, "relative_cost": float,
+         "is_truth": bool, "estimates_error": bool}
 
 
 def test_the_capability_list_is_the_one_checked_here():
@@ -38,12 +40,54 @@ def test_every_registered_solver_declares_every_capability(name):
         # Declared by the solver or its family (stepping.Stepper), never left to the contract.
         assert any(cap in vars(c) for c in cls.__mro__ if c is not Solver), f"{name}: {cap}"
         assert isinstance(getattr(cls, cap), TYPES[cap]), f"{name}: {cap}"
-    for method in ("supports", "solve"):
-        assert getattr(cls, method) is not getattr(Solver, method), f"{name}: {method}"
     assert cls.relative_cost > 0
-    # A solver without a step has no order in dt and no explicit step to be unstable.
-    assert cls.has_step or (cls.order is None and not cls.explicit_spring)
+    # A solver without a step has no order in dt and no step to be unstable.
+    assert cls.has_step or (cls.order is None and cls.step_limit is None)
     assert not cls.has_step or cls.order >= 1
+    assert contract_problems(cls) == []
+
+
+def test_the_step_limits_are_the_theory_of_each_method():
+    # Explicit spring steps (Euler-Cromer in either step order, Verlet, pymunk's impulse) are
+    # stable iff w*dt < 2; the step-free truths have no limit.
+    limits = {name: cls.step_limit for name, cls in METHODS.items()}
+    assert limits == {"euler-cromer": 2.0, "exact": None, "verlet": 2.0, "pymunk": 2.0,
+                      "reference": None, "euler-cromer-2d": 2.0}
+    # Their bounded swing at w*dt = h is h/(2 - h): 19 at 1.9, none past the limit.
+    assert METHODS["verlet"].swing(1.9) == pytest.approx(19.0)
+    assert METHODS["verlet"].swing(2.1) == float("inf")
+    assert METHODS["exact"].swing(1.9) is None
+
+
+def test_a_class_that_breaks_the_contract_is_refused_by_name():
+    class Half(Solver):  # no facts, no solve
+        name = "half"
+
+        @staticmethod
+        def supports(scene):
+            return None
+
+    problems = contract_problems(Half)
+    assert "order is not declared" in problems and "solve is not written" in problems
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(UsageError, match=r"solver = .*Half: does not keep the solver contract"):
+        simulate(scene, Half)
+    with pytest.raises(UsageError, match=r"solver = 3: must be one of euler-cromer, .* \(or a Solver subclass\)"):
+        simulate(scene, 3)
+    assert contract_problems(int) == ["not a subclass of dumbbell.solvers.Solver"]
+
+
+def test_a_contract_method_called_on_the_class_checks_its_arguments():
+    cls = METHODS["euler-cromer"]
+    with pytest.raises(DumbbellError, match="scene"):
+        cls.supports(None)
+    with pytest.raises(UsageError, match="options"):
+        cls.solve(SCENES / "textbook-1d.toml", None)
+    # ... and shows the parameters as written.
+    import inspect
+
+    assert list(inspect.signature(cls.solve).parameters) == ["scene", "options"]
+    assert list(inspect.signature(cls.supports).parameters) == ["scene"]
 
 
 def test_every_truth_solver_is_step_free_and_the_truth_exists_in_1d_and_2d():
@@ -70,7 +114,7 @@ class Still(Solver):
     name = "still"
     order = 1
     has_step = True
-    explicit_spring = False
+    step_limit = None
     flip_floor = False
     relative_cost = 0.5
     is_truth = False
@@ -95,7 +139,16 @@ def test_a_new_solver_is_one_class_and_one_registry_line(monkeypatch):
     assert "still" in supported(scene) and solver_class("still") is Still
     traj = simulate(scene, "still", t_end=0.01, every=10)
     assert traj.solver == "still" and traj.verdict.ok
-    # Analysis reads the facts from the class: a non-explicit spring has no step limit.
+    # Analysis reads the facts from the class: a spring step without a limit is never unstable.
     stiff = scene.with_values({"spring.stiffness": 1e9})
     assert predict(stiff, "still", 1e-3, 1.0).status == "ok"
     assert predict(stiff, "euler-cromer", 1e-3, 1.0).status == "unstable"
+
+
+def test_a_solver_class_runs_without_a_registry_line():
+    # Like scipy's method=, simulate takes the class itself.
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    traj = simulate(scene, Still, t_end=0.01, every=10)
+    assert traj.solver == "still" and len(traj) == 101
+    assert np.all(traj["xA"] == scene.system.A.height)
+    assert "still" not in METHODS and solver_class(Still) is Still

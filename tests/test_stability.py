@@ -15,8 +15,8 @@ import pytest
 from dumbbell.analysis.stability import find_cases, plan_cases, predict, rest_time
 from dumbbell.cli import main
 from dumbbell.model.scene import load_scene, scene_from_dict
-from dumbbell.solvers import REGISTRY, simulate
-from dumbbell.solvers.verdicts import seconds, stable_swing
+from dumbbell.solvers import METHODS, REGISTRY, simulate
+from dumbbell.solvers.verdicts import seconds
 from tests.conftest import SCENES, make_scene
 
 EXTREME = SCENES / "extreme"
@@ -66,7 +66,7 @@ def test_the_stable_swing_is_the_theory_bound():
         traj = simulate(_stiff(1.0, h), "euler-cromer")
         E = traj["E"]
         swing = float(np.max(np.abs(E - E[0])) / E[0])
-        assert swing == pytest.approx(stable_swing(h), rel=2e-3)
+        assert swing == pytest.approx(METHODS["euler-cromer"].swing(h), rel=2e-3)
 
 
 def test_default_threshold_names_the_swing_when_it_calls_a_stable_step_unstable():
@@ -137,7 +137,7 @@ def test_every_catalogue_scene_loads_and_says_what_it_tests():
         assert path.read_text().startswith("# Tests:"), path.name
         assert scene.title
     runs, _ = plan_cases(paths, None)
-    assert {s for _, s in runs} >= {"euler-cromer", "exact"}
+    assert {cls.name for _, cls in runs} >= {"euler-cromer", "exact"}
 
 
 def test_stability_command_writes_table_csv_and_map(tmp_path, capsys):
@@ -215,3 +215,24 @@ def test_every_report_column_has_a_unit():
     from dumbbell.analysis.stability import COLUMNS, UNITS
 
     assert set(UNITS) == set(COLUMNS)
+
+
+@pytest.mark.parametrize("solver,scene", [
+    ("euler-cromer", "textbook-1d"), ("verlet", "textbook-1d"), ("euler-cromer-2d", "tilted-2d"),
+    ("verlet", "tilted-2d")])
+def test_a_verdict_is_dated_at_its_step_whatever_the_sampling(solver, scene):
+    """dt = 0.1 s is far past the step limit (w*dt = 6.3): the energy passes the scene's
+    threshold within a few steps, long before the state overflows. Sampled every step, every
+    7th, every 100th, or so sparsely that the state overflows before the first sample is
+    kept, the verdict names the same step: the first whose energy error passes, computed
+    here from the every-step run's own columns."""
+    base = load_scene(SCENES / f"{scene}.toml").with_values({"run.dt": 0.1, "run.t_end": 30.0})
+    full = simulate(base, solver, every=1)
+    E = full["E"]
+    err = np.abs(E - E[0]) / abs(E[0])
+    first = int(np.flatnonzero(err > base.run.unstable_energy)[0])
+    assert full.verdict.status == "unstable" and full.verdict.t == full.t[first]
+    for every in (7, 100, 250):
+        v = simulate(base, solver, every=every).verdict
+        assert v.status == "unstable" and v.t == full.verdict.t, (every, v)
+        assert v.reason == full.verdict.reason

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from dumbbell.analysis.sweep import parse_axis, plan, run_sweep
+from dumbbell.analysis.sweep import SweepOptions, parse_axis, plan, run_sweep
 from dumbbell.cli import main
 from dumbbell.errors import UsageError
 from dumbbell.io.sweep import csv_text
@@ -54,7 +54,7 @@ def test_stiff_sweep_blows_up_where_theory_says():
     smallest that fails straddle the theory's 2/w (grid steps of 12%)."""
     scene = load_scene(STIFF)
     axes = [parse_axis("k=log:1e3:1e5:3"), parse_axis("dt=log:1e-4:1e-1:60")]
-    result = run_sweep(scene, axes, "euler-cromer", t_end=1.0, workers=1)
+    result = run_sweep(scene, axes, SweepOptions("euler-cromer", t_end=1.0, workers=1))
     rows = result.boundary()
     assert len(rows) == 3
     for row in rows:
@@ -95,8 +95,8 @@ def test_same_csv_from_serial_pool_and_dask(tmp_path):
     pytest.importorskip("dask.distributed")
     scene = load_scene(TEXTBOOK)
     axes = [parse_axis("k=log:1e2:1e5:3"), parse_axis("dt=log:1e-4:3e-3:3")]
-    serial = csv_text(run_sweep(scene, axes, "euler-cromer", 0.3, workers=1))
-    pooled = csv_text(run_sweep(scene, axes, "euler-cromer", 0.3, workers=2))
+    serial = csv_text(run_sweep(scene, axes, SweepOptions("euler-cromer", 0.3, workers=1)))
+    pooled = csv_text(run_sweep(scene, axes, SweepOptions("euler-cromer", 0.3, workers=2)))
     out = tmp_path / "dask"
     assert main(["sweep", TEXTBOOK, "--grid", "k=log:1e2:1e5:3", "dt=log:1e-4:3e-3:3",
                  "--t-end", "0.3", "--out", str(out), "-q", "--scheduler", "local",

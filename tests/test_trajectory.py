@@ -10,8 +10,8 @@ import pytest
 
 from dumbbell.model.energy import energy_columns, partition
 from dumbbell.model.trajectory import Trajectory, Verdict
-from dumbbell.solvers import simulate
-from dumbbell.solvers.verdicts import judge
+from dumbbell.solvers import METHODS, RunOptions, simulate
+from dumbbell.solvers.verdicts import RawRun, judge
 
 from .conftest import make_scene
 
@@ -81,7 +81,8 @@ def test_judge_changes_nothing_and_says_where_to_cut():
     E_like = np.array([0.0, 0.0, 0.001, 0.002, 0.5, 1.0])
     state = {"xA": 1.21 + E_like, "vA": 0 * t, "xB": 1.0 + 0 * t, "vB": 0 * t}
     before = {name: col.copy() for name, col in state.items()}
-    verdict, keep, energy = judge(scene, "test", t, state, (), Verdict(), 1e-4)
+    cls, options = METHODS["euler-cromer"], RunOptions(1e-4, 1.0)
+    verdict, keep, energy = judge(cls, scene, options, RawRun(t, state))
     for name, col in state.items():
         np.testing.assert_array_equal(col, before[name])
     full = partition(scene, t, state)
@@ -91,7 +92,8 @@ def test_judge_changes_nothing_and_says_where_to_cut():
     assert verdict.t == t[first_bad]
     assert all(len(col) == keep for col in energy.values())
     # A solver's own failure (not an energy one) keeps every sample.
-    verdict, keep, _ = judge(scene, "test", t, state, (), Verdict("tunnelled", 1.0, "x"), 1e-4)
+    verdict, keep, _ = judge(cls, scene, options, RawRun(t, state, (),
+                                                         Verdict("tunnelled", 1.0, "x")))
     assert verdict.status == "tunnelled" and keep == len(t)
 
 

@@ -1,7 +1,7 @@
 """One ordered map over three backends: this process, a local process pool, or Dask.
 
->>> ordered_map(evaluate, [(values, "verlet") for values in grid], shared=scene,
-...             workers=2)                                                # doctest: +SKIP
+>>> ordered_map(evaluate, [(values, Verlet) for values in grid], Backend(workers=2),
+...             shared=scene)                                             # doctest: +SKIP
 
 ``func(shared, *job)`` (or ``func(*job)`` without ``shared``) runs for every job; the results
 come back in job order whatever order they finish in, so the same jobs give the same result
@@ -18,11 +18,12 @@ import numbers
 import os
 import signal
 from collections.abc import Callable, Iterable, Sequence
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 from .errors import UsageError
 
-__all__ = ["batches", "cap_note", "cap_workers", "ordered_map"]
+__all__ = ["Backend", "batches", "cap_note", "cap_workers", "ordered_map"]
 
 def _check(ok: bool, name: str, value: Any, allowed: str) -> None:
     """UsageError naming ``name`` unless ``ok``. (This module sits below the model, so it
@@ -123,78 +124,105 @@ def _collect(futures: Iterable[Any], as_completed: Callable[[Any], Iterable[Any]
         pb.update(len(part))
 
 
-def ordered_map(
-    func: Callable[..., Any], jobs: Sequence[tuple], *, shared: Any = _NOTHING,
-    workers: int = 1, scheduler: str | None = None, processes: bool = True,
-    initializer: Callable[..., None] | None = None, initargs: tuple = (),
-    quiet: bool = True, desc: str = "", unit: str = "run", connect_timeout: float = 10.0,
-) -> list[Any]:
-    """``[func(shared, *job) for job in jobs]`` in job order.
+@dataclass(frozen=True)
+class Backend:
+    """Where and how :func:`ordered_map` runs its jobs.
 
     ``workers`` 1 (or a single job): in this process. More: a local process pool of that
-    many processes, each first calling ``initializer(*initargs)``. ``scheduler``: a Dask
-    cluster at that address, or 'local' for a new LocalCluster of ``workers``
-    single-threaded workers (threads instead of processes with ``processes`` False);
-    ``shared`` is then sent to every worker once. ``func`` must be a module-level function
-    (it is pickled). A progress bar counts the jobs on a terminal unless ``quiet``.
+    many processes (capped at one per CPU and per job, :func:`cap_workers`), each first
+    calling ``initializer(*initargs)``. ``scheduler``: a Dask cluster at that address, or
+    'local' for a new LocalCluster of ``workers`` single-threaded workers (threads instead of
+    processes with ``processes`` False); a scheduler that does not answer within
+    ``connect_timeout`` s is a UsageError naming its address. A progress bar counts the jobs
+    (``unit``, described by ``desc``) on a terminal unless ``quiet``."""
 
-    Local processes are capped at one per CPU and per job (:func:`cap_workers`). If anything
-    goes wrong here (an exception from a job, Ctrl-C, SIGTERM, SIGHUP) the pool's workers are
-    terminated before the exception goes on: none outlives the call. A Dask scheduler that
-    does not answer within ``connect_timeout`` s is a UsageError naming its address."""
+    workers: int = 1
+    scheduler: str | None = None
+    processes: bool = True
+    initializer: Callable[..., None] | None = None
+    initargs: tuple = ()
+    quiet: bool = True
+    desc: str = ""
+    unit: str = "run"
+    connect_timeout: float = 10.0
+
+    def __post_init__(self) -> None:
+        if self.scheduler is not None:
+            _check(isinstance(self.scheduler, str), "scheduler", self.scheduler,
+                   "a Dask scheduler's address (str), 'local' or None")
+        _whole(self.workers, "workers", "processes", 0 if self.scheduler is not None else 1)
+        for name in ("processes", "quiet"):
+            value = getattr(self, name)
+            _check(isinstance(value, bool) or type(value).__name__ == "bool_", name, value,
+                   "True or False")
+        _check(self.initializer is None or callable(self.initializer), "initializer",
+               self.initializer, "a function or None")
+        _check(isinstance(self.initargs, tuple | list), "initargs", self.initargs,
+               "a tuple of arguments")
+        for name in ("desc", "unit"):
+            _check(isinstance(getattr(self, name), str), name, getattr(self, name), "a str")
+        _check(not isinstance(self.connect_timeout, bool)
+               and isinstance(self.connect_timeout, numbers.Real)
+               and 0 < self.connect_timeout < math.inf, "connect_timeout",
+               self.connect_timeout, "a finite number > 0 (s)")
+
+
+class _Work(NamedTuple):
+    """The jobs of one :func:`ordered_map`: ``func``, the jobs with their indices, and the
+    leading argument every job gets (``()`` or ``(shared,)``)."""
+
+    func: Callable[..., Any]
+    indexed: list[tuple[int, tuple]]
+    lead: tuple
+
+
+def ordered_map(func: Callable[..., Any], jobs: Sequence[tuple], backend: Backend | None = None,
+                *, shared: Any = _NOTHING) -> list[Any]:
+    """``[func(shared, *job) for job in jobs]`` in job order, run where ``backend`` says (by
+    default in this process); ``shared`` is sent to every worker once. ``func`` must be a
+    module-level function (it is pickled).
+
+    If anything goes wrong here (an exception from a job, Ctrl-C, SIGTERM, SIGHUP) the pool's
+    workers are terminated before the exception goes on: none outlives the call."""
     from .progress import bar
 
     _check(callable(func), "func", func, "a function")
     _check(not isinstance(jobs, str) and isinstance(jobs, Sequence)
            and all(isinstance(job, tuple | list) for job in jobs),
            "jobs", jobs, "a list of argument tuples")
-    if scheduler is not None:
-        _check(isinstance(scheduler, str), "scheduler", scheduler,
-               "a Dask scheduler's address (str), 'local' or None")
-        workers = _whole(workers, "workers", "processes", 0)  # a cluster's own: 0 is fine
-    for name, value in (("processes", processes), ("quiet", quiet)):
-        _check(isinstance(value, bool) or type(value).__name__ == "bool_", name, value,
-               "True or False")
-    _check(initializer is None or callable(initializer), "initializer", initializer,
-           "a function or None")
-    _check(isinstance(initargs, tuple | list), "initargs", initargs, "a tuple of arguments")
-    for name, value in (("desc", desc), ("unit", unit)):
-        _check(isinstance(value, str), name, value, "a str")
-    _check(not isinstance(connect_timeout, bool) and isinstance(connect_timeout, numbers.Real)
-           and 0 < connect_timeout < math.inf, "connect_timeout", connect_timeout,
-           "a finite number > 0 (s)")
-    if scheduler is None or scheduler == "local":
+    backend = Backend() if backend is None else backend
+    _check(isinstance(backend, Backend), "backend", backend, "a Backend or None")
+    workers = backend.workers
+    if backend.scheduler is None or backend.scheduler == "local":
         workers, _ = cap_workers(workers, len(jobs))
     results: list[Any] = [None] * len(jobs)
-    indexed = list(enumerate(jobs))
-    lead = () if shared is _NOTHING else (shared,)
-    with bar(len(jobs), desc, unit, quiet=quiet) as pb:
-        if scheduler is not None:
-            _on_dask(func, indexed, lead, scheduler, workers, processes, results, pb,
-                     connect_timeout)
+    work = _Work(func, list(enumerate(jobs)), () if shared is _NOTHING else (shared,))
+    with bar(len(jobs), backend.desc, backend.unit, quiet=backend.quiet) as pb:
+        if backend.scheduler is not None:
+            _on_dask(work, backend, workers, results, pb)
         elif workers <= 1 or len(jobs) <= 1:
-            for i, job in indexed:
-                results[i] = func(*lead, *job)
+            for i, job in work.indexed:
+                results[i] = func(*work.lead, *job)
                 pb.update(1)
         else:
-            _on_pool(func, indexed, lead, workers, initializer, initargs, results, pb)
+            _on_pool(work, backend, workers, results, pb)
     return results
 
 
-def _on_pool(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: tuple,
-             workers: int, initializer: Callable[..., None] | None, initargs: tuple,
-             results: list[Any], pb: Any) -> None:
+def _on_pool(work: _Work, backend: Backend, workers: int, results: list[Any], pb: Any) -> None:
     import multiprocessing
 
-    items = [(func, lead, [indexed[i] for i in b]) for b in batches(len(indexed), workers)]
+    items = [(work.func, work.lead, [work.indexed[i] for i in b])
+             for b in batches(len(work.indexed), workers)]
     # A signal that lands between a worker's fork and its worker_init would run the parent's
     # stop handler inside the worker and print a traceback. So the stop signals stay blocked
     # while the pool forks (its helper threads, which fork replacements, inherit the mask);
     # a signal sent meanwhile waits, and is raised once the pool can be terminated.
     before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_NUMBERS)
     try:
-        pool = multiprocessing.get_context().Pool(workers, initializer=worker_init,
-                                                  initargs=(initializer, *initargs))
+        pool = multiprocessing.get_context().Pool(
+            workers, initializer=worker_init,
+            initargs=(backend.initializer, *backend.initargs))
     except BaseException:
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
         raise
@@ -212,9 +240,9 @@ def _on_pool(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: t
         pool.join()
 
 
-def _on_dask(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: tuple,
-             scheduler: str, workers: int, processes: bool, results: list[Any], pb: Any,
-             connect_timeout: float = 10.0) -> None:
+def _on_dask(work: _Work, backend: Backend, workers: int, results: list[Any], pb: Any
+             ) -> None:
+    scheduler = backend.scheduler
     try:
         from dask.distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -224,16 +252,16 @@ def _on_dask(func: Callable[..., Any], indexed: list[tuple[int, tuple]], lead: t
         if scheduler == "local":
             cluster = stack.enter_context(LocalCluster(
                 n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                processes=processes, dashboard_address=None, silence_logs=50))
+                processes=backend.processes, dashboard_address=None, silence_logs=50))
             client = stack.enter_context(Client(cluster))
         else:
-            client = stack.enter_context(_connect(Client, scheduler, connect_timeout))
+            client = stack.enter_context(_connect(Client, scheduler, backend.connect_timeout))
         n_workers = max(1, len(client.scheduler_info().get("workers", {})))
         # The shared value goes to every worker once; each batch names it by its future.
-        sent = [client.scatter(value, broadcast=True) for value in lead]
-        futures = [client.submit(_run_dask_batch, func, *sent, batch=[indexed[i] for i in b],
-                                 pure=False)
-                   for b in batches(len(indexed), n_workers)]
+        sent = [client.scatter(value, broadcast=True) for value in work.lead]
+        futures = [client.submit(_run_dask_batch, work.func, *sent,
+                                 batch=[work.indexed[i] for i in b], pure=False)
+                   for b in batches(len(work.indexed), n_workers)]
         try:
             _collect(futures, as_completed, results, pb)
         except BaseException:

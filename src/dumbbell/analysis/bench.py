@@ -55,20 +55,20 @@ from ..solvers import (
     MAX_SAMPLES,
     RunOptions,
     Solver,
-    make_options,
-    solver_class,
-    supported,
-    truth_solver,
+    supporting,
+    truth_class,
 )
-from .extended import extended_precision_exact, extended_precision_rigid
-from .metrics import energy_error, impact_time_error, position_error
+from ..solvers.base import run_options
+from ._fields import check
+from .extended import _exact_error, _rigid_error
+from .metrics import _energy_error, _impact_time_error, _position_error
 
 if TYPE_CHECKING:
     import pandas
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
-__all__ = ["BenchResult", "Fit", "Point", "default_solvers", "default_spacing", "dt_label",
-           "fit_order", "run_bench", "time_for_error"]
+__all__ = ["BenchOptions", "BenchResult", "Fit", "Point", "default_solvers",
+           "default_spacing", "dt_label", "fit_order", "run_bench", "time_for_error"]
 
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
 #: Default window of the position error (s): the textbook figures' 0-2 s.
@@ -146,12 +146,14 @@ class Point:
 
 @dataclass
 class Fit:
-    """A fitted convergence order: error ~ C dt^order over the steps ``dts`` (s)."""
+    """A fitted convergence order: error ~ C dt^order over the steps ``dts`` (s), beside the
+    order the solver declares (``expected``; None: it declares none)."""
 
     solver: str
     order: float
     log10_c: float
     dts: list[float] = field(default_factory=list)
+    expected: int | None = None
 
 
 #: Units of :data:`CSV_COLUMNS` ("1": dimensionless; "" for names and counts).
@@ -235,7 +237,7 @@ class BenchResult:
     def to_pandas(self) -> pandas.DataFrame:
         """One row per point with the CSV's columns (numbered from 0), units in
         ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         rows = [asdict(p) for p in self.points]
         return data_frame({c: [r[c] for r in rows] for c in CSV_COLUMNS}, units=CSV_UNITS)
@@ -267,7 +269,10 @@ def time_for_error(line: list[tuple[float, float]], target: float) -> float | No
 def default_spacing(scene: Scene) -> float:
     """Spacing of the compared samples (s): SAMPLE_SPACING, or 1/SAMPLES_PER_PERIOD of the
     spring's period when that is shorter."""
-    scene = args.scene(scene)
+    return _spacing(args.scene(scene))
+
+
+def _spacing(scene: Scene) -> float:
     if scene.system.omega > 0:
         return min(SAMPLE_SPACING, 2 * math.pi / scene.system.omega / SAMPLES_PER_PERIOD)
     return SAMPLE_SPACING
@@ -275,35 +280,87 @@ def default_spacing(scene: Scene) -> float:
 
 def default_solvers(scene: Scene) -> list[str]:
     """Every solver that can run ``scene``, except the truth."""
-    scene = args.scene(scene)
-    truth = truth_solver(scene)
-    return [n for n in supported(scene) if n != truth]
+    return [cls.name for cls in _default_solvers(args.scene(scene))]
 
 
-def check_request(scene: Scene, solvers: list[str], dts: list[float], window: float,
-                  t_end: float, spacing: float = SAMPLE_SPACING) -> None:
-    """UsageError naming the flag and what is allowed, before anything runs."""
-    for name in solvers:
-        reason = solver_class(name).supports(scene)
+def _default_solvers(scene: Scene) -> list[type[Solver]]:
+    truth = truth_class(scene)
+    return [cls for cls in supporting(scene) if cls is not truth]
+
+
+@dataclass(frozen=True)
+class BenchOptions:
+    """What :func:`run_bench` measures: ``solvers`` (names or Solver classes; None: every
+    solver that can run the scene but the truth) at the steps ``dts`` (s, kept largest first)
+    over ``t_end`` (s; None: the scene's); the position error over [0, ``window``] s;
+    ``repeat`` timed runs after a warm-up; a step whose runs would take more than ``budget``
+    s in all is skipped; samples about every ``spacing`` s (None: :func:`default_spacing`);
+    a progress bar unless ``quiet``. Built once, checked once."""
+
+    solvers: tuple[type[Solver], ...] | None = None
+    dts: tuple[float, ...] = DEFAULT_DTS
+    window: float = DEFAULT_WINDOW
+    repeat: int = DEFAULT_REPEAT
+    t_end: float | None = None
+    budget: float = DEFAULT_BUDGET
+    spacing: float | None = None
+    quiet: bool = True
+
+    def __post_init__(self) -> None:
+        check(self, {"solvers": "solvers", "dts": "steps", "window": "seconds",
+                     "t_end": "seconds?", "budget": "seconds", "spacing": "seconds?",
+                     "quiet": "flag"})
+        object.__setattr__(self, "dts", tuple(sorted(self.dts, reverse=True)))
+        if not (type(self.repeat) is int and 1 <= self.repeat <= MAX_REPEAT):
+            object.__setattr__(self, "repeat", args.whole(self.repeat, "repeat", "runs",
+                                                          hi=MAX_REPEAT))
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What every point of one benchmark shares: the options resolved for the scene (its
+    solvers, ``t_end`` and ``spacing`` filled in) and the truth solver (None: none)."""
+
+    options: BenchOptions
+    truth: type[Solver] | None
+
+    @property
+    def solvers(self) -> tuple[type[Solver], ...]:
+        return self.options.solvers or ()
+
+    @property
+    def truth_name(self) -> str:
+        return self.truth.name if self.truth is not None else ""
+
+
+def check_request(scene: Scene, plan: _Plan) -> None:
+    """UsageError naming the argument and what is allowed, before anything runs."""
+    options = plan.options
+    for cls in plan.solvers:
+        reason = cls._supports(scene)
         if reason is not None:
-            raise UsageError(f"solvers {name}: cannot run {scene.source}: {reason}", param="solvers")
-    if not solvers:
+            raise UsageError(f"solvers {cls.name}: cannot run {scene.source}: {reason}",
+                             param="solvers")
+    if not plan.solvers:
         raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
-    for dt in dts:
+    t_end, window, spacing = options.t_end, options.window, options.spacing
+    assert t_end is not None and spacing is not None  # filled in by the plan
+    for dt in options.dts:
         try:
-            make_options(scene, dt=dt, t_end=t_end)
+            run_options(scene, dt, t_end)
         except UsageError as exc:
             raise UsageError(f"dts: {exc.reason}", param="dts", fixes=exc.fixes) from None
     if window > t_end:
-        raise UsageError(f"window {window:g}: must be <= the run's t_end = {t_end:g} (s)", param="window")
+        raise UsageError(f"window {window:g}: must be <= the run's t_end = {t_end:g} (s)",
+                         param="window")
     if not 0 < spacing <= window:
         raise UsageError(f"sample_spacing {spacing:g}: must be > 0 and <= the window "
                          f"{window:g} (s)", param="sample_spacing")
     # The samples one run keeps, before anything runs: a stepping solver keeps every
     # round(spacing / dt)-th step, a solver without a step one sample per spacing.
     ratio = t_end / spacing  # a float: inf when the quotient passes the largest float
-    counts = [make_options(scene, dt=dt, t_end=t_end, every=_every(dt, spacing)).n_samples
-              for dt in dts]
+    counts = [run_options(scene, dt, t_end, _every(dt, spacing)).n_samples
+              for dt in options.dts]
     if not (ratio + 1 <= MAX_SAMPLES and max(counts, default=0) <= MAX_SAMPLES):
         most = max([*counts, round(ratio) + 1]) if math.isfinite(ratio) else None
         count = f"{most:,} samples" if most is not None else "more than 1e308 samples"
@@ -311,123 +368,89 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
                          f"keep {count}, past the budget of {MAX_SAMPLES:,}",
                          fixes=("keep fewer with a larger {spacing}", "a shorter {t_end}"))
     # Every solver's own work budget (the exact solver's impacts), before the first run.
-    truth = truth_solver(scene)
-    for name in [*solvers, *([truth] if truth else [])]:
-        solver_class(name).check_work(scene, make_options(scene, dt=spacing, t_end=t_end))
+    for cls in [*plan.solvers, *([plan.truth] if plan.truth else [])]:
+        cls._check_work(scene, run_options(scene, spacing, t_end))
 
 
-def run_bench(
-    scene: Scene | str | Path,
-    solvers: list[str] | None = None,
-    dts: list[float] | None = None,
-    window: float = DEFAULT_WINDOW,
-    repeat: int = DEFAULT_REPEAT,
-    t_end: float | None = None,
-    budget: float = DEFAULT_BUDGET,
-    spacing: float | None = None,
-    quiet: bool = True,
-) -> BenchResult:
-    """Measure error against run time for ``solvers`` (default: all but the truth) at the
-    steps ``dts`` (s; default half-decades 1e-3..1e-6) over the scene's ``t_end`` (s).
-    ``window`` (s) bounds the position error; ``repeat`` timed runs follow a warm-up run;
-    a step whose runs would take more than ``budget`` s in all is skipped. Samples are kept
-    about every ``spacing`` s (default :func:`default_spacing`; the step-free solvers:
-    exactly)."""
+def run_bench(scene: Scene | str | Path, options: BenchOptions) -> BenchResult:
+    """Measure error against run time as ``options`` say (:class:`BenchOptions()`: every
+    solver but the truth at half-decades of dt from 1e-3 to 1e-6 s over the scene's
+    ``t_end``)."""
     from ..progress import bar
-    from ..solvers import available
 
     scene = args.scene(scene)
-    t_end = scene.run.t_end if t_end is None else args.real(t_end, "t_end", "s")
-    spacing = default_spacing(scene) if spacing is None else args.real(spacing, "spacing", "s")
-    solvers = (default_solvers(scene) if solvers is None
-               else list(dict.fromkeys(args.names(solvers, "solvers", available()))))
-    dts = sorted(DEFAULT_DTS if dts is None else args.positives(dts, "dts", "s"), reverse=True)
-    window = args.real(window, "window", "s")
-    repeat = args.whole(repeat, "repeat", "runs", hi=MAX_REPEAT)
-    budget = args.real(budget, "budget", "s")
-    quiet = args.flag(quiet, "quiet")
-    check_request(scene, solvers, dts, window, t_end, spacing)
-    truth = truth_solver(scene)
+    options = args.instance(options, "options", BenchOptions, "BenchOptions")
+    truth = truth_class(scene)
+    solvers = options.solvers or tuple(_default_solvers(scene))
+    plan = _Plan(replace(options, solvers=solvers,
+                         t_end=scene.run.t_end if options.t_end is None else options.t_end,
+                         spacing=options.spacing or _spacing(scene)), truth)
+    check_request(scene, plan)
+    o = plan.options
     notes: list[str] = []
     if truth is None:
         notes.append("no truth solver for this scene (2D needs 'reference'): position and "
                       "impact-time errors are not computed")
     truths: dict[tuple[float, int], Trajectory] = {}
 
-    def truth_at(options: RunOptions) -> Trajectory | None:
+    def truth_at(run: RunOptions) -> Trajectory | None:
         if truth is None:
             return None
-        key = (options.dt, options.every)
+        key = (run.dt, run.every)
         if key not in truths:
-            truths[key] = solver_class(truth).solve(scene, replace(options, quiet=True),
-                                                    **_no_estimate(solver_class(truth)))
+            truths[key] = truth._solve(scene, replace(run, quiet=True), **_no_estimate(truth))
         return truths[key]
 
     points: list[Point] = []
     # A solver without a step is one point: dt only sets its sample times.
-    steppers = [n for n in solvers if solver_class(n).has_step]
-    single = [n for n in solvers if not solver_class(n).has_step and n != truth]
-    total = len(steppers) * len(dts) + len(single) + (truth is not None)
-    plan = _Plan(dts, window, t_end, repeat, budget, spacing, truth)
-    with bar(total, f"bench {scene.name}", "point", quiet=quiet) as pb:
-        for name in steppers:
-            points += _stepper_points(scene, name, plan, truth_at, pb)
-        for name in single:
-            pb.set_postfix_str(name)
-            points.append(_single_point(scene, name, plan, truth_at))
+    steppers = [cls for cls in solvers if cls.has_step]
+    single = [cls for cls in solvers if not cls.has_step and cls is not truth]
+    total = len(steppers) * len(o.dts) + len(single) + (truth is not None)
+    with bar(total, f"bench {scene.name}", "point", quiet=o.quiet) as pb:
+        for cls in steppers:
+            points += _stepper_points(scene, cls, plan, truth_at, pb)
+        for cls in single:
+            pb.set_postfix_str(cls.name)
+            points.append(_single_point(scene, cls, plan, truth_at))
             pb.update(1)
         if truth is not None:
-            pb.set_postfix_str(f"{truth} (truth)")
+            pb.set_postfix_str(f"{truth.name} (truth)")
             points.append(_single_point(scene, truth, plan, None))
             pb.update(1)
     fits = {}
-    for name in steppers:
-        fit = fit_order([p for p in points if p.solver == name])
+    for cls in steppers:
+        fit = fit_order([p for p in points if p.solver == cls.name])
         if fit is not None:
-            fits[name] = fit
-    return BenchResult(scene.name, scene.source, truth, window, t_end, repeat, budget, points,
-                       fits, notes, spacing)
+            fits[cls.name] = replace(fit, expected=cls.order)
+    return BenchResult(scene.name, scene.source, plan.truth_name or None, o.window,
+                       o.t_end, o.repeat, o.budget, points, fits, notes,  # type: ignore[arg-type]
+                       o.spacing)  # type: ignore[arg-type]
 
 
-@dataclass(frozen=True)
-class _Plan:
-    """What every point of one benchmark shares: the steps of the stepping solvers (s,
-    largest first), the error window and run length (s), the timed runs per point, the time
-    budget per point (s), the sample spacing (s) and the truth solver (None: none)."""
-
-    dts: list[float]
-    window: float
-    t_end: float
-    repeat: int
-    budget: float
-    spacing: float
-    truth: str | None
-
-
-def _stepper_points(scene: Scene, name: str, plan: _Plan, truth_at: Any,
+def _stepper_points(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any,
                     pb: Any) -> list[Point]:
-    """One point per step in ``plan.dts`` for the stepping solver ``name``. A step whose runs
-    the cost per step measured so far says would pass the budget is skipped."""
-    cls = solver_class(name)
+    """One point per step in the plan's dts for the stepping solver ``cls``. A step whose
+    runs the cost per step measured so far says would pass the budget is skipped."""
+    o = plan.options
     compile_s = cls.warm_up()
     cost_per_step = None
     points = []
-    for dt in plan.dts:
-        pb.set_postfix_str(f"{name} dt={dt:g}")
-        options = make_options(scene, dt=dt, t_end=plan.t_end,
-                               every=_every(dt, plan.spacing))
-        base = Point(name, dt, window=plan.window, t_end=plan.t_end, truth=plan.truth or "",
-                     steps=options.n_steps, every=options.every, compile_seconds=compile_s)
+    for dt in o.dts:
+        pb.set_postfix_str(f"{cls.name} dt={dt:g}")
+        options = run_options(scene, dt, o.t_end, _every(dt, o.spacing))  # type: ignore[arg-type]
+        base = Point(cls.name, dt, window=o.window, t_end=o.t_end,  # type: ignore[arg-type]
+                     truth=plan.truth_name, steps=options.n_steps, every=options.every,
+                     compile_seconds=compile_s)
         estimate = None if cost_per_step is None else cost_per_step * options.n_steps
-        if estimate is not None and estimate * (plan.repeat + 1) > plan.budget:
+        if estimate is not None and estimate * (o.repeat + 1) > o.budget:
             base.verdict, base.seconds = None, estimate
-            base.reason = (f"estimated {estimate:.3g} s per run x {plan.repeat + 1} runs > "
-                           f"budget {plan.budget:g} s")
+            base.reason = (f"estimated {estimate:.3g} s per run x {o.repeat + 1} runs > "
+                           f"budget {o.budget:g} s")
             points.append(base)
             pb.update(1)
             continue
-        traj, point = _measure(cls, scene, options, plan.repeat, base)
-        _score(point, traj, truth_at(options), plan.window)
+        traj, point = _measure(cls, scene, options, o.repeat, base)
+        _score(point, traj, truth_at(options), o.window)
         points.append(point)
         if point.ok and point.steps:
             cost_per_step = point.seconds_call / point.steps
@@ -448,13 +471,13 @@ def _measure(cls: type[Solver], scene: Scene, options: RunOptions, repeat: int, 
              **first: Any) -> tuple[Trajectory, Point]:
     """Warm-up run (kept for the diagnostics; ``first`` are its extra keywords), then
     ``repeat`` timed runs."""
-    traj = cls.solve(scene, options, **first)
+    traj = cls._solve(scene, options, **first)
     own, call = [], []
     # Short runs are repeated until MIN_TIMED s are timed (at most MAX_REPEAT runs), so that
     # one busy moment of a shared machine cannot hold all of them.
     while len(own) < repeat or (sum(call) < MIN_TIMED and len(own) < MAX_REPEAT):
         t0 = time.perf_counter()
-        again = cls.solve(scene, options, **_no_estimate(cls))
+        again = cls._solve(scene, options, **_no_estimate(cls))
         call.append(time.perf_counter() - t0)
         own.append(again.wall_time if again.wall_time > 0 else call[-1])
     point.seconds = min(own)
@@ -468,39 +491,38 @@ def _measure(cls: type[Solver], scene: Scene, options: RunOptions, repeat: int, 
 
 
 def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: float) -> None:
-    point.energy_error = energy_error(traj, truth)
+    point.energy_error = _energy_error(traj, truth)
     if truth is None:
         return
     if not point.ok:
         point.error = math.inf
     else:
-        point.error = position_error(traj, truth, window)
+        point.error = _position_error(traj, truth, window)
     if traj.scene.system.floor is not None:
         point.impact_time_error, point.impacts_compared, point.impacts_truth = (
-            impact_time_error(traj, truth, window))
+            _impact_time_error(traj, truth, window))
 
 
-def _single_point(scene: Scene, name: str, plan: _Plan, truth_at: Any) -> Point:
+def _single_point(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any) -> Point:
     """A solver without a step as one point: its cost for the bench's samples
-    (every ``plan.spacing`` s over t_end) and its error; for the truth itself, against a
+    (every ``spacing`` s over t_end) and its error; for the truth itself, against a
     tighter evaluation (exact: extended precision) or its own estimate (reference)."""
-    t_end, window, repeat, truth = plan.t_end, plan.window, plan.repeat, plan.truth
-    spacing = plan.spacing
-    cls = solver_class(name)
-    options = make_options(scene, dt=spacing, t_end=t_end, every=1)
-    is_truth = name == truth
-    base = Point(name, None, window=window, t_end=t_end, truth="self" if is_truth else truth
-                 or "", steps=0, every=1,
+    o = plan.options
+    window = o.window
+    options = run_options(scene, o.spacing, o.t_end, 1)
+    is_truth = cls is plan.truth
+    base = Point(cls.name, None, window=window, t_end=o.t_end,  # type: ignore[arg-type]
+                 truth="self" if is_truth else plan.truth_name, steps=0, every=1,
                  compile_seconds=cls.warm_up())
     first = {} if is_truth else _no_estimate(cls)
-    traj, point = _measure(cls, scene, options, repeat, base, **first)
+    traj, point = _measure(cls, scene, options, o.repeat, base, **first)
     if not is_truth:
         _score(point, traj, truth_at(options) if truth_at else None, window)
         return point
-    point.energy_error = energy_error(traj, None)
+    point.energy_error = _energy_error(traj, None)
     if not cls.estimates_error:
         rigid = scene.system.rigid is not None
-        check = extended_precision_rigid if rigid else extended_precision_exact
+        check = _rigid_error if rigid else _exact_error
         point.error, point.impact_time_error = check(traj, window)
         point.reason = "errors against the same closed form in extended precision"
     else:

@@ -26,17 +26,20 @@ The measures are :mod:`dumbbell.analysis.metrics`', the same as ``bench`` report
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.scene import Scene
 from ..model.trajectory import Trajectory
-from ..solvers import no_truth_reason, solver_class, truth_solver
-from .metrics import energy_error, position_error, position_error_series
+from ..solvers import METHODS, Solver, truth_class
+from ..solvers.base import RunOptions, run_options
+from ._fields import check
+from .metrics import _energy_error, _position_error, _position_error_series
 
 if TYPE_CHECKING:
     import pandas
@@ -44,7 +47,8 @@ if TYPE_CHECKING:
 #: Default window (s) for position errors.
 WINDOW = 2.0
 
-__all__ = ["Comparison", "Row", "Timing", "compare", "default_solvers", "timed_run"]
+__all__ = ["CompareOptions", "Comparison", "Row", "Timing", "compare", "default_solvers",
+           "timed_run"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
@@ -156,12 +160,12 @@ class Comparison:
             seconds = timing.seconds
             out.append({
                 "label": r.solver if row is None else row.label, "solver": r.solver,
-                "dt": r.dt if r.dt and solver_class(r.solver).has_step else None,
+                "dt": r.dt if r.dt and steps is not None else None,
                 "wall_time": seconds,
                 "steps_per_s": steps / seconds if steps and seconds > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
                 "diverged_at": None if row is None else row.diverged_at,
-                "energy_error": energy_error(r, None) if row is None else row.energy_error,
+                "energy_error": _energy_error(r, None) if row is None else row.energy_error,
                 "impacts": len(r.events),
                 "verdict": r.verdict, "warm_up": timing.warm_up})
         return out
@@ -169,7 +173,7 @@ class Comparison:
     def to_pandas(self) -> pandas.DataFrame:
         """:meth:`summary` as a DataFrame indexed by label, the verdict as text, units in
         ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         records = self.summary()
         columns = {name: [rec[name] for rec in records] for name in ["label", *SUMMARY_UNITS]}
@@ -179,7 +183,7 @@ class Comparison:
 
     def impacts_to_pandas(self) -> pandas.DataFrame:
         """:meth:`impacts` as a DataFrame indexed by impact number (times in s)."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         records = self.impacts()
         names = list(records[0]) if records else ["n", "body", "truth_t"]
@@ -203,54 +207,65 @@ class Comparison:
 
 def default_solvers(scene: Scene) -> list[str]:
     """The engine, and the hand-written method that shares its step order or the textbook's."""
-    from ..model import args
+    return [cls.name for cls in _default_solvers(args.scene(scene))]
 
-    scene = args.scene(scene)
+
+def _default_solvers(scene: Scene) -> list[type[Solver]]:
     names = ["pymunk", "euler-cromer" if scene.system.dimensions == 1 else "euler-cromer-2d"]
-    return [n for n in names if solver_class(n).supports(scene) is None]
+    return [METHODS[n] for n in names if METHODS[n]._supports(scene) is None]
 
 
-def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
-            dts: list[float] | None = None, window: float = WINDOW, t_end: float | None = None, quiet: bool = True
-            ) -> Comparison:
-    """Run ``solvers`` (default :func:`default_solvers`) at each step in ``dts`` (s; default
-    the scene's) and the truth, sampled at the same times, and measure them. Raises
-    UsageError before running anything if a solver cannot run the scene."""
-    from ..model import args
-    from ..solvers import available
+@dataclass(frozen=True)
+class CompareOptions:
+    """What :func:`compare` runs: ``solvers`` (names or Solver classes; None:
+    :func:`default_solvers`) at each step in ``dts`` (s; None: the scene's) over ``t_end``
+    (s; None: the scene's), the position error over [0, ``window``] s, quietly or with
+    progress bars. Built once, checked once."""
 
+    solvers: tuple[type[Solver], ...] | None = None
+    dts: tuple[float, ...] | None = None
+    window: float = WINDOW
+    t_end: float | None = None
+    quiet: bool = True
+
+    def __post_init__(self) -> None:
+        check(self, {"solvers": "solvers", "dts": "steps?", "window": "seconds",
+                     "t_end": "seconds?", "quiet": "flag"})
+
+
+def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
+    """Run the solvers of ``options`` (:class:`CompareOptions`) at each of its steps, and
+    the truth, sampled at the same times, and measure them. Raises UsageError before running
+    anything if a solver cannot run the scene."""
     scene = args.scene(scene)
-    solvers = default_solvers(scene) if solvers is None else args.names(solvers, "solvers",
-                                                                         available())
-    dts = [scene.run.dt] if dts is None else args.positives(dts, "dts", "s")
-    t_end = scene.run.t_end if t_end is None else args.real(t_end, "t_end", "s")
-    window = args.real(window, "window", "s")
-    quiet = args.flag(quiet, "quiet")
-    for name in solvers:
-        reason = solver_class(name).supports(scene)
+    options = args.instance(options, "options", CompareOptions, "CompareOptions")
+    solvers = options.solvers or tuple(_default_solvers(scene))
+    dts = list(options.dts or (scene.run.dt,))
+    t_end = scene.run.t_end if options.t_end is None else options.t_end
+    window = options.window
+    for cls in solvers:
+        reason = cls._supports(scene)
         if reason is not None:
-            raise UsageError(f"solvers: {name!r} cannot run {scene.source}: {reason}", param="solvers")
-    if not (window > 0 and math.isfinite(window)):
-        raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
+            raise UsageError(f"solvers: {cls.name!r} cannot run {scene.source}: {reason}",
+                             param="solvers")
     spacing = _spacing(scene, dts, t_end)
     # Every run's own work budget (the exact truth's impacts), before the first run.
-    from ..solvers import make_options
-
-    truth_name = truth_solver(scene)
-    for name in [*solvers, *([truth_name] if truth_name else [])]:
-        solver_class(name).check_work(scene, make_options(scene, spacing, t_end))
-    (truth, truth_timing), truth_note = _truth(scene, min(dts), spacing, t_end, quiet)
+    truth_cls = truth_class(scene)
+    for cls in [*solvers, *([truth_cls] if truth_cls else [])]:
+        cls._check_work(scene, run_options(scene, spacing, t_end))
+    (truth, truth_timing), truth_note = _truth(scene, truth_cls, min(dts), (spacing, t_end),
+                                               options.quiet)
     rows = []
-    for name in solvers:
+    for cls in solvers:
         for dt in dts:
-            run, timing = timed_run(scene, name, dt=dt, t_end=t_end,
-                                    every=round(spacing / dt), quiet=quiet)
-            err = position_error_series(run, truth)
+            run, timing = _timed(scene, cls, replace(
+                run_options(scene, dt, t_end, round(spacing / dt)), quiet=options.quiet))
+            err = _position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
-            label = name if len(dts) == 1 else f"{name} dt={dt:g}"
-            rows.append(Row(label, run, err, position_error(run, truth, window),
+            label = cls.name if len(dts) == 1 else f"{cls.name} dt={dt:g}"
+            rows.append(Row(label, run, err, _position_error(run, truth, window),
                             float(run.t[over[0]]) if over.size else None,
-                            energy_error(run, truth), timing))
+                            _energy_error(run, truth), timing))
     notes = []
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
@@ -263,21 +278,24 @@ def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, T
     :data:`TIME_AGAIN_BELOW` s, and any run of a solver without a step, is timed again (the
     runs are deterministic) until :data:`TIMED` s are timed, at most :data:`MAX_TIMED_RUNS`
     times."""
-    from ..model import args
-    from ..solvers import available, simulate
+    from ..solvers import available, make_options
 
     scene = args.scene(scene)
-    name = args.choice(name, "name", available())
-    cls = solver_class(name)
+    cls = METHODS[args.choice(name, "name", available())]
+    return _timed(scene, cls, make_options(scene, **options))
+
+
+def _timed(scene: Scene, cls: type[Solver], options: RunOptions) -> tuple[Trajectory, Timing]:
+    """:func:`timed_run` of checked values."""
     compiled = cls.warm_up()
-    first = simulate(scene, name, **options)
+    first = cls._solve(scene, options)
     again: list[float] = []
     # A step-free solver (exact, reference) may compile or load its code in its first run,
     # however long that took on a busy machine: it is always timed again.
     if first.wall_time < TIME_AGAIN_BELOW or not cls.has_step:
-        quiet = {**options, "quiet": True}
+        quiet = replace(options, quiet=True)
         while sum(again) < TIMED and len(again) < MAX_TIMED_RUNS:
-            again.append(simulate(scene, name, **quiet).wall_time)
+            again.append(cls._solve(scene, quiet).wall_time)
     seconds = min(again) if again else first.wall_time
     # Measured only: the first run's excess when there were later runs, plus the compile.
     parts = [p for p in (max(0.0, first.wall_time - seconds) if again else math.nan, compiled)
@@ -285,17 +303,16 @@ def timed_run(scene: Scene, name: str, **options: object) -> tuple[Trajectory, T
     return first, Timing(seconds, sum(parts) if parts else math.nan, 1 + len(again))
 
 
-
 def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
     """The one sample spacing (s) of every run, so that they compare point by point: the
     largest dt or the scene's dt * every, which each dt must divide. UsageError before
     anything runs if a dt does not fit or the samples would pass the budget."""
-    from ..solvers import MAX_SAMPLES, make_options
+    from ..solvers import MAX_SAMPLES
 
     spacing = max(max(dts), scene.run.dt * scene.run.every)
     for dt in dts:
         try:
-            make_options(scene, dt, t_end)  # validates dt against t_end
+            run_options(scene, dt, t_end)  # validates dt against t_end
         except UsageError as exc:
             raise UsageError(f"dts: {exc.reason}", param="dts", fixes=exc.fixes) from None
         ratio = spacing / dt
@@ -312,22 +329,24 @@ def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:
     return spacing
 
 
-def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
-           quiet: bool) -> tuple[tuple[Trajectory, Timing], str]:
-    """The run every solver is measured against, sampled every ``spacing`` (s), with its
-    timing, and a note saying what it is: the scene's truth solver, or pymunk at a tenth of
-    the smallest step ``dt_min`` (s) where there is none."""
-    truth_name = truth_solver(scene)
-    if truth_name is None:
+def _truth(scene: Scene, cls: type[Solver] | None, dt_min: float,
+           samples: tuple[float, float], quiet: bool) -> tuple[tuple[Trajectory, Timing], str]:
+    """The run every solver is measured against, with samples = (spacing, t_end) in s, its
+    timing, and a note saying what it is: the scene's truth solver ``cls``, or pymunk at a
+    tenth of the smallest step ``dt_min`` (s) where there is none."""
+    from ..solvers import no_truth_reason
+
+    spacing, t_end = samples
+    if cls is None:
         truth_dt = dt_min / 10
-        timed = timed_run(scene, "pymunk", dt=truth_dt, t_end=t_end,
-                          every=round(spacing / truth_dt), quiet=quiet)
+        timed = _timed(scene, METHODS["pymunk"], replace(run_options(
+            scene, truth_dt, t_end, round(spacing / truth_dt)), quiet=quiet))
         why = no_truth_reason(scene)
         return timed, (f"pymunk at dt = {truth_dt:g} s (no exact or reference solution: "
                        f"{why}; so errors are against a ten times smaller step)")
-    timed = truth, _ = timed_run(scene, truth_name, dt=spacing, t_end=t_end, every=1,
-                                 quiet=quiet)
-    truth_note = truth_name
+    timed = truth, _ = _timed(scene, cls, replace(run_options(scene, spacing, t_end, 1),
+                                                  quiet=quiet))
+    truth_note = cls.name
     est = truth.info.get("estimated_error")
     if est:
         method = ("RK8 on d = rA - rB, no impact missed" if truth.info.get("rk_steps")
@@ -335,7 +354,7 @@ def _truth(scene: Scene, dt_min: float, spacing: float, t_end: float,
         truth_note += (f" ({method}; its own estimated error: "
                        f"{est['position_m_window']:.1e} m over [0, {est['window_s']:g}] s, "
                        f"energy {est['energy_relative']:.1e})")
-    elif truth_name == "exact":
+    elif cls.name == "exact":
         truth_note += (" (closed form; each impact located to about 1e-14 s, which the "
                        "chaotic map amplifies about 10x per impact)")
     return timed, truth_note

@@ -40,15 +40,25 @@ def extended_precision_exact(traj: Trajectory, window: float) -> tuple[float, fl
     closed form evaluated in numpy's extended precision (80-bit on x86: 64-bit mantissa),
     with each impact time refined by Newton's method in that precision. It checks the
     rounding of the double-precision solution, given its sequence of impacts."""
-    traj, window = _checked(traj, window, rigid=False)
+    return _exact_error(*_checked(traj, window, rigid=False))
+
+
+def _long(system: Any) -> tuple[Any, Any, Any, Any, Any]:
+    """mA, mB (kg), g (m/s^2), M (kg) and the floor's elasticity of ``system`` in extended
+    precision."""
+    L = np.longdouble
+    mA, mB = L(system.A.mass), L(system.B.mass)
+    e = L(system.floor.elasticity) if system.floor else L(1)
+    return mA, mB, L(system.g), mA + mB, e
+
+
+def _exact_error(traj: Trajectory, window: float) -> tuple[float, float]:
     L = np.longdouble
     scene = traj.scene
-    mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
-    M = mA + mB
+    mA, mB, g, M, e = _long(scene.system)
     k = L(scene.system.spring.stiffness) if scene.system.spring else L(0)
     b = L(scene.system.spring.rest_length) if scene.system.spring else L(0)
     w = np.sqrt(k * M / (mA * mB))
-    e = L(scene.system.floor.elasticity) if scene.system.floor else L(1)
 
     def state(seg, tau):
         _t0, X0, V0, s0, sd0 = seg
@@ -101,17 +111,18 @@ def extended_precision_rigid(traj: Trajectory, window: float) -> tuple[float, fl
     """:func:`extended_precision_exact` for the rigid 2D dumbbell: the parabola-and-rotation
     closed form and the impulse law in numpy's extended precision, each impact time refined
     by Newton's method there; largest position error (m) and impact time error (s)."""
-    traj, window = _checked(traj, window, rigid=True)
+    return _rigid_error(*_checked(traj, window, rigid=True))
+
+
+def _rigid_error(traj: Trajectory, window: float) -> tuple[float, float]:
     from ..model.energy import rigid_moment
 
     L = np.longdouble
     scene = traj.scene
-    mA, mB, g = L(scene.system.A.mass), L(scene.system.B.mass), L(scene.system.g)
-    M = mA + mB
+    mA, mB, g, M, e = _long(scene.system)
     length = L(scene.system.rigid.length)  # type: ignore[union-attr]
     arm = {"A": mB / M * length, "B": -mA / M * length}
     moment = L(rigid_moment(scene))
-    e = L(scene.system.floor.elasticity) if scene.system.floor else L(1)
     A, B = scene.system.A, scene.system.B
     d = (L(A.x) - L(B.x), L(A.height) - L(B.height))
     w = (L(A.vx) - L(B.vx), L(A.vy) - L(B.vy))

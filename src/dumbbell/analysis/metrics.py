@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..model import args
-from ..model.energy import BOOKKEEPING, energy_scale, relative_energy_error
+from ..model.energy import _relative_energy_error, _start_scale
 from ..model.trajectory import Trajectory
 
 __all__ = ["energy_error", "impact_time_error", "position_error", "position_error_series"]
@@ -48,7 +48,10 @@ def _check_shared_times(run: Trajectory, truth: Trajectory, n: int) -> None:
 def position_error_series(run: Trajectory, truth: Trajectory) -> np.ndarray:
     """The position error at each sample both runs have (m): the distance |r - r_truth| of
     either particle, the larger of A and B (in 1D the height difference)."""
-    run, truth = _pair(run, truth)
+    return _position_error_series(*_pair(run, truth))
+
+
+def _position_error_series(run: Trajectory, truth: Trajectory) -> np.ndarray:
     n = min(len(run.t), len(truth.t))
     _check_shared_times(run, truth, n)
     per_body = []
@@ -63,11 +66,14 @@ def position_error(run: Trajectory, truth: Trajectory, window: float) -> float:
     """The largest :func:`position_error_series` over the samples in [0, window] (m); inf if
     the run stopped before the window ended. Both must share their sample times."""
     run, truth = _pair(run, truth)
-    window = args.real(window, "window", "s")
+    return _position_error(run, truth, args.real(window, "window", "s"))
+
+
+def _position_error(run: Trajectory, truth: Trajectory, window: float) -> float:
     n = int(np.searchsorted(truth.t, window * (1 + 1e-12), side="right"))
     if len(run.t) < n:
         return math.inf
-    return float(np.max(position_error_series(run, truth)[:n]))
+    return float(np.max(_position_error_series(run, truth)[:n]))
 
 
 def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
@@ -77,7 +83,11 @@ def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
     Impacts are paired in order; inf if the solver's sequence misses one or names another
     body before the window ends."""
     traj, truth = _pair(traj, truth, "traj")
-    window = args.real(window, "window", "s")
+    return _impact_time_error(traj, truth, args.real(window, "window", "s"))
+
+
+def _impact_time_error(traj: Trajectory, truth: Trajectory, window: float
+                       ) -> tuple[float, int, int]:
     wanted = [e for e in truth.events if e.t <= window]
     worst, compared = 0.0, 0
     for mine, true in zip(traj.events, wanted):
@@ -93,16 +103,18 @@ def impact_time_error(traj: Trajectory, truth: Trajectory, window: float
 def energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     """Largest relative energy error over the whole run: drift from E(0), or for a
     dissipative scene the distance from the truth's E at the same times (dimensionless)."""
-    traj = args.trajectory(traj)
-    if truth is not None:
-        traj, truth = _pair(traj, truth, "traj")
+    if truth is None:
+        return _energy_error(args.trajectory(traj), None)
+    return _energy_error(*_pair(traj, truth, "traj"))
+
+
+def _energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     if len(traj.t) == 0:
         return math.nan
     if not traj.scene.system.dissipative:
-        return float(np.max(relative_energy_error(traj.energy)))
+        return float(np.max(_relative_energy_error(traj.energy)))
     if truth is None:
         return math.nan
     n = min(len(traj.t), len(truth.t))
     E, E_true = traj["E"][:n], truth["E"][:n]
-    terms = {k: float(v[0]) for k, v in truth.energy.items() if k not in BOOKKEEPING}
-    return float(np.max(np.abs(E - E_true)) / energy_scale(float(E_true[0]), terms))
+    return float(np.max(np.abs(E - E_true)) / _start_scale(truth.energy))

@@ -5,8 +5,9 @@
 
 Theory (docs/physics.md: the stability limit, how pymunk collides), which :func:`predict` turns into an expected verdict:
 
-- the explicit spring step of Euler-Cromer, Verlet and pymunk is stable iff w*dt < 2, with
-  w = sqrt(k/mu); the exact and reference solutions take no such step;
+- a solver's spring step is stable iff w*dt is below its ``step_limit``, with w = sqrt(k/mu):
+  2 for the explicit step of Euler-Cromer, Verlet and pymunk, 2 sqrt(2) for classic
+  Runge-Kutta; the exact and reference solutions take no such step;
 - pymunk finds a contact only once shapes overlap, so a particle that moves farther in one
   step at impact than the floor's box is thick plus its own diameter passes through it;
 - on an inelastic floor a bouncing point mass comes to rest after
@@ -14,8 +15,9 @@ Theory (docs/physics.md: the stability limit, how pymunk collides), which :func:
   velocity flips (exact, Euler-Cromer, Verlet, the reference) must stop there with
   ``failed``; pymunk holds resting contact.
 
-Which rule applies to a solver is its own declaration (``explicit_spring``, ``flip_floor``,
-``catch_depth`` on its class in :mod:`dumbbell.solvers`), not a list here.
+Which rule applies to a solver is its own declaration (``step_limit``, ``flip_floor``,
+``catch_depth`` on its class in :mod:`dumbbell.solvers`), not a list here; so the catalogue
+runs a solver class written outside the package as it runs the registered ones.
 
 The stability map runs a grid over (w*dt, mass ratio) for each time-stepping solver with no
 floor and no gravity, so only the spring's limit counts.
@@ -33,16 +35,18 @@ from typing import TYPE_CHECKING, Any
 from ..errors import DumbbellError, UsageError
 from ..model import args
 from ..model.scene import Scene, load_scene, scene_from_dict, scenes_dir
-from ..parallel import ordered_map
+from ..parallel import Backend, ordered_map
+from ..solvers import Solver, solver_class, solver_classes
+from ._fields import check
 
 if TYPE_CHECKING:
     import pandas
 
     from .sweep import PointResult
 
-__all__ = ["AGREES", "COLUMNS", "Prediction", "StabilityResult", "StabilityRow",
-           "default_cases", "default_solvers", "find_cases", "map_scene", "map_solvers",
-           "predict", "rest_time", "run_stability"]
+__all__ = ["AGREES", "COLUMNS", "Prediction", "StabilityOptions", "StabilityResult",
+           "StabilityRow", "default_cases", "default_solvers", "find_cases", "map_scene",
+           "map_solvers", "predict", "rest_time", "run_stability"]
 
 #: :attr:`StabilityRow.agreement` when the verdict is the one the theory expects; any other
 #: value says what differs.
@@ -130,7 +134,7 @@ class StabilityResult:
     def to_pandas(self) -> pandas.DataFrame:
         """One row per run with the CSV's columns, units in ``df.attrs["units"]``. Needs
         pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         return data_frame({c: [getattr(r, c) for r in self.rows] for c in COLUMNS},
                           units=UNITS)
@@ -163,11 +167,14 @@ def find_cases(folder: str | Path) -> list[Path]:
 def default_solvers(scene: Scene) -> list[str]:
     """Solvers run on a case by default: all that can run it, but of the truth solvers only
     the scene's own (the exact solution in 1D, not the slow reference)."""
-    scene = args.scene(scene)
-    from ..solvers import METHODS, supported, truth_solver
+    return [cls.name for cls in _default_solvers(args.scene(scene))]
 
-    truth = truth_solver(scene)
-    return [n for n in supported(scene) if not METHODS[n].is_truth or n == truth]
+
+def _default_solvers(scene: Scene) -> list[type[Solver]]:
+    from ..solvers import supporting, truth_class
+
+    truth = truth_class(scene)
+    return [cls for cls in supporting(scene) if not cls.is_truth or cls is truth]
 
 
 def _impact_speed(scene: Scene) -> float:
@@ -190,22 +197,19 @@ def rest_time(scene: Scene) -> float:
     return t1 + 2.0 * e * v1 / (scene.system.g * (1.0 - e))
 
 
-def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
-    """The verdict theory expects for ``scene`` run by ``solver`` at step ``dt`` up to
-    ``t_end`` (s); see the module docstring."""
-    from ..solvers import available
+def predict(scene: Scene, solver: str | type[Solver], dt: float, t_end: float) -> Prediction:
+    """The verdict theory expects for ``scene`` run by ``solver`` (a name or a Solver class)
+    at step ``dt`` up to ``t_end`` (s); see the module docstring."""
+    return _predict(args.scene(scene), solver_class(solver), args.real(dt, "dt", "s"),
+                    args.real(t_end, "t_end", "s"))
 
-    scene = args.scene(scene)
-    args.choice(solver, "solver", available())
-    dt = args.real(dt, "dt", "s")
-    t_end = args.real(t_end, "t_end", "s")
-    from ..solvers import solver_class
 
-    cls = solver_class(solver)
+def _predict(scene: Scene, cls: type[Solver], dt: float, t_end: float) -> Prediction:
     w_dt = scene.system.omega * dt
-    if cls.explicit_spring and scene.system.spring is not None and w_dt >= 2.0:
-        return Prediction("unstable", f"w*dt = {w_dt:.2f} >= 2")
-    reach = cls.catch_depth(scene)
+    limit = cls.step_limit if scene.system.spring is not None else None
+    if limit is not None and w_dt >= limit:
+        return Prediction("unstable", f"w*dt = {w_dt:.2f} >= {limit:.3g}")
+    reach = cls._catch_depth(scene)
     if reach is not None and scene.system.floor is not None and scene.system.g > 0:
         v = _impact_speed(scene)
         if v * dt > reach:
@@ -216,25 +220,26 @@ def predict(scene: Scene, solver: str, dt: float, t_end: float) -> Prediction:
     if cls.flip_floor and t_rest < t_end:
         return Prediction("failed", f"a point mass comes to rest at {t_rest:.2f} s "
                                     f"< t_end = {t_end:g} s")
-    if scene.system.spring is not None and cls.explicit_spring:
-        return Prediction("ok", f"w*dt = {w_dt:.2g} < 2")
+    if limit is not None:
+        return Prediction("ok", f"w*dt = {w_dt:.2g} < {limit:.3g}")
     return Prediction("ok", "no step limit applies")
 
 
-def run_case(path: str, solver: str) -> StabilityRow:
-    """Run one case with one solver and put the result beside the theory (one report row)."""
-    from .sweep import evaluate
+def run_case(path: str, cls: type[Solver]) -> StabilityRow:
+    """Run one case with the solver ``cls`` and put the result beside the theory (one
+    report row)."""
+    from .sweep import _evaluate
 
     scene = load_scene(path)
     t0 = time.perf_counter()
-    result = evaluate(scene, {}, solver)
+    result = _evaluate(scene, {}, cls)
     wall = time.perf_counter() - t0
-    expected = predict(scene, solver, scene.run.dt, scene.run.t_end)
+    expected = _predict(scene, cls, scene.run.dt, scene.run.t_end)
     if result.verdict == expected.status:
         agreement = AGREES
     else:
         agreement = f"DISAGREES: theory expects {expected.status}, got {result.verdict}"
-    return StabilityRow(case=scene.name, title=scene.title, solver=solver, dt=scene.run.dt,
+    return StabilityRow(case=scene.name, title=scene.title, solver=cls.name, dt=scene.run.dt,
                         w_dt=result.w_dt, verdict=result.verdict,
                         t_fail=result.t_fail,
                         max_rel_energy_error=result.max_rel_energy_error,
@@ -243,58 +248,58 @@ def run_case(path: str, solver: str) -> StabilityRow:
                         wall_s=wall)
 
 
-def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple[str, str]],
-                                                                        list[str]]:
-    """The (case, solver) runs to make, every scene validated first, and the pairs skipped
-    (with why). ``solvers`` None means :func:`default_solvers` per case."""
-    from ..solvers import make_options, solver_class
+#: One run of the catalogue: a case's path and the solver that runs it.
+Run = tuple[str, type[Solver]]
 
-    for name in solvers or ():
-        solver_class(name)
+
+def plan_cases(paths: list[Path], solvers: list[type[Solver]] | None
+               ) -> tuple[list[Run], list[str]]:
+    """The (case, solver) runs to make, every scene validated first, and the pairs skipped
+    (with why). ``solvers`` (names or classes) None means :func:`default_solvers` per
+    case."""
+    from ..solvers.base import run_options
+
+    solvers = solver_classes(solvers)
     runs, skipped = [], []
     for path in paths:
         scene = load_scene(path)
         try:
-            make_options(scene)  # the step cap, before any case runs
+            run_options(scene)  # the step cap, before any case runs
         except DumbbellError as exc:
             fixes = exc.fixes if isinstance(exc, UsageError) else ()
             raise UsageError(f"{path}: {getattr(exc, 'reason', exc)}", fixes=fixes).named(
                 {"dt": "run.dt", "t_end": "run.t_end"}) from None
-        names = default_solvers(scene) if solvers is None else solvers
-        for name in names:
-            reason = solver_class(name).supports(scene)
+        for cls in _default_solvers(scene) if solvers is None else solvers:
+            reason = cls._supports(scene)
             if reason is None:
-                runs.append((str(path), name))
+                runs.append((str(path), cls))
             else:
-                skipped.append(f"{scene.name} with {name}: {reason}")
+                skipped.append(f"{scene.name} with {cls.name}: {reason}")
     return runs, skipped
 
 
-def run_cases(runs: list[tuple[str, str]], workers: int | None = None, quiet: bool = True
+def run_cases(runs: list[Run], workers: int | None = None, quiet: bool = True
               ) -> list[StabilityRow]:
     """Every (case path, solver) run as a report row, in the given order."""
     workers = workers or os.cpu_count() or 1
     # The longest runs first keep the pool busy to the end; results keep the given order.
-    cost = {run: _cost(*run) for run in runs}
-    order = sorted(range(len(runs)), key=lambda i: -cost[runs[i]])
-    done = ordered_map(run_case, [runs[i] for i in order], workers=workers, quiet=quiet,
-                       desc="stability cases")
+    cost = [_cost(*run) for run in runs]
+    order = sorted(range(len(runs)), key=lambda i: -cost[i])
+    done = ordered_map(run_case, [runs[i] for i in order],
+                       Backend(workers, quiet=quiet, desc="stability cases"))
     results: list[StabilityRow | None] = [None] * len(runs)
     for i, row in zip(order, done, strict=True):
         results[i] = row
     return [r for r in results if r is not None]
 
 
-def _cost(path: str, solver: str) -> float:
+def _cost(path: str, cls: type[Solver]) -> float:
     """A rough cost of one run: its steps, weighted by how slow the solver's step is."""
     scene = load_scene(path)
-    steps = scene.run.t_end / scene.run.dt
-    from ..solvers import solver_class
-
-    return steps * solver_class(solver).relative_cost
+    return scene.run.t_end / scene.run.dt * cls.relative_cost
 
 
-def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
+def guard_lines(runs: list[Run]) -> list[str]:
     """What the step-size guard (:func:`dumbbell.spaces.check`, stability only: no energy
     swing tolerance) says about each case run by pymunk, on the space the solver builds, at
     the case's dt: its findings and the sub-steps that clear them, or that it finds
@@ -305,7 +310,7 @@ def guard_lines(runs: list[tuple[str, str]]) -> list[str]:
     from ..spaces.guard import check, substeps
 
     lines = []
-    for path in sorted({p for p, solver in runs if solver == "pymunk"}):
+    for path in sorted({p for p, cls in runs if cls.name == "pymunk"}):
         scene = load_scene(path)
         space = build(scene).space
         dt = scene.run.dt
@@ -351,58 +356,68 @@ def map_points(scene: Scene) -> list[Any]:
     return points
 
 
-def map_rows(solver: str, workers: int | None = None, quiet: bool = True
+def map_rows(solver: str | type[Solver], workers: int | None = None, quiet: bool = True
              ) -> list[PointResult]:
-    """The map's rows for one solver, in grid order."""
-    from ..solvers import available
-
-    args.choice(solver, "solver", available())
+    """The map's rows for one solver (a name or a class), in grid order."""
+    cls = solver_class(solver)
     workers = None if workers is None else args.whole(workers, "workers", "processes")
     quiet = args.flag(quiet, "quiet")
-    from .sweep import evaluate, warm_up
+    return _map_rows(cls, workers, quiet)
+
+
+def _map_rows(cls: type[Solver], workers: int | None, quiet: bool) -> list[PointResult]:
+    from .sweep import _evaluate, warm_up
 
     scene = map_scene()
     points = map_points(scene)
-    return ordered_map(evaluate, [(p.values, solver) for p in points], shared=scene,
-                       workers=workers or os.cpu_count() or 1, initializer=warm_up,
-                       initargs=(solver,), quiet=quiet, desc=f"stability map {solver}")
+    return ordered_map(_evaluate, [(p.values, cls) for p in points],
+                       Backend(workers or os.cpu_count() or 1, initializer=warm_up,
+                               initargs=(cls,), quiet=quiet,
+                               desc=f"stability map {cls.name}"), shared=scene)
 
 
-def map_solvers(solvers: list[str] | None) -> list[str]:
-    """The time-stepping solvers a map is drawn for: those asked for (all by default) that
-    can run the 1D map scene."""
-    from ..solvers import available
+def map_solvers(solvers: list[str | type[Solver]] | None) -> list[type[Solver]]:
+    """The time-stepping solvers a map is drawn for: those asked for (names or classes; all
+    registered ones by default) whose spring step has a limit and that can run the 1D map
+    scene."""
+    from ..solvers import METHODS
 
-    solvers = None if solvers is None else args.names(solvers, "solvers", available())
-    from ..solvers import available, solver_class
-
-    names = available() if solvers is None else solvers
+    classes = solver_classes(solvers) or list(METHODS.values())
     scene = map_scene()
-    return [n for n in names
-            if solver_class(n).explicit_spring and solver_class(n).supports(scene) is None]
+    return [cls for cls in classes if cls.step_limit is not None and cls._supports(scene) is None]
 
 
-def run_stability(cases: str | Path | None = None, solvers: list[str] | None = None,
-                  workers: int | None = None, quiet: bool = True) -> StabilityResult:
-    """Run every case in the folder ``cases`` (default: the shipped catalogue) with
-    ``solvers`` (default: every solver that can run each case) and put each verdict beside
-    the theory's. Everything is validated before anything runs; nothing is written."""
-    from ..solvers import available
+@dataclass(frozen=True)
+class StabilityOptions:
+    """What :func:`run_stability` runs: the scenes in the folder ``cases`` (None: the
+    shipped catalogue), with ``solvers`` (names or Solver classes; None: every solver that
+    can run each case), on ``workers`` local processes (None: one per CPU), quietly or with
+    a progress bar."""
 
-    cases = None if cases is None else args.path(cases, "cases")
-    solvers = None if solvers is None else args.names(solvers, "solvers", available())
-    workers = None if workers is None else args.whole(workers, "workers", "processes")
-    quiet = args.flag(quiet, "quiet")
-    runs, skipped = plan_runs(cases, solvers)
-    return StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
-                           tuple(guard_lines(runs)))
+    cases: Path | None = None
+    solvers: tuple[type[Solver], ...] | None = None
+    workers: int | None = None
+    quiet: bool = True
+
+    def __post_init__(self) -> None:
+        check(self, {"cases": "path?", "solvers": "solvers", "workers": "workers?",
+                     "quiet": "flag"})
 
 
-def plan_runs(cases: str | Path | None, solvers: list[str] | None
-          ) -> tuple[list[tuple[str, str]], list[str]]:
-    """:func:`plan_cases` for the folder ``cases`` (default: the catalogue); at least one run."""
-    runs, skipped = plan_cases(find_cases(cases if cases is not None else default_cases()),
-                               solvers)
+def run_stability(options: StabilityOptions) -> StabilityResult:
+    """Run every case of ``options`` with its solvers and put each verdict beside the
+    theory's. Everything is validated before anything runs; nothing is written."""
+    options = args.instance(options, "options", StabilityOptions, "StabilityOptions")
+    runs, skipped = plan_runs(options)
+    return StabilityResult(tuple(run_cases(runs, options.workers, options.quiet)),
+                           tuple(skipped), tuple(guard_lines(runs)))
+
+
+def plan_runs(options: StabilityOptions) -> tuple[list[Run], list[str]]:
+    """:func:`plan_cases` for the folder ``options.cases`` (default: the catalogue) and
+    ``options.solvers``; at least one run."""
+    runs, skipped = plan_cases(find_cases(options.cases if options.cases is not None
+                                          else default_cases()), options.solvers)
     if not runs:
         raise UsageError("solvers: none of them can run any of the cases", param="solvers")
     return runs, skipped

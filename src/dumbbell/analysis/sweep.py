@@ -1,7 +1,7 @@
 """Parameter sweeps: one scene run over a grid of values, on a process pool or a Dask cluster.
 
 >>> axes = [parse_axis("k=log:1e2:1e7:50"), parse_axis("dt=log:1e-6:1e-2:50")]  # doctest: +SKIP
->>> result = run_sweep(load_scene("scenes/textbook-1d.toml"), axes, "euler-cromer", 1.0)  # doctest: +SKIP
+>>> result = run_sweep(load_scene("scenes/textbook-1d.toml"), axes, SweepOptions(t_end=1.0))  # doctest: +SKIP
 >>> dumbbell.io.sweep.write_csv(result, "sweep.csv"); dumbbell.plot.sweep_map(result)  # doctest: +SKIP
 
 A grid axis is ``NAME=SPEC``: NAME a dotted scene key (``spring.stiffness``, ``bodies.A.mass``,
@@ -29,14 +29,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import DumbbellError, UsageError
+from ..model import args
 from ..model.scene import Scene
-from ..parallel import ordered_map
+from ..parallel import Backend, ordered_map
+from ..solvers import Solver, scene_class, solver_class
+from ._fields import check
 
 if TYPE_CHECKING:
     import pandas
 
-__all__ = ["Axis", "Point", "PointResult", "SweepResult", "check_axes", "evaluate",
-           "parse_axis", "plan", "run_sweep", "warm_up"]
+__all__ = ["Axis", "Point", "PointResult", "SweepOptions", "SweepResult", "check_axes",
+           "evaluate", "parse_axis", "plan", "run_sweep", "warm_up"]
 
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}
@@ -98,8 +101,6 @@ def parse_axis(text: str) -> Axis:
     (UsageError naming the item and what is allowed)."""
     form = "NAME=log:A:B:N, NAME=lin:A:B:N or NAME=V1,V2,..."
     if not isinstance(text, str):
-        from ..model import args
-
         raise UsageError(f"text = {args.show(text)}: must be a grid axis, {form}", param="text")
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
@@ -152,8 +153,6 @@ def _listed_values(text: str, spec: str, form: str) -> tuple[Any, ...]:
 
 
 def _check_axis_list(axes: Any) -> None:
-    from ..model import args
-
     if not isinstance(axes, list | tuple) or not all(isinstance(a, Axis) for a in axes):
         raise UsageError(f"axes = {args.show(axes)}: must be a list of Axis (parse_axis)",
                          param="axes")
@@ -181,22 +180,22 @@ class Point:
     values: dict[str, Any]
 
 
-def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = None
-         ) -> list[Point]:
+def plan(scene: Scene, axes: Sequence[Axis], solver: str | type[Solver],
+         t_end: float | None = None) -> list[Point]:
     """Every grid point, validated as a scene and as a bounded run before anything runs.
 
-    ``t_end`` (s) overrides the scene's ``run.t_end``. Raises UsageError naming the axis."""
-    from ..model import args
-    from ..solvers import available
-
+    ``solver`` is a name or a Solver class; ``t_end`` (s) overrides the scene's
+    ``run.t_end``. Raises UsageError naming the axis."""
     scene = args.scene(scene)
-    _check_axis_list(axes)
-    args.choice(solver, "solver", available())
-    t_end = None if t_end is None else args.real(t_end, "t_end", "s")
-    from ..solvers import make_options, solver_class
-
     check_axes(axes)
-    cls = solver_class(solver)
+    return _plan(scene, axes, solver_class(solver),
+                 None if t_end is None else args.real(t_end, "t_end", "s"))
+
+
+def _plan(scene: Scene, axes: Sequence[Axis], cls: type[Solver], t_end: float | None
+          ) -> list[Point]:
+    from ..solvers.base import run_options
+
     fixed = {"run.t_end": t_end} if t_end is not None else {}
     points, total = [], 0
     for index, combo in enumerate(itertools.product(*(a.values for a in axes))):
@@ -206,11 +205,12 @@ def plan(scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = 
             point_scene = scene.with_values(values)
         except DumbbellError as exc:
             raise UsageError(f"grid at {where}: {exc}", param="grid") from None
-        reason = cls.supports(point_scene)
+        reason = cls._supports(point_scene)
         if reason is not None:
-            raise UsageError(f"grid at {where}: solver {solver!r} cannot run it: {reason}", param="grid")
+            raise UsageError(f"grid at {where}: solver {cls.name!r} cannot run it: {reason}",
+                             param="grid")
         try:
-            options = make_options(point_scene)
+            options = run_options(point_scene)
         except DumbbellError as exc:
             raise UsageError(f"grid at {where}: {exc}", param="grid") from None
         if options.n_steps > MAX_STEPS_PER_POINT:
@@ -253,27 +253,30 @@ class PointResult:
 RESULT_COLUMNS = tuple(f.name for f in fields(PointResult) if f.name != "values")
 
 
-def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> PointResult:
-    """Run one grid point (``scene`` with the dotted ``values`` set) and summarise it as a
-    :class:`PointResult`. A solver error becomes the verdict ``failed``."""
-    from ..model import args
-    from ..model.scene import Scene
-    from ..solvers import available
-
+def evaluate(scene: Scene, values: dict[str, Any], solver: str | type[Solver]
+             ) -> PointResult:
+    """Run one grid point (``scene`` with the dotted ``values`` set) with ``solver`` (a name
+    or a Solver class) and summarise it as a :class:`PointResult`. A solver error becomes the
+    verdict ``failed``."""
     args.instance(scene, "scene", Scene, "a Scene")
     args.mapping(values, "values", "a dict of dotted scene keys to values")
-    args.choice(solver, "solver", available())
-    from ..model.energy import relative_energy_error
-    from ..solvers import make_options, simulate
+    return _evaluate(scene, values, solver_class(solver))
+
+
+def _evaluate(scene: Scene, values: dict[str, Any], cls: type[Solver]) -> PointResult:
+    from ..model.energy import _relative_energy_error
+    from ..solvers import runnable
+    from ..solvers.base import run_options
 
     point = scene.with_values(values)
     pairs = tuple(values.items())
-    options = make_options(point)
+    options = run_options(point)
     every = max(1, math.ceil(options.n_steps / (MAX_SAMPLES - 1)))
     w_dt = point.system.omega * options.dt
     try:
-        traj = simulate(point, solver, every=every, quiet=True)
-        err = relative_energy_error(traj.energy)
+        runnable(cls, point)
+        traj = cls._solve(point, run_options(point, every=every))
+        err = _relative_energy_error(traj.energy)
         finite = err[np.isfinite(err)]
         max_err = float(finite.max()) if finite.size else math.nan
         verdict = traj.verdict
@@ -283,14 +286,8 @@ def evaluate(scene: Scene, values: dict[str, Any], solver: str) -> PointResult:
         return PointResult(pairs, w_dt, "failed", None, math.nan, f"solver error: {text}")
 
 
-def warm_up(solver: str) -> None:
+def warm_up(solver: str | type[Solver]) -> None:
     """Load a solver's compiled code (if it has any) in a worker before the work arrives."""
-    from ..model import args
-    from ..solvers import available
-
-    args.choice(solver, "solver", available())
-    from ..solvers import solver_class
-
     solver_class(solver).warm_up()
 
 
@@ -340,7 +337,7 @@ class SweepResult:
         """One row per grid point in grid order, the CSV's columns, units in
         ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).
         Needs pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
 
         units = {a.key: "" for a in self.axes} | RESULT_UNITS
         cells = list(zip(*(row.cells for row in self.rows))) or [()] * len(self.columns)
@@ -385,37 +382,49 @@ class SweepResult:
 # --- backends -------------------------------------------------------------------------------
 
 
-def run_sweep(
-    scene: Scene, axes: Sequence[Axis], solver: str, t_end: float | None = None,
-    workers: int | None = None, scheduler: str | None = None, quiet: bool = True,
-    processes: bool = True, points: list[Point] | None = None, connect_timeout: float = 10.0,
-) -> SweepResult:
-    """Run ``scene`` (a Scene or a scene file's path) over the grid ``axes`` with ``solver``;
-    ``t_end`` (s) overrides the scene's. One worker runs in this process; more use a process
-    pool of at most one process per CPU and per point; ``scheduler`` a Dask cluster ('local'
-    for a new LocalCluster; ``connect_timeout`` s to reach it). Rows come back in grid order."""
-    from ..model import args
+@dataclass(frozen=True)
+class SweepOptions:
+    """How :func:`run_sweep` runs a grid: with ``solver`` (a name or a Solver class; None:
+    the scene's ``run.solver``), over ``t_end`` (s; None: the scene's), on ``workers`` local
+    processes (default 1: this process; None: one per CPU; capped at one per point) or a Dask ``scheduler`` ('local'
+    for a new LocalCluster, of processes unless ``processes`` is False; ``connect_timeout``
+    s to reach one), quietly or with a progress bar."""
+
+    solver: type[Solver] | None = None
+    t_end: float | None = None
+    workers: int | None = 1
+    scheduler: str | None = None
+    quiet: bool = True
+    processes: bool = True
+    connect_timeout: float = 10.0
+
+    def __post_init__(self) -> None:
+        check(self, {"solver": "solver?", "t_end": "seconds?", "workers": "workers?",
+                     "scheduler": "text?", "quiet": "flag", "processes": "flag",
+                     "connect_timeout": "seconds"})
+
+
+def run_sweep(scene: Scene, axes: Sequence[Axis], options: SweepOptions,
+              points: list[Point] | None = None) -> SweepResult:
+    """Run ``scene`` (a Scene or a scene file's path) over the grid ``axes`` as ``options``
+    say; ``points`` are the grid's points when :func:`plan` has made them already. One worker
+    runs in this process; more use a process pool of at most one process per CPU and per
+    point, or a Dask cluster. Rows come back in grid order."""
     from ..parallel import cap_workers
-    from ..solvers import available
 
     scene = args.scene(scene)
     _check_axis_list(axes)
-    args.choice(solver, "solver", available())
-    t_end = None if t_end is None else args.real(t_end, "t_end", "s")
-    if workers is not None:
-        workers = args.whole(workers, "workers", "processes")
-    if scheduler is not None:
-        args.text(scheduler, "scheduler", "a Dask scheduler address ('tcp://HOST:PORT', or "
-                  "'local') or None")
-    quiet = args.flag(quiet, "quiet")
-    processes = args.flag(processes, "processes")
-    connect_timeout = args.real(connect_timeout, "connect_timeout", "s")
+    options = args.instance(options, "options", SweepOptions, "SweepOptions")
     if points is not None and (not isinstance(points, list | tuple)
                                or not all(isinstance(p, Point) for p in points)):
         raise UsageError(f"points = {args.show(points)}: must be a list of Point (from plan) "
                          "or None", param="points")
-    points = plan(scene, axes, solver, t_end) if points is None else points
-    workers, _ = cap_workers(workers, len(points))
+    cls = options.solver or scene_class(scene)
+    if points is None:
+        check_axes(axes)
+        points = _plan(scene, axes, cls, options.t_end)
+    workers, _ = cap_workers(options.workers, len(points))
+    scheduler = options.scheduler
     if scheduler is not None:
         backend, desc = f"dask {scheduler}", f"sweep {scene.name} (dask)"
         workers = workers if scheduler == "local" else 0
@@ -425,15 +434,15 @@ def run_sweep(
         backend = f"process pool of {workers}"
         desc = f"sweep {scene.name} ({workers} processes)"
     t0 = time.perf_counter()
-    results = ordered_map(evaluate, [(p.values, solver) for p in points], shared=scene,
-                          workers=workers, scheduler=scheduler, processes=processes,
-                          initializer=warm_up, initargs=(solver,), quiet=quiet, desc=desc,
-                          connect_timeout=connect_timeout)
+    results = ordered_map(_evaluate, [(p.values, cls) for p in points],
+                          Backend(workers, scheduler, options.processes, warm_up, (cls,),
+                                  options.quiet, desc, connect_timeout=options.connect_timeout),
+                          shared=scene)
     wall = time.perf_counter() - t0
     by_index = {p.index: r for p, r in zip(points, results, strict=True)}
     # A row's values are its grid coordinates only (not the t_end every point shares).
     rows = [replace(by_index[i],
                     values=tuple((a.key, v) for a, v in zip(axes, combo, strict=True)))
             for i, combo in enumerate(itertools.product(*(a.values for a in axes)))]
-    return SweepResult(scene, list(axes), solver,
-                       t_end if t_end is not None else scene.run.t_end, rows, wall, backend)
+    t_end = options.t_end if options.t_end is not None else scene.run.t_end
+    return SweepResult(scene, list(axes), cls.name, t_end, rows, wall, backend)

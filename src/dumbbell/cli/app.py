@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import importlib
 import math
 import os
@@ -17,6 +18,7 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator, Sequence
+from typing import Any
 
 from ..errors import DumbbellError, UsageError
 from ..parallel import STOP_SIGNALS
@@ -214,6 +216,15 @@ def _check_paths(args: argparse.Namespace, transaction) -> None:
         check_writable(value, flag, folder)
         if not folder:
             transaction.claim(value, f"{flag} {value}")
+
+
+def options(kind: type, args: argparse.Namespace, **flags: str) -> Any:
+    """The options record ``kind`` (a frozen dataclass of an analysis) from the flags of
+    ``args``: each field from the flag of its name, or of the name ``flags`` gives it; a flag
+    left unset (None) leaves the field's default."""
+    given = {f.name: getattr(args, flags.get(f.name, f.name), None)
+             for f in dataclasses.fields(kind)}
+    return kind(**{name: value for name, value in given.items() if value is not None})
 
 
 def flag_for(param: str, args: argparse.Namespace | None) -> str | None:

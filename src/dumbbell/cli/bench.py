@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float, positive_int, read_scene
+from .app import add_out, add_quiet, options, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -64,13 +64,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.bench import run_bench
+    from ..analysis.bench import BenchOptions, run_bench
     from ..io.bench import write_all
 
     scene = read_scene(args.scene, stdin=False)
-    result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
-                       repeat=args.repeat, t_end=args.t_end, budget=args.budget,
-                       spacing=args.sample_spacing, quiet=args.quiet)
+    result = run_bench(scene, options(BenchOptions, args, spacing="sample_spacing"))
     written = write_all(result, Path(args.out))
     from ..io.figures import save_figure
     from ..plot.bench import convergence, work_precision

@@ -40,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.compare import compare
+    from ..analysis.compare import CompareOptions, compare
     from ..errors import UsageError
     from ..io.compare import text, write
     from ..solvers import available
@@ -54,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
                              + ", ".join(available()))
     try:
-        result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
+        result = compare(scene, CompareOptions(solvers, args.dt, args.window, args.t_end,
+                                               args.quiet))
     except UsageError as exc:
         if exc.param != "dts":
             raise

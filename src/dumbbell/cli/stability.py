@@ -5,9 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from .app import add_out, add_quiet, positive_int
+from .app import add_out, add_quiet, options, positive_int
+
+if TYPE_CHECKING:
+    from ..analysis.stability import StabilityOptions
+    from ..solvers import Solver
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -32,9 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
-           workers: int | None = None, quiet: bool = True,
-           note: str | None = None) -> dict[str, Any]:
+def report(options: StabilityOptions, out: str | Path, note: str | None = None
+           ) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
     Everything is validated before anything runs, and only then is ``note`` (a line about
     the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
@@ -43,7 +46,8 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     from ..errors import UsageError
     from ..io.stability import write
 
-    runs, skipped = plan_runs(cases, solvers)
+    runs, skipped = plan_runs(options)
+    workers, quiet = options.workers, options.quiet
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
@@ -52,14 +56,14 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
     written = write(result, out)
-    path = write_map(solvers, out, workers, quiet)
+    path = write_map(options.solvers, out, workers, quiet)
     if path is not None:
         written.append(path)
     return {"rows": list(result.rows), "skipped": skipped, "written": written}
 
 
-def write_map(solvers: list[str] | None, out: str | Path, workers: int | None = None,
-              quiet: bool = True) -> Path | None:
+def write_map(solvers: tuple[type[Solver], ...] | None, out: str | Path,
+              workers: int | None = None, quiet: bool = True) -> Path | None:
     """OUT/stability-map.png for the time-stepping ``solvers`` among those asked for (all by
     default); None when there is none."""
     from ..analysis.stability import map_rows, map_solvers
@@ -69,16 +73,17 @@ def write_map(solvers: list[str] | None, out: str | Path, workers: int | None = 
     steppers = map_solvers(solvers)
     if not steppers:
         return None
-    panels = stability_map({name: map_rows(name, workers, quiet) for name in steppers})
+    panels = stability_map({cls.name: map_rows(cls, workers, quiet) for cls in steppers})
     return save_figure(panels[0].figure, Path(out) / "stability-map.png", dpi=90)
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..analysis.stability import StabilityOptions
     from ..parallel import cap_note
 
     # Jobs are many (cases x solvers); the CPUs are the cap that binds.
     note = cap_note("--workers", args.workers, 1 << 30)
-    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note)
+    result = report(options(StabilityOptions, args), args.out, note)
     if not args.quiet:
         rows = result["rows"]
         bad = sum(not r.agrees for r in rows)

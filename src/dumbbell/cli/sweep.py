@@ -46,7 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.sweep import check_axes, parse_axis, plan, run_sweep
+    from ..analysis.sweep import SweepOptions, check_axes, parse_axis, plan, run_sweep
     from ..errors import UsageError
     from ..parallel import cap_note
     from ..solvers import solver_class
@@ -57,8 +57,7 @@ def run(args: argparse.Namespace) -> int:
     for axis in axes:
         if not axis.numeric:
             raise UsageError(f"--grid {axis.text!r}: a map needs numbers; list numbers only")
-    solver = args.solver or scene.run.solver
-    solver_class(solver)
+    solver = solver_class(args.solver or scene.run.solver)
     if args.scheduler is not None:
         address = args.scheduler.strip()
         if address != "local" and "://" not in address:
@@ -79,9 +78,9 @@ def run(args: argparse.Namespace) -> int:
     note = cap_note("--workers", args.workers, len(points), "grid points")
     if note:
         sys.stderr.write(f"dumbbell sweep: {note}\n")
-    result = run_sweep(scene, axes, solver, args.t_end, workers=args.workers,
-                       scheduler=args.scheduler and args.scheduler.strip(), quiet=args.quiet,
-                       points=points, connect_timeout=args.connect_timeout)
+    result = run_sweep(scene, axes, SweepOptions(
+        solver, args.t_end, args.workers, args.scheduler and args.scheduler.strip(), args.quiet,
+        connect_timeout=args.connect_timeout), points)
     from ..io.figures import save_figure
     from ..io.sweep import write_csv
 

@@ -5,5 +5,5 @@ from .._lazy import attach
 #: The writers, one module per result, and what they share; each is imported when first
 #: read (``dumbbell.io.trajectory.write_csv``).
 __getattr__, __dir__, __all__ = attach(__name__, [
-    "bench", "compare", "figures", "files", "frames", "restitution", "stability", "sweep",
+    "bench", "compare", "figures", "files", "restitution", "stability", "sweep",
     "tables", "trajectory"])

@@ -113,7 +113,8 @@ def markdown(result: BenchResult) -> str:
     if result.fits:
         fit_text = "; ".join(
             f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
-            f"{len(f.dts)} points)" for n, f in result.fits.items())
+            f"{len(f.dts)} points{'' if f.expected is None else f'; its order {f.expected}'})"
+            for n, f in result.fits.items())
         lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
                      f"(least squares in log-log over the ok points with error between "
                      f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")

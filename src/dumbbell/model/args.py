@@ -184,11 +184,49 @@ def instance(value: Any, name: str, kind: type | tuple[type, ...], what: str) ->
     return value
 
 
+def _model(module: str, name: str) -> Any:
+    """The class ``name`` of ``dumbbell.model.<module>`` if that module is loaded, else an
+    empty tuple (no object of it can exist yet): the checks here import no model module but
+    the scene's, so that the model's files import each other in one direction only."""
+    loaded = sys.modules.get(f"dumbbell.model.{module}")
+    return getattr(loaded, name) if loaded is not None else ()
+
+
 def trajectory(value: Any, name: str = "traj") -> Any:
     """``value`` as a Trajectory."""
-    from .trajectory import Trajectory
+    return instance(value, name, _model("trajectory", "Trajectory"),
+                    "a Trajectory (from dumbbell.simulate)")
 
-    return instance(value, name, Trajectory, "a Trajectory (from dumbbell.simulate)")
+
+def impacts(value: Any, name: str = "events") -> list[Any]:
+    """``value`` (a list or tuple of Impact) as a list."""
+    kind = _model("trajectory", "Impact")
+    if not isinstance(value, list | tuple) or not all(isinstance(e, kind) for e in value):
+        raise UsageError(f"{name} = {show(value)}: must be a list of Impact", param=name)
+    return list(value)
+
+
+def samples(value: Any, name: str) -> Any:
+    """``value`` (a 1-d array, list or tuple of numbers) as a numpy array."""
+    import numpy as np
+
+    array = np.asarray(value) if isinstance(value, np.ndarray | list | tuple) else None
+    if array is None or array.ndim != 1 or array.dtype.kind not in "fiu":
+        raise UsageError(f"{name} = {show(value)}: must be a 1-d array of numbers",
+                         param=name)
+    return array
+
+
+def columns(value: Any, n: int, name: str) -> dict[str, Any]:
+    """``value`` (a dict of columns by name) with each column as a numpy array of ``n``
+    samples (as many as the times ``t``)."""
+    out = {key: samples(col, f"{name}[{key!r}]")
+           for key, col in mapping(value, name, "a dict of columns by name").items()}
+    for key, col in out.items():
+        if len(col) != n:
+            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
+                             f"t ({n})", param=name)
+    return out
 
 
 def pair(value: Any, name: str, unit: str) -> tuple[float, float]:

@@ -36,8 +36,11 @@ from ..errors import UsageError
 from . import args
 
 if TYPE_CHECKING:
-    from .scene import Scene
-    from .trajectory import Impact
+    from .scene import Scene, System
+
+#: Impacts with the floor (:class:`dumbbell.model.trajectory.Impact`: t, body, v_before,
+#: v_after, heat), which this module reads by their fields.
+Impacts = Iterable[Any]
 
 #: State columns by name (m, m/s, rad/s), one value per sample.
 Columns = Mapping[str, np.ndarray]
@@ -70,24 +73,30 @@ def _state(scene: Scene, state: Any, n: int | None = None, name: str = "state"
            ) -> dict[str, np.ndarray]:
     """``state`` checked to be a dict of 1-d columns holding every state column of ``scene``
     (and the spins where the particles spin), all as long as the first (or ``n``)."""
-    from .trajectory import _columns
-
     args.mapping(state, name, "a dict of state columns by name")
-    needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if spins(scene) else [])
+    needed = state_columns(scene) + ([f"omega{p}" for p in "AB"] if scene.system.discs
+                                      else [])
     missing = [c for c in needed if c not in state]
     if missing:
         raise UsageError(f"{name} has no column {missing[0]!r}: needs {', '.join(needed)}",
                          param=name)
     if n is None:
         n = _length(state[needed[0]])
-    return _columns({c: state[c] for c in [*needed, *(["heat"] if "heat" in state else [])]},
-                    n, name)
+    return args.columns({c: state[c] for c in [*needed, *(["heat"] if "heat" in state else [])]},
+                        n, name)
+
+
+def _scene(scene: Any) -> Scene:
+    """``scene`` as a Scene: a Scene passes as it is (it was checked when it was made),
+    anything else is checked (a path is loaded)."""
+    from .scene import Scene
+
+    return scene if isinstance(scene, Scene) else args.scene(scene)
 
 
 def state_columns(scene: Scene) -> list[str]:
     """Position and velocity columns of a scene (m, m/s), in CSV order."""
-    scene = args.scene(scene)
-    if scene.system.dimensions == 1:
+    if _scene(scene).system.dimensions == 1:
         return ["xA", "vA", "xB", "vB"]
     return ["xA", "yA", "vxA", "vyA", "xB", "yB", "vxB", "vyB"]
 
@@ -116,17 +125,17 @@ def column_unit(name: str) -> str:
 def spins(scene: Scene) -> bool:
     """True when the particles are spinning discs (:attr:`System.discs
     <dumbbell.model.scene.System.discs>`, 2D only)."""
-    return args.scene(scene).system.discs
+    return _scene(scene).system.discs
 
 
 def energy_columns(scene: Scene) -> list[str]:
     """The energy terms (J) a scene can have, in CSV order; those it cannot have are left out."""
-    scene = args.scene(scene)
+    scene = _scene(scene)
     if scene.system.dimensions == 1:
         cols = ["K_cm", "K_int", "U_g", "U_spring", "E"]
     else:
         cols = ["K_cm", "K_rot", "K_vib"]
-        if spins(scene):
+        if scene.system.discs:
             cols.append("K_spin")
         cols.append("U_g")
         if scene.system.spring is not None:
@@ -144,23 +153,21 @@ BOOKKEEPING = ("E", "E_lost", "E_heat", "E_err")
 def momentum_columns(scene: Scene) -> list[str]:
     """The angular-momentum columns (kg m^2/s) of a scene, after the energy terms in the CSV:
     ``L_cm`` in 2D, none in 1D."""
-    scene = args.scene(scene)
-    return ["L_cm"] if scene.system.dimensions == 2 else []
+    return ["L_cm"] if _scene(scene).system.dimensions == 2 else []
 
 
-def partition_1d(
-    mA: float, mB: float, k: float, b: float, g: float,
-    xA: np.ndarray, vA: np.ndarray, xB: np.ndarray, vB: np.ndarray,
-) -> dict[str, np.ndarray]:
-    """1D partition from masses (kg), stiffness (N/m), rest length (m), gravity (m/s^2) and
-    positions/velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J.
+def partition_1d(system: System, xA: np.ndarray, vA: np.ndarray, xB: np.ndarray,
+                 vB: np.ndarray) -> dict[str, np.ndarray]:
+    """1D partition of ``system`` (its masses in kg, spring in N/m and m, gravity in m/s^2)
+    from positions and velocities (m, m/s). Returns K_cm, K_int, U_g, U_spring, E in J.
 
-    >>> partition_1d(0.1, 0.1, 200.0, 0.2, 9.8, *np.array([[1.2], [0.0], [1.0], [0.0]]))["E"]
+    >>> partition_1d(scene.system, *np.array([[1.2], [0.0], [1.0], [0.0]]))["E"]  # doctest: +SKIP
     array([2.156])
     """
     arrays = [np.ascontiguousarray(np.atleast_1d(a), dtype=np.float64) for a in (xA, vA, xB, vB)]
-    out = np.empty((5, arrays[0].size))
-    _loop_1d()(float(mA), float(mB), float(k), float(b), float(g), *arrays, out)
+    constants = (float(system.A.mass), float(system.B.mass), float(system.k), float(system.b),
+                 float(system.g))
+    out = _loop_1d()(constants, *arrays)
     return dict(zip(("K_cm", "K_int", "U_g", "U_spring", "E"), out, strict=True))
 
 
@@ -171,8 +178,10 @@ def _loop_1d():
     from numba import njit
 
     @njit(cache=True, nogil=True)
-    def loop(mA, mB, k, b, g, xA, vA, xB, vB, out):  # pragma: no cover
+    def loop(constants, xA, vA, xB, vB):  # pragma: no cover
+        mA, mB, k, b, g = constants
         M = mA + mB
+        out = np.empty((5, xA.size))
         for i in range(xA.size):
             X = (mA * xA[i] + mB * xB[i]) / M
             V = (mA * vA[i] + mB * vB[i]) / M
@@ -186,16 +195,17 @@ def _loop_1d():
             out[2, i] = U_g
             out[3, i] = U_spring
             out[4, i] = K_cm + K_int + U_g + U_spring
+        return out
 
     return loop
 
 
-def partition_2d(
-    mA: float, mB: float, k: float, b: float, g: float,
-    rA: np.ndarray, vA: np.ndarray, rB: np.ndarray, vB: np.ndarray,
-) -> dict[str, np.ndarray]:
-    """2D partition; positions and velocities are (n, 2) arrays (m, m/s), y vertical.
-    Returns K_cm, K_rot, K_vib, U_g, U_spring, E in J (K_spin is added by :func:`partition`)."""
+def partition_2d(system: System, rA: np.ndarray, vA: np.ndarray, rB: np.ndarray,
+                 vB: np.ndarray) -> dict[str, np.ndarray]:
+    """2D partition of ``system``; positions and velocities are (n, 2) arrays (m, m/s), y
+    vertical. Returns K_cm, K_rot, K_vib, U_g, U_spring, E in J (K_spin is added by
+    :func:`partition`)."""
+    mA, mB, k, b, g = system.A.mass, system.B.mass, system.k, system.b, system.g
     M = mA + mB
     mu = mA * mB / M
     V = (mA * vA + mB * vB) / M
@@ -260,14 +270,16 @@ def impact_heat(mass: float, v_before: float, v_after: float) -> float:
     return 0.5 * mass * (v_before * v_before - v_after * v_after)
 
 
-def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) -> np.ndarray:
+def heat(scene: Scene, t: np.ndarray, state: Columns, events: Impacts) -> np.ndarray:
     """Energy the contacts dissipated up to each sample time ``t`` (s), in J: counted by the
     solver where the state has a ``heat`` column (pymunk), else summed over the impacts up to
     each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
     scene = args.scene(scene)
     t = np.asarray(args.array(t, "t", "s"))
-    state = _state(scene, state, t.size)
-    events = _impacts(events)
+    return _heat(scene, t, _state(scene, state, t.size), args.impacts(events))
+
+
+def _heat(scene: Scene, t: np.ndarray, state: Columns, events: Impacts) -> np.ndarray:
     if "heat" in state:
         return np.asarray(state["heat"], dtype=float)
     mass = {"A": scene.system.A.mass, "B": scene.system.B.mass}
@@ -279,35 +291,26 @@ def heat(scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact]) 
     return total[np.searchsorted(times, t, side="right")] if len(times) else np.zeros(len(t))
 
 
-def _impacts(events: Any) -> list[Impact]:
-    """``events`` (a list or tuple of Impact) as a list; UsageError naming ``events``."""
-    from .trajectory import Impact
-
-    if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
-        raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
-                         param="events")
-    return list(events)
-
-
 def disc_inertia(mass: float, radius: float) -> float:
     """Moment of inertia of a uniform disc about its centre, 1/2 m r^2 (kg m^2)."""
-    mass = args.real(mass, "mass", "kg")
-    radius = args.real(radius, "radius", "m", lo=0.0)
+    return _disc(args.real(mass, "mass", "kg"), args.real(radius, "radius", "m", lo=0.0))
+
+
+def _disc(mass: float, radius: float) -> float:
     return 0.5 * mass * radius**2
 
 
 def rigid_moment(scene: Scene) -> float:
     """Moment of inertia of a rigid dumbbell about its centre of mass (kg m^2): mu L^2 for the
     two point masses, plus each disc's own 1/2 m r^2 where the particles may spin."""
-    scene = args.scene(scene)
+    scene = _scene(scene)
     if scene.system.rigid is None:
         raise UsageError(f"scene = {scene.name}: must be a rigid dumbbell (a [rigid] table)",
                          param="scene")
     system = scene.system
     moment = system.mu * system.rigid.length**2
-    if spins(scene):
-        moment += (disc_inertia(system.A.mass, system.A.radius)
-                   + disc_inertia(system.B.mass, system.B.radius))
+    if system.discs:
+        moment += _disc(system.A.mass, system.A.radius) + _disc(system.B.mass, system.B.radius)
     return moment
 
 
@@ -319,12 +322,12 @@ def _positions_velocities(state: Columns) -> tuple[np.ndarray, ...]:
 
 def _disc_spin(scene: Scene, state: Columns) -> np.ndarray:
     """K_spin, the discs' own 1/2 I omega^2 summed (J)."""
-    return sum(rotational_ke(disc_inertia(p.mass, p.radius), state[f"omega{p.name}"])
+    return sum(rotational_ke(_disc(p.mass, p.radius), state[f"omega{p.name}"])
                for p in (scene.system.A, scene.system.B))
 
 
 def partition(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact] = (),
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts = (),
 ) -> dict[str, np.ndarray]:
     """All energy columns (J, :func:`energy_columns` order) of ``scene`` at the sample times
     ``t`` (s) with the state columns ``state`` (m, m/s, rad/s) and the impacts ``events``
@@ -333,17 +336,16 @@ def partition(
     t = args.array(t, "t", "s")
     if t.ndim != 1:
         raise UsageError(f"t = {args.show(t)}: must be a 1-d array of times (s)", param="t")
-    state = _state(scene, state, t.size)
-    events = _impacts(events)
-    k, b = scene.system.k, scene.system.b
+    return _partition(scene, t, _state(scene, state, t.size), args.impacts(events))
+
+
+def _partition(scene: Scene, t: np.ndarray, state: Columns, events: Impacts = (),
+               ) -> dict[str, np.ndarray]:
     if scene.system.dimensions == 1:
-        parts = partition_1d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
-                             state["xA"], state["vA"], state["xB"], state["vB"])
+        parts = partition_1d(scene.system, state["xA"], state["vA"], state["xB"], state["vB"])
     else:
-        rA, vA, rB, vB = _positions_velocities(state)
-        parts = partition_2d(scene.system.A.mass, scene.system.B.mass, k, b, scene.system.g,
-                             rA, vA, rB, vB)
-        if spins(scene):
+        parts = partition_2d(scene.system, *_positions_velocities(state))
+        if scene.system.discs:
             parts["K_spin"] = _disc_spin(scene, state)
             parts["E"] = parts["E"] + parts["K_spin"]
     return _with_losses(scene, t, state, events, parts)
@@ -372,20 +374,20 @@ def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
 
 
 def _with_losses(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts,
     parts: dict[str, np.ndarray],
 ) -> dict[str, np.ndarray]:
     """``parts`` in :func:`energy_columns` order, with E_lost = E(0) - E, E_heat (:func:`heat`)
     and E_err = E_lost - E_heat added where the scene is dissipative (J)."""
     if scene.system.dissipative:
         parts["E_lost"] = parts["E"][0] - parts["E"] if len(parts["E"]) else parts["E"]
-        parts["E_heat"] = heat(scene, t, state, events)
+        parts["E_heat"] = _heat(scene, t, state, events)
         parts["E_err"] = parts["E_lost"] - parts["E_heat"]
     return {name: parts[name] for name in energy_columns(scene)}
 
 
 def partition_from_terms(
-    scene: Scene, t: np.ndarray, state: Columns, events: Iterable[Impact],
+    scene: Scene, t: np.ndarray, state: Columns, events: Impacts,
     terms: Columns,
 ) -> dict[str, np.ndarray]:
     """The dumbbell's energy columns (J, :func:`energy_columns` order) from the general
@@ -403,10 +405,9 @@ def partition_from_terms(
         parts["K_int"] = terms["K_int"]
     else:
         system = scene.system
-        axis = partition_2d(system.A.mass, system.B.mass, system.k, system.b, system.g,
-                            *_positions_velocities(state))
+        axis = partition_2d(system, *_positions_velocities(state))
         parts["K_rot"], parts["K_vib"] = axis["K_rot"], axis["K_vib"]
-        if spins(scene):
+        if system.discs:
             parts["K_spin"] = (terms["K_rot"] if system.rigid is None
                                else _disc_spin(scene, state))
     return _with_losses(scene, t, state, events, parts)
@@ -420,6 +421,10 @@ def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> f
         args.mapping(terms_at_start, "terms_at_start", "a dict of energy terms (J) or None")
         terms_at_start = {key: args.real(v, "terms_at_start", "J", positive=False)
                           for key, v in terms_at_start.items()}
+    return _energy_scale(E0, terms_at_start)
+
+
+def _energy_scale(E0: float, terms_at_start: Mapping[str, float] | None) -> float:
     scale = abs(E0)
     if terms_at_start:
         largest = max(abs(v) for v in terms_at_start.values())
@@ -431,15 +436,21 @@ def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> f
 def relative_energy_error(energy: Columns) -> np.ndarray:
     """|E(t) - E(0)| / scale for every sample (dimensionless) of the energy columns ``energy``
     (J, as :func:`partition` gives them), scale from :func:`energy_scale`."""
-    from .trajectory import _columns
-
     args.mapping(energy, "energy", "a dict of energy columns (J) by name")
     if "E" not in energy:
         raise UsageError("energy has no column 'E': must hold the total energy E (J)",
                          param="energy")
-    energy = _columns(energy, _length(energy["E"]), "energy")
+    return _relative_energy_error(args.columns(energy, _length(energy["E"]), "energy"))
+
+
+def _relative_energy_error(energy: Columns) -> np.ndarray:
     E = energy["E"]
     if len(E) == 0:
         return E
+    return np.abs(E - E[0]) / _start_scale(energy)
+
+
+def _start_scale(energy: Columns) -> float:
+    """The :func:`energy_scale` of energy columns (J) at their first sample."""
     terms = {name: float(v[0]) for name, v in energy.items() if name not in BOOKKEEPING}
-    return np.abs(E - E[0]) / energy_scale(float(E[0]), terms)
+    return _energy_scale(float(energy["E"][0]), terms)

@@ -25,13 +25,12 @@ import stat
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from ..errors import SceneError, UsageError
 
 __all__ = [
-    "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "PymunkSettings",
-    "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "load_scene_bytes",
+    "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "load_scene_bytes",
     "packaged_scene", "parse_size", "scene_from_dict", "scenes_dir",
 ]
 
@@ -102,33 +101,13 @@ class RunSettings:
     unstable_energy: float
 
 
-@dataclass(frozen=True)
-class PymunkSettings:
-    """Engine settings of the ``pymunk`` solver in SI units, as the scene's ``[pymunk]`` table
-    gives them; ``None`` means the default below (:meth:`resolved` fills them in). Why these
-    defaults is explained in :mod:`dumbbell.solvers.engine`."""
-
-    collision_slop: float | None
-    collision_bias: float | None
-    iterations: int | None
-
-    #: Overlap tolerated before the position correction acts (m); pymunk's 0.1 is pixels.
-    DEFAULT_SLOP: ClassVar[float] = 1e-4
-    #: Share of an overlap left after one second: 1.0 turns the correction off, which would
-    #: otherwise add energy at each impact.
-    DEFAULT_BIAS: ClassVar[float] = 1.0
-    #: Contact-impulse iterations per step (pymunk's default).
-    DEFAULT_ITERATIONS: ClassVar[int] = 10
-
-    def resolved(self) -> dict[str, Any]:
-        """The settings used: the scene's values, else the defaults."""
-        return {
-            "collision_slop": (self.DEFAULT_SLOP if self.collision_slop is None
-                               else self.collision_slop),
-            "collision_bias": (self.DEFAULT_BIAS if self.collision_bias is None
-                               else self.collision_bias),
-            "iterations": self.DEFAULT_ITERATIONS if self.iterations is None else self.iterations,
-        }
+#: The scene tables a solver owns, by table name: the owner's settings class. A solver's
+#: package registers it (:mod:`dumbbell.solvers` registers the pymunk solver's ``[pymunk]``),
+#: so the model names no solver's settings: they stay on their owner, as pymunk keeps a
+#: space's settings on the space. The class reads its table (``_read(table)``, the table's
+#: checker, or None for a scene without it) and writes it back (``_table()``, the keys the
+#: scene gave) for :meth:`Scene.to_dict`.
+OWNED_TABLES: dict[str, Any] = {}
 
 
 @dataclass(frozen=True)
@@ -240,7 +219,7 @@ class Scene:
     system: System
     run: RunSettings
     outputs: OutputSettings
-    pymunk: PymunkSettings
+    pymunk: Any
     source: str = "<scene>"
 
     @property
@@ -274,9 +253,7 @@ class Scene:
             if out.gif.t_end != run.t_end:
                 gif["t_end"] = out.gif.t_end
             doc["outputs"]["gif"] = gif
-        pymunk = {key: getattr(self.pymunk, key) for key in
-                  ("collision_slop", "collision_bias", "iterations")}
-        pymunk = {key: value for key, value in pymunk.items() if value is not None}
+        pymunk = self.pymunk._table()
         if s.discs:
             pymunk["spin"] = True
         if pymunk:
@@ -713,20 +690,18 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
     return OutputSettings(figures, csv, gif)
 
 
-def _pymunk(top: _Checker) -> tuple[PymunkSettings, bool]:
-    """[pymunk]: engine settings (None where the scene leaves the engine's default), and its
-    ``spin`` key, which says whether the particles are spinning discs (:attr:`System.discs`)."""
+def _pymunk(top: _Checker) -> tuple[Any, bool]:
+    """[pymunk]: the engine's settings, as their owner reads them (:data:`OWNED_TABLES`), and
+    the table's ``spin`` key, which says whether the particles are spinning discs
+    (:attr:`System.discs`)."""
+    owner = OWNED_TABLES["pymunk"]
     cp = top.sub("pymunk")
     if cp is None:
-        return PymunkSettings(None, None, None), False
-    pm = PymunkSettings(
-        cp.number("collision_slop", lo=0.0, unit="m") if cp.has("collision_slop") else None,
-        cp.number("collision_bias", lo=0.0, hi=1.0) if cp.has("collision_bias") else None,
-        cp.integer("iterations", 10, lo=1, hi=10000) if cp.has("iterations") else None,
-    )
+        return owner._read(None), False
+    settings = owner._read(cp)
     discs = bool(cp.boolean("spin", False))
     cp.done()
-    return pm, discs
+    return settings, discs
 
 
 def _parse_size(text: Any) -> tuple[int, int] | None:

@@ -14,6 +14,7 @@ the formulas, at construction.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -126,7 +127,8 @@ class Verdict:
             raise UsageError(f"status = {args.show(self.status)}: must be one of "
                              f"{', '.join(VERDICTS)}", param="status")
         _time(self.t, "t", optional=True)
-        args.text(self.reason, "reason", "a str (why the run ended so)")
+        if type(self.reason) is not str:
+            args.text(self.reason, "reason", "a str (why the run ended so)")
 
     @property
     def ok(self) -> bool:
@@ -140,31 +142,13 @@ class Verdict:
 
 def read_only(values: np.ndarray) -> np.ndarray:
     """A read-only view of the array ``values``; the caller's own array stays writeable."""
-    args.instance(values, "values", np.ndarray, "a numpy array")
+    return _view(args.instance(values, "values", np.ndarray, "a numpy array"))
+
+
+def _view(values: np.ndarray) -> np.ndarray:
     view = values.view()
     view.flags.writeable = False
     return view
-
-
-def _samples(values: Any, name: str) -> np.ndarray:
-    """``values`` (a 1-d array of numbers) as a read-only view; UsageError naming ``name``."""
-    array = np.asarray(values) if isinstance(values, np.ndarray | list | tuple) else None
-    if array is None or array.ndim != 1 or array.dtype.kind not in "fiu":
-        raise UsageError(f"{name} = {args.show(values)}: must be a 1-d array of numbers",
-                         param=name)
-    return read_only(array)
-
-
-def _columns(columns: Any, n: int, name: str) -> dict[str, np.ndarray]:
-    """Read-only views of the columns by name ``columns``, each checked to hold ``n``
-    samples (as many as ``t``); UsageError naming ``name``."""
-    args.mapping(columns, name, "a dict of columns by name")
-    out = {key: _samples(col, f"{name}[{key!r}]") for key, col in columns.items()}
-    for key, col in out.items():
-        if len(col) != n:
-            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
-                             f"t ({n})", param=name)
-    return out
 
 
 def _first_rows(cells: list[list[str]], total: int) -> str:
@@ -204,8 +188,7 @@ class Trajectory:
     contacts: tuple[Contact, ...] = ()
 
     def __post_init__(self) -> None:
-        # The one place a frozen Trajectory's fields are set: checked, then copies and
-        # read-only views, so neither the solver nor a user can change the result afterwards.
+        # A Trajectory built by hand: checked, then frozen (copies and read-only views).
         put = object.__setattr__
         args.instance(self.scene, "scene", Scene, "a Scene")
         args.text(self.solver, "solver", "the solver's name (str)")
@@ -214,27 +197,55 @@ class Trajectory:
             args.real(self.dt, "dt", "s")
         args.whole(self.every, "every", "steps")
         args.real(self.wall_time, "wall_time", "s", lo=0.0)
-        t = _samples(self.t, "t")
+        t = args.samples(self.t, "t")
         put(self, "t", t)
-        put(self, "state", _columns(self.state, len(t), "state"))
-        events = self.events
-        if not isinstance(events, list | tuple) or not all(isinstance(e, Impact) for e in events):
-            raise UsageError(f"events = {args.show(events)}: must be a list of Impact",
-                             param="events")
-        put(self, "events", tuple(events))
+        put(self, "state", args.columns(self.state, len(t), "state"))
+        put(self, "events", tuple(args.impacts(self.events)))
         contacts = self.contacts
         if not isinstance(contacts, list | tuple) or not all(
                 isinstance(c, Contact) for c in contacts):
             raise UsageError(f"contacts = {args.show(contacts)}: must be a list of Contact",
                              param="contacts")
-        put(self, "contacts", tuple(contacts))
-        put(self, "info", dict(args.mapping(self.info, "info", "a dict")))
+        args.mapping(self.info, "info", "a dict")
+        if self.energy is not None:
+            put(self, "energy", args.columns(self.energy, len(t), "energy"))
+        else:
+            from .energy import _state
+
+            _state(self.scene, self.state, len(t))  # every column the partition needs
+        self._freeze()
+
+    @classmethod
+    def _made(cls, **fields: Any) -> Trajectory:
+        """The Trajectory of ``fields`` that a solver has built and checked (what
+        :func:`dumbbell.solvers.verdicts.conclude` makes), frozen as the constructor freezes
+        one, without its checks."""
+        self = object.__new__(cls)
+        for f in dataclasses.fields(cls):
+            if f.name in fields:
+                value = fields[f.name]
+            else:
+                value = f.default_factory() if f.default is dataclasses.MISSING else f.default
+            object.__setattr__(self, f.name, value)
+        self._freeze()
+        return self
+
+    def _freeze(self) -> None:
+        """The one place a Trajectory's fields are made final: copies and read-only views, so
+        neither the solver nor a user can change the result afterwards; the energy columns
+        from :func:`dumbbell.model.energy.partition` when the solver did not count them."""
+        put = object.__setattr__
+        put(self, "t", _view(np.asarray(self.t)))
+        put(self, "state", {key: _view(np.asarray(col)) for key, col in self.state.items()})
+        put(self, "events", tuple(self.events))
+        put(self, "contacts", tuple(self.contacts))
+        put(self, "info", dict(self.info))
         energy = self.energy
         if energy is None:
-            from .energy import partition
+            from .energy import _partition
 
-            energy = partition(self.scene, self.t, self.state, self.events)
-        put(self, "energy", _columns(energy, len(t), "energy"))
+            energy = _partition(self.scene, self.t, self.state, self.events)
+        put(self, "energy", {key: _view(np.asarray(col)) for key, col in energy.items()})
 
     @property
     def columns(self) -> list[str]:
@@ -326,7 +337,7 @@ class Trajectory:
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every
         column's unit in ``df.attrs["units"]``. Needs the extra: pip install 'dumbbell[pandas]'."""
-        from ..io.frames import data_frame
+        from ..frames import data_frame
         from .energy import column_unit
 
         return data_frame({name: self[name] for name in self.columns}, index="t",

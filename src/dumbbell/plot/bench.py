@@ -38,7 +38,7 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
         pts = [p for p in result.points if p.solver == name and p.ran]
         good = [p for p in pts if math.isfinite(p.error) and p.error > 0]
         bad = [p for p in pts if not math.isfinite(p.error)]
-        single = not solver_class(name).has_step
+        single = all(p.dt is None for p in pts)  # a solver without a step: one point
         label = name
         if name == result.truth:
             label += (" (truth; error vs extended precision)"
@@ -137,7 +137,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     if own:
         fig, ax = pyplot().subplots(figsize=(9.6, 5.0), dpi=100)
     names = [n for n in dict.fromkeys(p.solver for p in result.points)
-             if solver_class(n).has_step]
+             if any(p.dt is not None for p in result.points if p.solver == n)]
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
     top = max(finite) * 8 if finite else 1.0
     for i, name in enumerate(names):
@@ -148,11 +148,19 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
         fit = result.fits.get(name)
         label = name + (f":\nfitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
                         f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
+        if fit and fit.expected is not None:
+            label += f"; its own order {fit.expected}: dashed"
         ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
                 lw=0, label=label)
         if fit:
             xs = np.array([min(fit.dts), max(fit.dts)])
             ax.plot(xs, 10 ** (fit.log10_c + fit.order * np.log10(xs)), color=colour, lw=1.2)
+            if fit.expected is not None:
+                # The slope the solver declares, through the middle of the fitted line.
+                mid = np.log10(xs).mean()
+                y_mid = fit.log10_c + fit.order * mid
+                ax.plot(xs, 10 ** (y_mid + fit.expected * (np.log10(xs) - mid)), color=colour,
+                        lw=1.0, ls="--")
         if bad:
             ax.plot([p.dt for p in bad], [top] * len(bad), ls="none", marker="x", color=colour,
                     ms=9, mew=2, label=f"{name}: failed")

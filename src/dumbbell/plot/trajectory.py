@@ -109,10 +109,9 @@ def _checked(traj: Any, ax: Any, window: Any) -> tuple[Trajectory, Any, float]:
 def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle: str) -> None:
     """Finish a figure this module made: shared frame, then the title naming the run."""
     _frame(axes, traj, window)
-    from ..solvers import solver_class
-
-    # A solver without a step takes dt only as the sample spacing: not worth a title.
-    dt = f", dt = {traj.dt:g} s" if traj.dt and solver_class(traj.solver).has_step else ""
+    # A solver without a step takes dt only as the sample spacing: not worth a title (a
+    # stepping solver counts its steps in info).
+    dt = f", dt = {traj.dt:g} s" if traj.dt and "steps" in traj.info else ""
     fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
     if fig.get_layout_engine() is None:
         fig.tight_layout()

@@ -3,26 +3,39 @@
 >>> traj = simulate(load_scene("scenes/textbook-1d.toml"), "exact", every=100)  # doctest: +SKIP
 
 A solver is a :class:`Solver` subclass (the contract is in :mod:`dumbbell.solvers.base`): its
-facts (order, step, floor, cost, ...) are class attributes, and ``supports(scene)`` and
-``solve(scene, options)`` are class methods. :data:`METHODS` is the registry. Adding a solver
-is one module with one subclass and one line in :data:`METHODS`; the heavy parts (numba
-kernels, pymunk, scipy) load only when that solver runs.
+facts (order, step limit, floor, cost, ...) are class attributes, and ``supports(scene)`` and
+``solve(scene, options)`` are class methods. A stepping solver subclasses :class:`Stepper` and
+writes only its step (a :class:`Kernel`). :func:`simulate` and the analyses take such a class
+as it is, like scipy's ``method=``; :data:`METHODS` is the registry of the names scenes and
+the command line know. The heavy parts (numba kernels, pymunk, scipy) load only when a solver
+runs.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from ..errors import SceneError, UsageError
 from ..model import args
-from ..model.scene import Scene
+from ..model.scene import OWNED_TABLES, Scene
 from ..model.trajectory import Trajectory
-from .base import MAX_SAMPLES, MAX_STEPS, RunOptions, Solver, make_options
+from .base import (
+    MAX_SAMPLES,
+    MAX_STEPS,
+    RunOptions,
+    Solver,
+    contract_problems,
+    make_options,
+)
 from .engine import Pymunk
 from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
 from .exact import Exact
+from .kernels import Kernel
+from .pymunk_settings import PymunkSettings
 from .reference import Reference
+from .stepping import Stepper
 from .verlet import Verlet
 
 #: Solver name -> class, in the order listings show them.
@@ -31,14 +44,18 @@ METHODS: dict[str, type[Solver]] = {
 }
 #: Another name for :data:`METHODS`.
 REGISTRY = METHODS
+# The scene's [pymunk] table belongs to the pymunk solver: its settings, on their owner.
+OWNED_TABLES["pymunk"] = PymunkSettings
 
 __all__ = [
     "MAX_SAMPLES",
     "MAX_STEPS",
     "METHODS",
     "REGISTRY",
+    "Kernel",
     "RunOptions",
     "Solver",
+    "Stepper",
     "available",
     "make_options",
     "no_truth_reason",
@@ -50,21 +67,53 @@ __all__ = [
 ]
 
 
-def solver_class(solver: str) -> type[Solver]:
-    """The class of the solver named ``solver``; UsageError naming the choices when there is
-    none."""
-    if not isinstance(solver, str):
-        raise UsageError(f"solver = {args.show(solver)}: must be a solver name, one of "
-                         f"{', '.join(available())}", param="solver")
-    if solver not in METHODS:
-        raise UsageError(f"solver {solver!r}: must be one of {', '.join(available())}")
-    return METHODS[solver]
+def solver_class(solver: str | type[Solver]) -> type[Solver]:
+    """The class of the solver named ``solver``, or ``solver`` itself when it is a
+    :class:`Solver` subclass that keeps the contract (like scipy's ``method=``, which takes a
+    name or an ``OdeSolver`` subclass); UsageError naming the choices otherwise."""
+    if isinstance(solver, str):
+        if solver not in METHODS:
+            raise UsageError(f"solver {solver!r}: must be one of {', '.join(available())}")
+        return METHODS[solver]
+    return _solver(solver, "solver")
+
+
+def _solver(solver: Any, param: str) -> type[Solver]:
+    """``solver`` (a registered name or a Solver subclass) as a class; UsageError naming
+    ``param`` when it is neither, or a class that breaks the contract."""
+    if isinstance(solver, str) and solver in METHODS:
+        return METHODS[solver]
+    if isinstance(solver, type) and issubclass(solver, Solver):
+        problems = contract_problems(solver)
+        if problems:
+            raise UsageError(f"{param} = {solver.__qualname__}: does not keep the solver "
+                             f"contract: {'; '.join(problems)}", param=param)
+        return solver
+    raise UsageError(f"{param} = {args.show(solver)}: must be one of {', '.join(available())}"
+                     " (or a Solver subclass)", param=param)
+
+
+def solver_classes(solvers: Any, param: str = "solvers") -> list[type[Solver]] | None:
+    """None (the caller's default set), or one solver or a list of them (names or classes,
+    see :func:`solver_class`) as a list of classes, each once; UsageError naming ``param``."""
+    if solvers is None or (isinstance(solvers, list | tuple) and not solvers):
+        return None
+    if isinstance(solvers, str | type):
+        solvers = [solvers]
+    if not isinstance(solvers, list | tuple):
+        raise UsageError(f"{param} = {args.show(solvers)}: must be a list of solvers (names "
+                         f"among {', '.join(available())}, or Solver subclasses)", param=param)
+    return list(dict.fromkeys(_solver(s, param) for s in solvers))
 
 
 def scene_solver(scene: Scene) -> type[Solver]:
     """The class of the solver the scene's ``run.solver`` names; SceneError naming the file
     and key when no solver has that name."""
-    scene = args.scene(scene)
+    return scene_class(args.scene(scene))
+
+
+def scene_class(scene: Scene) -> type[Solver]:
+    """:func:`scene_solver` of a Scene."""
     name = scene.run.solver
     if name not in METHODS:
         raise SceneError(f"{scene.source}: run.solver = {name!r}: must be one of "
@@ -79,22 +128,31 @@ def available() -> list[str]:
 
 def supported(scene: Scene) -> list[str]:
     """Names of the solvers that can run ``scene``."""
-    scene = args.scene(scene)
-    return [n for n, cls in METHODS.items() if cls.supports(scene) is None]
+    return [cls.name for cls in supporting(args.scene(scene))]
+
+
+def supporting(scene: Scene) -> list[type[Solver]]:
+    """The registered solvers that can run the Scene ``scene``, in registry order."""
+    return [cls for cls in METHODS.values() if cls._supports(scene) is None]
 
 
 def _truth_class(scene: Scene) -> type[Solver] | None:
     """The truth solver for scenes of ``scene``'s kind, whether or not it can run this one."""
-    return next((cls for cls in METHODS.values() if cls.is_truth and cls.truth_for(scene)),
+    return next((cls for cls in METHODS.values() if cls.is_truth and cls._truth_for(scene)),
                 None)
 
 
 def truth_solver(scene: Scene) -> str | None:
     """The solver analysis takes as truth for ``scene`` (``exact`` in 1D and for the rigid 2D
     dumbbell, ``reference`` for a 2D spring); None when it cannot run the scene."""
-    scene = args.scene(scene)
+    cls = truth_class(args.scene(scene))
+    return None if cls is None else cls.name
+
+
+def truth_class(scene: Scene) -> type[Solver] | None:
+    """:func:`truth_solver` of a Scene, as its class."""
     cls = _truth_class(scene)
-    return cls.name if cls is not None and cls.supports(scene) is None else None
+    return cls if cls is not None and cls._supports(scene) is None else None
 
 
 def no_truth_reason(scene: Scene) -> str | None:
@@ -103,27 +161,31 @@ def no_truth_reason(scene: Scene) -> str | None:
     cls = _truth_class(scene)
     if cls is None:
         return "no solver is the truth for this kind of scene"
-    return cls.supports(scene)
+    return cls._supports(scene)
 
 
 def simulate(
     scene: Scene | str | Path,
-    solver: str | None = None,
+    solver: str | type[Solver] | None = None,
     dt: float | None = None,
     t_end: float | None = None,
     every: int | None = None,
     quiet: bool = True,
     max_samples: int | None = MAX_SAMPLES,
 ) -> Trajectory:
-    """Run ``scene`` (a Scene or the path of a scene file) with ``solver`` (default: the
-    scene's). ``dt`` and ``t_end`` in s override the scene's ``[run]``; ``every`` keeps every
-    N-th step; a run that would keep more than ``max_samples`` samples is refused before it
-    starts (None: no budget). Returns a :class:`Trajectory` whose ``verdict`` says whether
-    the run ended well."""
+    """Run ``scene`` (a Scene or the path of a scene file) with ``solver`` (a name, or a
+    :class:`Solver` subclass; default: the scene's). ``dt`` and ``t_end`` in s override the
+    scene's ``[run]``; ``every`` keeps every N-th step; a run that would keep more than
+    ``max_samples`` samples is refused before it starts (None: no budget). Returns a
+    :class:`Trajectory` whose ``verdict`` says whether the run ended well."""
     scene = args.scene(scene)
-    cls = scene_solver(scene) if solver is None else solver_class(solver)
-    name = cls.name
-    reason = cls.supports(scene)
+    cls = scene_class(scene) if solver is None else solver_class(solver)
+    runnable(cls, scene)
+    return cls._solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))
+
+
+def runnable(cls: type[Solver], scene: Scene) -> None:
+    """UsageError when the solver ``cls`` cannot run ``scene``, saying why."""
+    reason = cls._supports(scene)
     if reason is not None:
-        raise UsageError(f"solver {name!r} cannot run {scene.source}: {reason}")
-    return cls.solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))
+        raise UsageError(f"solver {cls.name!r} cannot run {scene.source}: {reason}")

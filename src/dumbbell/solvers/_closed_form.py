@@ -7,6 +7,7 @@ file level.
 from __future__ import annotations
 
 from ..model.trajectory import Verdict
+from .kernels import REST_SPEED  # the stepping kernels end a run at the same speed
 
 #: Nothing public: tolerances and a verdict the closed-form solvers share.
 __all__: list[str] = []
@@ -16,8 +17,6 @@ ROOT_XTOL = 1e-14
 #: Intervals shorter than this (s) are not split further: a dip below the floor inside one
 #: would be shallower than C * MIN_SPLIT^2 / 8, about 1e-25 m.
 MIN_SPLIT = 1e-13
-#: An impact slower than this (m/s) means the particle has come to rest on the floor.
-REST_SPEED = 1e-9
 #: A point of a particle's height curve, as the root searches pass it: time (s), height (m)
 #: and vertical velocity (m/s).
 HeightPoint = tuple[float, float, float]

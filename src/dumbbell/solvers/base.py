@@ -10,9 +10,10 @@ registry costs nothing to load.
 from __future__ import annotations
 
 import functools
+import inspect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -51,7 +52,12 @@ class RunOptions:
     quiet: bool = True
 
     def __post_init__(self) -> None:
-        # Built once a run: a wrong value here would surface deep in a solver's loop.
+        # What the package builds (checked floats and ints) passes this first test alone; a
+        # value built by hand is looked at field by field, where a wrong one names itself.
+        if (type(self.dt) is float and type(self.t_end) is float and type(self.every) is int
+                and type(self.quiet) is bool and 0 < self.dt < math.inf
+                and 0 < self.t_end < math.inf and self.every >= 1):
+            return
         from ..model import args
 
         args.real(self.dt, "dt", "s")
@@ -72,25 +78,39 @@ class RunOptions:
     def sample_times(self, count: int | None = None) -> np.ndarray:
         """Times of the first ``count`` samples (s; all by default): step * dt, with the step
         index j * every kept whole so every solver and every ``every`` share the same floats."""
-        if count is not None:
+        if count is not None and type(count) is not int:
             from ..model import args
 
             count = args.whole(count, "count", "samples", lo=0)
+        if count is not None and count < 0:
+            raise UsageError(f"count = {count}: must be a whole number >= 0 (samples)",
+                             param="count")
         steps = np.arange(self.n_samples if count is None else count, dtype=np.int64)
         return (steps * self.every) * self.dt
 
 
+#: The class methods of the contract whose arguments a call from outside has checked (the
+#: scene, and for ``solve`` and ``check_work`` the RunOptions and the scene's support).
+CHECKED = ("supports", "solve", "check_work", "truth_for", "catch_depth")
+
+
 class Solver:
     """The contract of a solver. Subclasses set every attribute below and implement
-    :meth:`supports` and :meth:`solve`; they are never instantiated (all is class-level).
+    :meth:`supports` and :meth:`solve`; they are never instantiated (all is class-level). Like
+    scipy's ``solve_ivp(method=)``, :func:`~dumbbell.solvers.simulate` and the analyses take
+    such a class as well as a registered name, checked against this contract
+    (:func:`contract_problems`).
 
-    Capabilities (a test checks that every registered solver declares each one):
+    Facts (a test checks that every registered solver declares each one):
 
     - ``name``: what scenes, the CLI and the outputs call it;
-    - ``order``: the order p of its position error in the step, error ~ dt^p through
-      impacts (None without a step);
+    - ``order``: the order p of its position error in the step, error ~ dt^p (None without a
+      step); bench fits the order it measures beside it and draws this slope;
     - ``has_step``: it advances by a fixed step ``dt`` (False: ``dt`` only spaces the samples);
-    - ``explicit_spring``: its spring step is explicit, stable iff w*dt < 2 (w = sqrt(k/mu));
+    - ``step_limit``: the largest w*dt (w = sqrt(k/mu)) at which its spring step is stable: 2
+      for an explicit step (Euler-Cromer, Verlet, pymunk), 2*sqrt(2) for classic Runge-Kutta;
+      None where no step limits it. The stability theory, the verdicts' messages and the
+      stability catalogue read it;
     - ``flip_floor``: its floor reverses velocities at impacts, so it cannot hold a particle in
       lasting contact (an inelastic floor ends the run as ``failed``);
     - ``relative_cost``: rough cost of one step (or one sample) against Euler-Cromer's, for
@@ -99,32 +119,36 @@ class Solver:
       truth for scenes it supports (the first registered one that does);
     - ``estimates_error``: ``solve`` takes ``estimate_error=False`` to skip measuring its own
       error with a second, tighter run.
+
+    The methods a subclass writes (:data:`CHECKED`) are wrapped when the class is made: called
+    on the class they check their arguments first, while the package, which has checked them
+    at its border, calls the method as written, under the same name with a leading
+    underscore (``cls._solve(scene, options)``).
     """
 
     name: ClassVar[str]
     order: ClassVar[int | None]
     has_step: ClassVar[bool]
-    explicit_spring: ClassVar[bool]
+    step_limit: ClassVar[float | None]
     flip_floor: ClassVar[bool]
     relative_cost: ClassVar[float]
     is_truth: ClassVar[bool]
     estimates_error: ClassVar[bool]
 
-    #: Every capability a solver must declare itself (checked by the test suite).
-    CAPABILITIES: ClassVar[tuple[str, ...]] = (
-        "name", "order", "has_step", "explicit_spring", "flip_floor", "relative_cost",
-        "is_truth", "estimates_error",
-    )
+    #: Every fact a solver must declare itself, with the types it may have.
+    CAPABILITIES: ClassVar[dict[str, tuple[type, ...]]] = {
+        "name": (str,), "order": (int, type(None)), "has_step": (bool,),
+        "step_limit": (float, type(None)), "flip_floor": (bool,), "relative_cost": (float,),
+        "is_truth": (bool,), "estimates_error": (bool,),
+    }
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
-        """Every solver's class methods check their arguments where they are entered (a
-        Scene, or a scene file's path, and RunOptions for ``solve``), so a subclass's own
-        functions can trust them."""
         super().__init_subclass__(**kwargs)
-        for name in ("supports", "solve", "check_work", "truth_for", "catch_depth"):
+        for name in CHECKED:
             fn = vars(cls).get(name)
-            if isinstance(fn, staticmethod):
-                setattr(cls, name, staticmethod(_checked(cls, name, fn.__func__)))
+            if isinstance(fn, staticmethod | classmethod):
+                setattr(cls, f"_{name}", fn)
+                setattr(cls, name, _checked(name, fn.__func__, isinstance(fn, staticmethod)))
 
     @classmethod
     def supports(cls, scene: Scene) -> str | None:
@@ -137,22 +161,29 @@ class Solver:
         raise NotImplementedError
 
     @classmethod
-    def check_work(cls, scene: Scene, options: RunOptions) -> None:
+    def _check_work(cls, scene: Scene, options: RunOptions) -> None:
         """UsageError, before any work, when the run is known to exceed this solver's work
         budget (the default: no such estimate). :meth:`solve` calls it first; callers that
         plan several runs call it for each before the first."""
 
     @classmethod
-    def truth_for(cls, scene: Scene) -> bool:
+    def _truth_for(cls, scene: Scene) -> bool:
         """Whether this (``is_truth``) solver is the truth for scenes of ``scene``'s kind,
         whether or not it can run this one (False for every other solver)."""
         return False
 
     @classmethod
-    def catch_depth(cls, scene: Scene) -> float | None:
+    def _catch_depth(cls, scene: Scene) -> float | None:
         """How far (m) a particle may move in one step and still be caught by a floor that is
         a body of finite thickness (beyond it, it passes through); None when the floor is not
         such a body."""
+        return None
+
+    @classmethod
+    def swing(cls, ratio: float) -> float | None:
+        """The largest relative swing of the vibration energy that a *stable* run of this
+        solver makes at w*dt = ``ratio``, for the verdict's message near the step limit; None
+        where the theory gives no such bound (the default)."""
         return None
 
     @classmethod
@@ -160,6 +191,59 @@ class Solver:
         """Compile or load what the first run would; returns the seconds it took, NaN when
         there is nothing to compile (the default)."""
         return math.nan
+
+
+class ExplicitSpring:
+    """The fact of an explicit, symplectic spring step (Euler-Cromer, Verlet, pymunk's
+    impulse): stable iff w*dt < 2, and while stable the vibration energy swings by at most
+    h/(2 - h) times itself at w*dt = h (a 19-fold swing at 1.9), without growing. A solver
+    class lists it before its base class."""
+
+    step_limit: ClassVar[float | None] = 2.0
+
+    @classmethod
+    def swing(cls, ratio: float) -> float | None:
+        if type(ratio) is not float:
+            from ..model import args
+
+            ratio = args.real(ratio, "ratio", "1", lo=0.0)
+        return ratio / (2.0 - ratio) if ratio < 2.0 else math.inf
+
+
+def contract_problems(cls: Any) -> list[str]:
+    """What keeps ``cls`` from being a solver: not a :class:`Solver` subclass, a fact left out
+    or of the wrong type (:attr:`Solver.CAPABILITIES`) or out of its range, ``supports`` or
+    ``solve`` not written. Empty for a solver that keeps the contract."""
+    if not (isinstance(cls, type) and issubclass(cls, Solver)) or cls is Solver:
+        return ["not a subclass of dumbbell.solvers.Solver"]
+    problems = []
+    for fact, kinds in Solver.CAPABILITIES.items():
+        value = getattr(cls, fact, _MISSING)
+        if value is _MISSING:
+            problems.append(f"{fact} is not declared")
+        elif isinstance(value, bool) and bool not in kinds or not isinstance(value, kinds):
+            problems.append(f"{fact} = {value!r} must be {' or '.join(k.__name__ for k in kinds)}")
+    problems += [] if problems else _range_problems(cls)
+    problems += [f"{method[1:]} is not written" for method in ("_supports", "_solve")
+                 if not hasattr(cls, method)]
+    return problems
+
+
+def _range_problems(cls: type[Solver]) -> list[str]:
+    """The facts of ``cls`` (each of the right type) that are out of their range."""
+    checks = [
+        (bool(cls.name), "name is empty"),
+        (cls.order is None or cls.order >= 1, f"order = {cls.order} must be >= 1 or None"),
+        (cls.step_limit is None or 0 < cls.step_limit < math.inf,
+         f"step_limit = {cls.step_limit} must be > 0 and finite, or None"),
+        (cls.has_step or (cls.order is None and cls.step_limit is None),
+         "a solver without a step has no order and no step limit"),
+        (cls.relative_cost > 0, f"relative_cost = {cls.relative_cost} must be > 0"),
+    ]
+    return [problem for fine, problem in checks if not fine]
+
+
+_MISSING = object()
 
 
 class OverBudget(Exception):
@@ -236,27 +320,41 @@ def check_impacts(scene: Scene, options: RunOptions, vertical_energy: float,
         f"air between two), past the budget of {limit:,} per run", param="t_end",
         fixes=("lower {t_end}",))
 
-def _checked(cls: type[Solver], name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
-    """``fn`` (a solver's ``name`` method, first argument the scene) with its arguments
-    checked first; ``solve`` and ``check_work`` also take only RunOptions and a scene the
-    solver supports."""
-    from ..model import args
+def _checked(name: str, fn: Callable[..., Any], static: bool) -> classmethod:
+    """The contract method ``name`` (``fn`` as written, a static method if ``static``, its
+    first argument after ``cls`` the scene) as a class method that checks its arguments first:
+    the scene (or a scene file's path), and for ``solve`` and ``check_work`` also RunOptions
+    and a scene the solver supports. It then calls ``cls._NAME``, the method as written."""
 
     @functools.wraps(fn)
-    def method(scene: Any, *rest: Any, **kwargs: Any) -> Any:
+    def method(cls: type[Solver], scene: Any, *rest: Any, **kwargs: Any) -> Any:
+        from ..model import args
+
         scene = args.scene(scene)
         if name in ("solve", "check_work"):
             options = rest[0] if rest else kwargs.pop("options", None)
             args.instance(options, "options", RunOptions,
                           "RunOptions (from dumbbell.solvers.make_options)")
-            reason = cls.supports(scene)
+            reason = cls._supports(scene)
             if reason is not None:
                 raise UsageError(f"scene = {scene.name}: {cls.name} cannot run it: {reason}",
                                  param="scene")
             rest = (options, *rest[1:])
-        return fn(scene, *rest, **kwargs)
+        return getattr(cls, f"_{name}")(scene, *rest, **kwargs)
 
-    return method
+    # Its signature is the method's as written (a static one gains ``cls``, which the class
+    # binds), so that help() and inspect show the real parameters.
+    signature = inspect.signature(fn)
+    if static:
+        cls_param = inspect.Parameter("cls", inspect.Parameter.POSITIONAL_OR_KEYWORD)
+        signature = signature.replace(parameters=[cls_param, *signature.parameters.values()])
+    method.__signature__ = signature  # type: ignore[attr-defined]
+    return classmethod(method)
+
+
+# The contract's optional methods, public and checked on every solver that keeps the default.
+for _name in ("check_work", "truth_for", "catch_depth"):
+    setattr(Solver, _name, _checked(_name, vars(Solver)[f"_{_name}"].__func__, static=False))
 
 
 def kernel_params(system: System, dt: float) -> Params:
@@ -286,28 +384,48 @@ def make_options(
     quiet: bool = True, max_samples: int | None = None,
 ) -> RunOptions:
     """Fill run options from the scene's ``[run]`` table and check them (UsageError): ``dt``
-    and ``t_end`` in s, ``every`` in steps. The step count is checked against
-    :data:`MAX_STEPS` and, when ``max_samples`` is given, the samples kept against it, both as
-    exact integers before anything is allocated."""
+    and ``t_end`` in s, ``every`` in steps (each checked if given; None: the scene's). The
+    step count is checked against :data:`MAX_STEPS` and, when ``max_samples`` is given, the
+    samples kept against it, both as exact integers before anything is allocated."""
     from ..model import args
 
     scene = args.scene(scene)
-    dt = args.real(scene.run.dt if dt is None else dt, "dt", "s")
-    t_end = args.real(scene.run.t_end if t_end is None else t_end, "t_end", "s")
+    if dt is not None:
+        dt = args.real(dt, "dt", "s")
+    if t_end is not None:
+        t_end = args.real(t_end, "t_end", "s")
+    if every is not None:
+        every = args.whole(every, "every", "steps", hi=MAX_STEPS)
+    options = run_options(scene, dt, t_end, every)
+    if quiet is not True:
+        options = replace(options, quiet=args.flag(quiet, "quiet"))
+    if max_samples is not None:
+        # The default needs no check (simulate's budget, MAX_SAMPLES).
+        budget = (max_samples if max_samples is MAX_SAMPLES
+                  else args.whole(max_samples, "max_samples", "samples"))
+        check_samples(scene, options, budget)
+    return options
+
+
+def run_options(scene: Scene, dt: float | None = None, t_end: float | None = None,
+                every: int | None = None) -> RunOptions:
+    """The (quiet) run options of ``scene`` with the values given, checked already (None:
+    the scene's ``[run]``): UsageError when ``dt`` passes ``t_end`` or the run would take
+    more than :data:`MAX_STEPS` steps, counted before anything is allocated."""
+    dt = scene.run.dt if dt is None else float(dt)
+    t_end = scene.run.t_end if t_end is None else float(t_end)
+    every = scene.run.every if every is None else int(every)
     if dt > t_end:
         raise UsageError(f"dt = {dt:g}: must be <= t_end = {t_end:g} (s)", param="dt")
-    every = args.whole(scene.run.every if every is None else every, "every", "steps",
-                       hi=MAX_STEPS)
-    quiet = args.flag(quiet, "quiet")
+    if every > MAX_STEPS:
+        raise UsageError(f"every = {every}: must be a whole number from 1 to "
+                         f"{MAX_STEPS:,} (steps)", param="every")
     ratio = t_end / dt  # a float; inf when the quotient passes the largest float
     if not ratio <= MAX_STEPS:
         count = f"{round(ratio):,} steps" if math.isfinite(ratio) else "more than 1e308 steps"
         raise UsageError(f"t_end / dt = {t_end:g} s / {dt:g} s = {count}: a run may take at "
                          f"most {MAX_STEPS:,} steps", fixes=("raise {dt}", "lower {t_end}"))
-    options = RunOptions(dt, t_end, every, quiet)
-    if max_samples is not None:
-        check_samples(scene, options, args.whole(max_samples, "max_samples", "samples"))
-    return options
+    return RunOptions(dt, t_end, every, True)
 
 
 def check_samples(scene: Scene, options: RunOptions, max_samples: int) -> None:

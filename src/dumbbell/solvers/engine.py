@@ -59,8 +59,8 @@ import numpy as np
 from ..model.energy import disc_inertia, partition_from_terms, spins, state_columns
 from ..model.scene import Particle, Scene
 from ..model.trajectory import Contact, Impact, Trajectory, Verdict
-from .base import RunOptions, Solver
-from .verdicts import conclude, nonfinite_reason, tunnel_reason
+from .base import ExplicitSpring, RunOptions, Solver
+from .verdicts import RawRun, Sinking, conclude, nonfinite_reason, tunnel_reason
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Pymunk"]
@@ -80,7 +80,7 @@ _PARTICLE_TYPE = {"A": 2, "B": 3}
 
 def settings(scene: Scene) -> dict[str, Any]:
     """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else the
-    defaults declared on :class:`~dumbbell.model.scene.PymunkSettings`."""
+    defaults declared on :class:`~dumbbell.solvers.pymunk_settings.PymunkSettings`."""
     return scene.pymunk.resolved()
 
 
@@ -385,15 +385,14 @@ class _Watch:
         """The verdict of the sample ``row`` at ``t`` (s) of a run at step ``dt`` (s), or
         None when the run goes on."""
         if not all(abs(v) < _BIG for v in row):
-            return Verdict("unstable", t, nonfinite_reason(self.scene, dt))
+            return Verdict("unstable", t, nonfinite_reason(self.scene, dt, Pymunk.step_limit))
         if not self.floors:
             return None
         for name in "AB":
             y, vy = row[self.columns[name][0]], row[self.columns[name][1]]
             if y < -self.radius[name] and vy < 0:
-                return Verdict("tunnelled", t, tunnel_reason(
-                    self.scene, name, y, vy, dt,
-                    depth=self.radius[name] + FLOOR_THICKNESS / 2))
+                return Verdict("tunnelled", t, tunnel_reason(self.scene, Sinking(
+                    name, y, vy, depth=self.radius[name] + FLOOR_THICKNESS / 2), dt))
         return None
 
 
@@ -464,19 +463,19 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
         info.update(log.notes())
     t = options.sample_times(kept)
     events = [e for e in log.events if verdict is None or e.t <= verdict.t] if log else []
-    traj = conclude(scene, NAME, t, state, events, verdict or Verdict(), dt=dt, every=every,
-                    wall_time=wall, info=info, energy=_energy(scene, world, t, state, events))
+    traj = conclude(Pymunk, scene, options, RawRun(
+        t, state, events, verdict or Verdict(), wall, info,
+        energy=_energy(scene, world, t, state, events)))
     contacts = log.contacts(float(traj.t[-1])) if log and len(traj.t) else ()
     return dataclasses.replace(traj, contacts=contacts) if contacts else traj
 
 
-class Pymunk(Solver):
+class Pymunk(ExplicitSpring, Solver):
     """The pymunk (Chipmunk) engine (see the module docstring)."""
 
     name = NAME
     order = 1
     has_step = True
-    explicit_spring = True
     flip_floor = False
     relative_cost = 30.0
     is_truth = False

@@ -35,7 +35,7 @@ from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
 from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_failed
 from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
-from .verdicts import conclude
+from .verdicts import RawRun, conclude
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Exact"]
@@ -188,9 +188,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     out = kernels.sample(rows, t, _motion(scene))
     cols = {name: out[c] for c, name in enumerate(_COLUMNS)}
     wall = time.perf_counter() - t0
-    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
-                    wall_time=wall, info={"segments": len(rows), "root_xtol": ROOT_XTOL},
-                    truth=True)
+    return conclude(Exact, scene, options, RawRun(t, cols, events, verdict, wall,
+                                                  {"segments": len(rows), "root_xtol": ROOT_XTOL}))
 
 
 def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
@@ -206,10 +205,9 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
         t = t[t <= verdict.t]
     cols = sample(scene, segs, t)
     wall = time.perf_counter() - t0
-    return conclude(scene, NAME, t, cols, events, verdict, dt=options.dt, every=options.every,
-                    wall_time=wall, truth=True,
-                    info={"segments": len(segs), "root_xtol": ROOT_XTOL,
-                          "moment": rigid_moment(scene)})
+    return conclude(Exact, scene, options, RawRun(t, cols, events, verdict, wall,
+                                                  {"segments": len(segs), "root_xtol": ROOT_XTOL,
+                                                   "moment": rigid_moment(scene)}))
 
 
 class Exact(Solver):
@@ -219,7 +217,7 @@ class Exact(Solver):
     name = NAME
     order = None
     has_step = False
-    explicit_spring = False
+    step_limit = None
     flip_floor = True
     relative_cost = 0.01
     is_truth = True

@@ -47,8 +47,8 @@ from typing import Any
 import numpy as np
 
 from ..model.energy import (
+    _relative_energy_error,
     impact_heat,
-    relative_energy_error,
     rigid_moment,
     spins,
     state_columns,
@@ -56,7 +56,8 @@ from ..model.energy import (
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .base import RunOptions, Solver
-from .verdicts import head, judge
+from .kernels import REST_SPEED
+from .verdicts import RawRun, head, judge
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
 __all__ = ["Reference"]
@@ -67,8 +68,6 @@ RTOL = 1e-12
 ATOL = 1e-12
 #: The window (s) over which the error estimate is stated separately (chaos: see docs/physics.md).
 ERROR_WINDOW = 2.0
-#: An impact slower than this (m/s) means the particle has come to rest on the floor.
-REST_SPEED = 1e-9
 MAX_IMPACTS = 100_000
 
 
@@ -317,7 +316,8 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
     from ..model import args
     from ..progress import bar
 
-    estimate_error = args.flag(estimate_error, "estimate_error")
+    if not isinstance(estimate_error, bool):
+        estimate_error = args.flag(estimate_error, "estimate_error")
     times = options.sample_times()
     if scene.system.dimensions == 2 and scene.system.rigid is None:
         warm_up()  # numba compiles (or loads) the kernel outside the solver's clock
@@ -336,12 +336,11 @@ def solve(scene: Scene, options: RunOptions, estimate_error: bool = True) -> Tra
         info = {"method": "DOP853", "rtol": RTOL, "atol": ATOL, "nfev": nfev}
     if scene.system.rigid is not None:
         info["moment"] = rigid_moment(scene)
-    verdict, keep, energy = judge(scene, NAME, t, cols, impacts, verdict, options.dt,
-                                  truth=True)
+    verdict, keep, energy = judge(Reference, scene, options, RawRun(t, cols, impacts, verdict))
     t, cols = t[:keep], head(cols, keep)
     if estimate_error and len(t):
         info["estimated_error"] = _estimate_error(scene, t, cols, impacts, energy)
-    return Trajectory(scene=scene, solver=NAME, t=t, state=cols, events=impacts,
+    return Trajectory._made(scene=scene, solver=NAME, t=t, state=cols, events=impacts,
                       verdict=verdict, dt=options.dt, every=options.every, wall_time=wall,
                       info=info, energy=energy)
 
@@ -361,7 +360,7 @@ def _estimate_error(
         "position_m_window": float(diff[window].max()),
         "window_s": float(min(ERROR_WINDOW, t[n - 1])),
         "position_m_whole_run": float(diff.max()),
-        "energy_relative": float(relative_energy_error(energy).max()),
+        "energy_relative": float(_relative_energy_error(energy).max()),
     }
     early = [(a, b) for a, b in zip(impacts, events, strict=False)
              if max(a.t, b.t) <= ERROR_WINDOW and a.body == b.body]
@@ -377,7 +376,7 @@ class Reference(Solver):
     name = NAME
     order = None
     has_step = False
-    explicit_spring = False
+    step_limit = None
     flip_floor = True
     relative_cost = 100.0
     is_truth = True

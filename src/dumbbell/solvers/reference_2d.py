@@ -30,7 +30,7 @@ from scipy.optimize import brentq
 from ..model.energy import spins
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Verdict
-from ._closed_form import HeightPoint
+from ._closed_form import REST_SPEED, HeightPoint
 
 #: Nothing public: the machinery the solver classes share.
 __all__: list[str] = []
@@ -40,7 +40,6 @@ __all__: list[str] = []
 STEP_ANGLE = 0.02
 ROOT_XTOL = 1e-14
 MIN_SPLIT = 1e-13
-REST_SPEED = 1e-9
 MAX_IMPACTS = 100_000
 
 

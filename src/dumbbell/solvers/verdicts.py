@@ -1,9 +1,11 @@
 """Verdicts shared by the solvers: how a run ended, and the likely cause in words.
 
-A solver hands its raw samples and its own verdict (from its status) to :func:`conclude`, the
-one path from a finished run to its frozen Trajectory: :func:`judge` settles the final verdict
-and how many samples the run keeps (those up to the failure), without changing any array, and
-the Trajectory is built once from them. The verdict's ``str`` is the line ``dumbbell
+A solver hands its raw samples and its own verdict (from its status), as a :class:`RawRun`, to
+:func:`conclude`, the one path from a finished run to its frozen Trajectory: :func:`judge`
+settles the final verdict and how many samples the run keeps (those up to the failure),
+without changing any array, and the Trajectory is built once from them. A verdict is dated at
+the step where it happens, whatever the sampling: a stepping solver can replay its steps
+between the samples (``RawRun.replay``), and the energy is then judged step by step. The verdict's ``str`` is the line ``dumbbell
 simulate`` prints:
 
 - ``unstable``: the state stopped being finite or the energy grew past ``run.unstable_energy``
@@ -11,34 +13,29 @@ simulate`` prints:
 - ``tunnelled``: a particle went through the floor (:func:`tunnel_reason`);
 - ``failed``: anything else, with the reason.
 
-The theory behind the messages (explicit spring steps are stable iff w*dt < 2, with
-w = sqrt(k/mu)) is in docs/physics.md.
+The theory behind the messages (a solver's spring step is stable iff w*dt is below its
+``step_limit``, 2 for an explicit step, with w = sqrt(k/mu)) is in docs/physics.md.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..model.energy import partition, relative_energy_error
+from ..model.energy import _partition, _start_scale
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .kernels import BIG
 
+if TYPE_CHECKING:
+    from .base import RunOptions, Solver
+
 #: Nothing public: the machinery the solver classes share.
 __all__: list[str] = []
-
-#: The explicit spring step (Euler-Cromer, Verlet, pymunk) is stable iff w*dt < this.
-STEP_LIMIT = 2.0
-
-
-def stability_limit(scene: Scene) -> float | None:
-    """The largest stable step of the explicit spring, 2/w (s); None without a spring force."""
-    w = scene.system.omega
-    return STEP_LIMIT / w if w > 0 else None
 
 
 def step_ratio(scene: Scene, dt: float | None) -> float:
@@ -55,65 +52,70 @@ def seconds(value: float) -> str:
     return f"{mantissa}e{int(exponent)}"
 
 
-def ratio_text(ratio: float) -> str:
-    """w*dt for a message: two decimals, more near the limit so that 1.999 is not '2.00'."""
-    if abs(ratio - STEP_LIMIT) < 0.005:
+def ratio_text(ratio: float, limit: float) -> str:
+    """w*dt for a message: two decimals, more near the step ``limit`` so that 1.999 is not
+    '2.00'."""
+    if abs(ratio - limit) < 0.005:
         return f"{ratio:.5f}"
     return f"{ratio:.2f}" if ratio >= 0.1 else f"{ratio:.2g}"
 
 
-def stable_swing(ratio: float) -> float:
-    """Largest relative swing of a *stable* explicit oscillator's energy at w*dt = ``ratio``:
-    h/(2 - h) of its vibration energy (a 19-fold swing at 1.9); inf at and past the limit."""
-    return ratio / (STEP_LIMIT - ratio) if ratio < STEP_LIMIT else math.inf
-
-
-def nonfinite_reason(scene: Scene, dt: float) -> str:
-    """Why a state most likely blew up at step ``dt`` (s), with the fix when it is the step."""
+def nonfinite_reason(scene: Scene, dt: float, limit: float | None) -> str:
+    """Why a state most likely blew up at step ``dt`` (s) of a solver whose spring step is
+    stable below w*dt = ``limit`` (None: no such limit), with the fix when it is the step."""
     w = scene.system.omega
-    limit = stability_limit(scene)
-    if limit is not None and w * dt >= STEP_LIMIT:
-        return (f"w*dt = {ratio_text(w * dt)} > 2 (w = sqrt(k/mu) = {w:.4g} rad/s); "
-                f"use dt < {seconds(limit)} s")
-    if limit is not None:
-        return (f"the state grew without bound although w*dt = {ratio_text(w * dt)} < 2 "
-                f"(w = {w:.4g} rad/s)")
-    return "the state grew without bound"
+    if limit is None or not w > 0:
+        return "the state grew without bound"
+    if w * dt >= limit:
+        return (f"w*dt = {ratio_text(w * dt, limit)} > {limit:.3g} (w = sqrt(k/mu) = {w:.4g} "
+                f"rad/s); use dt < {seconds(limit / w)} s")
+    return (f"the state grew without bound although w*dt = {ratio_text(w * dt, limit)} < "
+            f"{limit:.3g} (w = {w:.4g} rad/s)")
 
 
-def tunnel_reason(
-    scene: Scene, body: str, height: float, speed: float, dt: float | None,
-    depth: float | None = None,
-) -> str:
-    """Why ``body`` went through the floor: it is ``height`` (m, < 0) below it moving down at
-    ``speed`` (m/s). ``depth`` (m) is how far past the floor a contact can still be caught in
-    one step (2r for a circle on a thin floor); with it, the message gives the step to use."""
-    text = f"{body} is {abs(height):.3g} m below the floor, still moving down at {abs(speed):.3g} m/s"
+@dataclass(frozen=True)
+class Sinking:
+    """A particle found below the floor although the floor should have turned it back:
+    ``body`` ('A' or 'B'), ``height`` (m, < 0), ``speed`` its vertical velocity (m/s, < 0),
+    ``push`` the spring's downward acceleration on it (m/s^2), ``depth`` how far past the
+    floor a contact can still be caught (m; None: a flip at the first step below it)."""
+
+    body: str
+    height: float
+    speed: float
+    push: float = 0.0
+    depth: float | None = None
+
+
+def tunnel_reason(scene: Scene, sinking: Sinking, dt: float | None) -> str:
+    """Why a particle went through the floor (``sinking``: where it is, how fast it moves,
+    and how far past the floor a contact can still be caught in one step, 2r for a circle on
+    a thin floor; with that depth the message gives the step to use) at step ``dt`` (s)."""
+    speed, depth = abs(sinking.speed), sinking.depth
+    text = (f"{sinking.body} is {abs(sinking.height):.3g} m below the floor, still moving "
+            f"down at {speed:.3g} m/s")
     if dt is None:
         return text
-    travel = abs(speed) * dt
+    travel = speed * dt
     if depth is not None and depth > 0:
         text += (f": it moves {travel:.3g} m per step, more than the {depth:.3g} m in which "
-                 f"a contact is caught; use dt < {seconds(depth / abs(speed))} s or a larger "
+                 f"a contact is caught; use dt < {seconds(depth / speed)} s or a larger "
                  "radius")
     else:
         text += f" ({travel:.3g} m per step): the velocity flip came too late to stop it"
     return text
 
 
-def below_floor_verdict(
-    scene: Scene, t: float, body: str, height: float, speed: float, dt: float,
-    push: float = 0.0, depth: float | None = None, E: Sequence[float] | None = None,
-) -> Verdict:
-    """The verdict for ``body`` found ``height`` (m, < 0) below the floor at time ``t`` (s),
-    moving down at ``speed`` (m/s) although the floor should have turned it back. ``push`` is
-    the spring's downward acceleration on it (m/s^2), ``depth`` as in :func:`tunnel_reason`,
+def below_floor_verdict(scene: Scene, t: float, dt: float, sinking: Sinking,
+                        E: Sequence[float] | None = None) -> Verdict:
+    """The verdict for a particle ``sinking`` at time ``t`` (s) of a run at step ``dt`` (s);
     ``E`` the total energy (J) at the run's first and last samples, if known.
 
     Moving down no faster than a few steps of gravity plus the spring's push give, it is held
     on the floor (at rest, or pressed by the other particle), which a velocity-flip rule
     cannot do: ``failed``, saying how much energy was left. Otherwise it went through:
     ``tunnelled``."""
+    body, height, speed, push = sinking.body, sinking.height, sinking.speed, sinking.push
     pressed = max(push, 0.0)
     if abs(speed) <= 3.0 * (scene.system.g + pressed) * dt:
         how = (f"pressed onto it by the spring at {pressed:.3g} m/s^2" if pressed > scene.system.g
@@ -128,10 +130,10 @@ def below_floor_verdict(
                 reason += (f"; the floor is elastic, so the step's impact errors drained the "
                            f"energy to {left:.0%} of its start: use a smaller dt")
         return Verdict("failed", t, reason)
-    reason = tunnel_reason(scene, body, height, speed, dt, depth)
+    reason = tunnel_reason(scene, sinking, dt)
     if push > scene.system.g:
         reason += (f"; the spring pushed it back down (at {push:.3g} m/s^2) before it climbed "
-                   f"out, with w*dt = {ratio_text(step_ratio(scene, dt))}: use a smaller dt")
+                   f"out, with w*dt = {step_ratio(scene, dt):.2f}: use a smaller dt")
     return Verdict("tunnelled", t, reason)
 
 
@@ -162,38 +164,47 @@ def missed_impact(
                    f"{solver} missed an impact, so this run is not a truth"), j + 1
 
 
+def _energy_errors(scene: Scene, E: np.ndarray, E0: float, scale: float) -> np.ndarray:
+    """|E - E0| / scale at every sample (dimensionless); on a dissipative scene, which loses
+    energy by design, only a gain counts."""
+    err = np.abs(E - E0) / scale
+    return np.where(E > E0, err, 0.0) if scene.system.dissipative else err
+
+
+def _unstable(cls: type[Solver], scene: Scene, t: float, err: float, dt: float | None
+              ) -> Verdict:
+    """``unstable`` at ``t`` (s), where the relative energy error ``err`` passed the scene's
+    ``run.unstable_energy`` in a run of the solver ``cls`` at step ``dt`` (s; None: none)."""
+    ratio, limit = step_ratio(scene, dt), cls.step_limit
+    if limit is not None and ratio >= limit:
+        return Verdict("unstable", t, nonfinite_reason(scene, dt, limit))  # type: ignore[arg-type]
+    reason = (f"energy error {err:.3g} passed run.unstable_energy = "
+              f"{scene.run.unstable_energy:g}")
+    swing = cls.swing(ratio) if limit is not None and ratio > 1.0 else None
+    if swing is not None:
+        # Near the limit a stable step may swing the energy a lot without growing.
+        reason += (f"; w*dt = {ratio_text(ratio, limit)} < {limit:.3g}, where even a stable "  # type: ignore[arg-type]
+                   f"step swings the vibration energy by up to {swing:.3g} times itself: "
+                   "raise run.unstable_energy if that swing is expected, or lower dt")
+    return Verdict("unstable", t, reason)
+
+
 def energy_verdict(
-    scene: Scene, t: np.ndarray, energy: Mapping[str, np.ndarray], dt: float | None,
+    cls: type[Solver], scene: Scene, t: np.ndarray, energy: Mapping[str, np.ndarray],
+    dt: float | None,
 ) -> tuple[Verdict, int]:
     """``unstable`` if the relative energy error of the energy columns ``energy`` (J, at the
-    sample times ``t`` in s) passes the scene's ``run.unstable_energy``, else ``ok``; and how
-    many samples to keep (up to the first bad one; all when ok). ``dt`` is the step (s; None
-    for a truth solver, whose dt only sets the sample times).
-
-    Dissipative scenes lose energy by design; only a gain past the threshold counts there."""
+    sample times ``t`` in s) of a run of ``cls`` passes the scene's ``run.unstable_energy``,
+    else ``ok``; and how many samples to keep (up to the first bad one; all when ok). ``dt`` is
+    the step (s; None for a truth solver, whose dt only sets the sample times)."""
     if len(t) == 0:
         return Verdict(), 0
-    err = relative_energy_error(energy)
-    if scene.system.dissipative:
-        E = energy["E"]
-        err = np.where(E > E[0], err, 0.0)
+    err = _energy_errors(scene, energy["E"], float(energy["E"][0]), _start_scale(energy))
     bad = np.flatnonzero(~(err <= scene.run.unstable_energy))
     if bad.size == 0:
         return Verdict(), len(t)
     j = int(bad[0])
-    t_fail = float(t[j])
-    ratio = step_ratio(scene, dt)
-    if ratio >= STEP_LIMIT:
-        reason = nonfinite_reason(scene, dt)  # type: ignore[arg-type]
-    else:
-        reason = (f"energy error {float(err[j]):.3g} passed run.unstable_energy = "
-                  f"{scene.run.unstable_energy:g}")
-        if ratio > 1.0:
-            # Near the limit a stable explicit step swings the energy a lot without growing.
-            reason += (f"; w*dt = {ratio_text(ratio)} < 2, where even a stable step swings the "
-                       f"vibration energy by up to {stable_swing(ratio):.3g} times itself: "
-                       "raise run.unstable_energy if that swing is expected, or lower dt")
-    return Verdict("unstable", t_fail, reason), j + 1
+    return _unstable(cls, scene, float(t[j]), float(err[j]), dt), j + 1
 
 
 def finite_samples(state: Mapping[str, np.ndarray]) -> int:
@@ -212,60 +223,102 @@ def head(columns: Mapping[str, np.ndarray], count: int) -> dict[str, np.ndarray]
     return {name: col[:count] for name, col in columns.items()}
 
 
-def judge(
-    scene: Scene, solver: str, t: np.ndarray, state: Mapping[str, np.ndarray],
-    events: Iterable[Impact], verdict: Verdict, dt: float | None,
-    energy: Mapping[str, np.ndarray] | None = None, truth: bool = False,
-) -> tuple[Verdict, int, dict[str, np.ndarray]]:
-    """The one mapping from how a run ended to its verdict. ``verdict`` is the solver's own
-    (from its status), ``t`` (s), ``state`` and ``events`` its raw samples and impacts,
-    ``energy`` its energy columns (J) if it counted them itself, ``dt`` its step (s).
+#: The states of steps 1, 2, ... up to the step given, in blocks: each block the step indices
+#: (int array) and the state columns at those steps.
+Replay = Callable[[int], Iterator[tuple[np.ndarray, Mapping[str, np.ndarray]]]]
 
-    - a truth solver (``truth``) whose samples pass below the floor: ``failed`` there
+
+@dataclass(frozen=True)
+class RawRun:
+    """What a solver hands to :func:`conclude`: the sample times ``t`` (s) and state columns,
+    the impacts, its own verdict (from how it stopped), its clock (s), its notes (``info``),
+    its energy columns (J) if it counted them itself, and, for a stepping solver whose samples
+    skip steps, how to replay its steps (:data:`Replay`), so that a verdict is dated at the step
+    where it happens."""
+
+    t: np.ndarray
+    state: Mapping[str, np.ndarray]
+    events: Iterable[Impact] = ()
+    verdict: Verdict = field(default_factory=Verdict)
+    wall_time: float = 0.0
+    info: Mapping[str, Any] = field(default_factory=dict)
+    energy: Mapping[str, np.ndarray] | None = None
+    replay: Replay | None = None
+
+
+def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
+          ) -> tuple[Verdict, int, dict[str, np.ndarray]]:
+    """The one mapping from how a run of the solver ``cls`` with ``options`` ended (``raw``)
+    to its verdict:
+
+    - a truth solver whose samples pass below the floor: ``failed`` there
       (:func:`missed_impact`);
     - ``unstable`` (the state blew up): the samples before the explosion, then the energy
       verdict if it finds the failure earlier, else the solver's;
     - ``tunnelled``, ``failed``: the solver's, all samples kept;
     - ``ok``: :func:`energy_verdict` (a truth solver's with no step).
 
+    An ``unstable`` verdict of a run that can replay its steps is dated at the first step
+    whose energy error passes the scene's threshold, not at the first such sample.
+
     Returns the verdict, how many samples the run keeps, and the energy columns of those
     samples (from :func:`dumbbell.model.energy.partition` unless given). Changes nothing."""
+    t, state, verdict = raw.t, raw.state, raw.verdict
     keep = len(t)
-    if truth:
-        missed = missed_impact(scene, solver, t, state)
+    dt = None if cls.is_truth else options.dt
+    if cls.is_truth:
+        missed = missed_impact(scene, cls.name, t, state)
         if missed is not None:
             verdict, keep = missed
-        dt = None
     elif verdict.status == "unstable":
         # The explosion's samples (up to 1e300 J) would swamp every plot and bar scale.
         keep = finite_samples(state)
     t, state = t[:keep], head(state, keep)
-    energy = (partition(scene, t, state, events) if energy is None
-              else head(energy, keep))
+    energy = (_partition(scene, t, state, tuple(raw.events)) if raw.energy is None
+              else head(raw.energy, keep))
     if verdict.ok or verdict.status == "unstable":
-        judged, keep = energy_verdict(scene, t, energy, dt)
+        judged, keep = energy_verdict(cls, scene, t, energy, dt)
+        if raw.replay is not None and dt is not None and len(t) and not (
+                judged.ok and verdict.ok):
+            # The last step to look at: the first bad sample's, else the explosion's.
+            last = round(judged.t / dt) if not judged.ok else round(verdict.t / dt)  # type: ignore[operator]
+            judged = _first_bad_step(cls, scene, dt, energy, raw.replay(last)) or judged
         if not (judged.ok and verdict.status == "unstable"):
             verdict = judged
     return verdict, keep, head(energy, keep)
 
 
-def conclude(
-    scene: Scene, solver: str, t: np.ndarray, state: Mapping[str, np.ndarray],
-    events: Iterable[Impact], verdict: Verdict, *, dt: float | None, every: int = 1,
-    wall_time: float = 0.0, info: Mapping[str, Any] | None = None,
-    energy: Mapping[str, np.ndarray] | None = None, truth: bool = False,
-) -> Trajectory:
-    """The finished run as its one frozen Trajectory: :func:`judge` decides the verdict and
-    where the run ends, then the Trajectory is built from the samples kept, and the impacts up
-    to the last of them. Arguments as for
-    :func:`judge`; ``every``, ``wall_time`` (s) and ``info`` go to the Trajectory as they are."""
-    events = tuple(events)
-    verdict, keep, energy = judge(scene, solver, t, state, events, verdict, dt, energy, truth)
+def _first_bad_step(cls: type[Solver], scene: Scene, dt: float,
+                    energy: Mapping[str, np.ndarray],
+                    blocks: Iterator[tuple[np.ndarray, Mapping[str, np.ndarray]]]
+                    ) -> Verdict | None:
+    """``unstable`` at the first of the replayed steps (``blocks`` of step indices and states;
+    step ``dt`` in s) whose energy error (against the run's first sample, ``energy``) passes
+    the scene's threshold; None if none does."""
+    E0, scale = float(energy["E"][0]), _start_scale(energy)
+    for steps, state in blocks:
+        E = _partition(scene, steps * dt, state)["E"]
+        err = _energy_errors(scene, E, E0, scale)
+        bad = np.flatnonzero(~(err <= scene.run.unstable_energy))
+        if bad.size:
+            j = int(bad[0])
+            return _unstable(cls, scene, float(steps[j]) * dt, float(err[j]), dt)
+    return None
+
+
+def conclude(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun) -> Trajectory:
+    """The finished run ``raw`` of the solver ``cls`` with ``options`` as its one frozen
+    Trajectory: :func:`judge` decides the verdict and where the run ends, then the Trajectory
+    is built from the samples kept, and the impacts up to the last of them."""
+    events = tuple(raw.events)
+    verdict, keep, energy = judge(cls, scene, options, raw)
+    t = raw.t
     if keep < len(t):
         # The verdict cut the run: impacts after its last sample belong to the part cut off
         # (an energy blow-up may bounce on for a while before the solver's end).
         end = float(t[keep - 1]) if keep else -math.inf
         events = tuple(e for e in events if e.t <= end)
-    return Trajectory(scene=scene, solver=solver, t=t[:keep], state=head(state, keep),
-                      events=events, verdict=verdict, dt=dt, every=every, wall_time=wall_time,
-                      info=dict(info or {}), energy=energy)
+    return Trajectory._made(scene=scene, solver=cls.name, t=t[:keep],
+                            state=head(raw.state, keep), events=events, verdict=verdict,
+                            dt=options.dt, every=options.every, wall_time=raw.wall_time,
+                            info=raw.info, energy=energy)

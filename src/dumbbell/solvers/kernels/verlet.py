@@ -1,7 +1,8 @@
-"""The numba kernel of ``verlet``: velocity Verlet with impacts located inside the step (1D and 2D).
+"""The steps of ``verlet``: velocity Verlet with impacts located inside the step (1D and 2D).
 
-The arithmetic and its order are the solver's contract (the 1D Euler-Cromer kernel
-reproduces the textbook listing's floats bit for bit): change them only on purpose.
+The arithmetic and its order are the solver's contract: change them only on purpose. The
+state carries the accelerations after the sampled columns, computed from the positions by
+``start`` (the same operations as at the end of a step, so resuming changes no float).
 Imported only when the solver runs, so ``import dumbbell`` does not load numba.
 """
 
@@ -11,12 +12,7 @@ import math
 
 from numba import njit
 
-from . import BIG, BLOWUP, OK, REST, TUNNEL_A, TUNNEL_B
-
-#: An impact slower than this (m/s), or more impacts than MAX_HITS in one step, means a
-#: particle has come to rest on the floor (the exact solver uses the same speed).
-REST_SPEED = 1e-9
-MAX_HITS = 64
+from . import Kernel
 
 
 @njit(cache=True, nogil=True)
@@ -64,95 +60,52 @@ def _first_root(c, b, a, h):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def advance(st, i, i_stop, p, every, out, ev):  # pragma: no cover
-    dt, mA, mB, k, b, g, e, floor, _, _ = p
-    xA = st[0]
-    vA = st[1]
-    xB = st[2]
-    vB = st[3]
-    f = k * (xA - xB - b)
-    aA = (-f - mA * g) / mA
-    aB = (f - mB * g) / mB
-    n_ev = 0
-    status = OK
-    while i < i_stop:
-        rem = dt
-        hits = 0
-        while True:
-            tau = rem + 1.0
-            body = -1
-            if floor:
-                tA = _first_root(xA, vA, aA, rem)
-                tB = _first_root(xB, vB, aB, rem)
-                if tB >= 0.0:
-                    tau = tB
-                    body = 1
-                if tA >= 0.0 and tA < tau:
-                    tau = tA
-                    body = 0
-            h = rem if body < 0 else tau
-            xA = xA + h * (vA + 0.5 * aA * h)
-            xB = xB + h * (vB + 0.5 * aB * h)
-            f = k * (xA - xB - b)
-            aA_new = (-f - mA * g) / mA
-            aB_new = (f - mB * g) / mB
-            vA = vA + 0.5 * (aA + aA_new) * h
-            vB = vB + 0.5 * (aB + aB_new) * h
-            aA = aA_new
-            aB = aB_new
-            if body < 0:
-                break
-            rem = rem - h
-            hits += 1
-            # The root is where the step's own quadratic meets the floor: place it there
-            # exactly, so rounding cannot leave it a hair below.
-            v_in = vA if body == 0 else vB
-            v_out = e * abs(v_in) if v_in < 0.0 else v_in
-            ev[n_ev, 0] = i * dt + (dt - rem)
-            ev[n_ev, 1] = body
-            ev[n_ev, 2] = v_in
-            ev[n_ev, 3] = v_out
-            n_ev += 1
-            if body == 0:
-                xA = 0.0
-                vA = v_out
-            else:
-                xB = 0.0
-                vB = v_out
-            f = k * (xA - xB - b)
-            aA = (-f - mA * g) / mA
-            aB = (f - mB * g) / mB
-            if abs(v_in) < REST_SPEED or hits > MAX_HITS:
-                status = REST
-                break
-        if status == REST:
-            break
-        i += 1
-        if floor:
-            if xA < 0.0 and vA < 0.0:
-                status = TUNNEL_A
-            if xB < 0.0 and vB < 0.0:
-                status = TUNNEL_B
-        if not (abs(xA) < BIG and abs(vA) < BIG and abs(xB) < BIG and abs(vB) < BIG):
-            status = BLOWUP
-        if i % every == 0:
-            j = i // every
-            out[j, 0] = xA
-            out[j, 1] = vA
-            out[j, 2] = xB
-            out[j, 3] = vB
-        # One step records at most MAX_HITS + 1 impacts: hand back while they still fit.
-        if status != OK or n_ev >= ev.shape[0] - 2 * MAX_HITS:
-            break
-    st[0] = xA
-    st[1] = vA
-    st[2] = xB
-    st[3] = vB
-    return i, status, n_ev
+def _first_impact(a, b, rem, floor):  # pragma: no cover - compiled
+    """How long a step may go (s) and which particle meets the floor at its end: the first
+    root in (0, ``rem``] of either particle's height (``a``, ``b``: height, vertical
+    velocity, vertical acceleration of A and B), or the whole ``rem`` and -1 (none)."""
+    tau = rem + 1.0
+    body = -1
+    if floor:
+        tA = _first_root(a[0], a[1], a[2], rem)
+        tB = _first_root(b[0], b[1], b[2], rem)
+        if tB >= 0.0:
+            tau = tB
+            body = 1
+        if tA >= 0.0 and tA < tau:
+            tau = tA
+            body = 0
+    return (rem if body < 0 else tau), body
 
 
 @njit(cache=True, nogil=True)
-def _accel_2d(xA, yA, xB, yB, p):  # pragma: no cover
+def _accel_1d(xA, xB, p):  # pragma: no cover - compiled
+    """Accelerations (m/s^2) of A and B from the spring and gravity, with the masses, spring
+    and gravity of the record ``p``."""
+    f = p.k * (xA - xB - p.b)
+    return (-f - p.mA * p.g) / p.mA, (f - p.mB * p.g) / p.mB
+
+
+def start_1d(s, p):  # pragma: no cover - compiled
+    aA, aB = _accel_1d(s[0], s[2], p)
+    return (s[0], s[1], s[2], s[3], aA, aB)
+
+
+def step_1d(s, p, rem):  # pragma: no cover - compiled
+    """Velocity Verlet over ``rem`` s, or up to the first root in (0, rem] of either
+    particle's height (returns the state, the time advanced and the body, -1 for none)."""
+    xA, vA, xB, vB, aA, aB = s
+    h, body = _first_impact((xA, vA, aA), (xB, vB, aB), rem, p.floor)
+    xA = xA + h * (vA + 0.5 * aA * h)
+    xB = xB + h * (vB + 0.5 * aB * h)
+    aA_new, aB_new = _accel_1d(xA, xB, p)
+    vA = vA + 0.5 * (aA + aA_new) * h
+    vB = vB + 0.5 * (aB + aB_new) * h
+    return (xA, vA, xB, vB, aA_new, aB_new), h, body
+
+
+@njit(cache=True, nogil=True)
+def _accel_2d(xA, yA, xB, yB, p):  # pragma: no cover - compiled
     """Accelerations (m/s^2) of A and B from the spring along their axis and gravity, with
     the masses, spring and gravity of the record ``p``."""
     mA, mB, k, b, g = p.mA, p.mB, p.k, p.b, p.g
@@ -168,85 +121,27 @@ def _accel_2d(xA, yA, xB, yB, p):  # pragma: no cover
     return -fx / mA, -fy / mA - g, fx / mB, fy / mB - g
 
 
-@njit(cache=True, nogil=True)
-def advance_2d(st, i, i_stop, p, every, out, ev):  # pragma: no cover
-    dt, e, floor = p.dt, p.e, p.floor
-    xA, yA, vxA, vyA, xB, yB, vxB, vyB = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
-    axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, p)
-    n_ev = 0
-    status = OK
-    while i < i_stop:
-        rem = dt
-        hits = 0
-        while True:
-            tau = rem + 1.0
-            body = -1
-            if floor:
-                tA = _first_root(yA, vyA, ayA, rem)
-                tB = _first_root(yB, vyB, ayB, rem)
-                if tB >= 0.0:
-                    tau = tB
-                    body = 1
-                if tA >= 0.0 and tA < tau:
-                    tau = tA
-                    body = 0
-            h = rem if body < 0 else tau
-            xA = xA + h * (vxA + 0.5 * axA * h)
-            yA = yA + h * (vyA + 0.5 * ayA * h)
-            xB = xB + h * (vxB + 0.5 * axB * h)
-            yB = yB + h * (vyB + 0.5 * ayB * h)
-            nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, p)
-            vxA = vxA + 0.5 * (axA + nxA) * h
-            vyA = vyA + 0.5 * (ayA + nyA) * h
-            vxB = vxB + 0.5 * (axB + nxB) * h
-            vyB = vyB + 0.5 * (ayB + nyB) * h
-            axA, ayA, axB, ayB = nxA, nyA, nxB, nyB
-            if body < 0:
-                break
-            rem = rem - h
-            hits += 1
-            # A frictionless floor reverses only the vertical velocity.
-            v_in = vyA if body == 0 else vyB
-            v_out = e * abs(v_in) if v_in < 0.0 else v_in
-            ev[n_ev, 0] = i * dt + (dt - rem)
-            ev[n_ev, 1] = body
-            ev[n_ev, 2] = v_in
-            ev[n_ev, 3] = v_out
-            n_ev += 1
-            if body == 0:
-                yA = 0.0
-                vyA = v_out
-            else:
-                yB = 0.0
-                vyB = v_out
-            axA, ayA, axB, ayB = _accel_2d(xA, yA, xB, yB, p)
-            if abs(v_in) < REST_SPEED or hits > MAX_HITS:
-                status = REST
-                break
-        if status == REST:
-            break
-        i += 1
-        if floor:
-            if yA < 0.0 and vyA < 0.0:
-                status = TUNNEL_A
-            if yB < 0.0 and vyB < 0.0:
-                status = TUNNEL_B
-        if not (abs(xA) < BIG and abs(yA) < BIG and abs(vxA) < BIG and abs(vyA) < BIG
-                and abs(xB) < BIG and abs(yB) < BIG and abs(vxB) < BIG
-                and abs(vyB) < BIG):
-            status = BLOWUP
-        if i % every == 0:
-            j = i // every
-            out[j, 0] = xA
-            out[j, 1] = yA
-            out[j, 2] = vxA
-            out[j, 3] = vyA
-            out[j, 4] = xB
-            out[j, 5] = yB
-            out[j, 6] = vxB
-            out[j, 7] = vyB
-        if status != OK or n_ev >= ev.shape[0] - 2 * MAX_HITS:
-            break
-    st[0], st[1], st[2], st[3] = xA, yA, vxA, vyA
-    st[4], st[5], st[6], st[7] = xB, yB, vxB, vyB
-    return i, status, n_ev
+def start_2d(s, p):  # pragma: no cover - compiled
+    axA, ayA, axB, ayB = _accel_2d(s[0], s[1], s[4], s[5], p)
+    return (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], axA, ayA, axB, ayB)
+
+
+def step_2d(s, p, rem):  # pragma: no cover - compiled
+    """:func:`step_1d` in 2D: the roots of the heights; the spring along the axis."""
+    xA, yA, vxA, vyA, xB, yB, vxB, vyB, axA, ayA, axB, ayB = s
+    h, body = _first_impact((yA, vyA, ayA), (yB, vyB, ayB), rem, p.floor)
+    xA = xA + h * (vxA + 0.5 * axA * h)
+    yA = yA + h * (vyA + 0.5 * ayA * h)
+    xB = xB + h * (vxB + 0.5 * axB * h)
+    yB = yB + h * (vyB + 0.5 * ayB * h)
+    nxA, nyA, nxB, nyB = _accel_2d(xA, yA, xB, yB, p)
+    vxA = vxA + 0.5 * (axA + nxA) * h
+    vyA = vyA + 0.5 * (ayA + nyA) * h
+    vxB = vxB + 0.5 * (axB + nxB) * h
+    vyB = vyB + 0.5 * (ayB + nyB) * h
+    return (xA, yA, vxA, vyA, xB, yB, vxB, vyB, nxA, nyA, nxB, nyB), h, body
+
+
+#: The steps in 1D and 2D: each stops at the impacts it locates, the roots of its quadratic.
+KERNELS = {1: Kernel(step_1d, floor="locate", start=start_1d),
+           2: Kernel(step_2d, floor="locate", start=start_2d)}

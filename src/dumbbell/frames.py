@@ -1,11 +1,15 @@
-"""Tables for notebooks: pandas DataFrames of results (pandas is imported only here)."""
+"""Tables for notebooks: pandas DataFrames of results (pandas is imported only here).
+
+Shared by every layer that has a ``to_pandas()`` (the model's Trajectory, the analyses'
+results), so it sits with the other modules every layer may use (errors, progress,
+parallel), below the model."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from ..errors import MissingExtraError, UsageError
+from .errors import MissingExtraError, UsageError
 
 __all__ = ["data_frame", "pandas_module"]
 
