@@ -79,7 +79,7 @@ def test_run_figures(runs, scene, name):
                          else ["textbook-1d", "tilted-2d"])
 def test_compare_figures(scene):
     from dumbbell import plot
-    from dumbbell.analysis.compare import compare
+    from dumbbell import compare
 
     s = load_scene(SCENES / f"{scene}.toml")
     result = (compare(s) if SHIPPED
@@ -89,12 +89,12 @@ def test_compare_figures(scene):
 
 
 def test_bench_figures(textbook):
-    from dumbbell.analysis.bench import run_bench
+    from dumbbell import bench
     from dumbbell.plot.bench import convergence, work_precision
 
-    result = (run_bench(textbook) if SHIPPED
-              else run_bench(textbook, solvers=["euler-cromer", "verlet", "pymunk", "exact"],
-                             dts=[1e-3, 3.2e-4, 1e-4], window=1.0, t_end=1.0, repeat=1))
+    result = (bench(textbook) if SHIPPED
+              else bench(textbook, solvers=["euler-cromer", "verlet", "pymunk", "exact"],
+                         dts=[1e-3, 3.2e-4, 1e-4], window=1.0, t_end=1.0, repeat=1))
     assert_fit(work_precision(result).figure)
     assert_fit(convergence(result).figure)
 
@@ -112,13 +112,13 @@ def test_stability_map():
 @pytest.mark.parametrize("grid", [("k=log:1e2:1e7:50", "dt=log:1e-6:1e-2:50"),
                                   ("dt=log:1e-5:1e-2:8",)], ids=["map", "line"])
 def test_sweep_figures(textbook, grid):
-    from dumbbell.analysis.sweep import parse_axis, run_sweep
+    from dumbbell import sweep
     from dumbbell.plot.maps import sweep_map
 
     if not SHIPPED:
         grid = tuple(g.replace(":50", ":8") for g in grid)
-    result = run_sweep(textbook, [parse_axis(g) for g in grid], "euler-cromer",
-                       1.0 if SHIPPED else 0.2, workers=1, processes=False)
+    result = sweep(textbook, list(grid), solver="euler-cromer", t_end=1.0 if SHIPPED else 0.2,
+                   workers=1, processes=False)
     assert_fit(sweep_map(result).figure)
 
 

@@ -19,7 +19,8 @@ DELEGATES = {("dumbbell.model.trajectory", "dumbbell.io.trajectory")}
 #: (``animation/recording.py``), as the commands are. The modules directly in the package
 #: (errors, progress, parallel, frames, _lazy, _display, ...) serve every layer: layer 0.
 LAYERS = {"model": 1, "spaces": 1, "spaces.recorder": 5, "solvers": 2,
-          "analysis": 3, "io": 4, "plot": 4, "animation": 4, "cli": 5, "examples": 5}
+          "analysis": 3, "io": 4, "plot": 4, "animation": 4, "cli": 5, "examples": 5,
+          "__main__": 5}
 
 
 def layer(module: str) -> int:
@@ -85,10 +86,11 @@ def upward_imports(root: Path = ROOT) -> list[str]:
 
 
 def _graph(root: Path = ROOT) -> dict[str, set[str]]:
+    """Who imports whom, but a listed delegate's import (it goes one way by design)."""
     graph = {}
     for path in sorted(root.rglob("*.py")):
         module, targets = imports(path, root=root)
-        graph[module] = {t for t in targets if t != module}
+        graph[module] = {t for t in targets if t != module and (module, t) not in DELEGATES}
     return graph
 
 

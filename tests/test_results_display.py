@@ -20,7 +20,9 @@ from tests.conftest import SCENES
 #: Records that are parts of a result (a row, an impact, a fit), shown by the result that
 #: holds them, and the inputs of an analysis.
 PARTS = {"Impact", "Verdict", "Point", "Fit", "PointResult", "StabilityRow", "Prediction",
-         "Axis", "Timing", "Contact"}
+         "Axis", "Timing", "Contact",
+         # the analyses' options records: what a run is asked, not what it gives
+         "CompareOptions", "BenchOptions", "SweepOptions", "StabilityOptions"}
 
 
 def public_dataclasses() -> set[str]:

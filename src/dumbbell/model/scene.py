@@ -101,13 +101,20 @@ class RunSettings:
     unstable_energy: float
 
 
-#: The scene tables a solver owns, by table name: the owner's settings class. A solver's
-#: package registers it (:mod:`dumbbell.solvers` registers the pymunk solver's ``[pymunk]``),
-#: so the model names no solver's settings: they stay on their owner, as pymunk keeps a
-#: space's settings on the space. The class reads its table (``_read(table)``, the table's
-#: checker, or None for a scene without it) and writes it back (``_table()``, the keys the
-#: scene gave) for :meth:`Scene.to_dict`.
-OWNED_TABLES: dict[str, Any] = {}
+#: The scene tables a solver owns, by table name: where the owner's settings class lives
+#: ("module:class"), loaded when a scene is read. The model names no solver's settings: they
+#: stay on their owner, as pymunk keeps a space's settings on the space. The class reads its
+#: table (``_read(table)``, the table's checker, or None for a scene without it) and writes
+#: it back (``_table()``, the keys the scene gave) for :meth:`Scene.to_dict`.
+OWNED_TABLES: dict[str, str] = {"pymunk": "dumbbell.solvers.pymunk_settings:PymunkSettings"}
+
+
+def _owner(table: str) -> Any:
+    """The settings class that owns the scene table ``table`` (:data:`OWNED_TABLES`)."""
+    import importlib
+
+    module, _, name = OWNED_TABLES[table].partition(":")
+    return getattr(importlib.import_module(module), name)
 
 
 @dataclass(frozen=True)
@@ -694,7 +701,7 @@ def _pymunk(top: _Checker) -> tuple[Any, bool]:
     """[pymunk]: the engine's settings, as their owner reads them (:data:`OWNED_TABLES`), and
     the table's ``spin`` key, which says whether the particles are spinning discs
     (:attr:`System.discs`)."""
-    owner = OWNED_TABLES["pymunk"]
+    owner = _owner("pymunk")
     cp = top.sub("pymunk")
     if cp is None:
         return owner._read(None), False

@@ -18,7 +18,7 @@ from typing import Any
 
 from ..errors import SceneError, UsageError
 from ..model import args
-from ..model.scene import OWNED_TABLES, Scene
+from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .base import (
     MAX_SAMPLES,
@@ -44,8 +44,6 @@ METHODS: dict[str, type[Solver]] = {
 }
 #: Another name for :data:`METHODS`.
 REGISTRY = METHODS
-# The scene's [pymunk] table belongs to the pymunk solver: its settings, on their owner.
-OWNED_TABLES["pymunk"] = PymunkSettings
 
 __all__ = [
     "MAX_SAMPLES",

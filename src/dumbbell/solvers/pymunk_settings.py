@@ -1,8 +1,8 @@
 """The settings of the ``pymunk`` solver, on their owner: the scene's ``[pymunk]`` table.
 
 The scene reader knows only that the table belongs to a solver
-(:data:`dumbbell.model.scene.OWNED_TABLES`, where :mod:`dumbbell.solvers` registers this
-class); what its keys mean, their bounds and their defaults are the solver's. Why these
+(:data:`dumbbell.model.scene.OWNED_TABLES` names this class, which the scene loads when it
+reads a scene); what its keys mean, their bounds and their defaults are the solver's. Why these
 defaults is explained in :mod:`dumbbell.solvers.engine`. The table's ``spin`` key is physics
 (whether the particles are spinning discs, :attr:`~dumbbell.model.scene.System.discs`), so the
 scene reads that one itself.
