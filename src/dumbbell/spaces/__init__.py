@@ -29,6 +29,7 @@ _WHERE = {
     "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
     "spring_omega": "guard", "shape_size": "guard",
     "HeatCounter": "heat",
+    "Ledger": "ledger", "Balance": "ledger", "Term": "ledger",
     "Recorder": "recorder", "PaletteDrawOptions": "recorder", "draw_options": "recorder",
 }
 
