@@ -95,6 +95,8 @@ def test_named_sources_of_the_examples(results):
     flipper = results["flipper"].balance
     assert all(t.energy > 0 for t in _terms(flipper, "constraint", "PinJoint"))
     assert _terms(flipper, "correction", "pushed apart body 0 / static body")
+    assert any("pushed apart" in note and "body 0 / static body" in note
+               for note in flipper.notes)  # the overlap is flagged in words too
     assert _terms(flipper, "contact", "contact body 0 / static body")[0].energy < 0
     cradle = results["newtons_cradle"].balance
     assert len(_terms(cradle, "constraint", "PinJoint")) >= 3  # the balls that swing

@@ -40,8 +40,8 @@ from ..model.energy import (
 )
 
 __all__ = ["BodyEnergy", "Inventory", "Skipped", "SpaceEnergy", "Spring", "SpringEnergy",
-           "State", "body_label", "check_finite", "constraint_label", "energy", "evaluate",
-           "inventory", "read_state", "refuse_bad_state"]
+           "State", "body_label", "constraint_label", "energy", "evaluate", "inventory",
+           "read_state"]
 
 #: Joints that hold no energy and, ideally, do no work.
 _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",

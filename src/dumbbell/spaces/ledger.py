@@ -44,14 +44,15 @@ fields) by an amount computed from the positions. The terms:
   impulses applied between steps, settings changed): measured, named per body, and
   ``complete`` is False; ``entered``/``left``: bodies added or removed, with their energy;
 - ``unattributed``: an impulse inside the step that no source explains (a callback that
-  applies one): named per body, ``complete`` is False.
+  applies one): named per body, ``complete`` is False; ``rounding``: what the sums round off.
 
 ``E`` counts the dynamic bodies as :func:`dumbbell.spaces.energy` does, plus the declared
 fields' potential. ``closure`` = E(t) - E(0) - the sum of all terms is the ledger's own error
-(rounding), and ``complete`` is True only when it, and anything unattributed, is below
-``tolerance`` times the energy ``scale``: the largest of the kinetic energy and of the change
-of each potential (gravity, springs, fields) from its start, over the steps seen. The
-potentials' zero is arbitrary (pixel spaces put U_g near -5e6), so |E(0)| is no scale.
+(rounding). ``complete`` is True only when nothing is named in ``unaccounted`` (the sources
+above that say so, beyond ``tolerance`` times the energy ``scale``) and the closure is within
+``tolerance`` of the scale: the largest of the kinetic energy and of the change of each
+potential (gravity, springs, fields) from its start, over the steps seen. The potentials'
+zero is arbitrary (pixel spaces put U_g near -1e8), so |E(0)| is no scale.
 """
 
 from __future__ import annotations
@@ -67,11 +68,6 @@ import numpy as np
 from . import _memory as mem
 
 __all__ = ["Balance", "Ledger", "Term"]
-
-#: Constraint kinds whose impulse the ledger reads (every pymunk constraint class).
-_JOINTS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "RotaryLimitJoint",
-           "RatchetJoint", "GearJoint", "SimpleMotor")
-_SPRINGS = ("DampedSpring", "DampedRotarySpring")
 
 #: Kinds of terms that are heat (energy turned into heat, negative when energy leaves).
 HEAT_KINDS = ("contact", "spring damping", "damping")
@@ -148,12 +144,19 @@ class Balance:
     def sources(self, kind: str | None = None, at_least: float = 0.0) -> list[Term]:
         """Terms (of ``kind``, all when None) with |energy| >= ``at_least`` (J), largest
         first."""
+        from ..model import args
+
+        at_least = args.real(at_least, "at_least", "J", lo=0.0)
         chosen = [t for t in self.terms if (kind is None or t.kind == kind)
                   and abs(t.energy) >= at_least]
         return sorted(chosen, key=lambda t: -abs(t.energy))
 
     def table(self, top: int = 4) -> str:
-        """The ledger as text: totals per kind with the largest sources, then the check."""
+        """The ledger as text: totals per kind with the ``top`` largest sources of each,
+        then the check."""
+        from ..model import args
+
+        top = args.whole(top, "top", "sources", lo=0)
         lines = [f"energy ledger over {self.steps} steps, t = {self.t:.6g}",
                  f"  E(0) = {self.E0:.9g}   E(t) = {self.E:.9g}   scale = {self.scale:.4g}"]
         for kind, total in sorted(self.by_kind().items(), key=lambda kv: -abs(kv[1])):
@@ -165,6 +168,8 @@ class Balance:
         lines.append(f"  closure E(t) - E(0) - sum = {self.closure:+.3g} "
                      f"({self.relative_closure:.2e} of the scale; worst step "
                      f"{self.worst_step:.2e})")
+        for note in self.notes:
+            lines.append(f"  note: {note}")
         for source, why in self.unaccounted:
             lines.append(f"  unaccounted: {source}: {why}")
         lines.append(f"  complete: {self.complete}")
@@ -326,11 +331,6 @@ class _Table:
         ua, ub = self.uid[ra], self.uid[rb]
         return pairs.slots(np.minimum(ua, ub) * _PAIR + np.maximum(ua, ub))
 
-    def rows_of(self, at: np.ndarray) -> np.ndarray:
-        """Table rows of body addresses (-1 for a body not in the table)."""
-        pos = np.minimum(np.searchsorted(self.sorted_at, at), len(self.sorted_at) - 1)
-        return np.where(self.sorted_at[pos] == at, self.order[pos], -1)
-
 
 class _Pairs:
     """Running contact work, and gravity's part of the position correction, per pair of
@@ -398,9 +398,6 @@ class _Contacts:
         self.span: mem.Span | None = None
         self.cspan: mem.Span | None = None
         self.no_j0 = np.zeros((2, 2, 1))
-
-    def reset(self) -> None:
-        pass
 
     @staticmethod
     def _span(span: mem.Span | None, lo: int, hi: int) -> mem.Span:
@@ -525,7 +522,10 @@ class Ledger:
         self._uids: dict[int, int] = {}
         self._labels: list[str] = []
         self._kept: list[Any] = []
-        self._counts = {"body": 0, "kinematic body": 0, "static body": 0}
+        # Bodies are named as spaces.energy names them when the ledger attaches ('body i',
+        # i their place in space.bodies); bodies that come later take the next numbers.
+        self._places = {id(b): i for i, b in enumerate(space.bodies)}
+        self._next = len(self._places)
         self._potentials: list[tuple[Any, Callable[..., Any], str]] = []
         self._terms: dict[tuple[str, str], float] = {}
         self._notes: dict[tuple[str, str], str] = {}
@@ -657,7 +657,8 @@ class Ledger:
         return Balance(E0=self._E0, E=self._E, terms=tuple(sorted(terms, key=_order)),
                        closure=self._E - self._E0 - total, worst_step=self._worst,
                        scale=self._scale, tolerance=self.tolerance,
-                       unaccounted=tuple(sorted(unacc.items())), steps=self.steps, t=self.t)
+                       unaccounted=tuple(sorted(unacc.items())), steps=self.steps, t=self.t,
+                       notes=_notes(terms, self._scale))
 
     # -- the hook ----------------------------------------------------------------------
 
@@ -729,6 +730,7 @@ class Ledger:
     # -- what is in the space ----------------------------------------------------------
 
     def _uid(self, body: Any) -> int:
+        """The stable id of ``body`` in the ledger (its label is ``self._labels[uid]``)."""
         import pymunk
 
         uid = self._uids.get(id(body))
@@ -736,10 +738,14 @@ class Ledger:
             if body is self.space.static_body:
                 label = "static body"
             else:
-                prefix = {pymunk.Body.DYNAMIC: "body", pymunk.Body.KINEMATIC:
-                          "kinematic body"}.get(body.body_type, "static body")
-                label = f"{prefix} {self._counts[prefix]}"
-                self._counts[prefix] += 1
+                place = self._places.pop(id(body), None)
+                if place is None:
+                    place = self._next
+                    self._next += 1
+                kind = {pymunk.Body.KINEMATIC: "kinematic body ",
+                        pymunk.Body.STATIC: "static body "}.get(body.body_type, "body ")
+                outside = "" if body.space is self.space else " (not in the space)"
+                label = f"{kind}{place}{outside}"
             uid = len(self._labels)
             self._uids[id(body)] = uid
             self._labels.append(label)
@@ -813,7 +819,6 @@ class Ledger:
         self._acc = {name: z.copy() for name in ("force", "vf", "unattributed", "program")}
         self._acc_kin = np.zeros(t.rows)
         self._acc_field = np.zeros(len(self._fields))
-        self._contacts.reset()
         self._push = None
 
     def _changed(self, F: np.ndarray, P: np.ndarray) -> str:
@@ -1414,6 +1419,22 @@ def _joint_note(c: Any) -> str:
         if math.isfinite(value):
             parts.append(f"{name} {value:g}")
     return ", ".join(parts)
+
+
+def _notes(terms: list[Term], scale: float) -> tuple[str, ...]:
+    """What deserves a word beyond the terms: shapes pushed apart (they overlapped) putting
+    energy in, with the pairs that did most."""
+    pushed = [t for t in terms if t.kind == "correction"]
+    total = sum(abs(t.energy) for t in pushed)
+    if scale <= 0 or total <= 0.01 * scale:
+        return ()
+    pairs = sorted((t for t in pushed if t.source.startswith("pushed apart")),
+                   key=lambda t: -abs(t.energy))[:3]
+    which = ", ".join(t.source.removeprefix("pushed apart ") for t in pairs)
+    return (f"overlapping shapes pushed apart by the contacts' position correction moved "
+            f"{total:.3g} J ({total / scale:.2g} of the scale)"
+            + (f", most between {which}" if which else "")
+            + "; joints pulling the bodies back turn it into their own work",)
 
 
 def _order(t: Term) -> tuple[str, float]:
