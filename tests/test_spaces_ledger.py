@@ -309,9 +309,10 @@ def test_a_custom_velocity_func_is_unaccounted_until_its_potential_is_declared()
     ledger.declare_potential(body.velocity_func, lambda x, y, m: 0.5 * 4.0 * m * (x * x + y * y),
                              name="harmonic field")
     energies = []
-    for _ in range(2000):
+    for i in range(2000):
         space.step(0.005)
-        energies.append(ledger.balance().E)
+        if i % 10 == 0:
+            energies.append(ledger.balance().E)
     bal = ledger.balance()
     assert bal.complete and bal.E0 == pytest.approx(0.5 + 2.0, rel=1e-15)
     # The true energy holds to the integrator's O(dt) swing, and the ledger names it.

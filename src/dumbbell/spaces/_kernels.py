@@ -30,10 +30,12 @@ def arbiters() -> Any:
     @njit(cache=True, nogil=True)
     def read(arb, i64, u32, f64, lo, o_contacts, o_body_a, o_body_b, o_count, o_state, o_n,
              csize, sorted_at, order, uid, keys, key_slot, lin_free, rows_out, n_out,
-             first_out, at_out, weight_out, slot_out, sign_out):  # pragma: no cover
+             first_out, at_out, weight_out, slot_out, sign_out, cf64, clo, chi, o_jn, o_jt,
+             coef, j0_out):  # pragma: no cover
         low = arb[0] * 0 + 9223372036854775807
         high = arb[0] * 0
         any_first = False
+        missing = False
         nb = sorted_at.size
         for i in range(arb.size):
             a = arb[i] - lo
@@ -79,7 +81,16 @@ def arbiters() -> Any:
             at_out[1, i] = c + (csize if count > 1 else 0)
             low = min(low, c)
             high = max(high, at_out[1, i])
-        return low, high, any_first
+            if first or coef != 1.0:
+                # The impulses the contacts carry in, if the contacts are in the span.
+                if c >= clo and at_out[1, i] + csize <= chi:
+                    for k in range(2):
+                        ck = at_out[k, i] - clo
+                        j0_out[0, k, i] = cf64[(ck + o_jn) >> 3]
+                        j0_out[1, k, i] = cf64[(ck + o_jt) >> 3]
+                else:
+                    missing = True
+        return low, high, any_first, missing
 
     return read
 

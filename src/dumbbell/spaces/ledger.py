@@ -380,6 +380,17 @@ class _Pairs:
 _PAIR = 1 << 31
 
 
+class _NoSpan:
+    """Stands for a span not made yet: covers nothing."""
+
+    f64 = np.zeros(1)
+    lo = 0
+    u8 = b""
+
+
+_NO_SPAN = _NoSpan()
+
+
 class _Contacts:
     """The contacts the solver uses in a step, read from pymunk's arbiters (at most two
     contacts each) by two compiled loops (:mod:`._kernels`): before the solver, the bodies'
@@ -397,7 +408,6 @@ class _Contacts:
         self.csize = pffi.sizeof("cpContact")
         self.span: mem.Span | None = None
         self.cspan: mem.Span | None = None
-        self.no_j0 = np.zeros((2, 2, 1))
 
     @staticmethod
     def _span(span: mem.Span | None, lo: int, hi: int) -> mem.Span:
@@ -422,11 +432,14 @@ class _Contacts:
         weight = np.empty((2, num))
         slots = np.empty(num, dtype=np.int64)
         sign = np.empty(num)
-        low, high, any_first = _kernels.arbiters()(
+        j0 = np.zeros((2, 2, num))
+        c = self.cspan or _NO_SPAN
+        low, high, any_first, missing = _kernels.arbiters()(
             arb, span.i64, span.u32, span.f64, span.lo, o["contacts"], o["body_a"],
             o["body_b"], o["count"], o["state"], o["n"], self.csize, table.sorted_i64,
             table.order, table.uid, pairs.sorted, pairs.slot_of, table.lin_free, rows, n,
-            first, at, weight, slots, sign)
+            first, at, weight, slots, sign, c.f64, c.lo, c.lo + len(c.u8), self.c["jnAcc"],
+            self.c["jtAcc"], coef, j0)
         if high == 0:
             return False
         ra, rb = rows
@@ -434,17 +447,24 @@ class _Contacts:
             raise RuntimeError("a contact touches a body the ledger does not know")
         if slots.min() < 0:
             slots = table.pair_slots(ra, rb, pairs)
-        self.cspan = self._span(self.cspan, int(low), int(high) + self.csize)
+        if self.cspan is None or low < self.cspan.lo or high + self.csize > c.lo + len(c.u8):
+            # The contact buffers the space cycles through: one span over all seen so far.
+            lo = int(low) if self.cspan is None else min(int(low), self.cspan.lo)
+            hi = int(high) + self.csize
+            if self.cspan is not None:
+                hi = max(hi, self.cspan.lo + len(self.cspan.u8))
+            self.cspan = mem.Span(lo, hi)
+        if missing:
+            cs = self.cspan
+            safe = np.where(at == 0, low, at) - cs.lo
+            read = np.stack([cs.f64[(safe + self.c["jnAcc"]) >> 3],
+                             cs.f64[(safe + self.c["jtAcc"]) >> 3]])
+            carried = (first | (coef != 1.0))[None, None, :]
+            j0 = np.where(carried, read, j0)
         self.at, self.n, self.first, self.ra, self.rb = at, n, first, ra, rb
         self.weight, self.slots, self.sign = weight, slots, sign
         self.has_j0 = coef != 1.0 or any_first
-        if self.has_j0:
-            c = self.cspan
-            safe = np.where(at == 0, low, at) - c.lo
-            self.j0 = np.stack([c.f64[(safe + self.c["jnAcc"]) >> 3],
-                                c.f64[(safe + self.c["jtAcc"]) >> 3]])
-        else:
-            self.j0 = self.no_j0
+        self.j0 = j0
         return True
 
     def work(self, coef: float, u: np.ndarray, imp: np.ndarray, table: _Table,
