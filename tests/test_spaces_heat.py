@@ -208,3 +208,15 @@ def test_replacing_its_callback_warns_once_and_says_so():
     assert not heat.attached and "replaced" in heat.stopped and heat.total == counted
     heat.detach()
     assert space._handlers[(None, None)].post_solve is _note
+
+
+def test_a_counter_dropped_without_detach_gives_the_handler_back():
+    import gc
+
+    space, _ = _slope(0.3, math.radians(30))
+    before = _handler_state(space)
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 0.1, substeps=100)
+    del heat
+    gc.collect()
+    assert _handler_state(space) == before

@@ -229,7 +229,7 @@ def check_space(space: Any) -> None:
 
 
 def _constraint_fields(c: Any) -> list[tuple[str, float]]:
-    name = type(c).__name__
+    name = next(kls.__name__ for kls in type(c).__mro__ if kls.__name__ in STRUCT)
     fields: list[tuple[str, float]] = [("c.max_force", c.max_force),
                                         ("c.error_bias", c.error_bias),
                                         ("c.max_bias", c.max_bias)]
@@ -254,12 +254,22 @@ def _constraint_fields(c: Any) -> list[tuple[str, float]]:
     return fields
 
 
+def struct_of(c: Any) -> str | None:
+    """The declared struct of a pymunk constraint (of a subclass too), or None."""
+    for kls in type(c).__mro__:
+        if kls.__name__ in STRUCT and kls.__module__.startswith("pymunk"):
+            return STRUCT[kls.__name__]
+    return None
+
+
 def check_constraint(c: Any) -> None:
     """Raise :class:`LayoutError` unless the declared struct of ``c`` reads its settings,
     its bodies and (up to sign) the impulse pymunk reports."""
     import math
 
-    kind = STRUCT[type(c).__name__]
+    kind = struct_of(c)
+    if kind is None:
+        raise LayoutError(f"{type(c).__name__}: not a constraint class the ledger reads")
     at = address(c._constraint)
     r = view(kind, at)
     if address(r.c.a) != address(c.a._body) or address(r.c.b) != address(c.b._body):

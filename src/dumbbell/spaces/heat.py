@@ -21,8 +21,8 @@ kick), so it shrinks with dt.
 The counters of a space listen on its wildcard handler (``on_collision(None, None)``)
 through one dispatcher (``pre_solve`` and ``post_solve``): callbacks already there are kept
 and called after the counters with their own data, handlers the user sets for particular
-collision types keep firing, and when the last counter detaches (in any order) the handler
-is exactly as it was. Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards
+collision types keep firing, and when the last counter detaches (in any order; dropping a
+counter detaches it) the handler is exactly as it was. Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards
 stops the counters: each warns once (a ``RuntimeWarning`` naming what stopped counting) and
 says so in ``stopped``. ``Space.copy()`` and pickling work with counters attached; the copy
 has the callbacks the space had before them, and no counter.
@@ -34,6 +34,7 @@ other source of energy.
 from __future__ import annotations
 
 import warnings
+import weakref
 from typing import Any
 
 __all__ = ["HeatCounter"]
@@ -72,6 +73,14 @@ class HeatCounter:
             d.remove(self)
         if self.stopped is None:
             self.stopped = "detached"
+
+    def __del__(self) -> None:
+        # A counter dropped without detach() leaves the handler as the others need it.
+        try:
+            if "space" in self.__dict__ and self.stopped is None:
+                self.detach()
+        except Exception:  # noqa: BLE001, S110 - never raise from a finalizer
+            pass
 
     def __getstate__(self) -> dict[str, Any]:
         # A copy of a counter keeps its counts and does not count (no callbacks point to it).
@@ -160,7 +169,7 @@ class _Phase:
         self.user = user
 
     def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
-        for counter in list(self.dispatch.counters):
+        for counter in self.dispatch.counters:
             if counter.stopped is None:
                 getattr(counter, f"_{self.phase}")(arbiter, space)
         if self.user is not None:
@@ -172,11 +181,14 @@ class _Phase:
 
 
 class _Dispatch:
-    """The counters of one space and the wildcard handler they share."""
+    """The counters of one space and the wildcard handler they share. It holds the space
+    and the counters weakly: a pymunk space must never be part of a reference cycle (the
+    cycle collector frees its bodies in any order, and pymunk's own clean-up then reads
+    freed memory)."""
 
     def __init__(self, space: Any) -> None:
-        self.space = space
-        self.counters: list[HeatCounter] = []
+        self._space = weakref.ref(space)
+        self._counters: list[weakref.ref[HeatCounter]] = []
         self.created = (None, None) not in space._handlers
         space.on_collision(None, None)  # make sure the wildcard handler exists
         self.handler = space._handlers[(None, None)]
@@ -198,13 +210,17 @@ class _Dispatch:
             d = space.__dict__[_KEY] = cls(space)
         return d
 
+    @property
+    def counters(self) -> list[HeatCounter]:
+        """The counters attached, still alive."""
+        return [c for c in (ref() for ref in self._counters) if c is not None]
+
     def add(self, counter: HeatCounter) -> None:
-        self.counters.append(counter)
+        self._counters.append(weakref.ref(counter))
 
     def remove(self, counter: HeatCounter) -> None:
-        if counter in self.counters:
-            self.counters.remove(counter)
-        if not self.counters:
+        self._counters = [ref for ref in self._counters if ref() not in (None, counter)]
+        if not self._counters:
             self.uninstall()
 
     def uninstall(self) -> None:
@@ -217,11 +233,14 @@ class _Dispatch:
                 setattr(h, phase, callback.user)
                 if phase in self.no_data:
                     h.data.pop(phase, None)
+        space = self._space()
+        if space is None:
+            return
         if self.created and h.begin is None and h.separate is None and not any(
                 getattr(h, phase) for phase in _PHASES) and not h.data:
             # pymunk keeps the C handler; the Python side is as before the first counter.
-            del self.space._handlers[(None, None)]
-        self.space.__dict__.pop(_KEY, None)
+            del space._handlers[(None, None)]
+        space.__dict__.pop(_KEY, None)
 
     def replaced(self, phase: str, new: Any) -> None:
         """The user set the wildcard ``phase`` callback: the counters stop, each warning

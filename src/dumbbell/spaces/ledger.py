@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
@@ -303,6 +304,7 @@ class _Table:
         self.m = first[9, :n].copy()
         moment = first[10, :n]
         self.finite = np.isfinite(moment)
+        self.all_finite = bool(self.finite.all())
         self.I = np.where(self.finite, moment, 0.0)
         self.mass3 = np.stack([self.m, self.m, self.I])
         self.inv3 = np.stack([1.0 / self.m, 1.0 / self.m,
@@ -531,7 +533,7 @@ class Ledger:
             for b in space.bodies:
                 mem.check_body(b)
             for c in space.constraints:
-                if type(c).__name__ in mem.STRUCT:
+                if mem.struct_of(c) is not None:
                     mem.check_constraint(c)
         except mem.LayoutError as e:
             import pymunk
@@ -587,10 +589,15 @@ class Ledger:
         lib.cpSpaceRemoveConstraint(self.space._space, self._sentinel._constraint)
         self._sentinel.pre_solve = None
         self._sentinel.post_solve = None
-        keep = self.space.__dict__.get("_dumbbell_ledgers", [])
-        if self in keep:
-            keep.remove(self)
         self._sentinel = None
+
+    def __del__(self) -> None:
+        # Dropped while attached: take the hook out, keeping the constraints' order.
+        try:
+            if self.__dict__.get("_sentinel") is not None:
+                self.detach()
+        except Exception:  # noqa: BLE001, S110 - never raise from a finalizer
+            pass
 
     def declare_potential(self, target: Any, potential: Callable[..., Any],
                           name: str | None = None) -> None:
@@ -693,14 +700,15 @@ class Ledger:
         # Hidden from Python: not in space.constraints, nor in the bodies' lists.
         space.static_body._constraints.pop(s, None)
         self._private._constraints.pop(s, None)
-        s.pre_solve = self._before_solver
-        s.post_solve = self._after_solver
+        # The hook holds the ledger weakly: a pymunk space must never be part of a reference
+        # cycle (the cycle collector frees its bodies in any order, and pymunk's clean-up
+        # then reads freed memory). The user's reference keeps the ledger, and so the hook.
+        me = weakref.ref(self)
+        s.pre_solve = _Hook(me, "_before_solver")
+        s.post_solve = _Hook(me, "_after_solver")
         self._sentinel = s
         lib.cpSpaceAddConstraint(space._space, s._constraint)
         _rotate(self._space_at, s, first=True)
-        # The space keeps the ledger (and so its hook) alive while it is attached; the
-        # name starts with '_', so pymunk's copy and pickle leave it out.
-        space.__dict__.setdefault("_dumbbell_ledgers", []).append(self)
 
     def _before_solver(self, constraint: Any, space: Any) -> None:
         if self._error is None:
@@ -786,14 +794,12 @@ class Ledger:
         by_kind: dict[str, tuple[list[Any], ...]] = {}
         for i, c in enumerate(t.constraint_key):
             name = type(c).__name__
-            base = next((k.__name__ for k in type(c).__mro__ if k.__name__ in mem.STRUCT
-                         and k.__module__.startswith("pymunk")), None)
+            kind = mem.struct_of(c)
             clabel = f"{name} {i}"
-            if base is None:
+            if kind is None:
                 self._current[clabel] = f"{name}: a constraint class the ledger cannot read"
                 continue
             mem.check_constraint(c)
-            kind = mem.STRUCT[base]
             default = True
             if kind in ("spring", "rotary_spring"):
                 default = (c._torque_func if kind == "rotary_spring" else c._force_func) is None
@@ -1263,6 +1269,8 @@ class Ledger:
         # What no source explains: a custom velocity_func's kicks, or an impulse from
         # outside the solver.
         R = t.mass3 * (vel1[:, :n] - vel0[:, :n]) - imp[:, :n] - ext
+        if not t.all_finite:
+            R[2] = np.where(t.finite, R[2], 0.0)  # an infinite moment's spin is imposed
         w_r = np.sum(R * un, axis=0)
         d_int = p["d_int"]
         if self._any_custom:
@@ -1416,6 +1424,21 @@ def _constraint_work(t: _Table, g: _Group, after: np.ndarray, initial: np.ndarra
     return total
 
 
+class _Hook:
+    """The hook's callback: the ledger's method, if the ledger is still there."""
+
+    __slots__ = ("ledger", "method")
+
+    def __init__(self, ledger: weakref.ref[Ledger], method: str) -> None:
+        self.ledger = ledger
+        self.method = method
+
+    def __call__(self, constraint: Any, space: Any) -> None:
+        ledger = self.ledger()
+        if ledger is not None:
+            getattr(ledger, self.method)(constraint, space)
+
+
 def _rotate(space_at: int, sentinel: Any, first: bool) -> None:
     """Rotate the space's C constraint array so that ``sentinel`` is first (or last, to be
     removed), keeping every other constraint in its order (the solver's order)."""
@@ -1454,7 +1477,7 @@ def _notes(terms: list[Term], scale: float) -> tuple[str, ...]:
     return (f"overlapping shapes pushed apart by the contacts' position correction moved "
             f"{total:.3g} J ({total / scale:.2g} of the scale)"
             + (f", most between {which}" if which else "")
-            + "; joints pulling the bodies back turn it into their own work",)
+            + " (shapes that start overlapping, or that a joint holds in another)",)
 
 
 def _order(t: Term) -> tuple[str, float]:
