@@ -182,9 +182,8 @@ class _Phase:
 
 class _Dispatch:
     """The counters of one space and the wildcard handler they share. It holds the space
-    and the counters weakly: a pymunk space must never be part of a reference cycle (the
-    cycle collector frees its bodies in any order, and pymunk's own clean-up then reads
-    freed memory)."""
+    and the counters weakly: the user's references keep the counters, dropping one detaches
+    it, and no cycle runs through the space."""
 
     def __init__(self, space: Any) -> None:
         self._space = weakref.ref(space)

@@ -700,9 +700,9 @@ class Ledger:
         # Hidden from Python: not in space.constraints, nor in the bodies' lists.
         space.static_body._constraints.pop(s, None)
         self._private._constraints.pop(s, None)
-        # The hook holds the ledger weakly: a pymunk space must never be part of a reference
-        # cycle (the cycle collector frees its bodies in any order, and pymunk's clean-up
-        # then reads freed memory). The user's reference keeps the ledger, and so the hook.
+        # The hook holds the ledger weakly and the space does not hold it: the user's
+        # reference keeps the ledger (and so the hook), and dropping it takes the hook out
+        # (__del__), with no cycle left through the space.
         me = weakref.ref(self)
         s.pre_solve = _Hook(me, "_before_solver")
         s.post_solve = _Hook(me, "_after_solver")
