@@ -154,6 +154,16 @@ def inventory(space: Any) -> Inventory:
         return i
 
     springs, unknown, notes = _constraints(space, index)
+    for b, label in zip(dyn, labels[: len(dyn)], strict=True):
+        if b._velocity_func is not None:
+            unknown.append(Skipped(label, "custom velocity_func: the energy of the field it "
+                                          "applies is not in E (declare its potential to a "
+                                          "spaces.Ledger)"))
+        if b._position_func is not None:
+            notes.append(f"{label} has a custom position_func: it moves the body its own way")
+    if any(kind == pymunk.Body.KINEMATIC for kind in types):
+        notes.append("kinematic bodies do work on what they push or pull (spaces.Ledger "
+                     "counts it)")
     if space.damping != 1.0:
         notes.append(f"space.damping = {space.damping:g}: bodies lose energy every step that "
                      "no term here counts")
@@ -186,10 +196,16 @@ def _constraints(space: Any, index: Callable[[Any], int]
                 continue
             if c.damping != 0.0:
                 notes.append(f"{label} has damping {c.damping:g}: it turns energy into heat "
-                             "that the heat counter does not see")
+                             "that the heat counter does not see (spaces.Ledger counts it)")
             springs.append(spring)
         elif name in _WORKLESS and type(c).__module__.startswith("pymunk"):
-            continue
+            moves = []
+            if name in ("SlideJoint", "RotaryLimitJoint", "RatchetJoint"):
+                moves.append("a stop: reached, it takes energy out")
+            if math.isfinite(c.max_force):
+                moves.append(f"max_force {c.max_force:g}: slipping, it takes energy out")
+            if moves:
+                notes.append(f"{label}: {'; '.join(moves)} (spaces.Ledger counts it)")
         elif isinstance(c, pymunk.SimpleMotor):
             unknown.append(Skipped(label, "motor: puts energy in (its work is not counted)"))
         else:
