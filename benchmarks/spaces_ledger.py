@@ -56,7 +56,7 @@ def cost(steps: int, repeat: int) -> None:
     with_t: list[float] = []
     for _ in range(repeat):
         bare, counted = base.copy(), base.copy()
-        spaces.Ledger(counted)
+        ledger = spaces.Ledger(counted)  # it counts while it is referenced
         counted.step(dt)  # the ledger's compiled loops load (or compile) here
         bare.step(dt)
         for _ in range(steps):
@@ -67,6 +67,7 @@ def cost(steps: int, repeat: int) -> None:
             t2 = time.perf_counter()
             bare_t.append(t1 - t0)
             with_t.append(t2 - t1)
+        assert ledger.balance().steps == steps + 1
     step, both = statistics.median(bare_t), statistics.median(with_t)
     print(f"box2d_pyramid, {len(list(base.bodies))} bodies awake, {steps} x {repeat} steps "
           "alternately:")

@@ -504,7 +504,8 @@ def _same(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 class Ledger:
     """Attach an energy ledger to ``space``: every later ``space.step`` (whoever calls it)
-    is counted, and :meth:`balance` gives the account so far.
+    is counted while the ledger is referenced (dropping it detaches it), and
+    :meth:`balance` gives the account so far.
 
     ``tolerance`` (relative to the energy scale) is what ``complete`` allows for the closure
     and for anything unattributed or changed by the program. See the module docstring for
