@@ -155,3 +155,23 @@ def test_import_is_lazy():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.strip()
     assert out == "[]"
+
+
+def test_what_moves_energy_over_time_is_named_in_the_snapshot():
+    # The minimal case: the snapshot cannot count what a joint does over a run, but
+    # it says which joints can (the ledger counts them), and a custom velocity_func's field
+    # is energy it cannot see.
+    space = pymunk.Space()
+    body = pymunk.Body(1, pymunk.moment_for_circle(1, 0, 0.1))
+    body.velocity = (2, 0)
+    pivot = pymunk.PivotJoint(space.static_body, body, (0, 0))
+    pivot.max_force = 10.0
+    space.add(body, pymunk.Circle(body, 0.1), pivot,
+              pymunk.SlideJoint(space.static_body, body, (0, 0), (0, 0), 0, 1))
+    e = spaces.energy(space)
+    assert e.complete and len(e.notes) == 2
+    assert "SlideJoint 1: a stop" in e.notes[1] and "max_force 10" in e.notes[0]
+    body.velocity_func = lambda b, g, d, dt: pymunk.Body.update_velocity(b, (0, -1), d, dt)
+    e = spaces.energy(space)
+    assert not e.complete and [u.subject for u in e.unknown] == ["body 0"]
+    assert "velocity_func" in e.unknown[0].reason

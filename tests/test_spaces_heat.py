@@ -137,3 +137,86 @@ def test_sliding_heat_holds_when_dt_changes_between_steps():
         space.step(1e-4 if i % 3 else 4e-4)
     slid = (body.position - start).length
     assert heat.total == pytest.approx(mu * 1.0 * 9.81 * math.cos(angle) * slid, rel=1e-3)
+
+
+def _handler_state(space: pymunk.Space):
+    h = space._handlers.get((None, None))
+    if h is None:
+        return None
+    return type(h), h.begin, h.pre_solve, h.post_solve, h.separate, dict(h.data)
+
+
+@pytest.mark.parametrize("order", [(0, 1), (1, 0)])
+@pytest.mark.parametrize("users", [False, True])
+def test_counters_detach_in_any_order_and_leave_the_handler_as_it_was(order, users):
+    space, _ = _slope(0.3, math.radians(30))
+    if users:
+        space.on_collision(None, None, pre_solve=lambda a, s, d: None, data="theirs")
+    before = _handler_state(space)
+    counters = [spaces.HeatCounter(space), spaces.HeatCounter(space)]
+    spaces.step(space, 0.5, substeps=500)
+    assert counters[0].total == counters[1].total > 0
+    counters[order[0]].detach()
+    assert counters[order[1]].attached and not counters[order[0]].attached
+    spaces.step(space, 0.2, substeps=200)
+    assert counters[order[1]].total > counters[order[0]].total
+    counters[order[1]].detach()
+    assert _handler_state(space) == before
+    assert not any(c.attached for c in counters)
+
+
+def test_copy_and_pickle_with_a_counter_attached():
+    import copy
+    import pickle
+
+    space, _ = _slope(0.3, math.radians(30))
+    seen = []
+    space.on_collision(None, None, post_solve=_note, data=seen)
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 0.2, substeps=200)
+    for other in (space.copy(), copy.deepcopy(space), pickle.loads(pickle.dumps(space))):
+        h = other._handlers[(None, None)]
+        # The copy has the callbacks the space had before the counter, and no counter.
+        assert h.post_solve is _note and h.pre_solve is None and "_dumbbell_heat" not in \
+            other.__dict__
+        spaces.step(other, 0.1, substeps=100)
+    counted = heat.total
+    spaces.step(space, 0.2, substeps=200)
+    assert heat.attached and heat.total > counted
+    clone = pickle.loads(pickle.dumps(heat))  # a copy of the counter keeps its count only
+    assert clone.total == heat.total and not clone.attached
+
+
+def _note(arbiter, space, data):
+    data.append(1)
+
+
+def test_replacing_its_callback_warns_once_and_says_so():
+    space, _ = _slope(0.3, math.radians(30))
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 0.2, substeps=200)
+    with pytest.warns(RuntimeWarning, match="wildcard post_solve callback was replaced "
+                                            r"\(by _note\) after \d+ contact-steps"):
+        space.on_collision(None, None, post_solve=_note, data=[])
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # once: no second warning
+        space.on_collision(None, None, post_solve=_note, data=[])
+        counted = heat.total
+        spaces.step(space, 0.2, substeps=200)
+    assert not heat.attached and "replaced" in heat.stopped and heat.total == counted
+    heat.detach()
+    assert space._handlers[(None, None)].post_solve is _note
+
+
+def test_a_counter_dropped_without_detach_gives_the_handler_back():
+    import gc
+
+    space, _ = _slope(0.3, math.radians(30))
+    before = _handler_state(space)
+    heat = spaces.HeatCounter(space)
+    spaces.step(space, 0.1, substeps=100)
+    del heat
+    gc.collect()
+    assert _handler_state(space) == before

@@ -126,27 +126,51 @@ def inventory(space: Any) -> Inventory:
     from ..model import args
 
     args.space(space)
-    dyn = [b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC]
+    bodies = space.bodies
+    place = {id(b): i for i, b in enumerate(bodies)}
+    types, masses, moments_all = _kinds(bodies)
+    dyn = [b for b, kind in zip(bodies, types, strict=True) if kind == pymunk.Body.DYNAMIC]
     tracked = list(dyn)
-    labels = [body_label(space, b) for b in dyn]
-    skipped = _skipped_bodies(space, dyn, labels)
+    where = {id(b): i for i, b in enumerate(tracked)}
+
+    def name(body: Any) -> str:
+        if body is space.static_body:
+            return "static body"
+        i = place.get(id(body))
+        return "body (not in the space)" if i is None else f"body {i}"
+
+    labels = [name(b) for b in dyn]
+    moments = [i for i, kind in zip(moments_all, types, strict=True)
+               if kind == pymunk.Body.DYNAMIC]
+    dyn_mass = [m for m, kind in zip(masses, types, strict=True) if kind == pymunk.Body.DYNAMIC]
+    skipped = _skipped_bodies(bodies, types, dyn, moments, labels, name)
 
     def index(body: Any) -> int:
-        for i, other in enumerate(tracked):
-            if other is body:
-                return i
-        tracked.append(body)
-        labels.append(body_label(space, body))
-        return len(tracked) - 1
+        i = where.get(id(body))
+        if i is None:
+            i = where[id(body)] = len(tracked)
+            tracked.append(body)
+            labels.append(name(body))
+        return i
 
     springs, unknown, notes = _constraints(space, index)
+    for b, label in zip(dyn, labels[: len(dyn)], strict=True):
+        if b._velocity_func is not None:
+            unknown.append(Skipped(label, "custom velocity_func: the energy of the field it "
+                                          "applies is not in E (declare its potential to a "
+                                          "spaces.Ledger)"))
+        if b._position_func is not None:
+            notes.append(f"{label} has a custom position_func: it moves the body its own way")
+    if any(kind == pymunk.Body.KINEMATIC for kind in types):
+        notes.append("kinematic bodies do work on what they push or pull (spaces.Ledger "
+                     "counts it)")
     if space.damping != 1.0:
         notes.append(f"space.damping = {space.damping:g}: bodies lose energy every step that "
                      "no term here counts")
     return Inventory(
         bodies=tuple(tracked), labels=tuple(labels), dynamic=len(dyn),
-        mass=np.array([b.mass for b in tracked], dtype=float),
-        moment=np.array([b.moment for b in tracked], dtype=float),
+        mass=np.array(dyn_mass + [b.mass for b in tracked[len(dyn):]], dtype=float),
+        moment=np.array(moments + [b.moment for b in tracked[len(dyn):]], dtype=float),
         gravity=(float(space.gravity[0]), float(space.gravity[1])),
         springs=tuple(springs), skipped=tuple(skipped), unknown=tuple(unknown),
         notes=tuple(notes),
@@ -162,9 +186,9 @@ def _constraints(space: Any, index: Callable[[Any], int]
     unknown: list[Skipped] = []
     notes: list[str] = []
     springs: list[Spring] = []
-    for c in space.constraints:
+    for i, c in enumerate(space.constraints):
         name = type(c).__name__
-        label = constraint_label(space, c)
+        label = f"{name} {i}"
         if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
             spring = _spring(c, label, index)
             if isinstance(spring, Skipped):
@@ -172,10 +196,16 @@ def _constraints(space: Any, index: Callable[[Any], int]
                 continue
             if c.damping != 0.0:
                 notes.append(f"{label} has damping {c.damping:g}: it turns energy into heat "
-                             "that the heat counter does not see")
+                             "that the heat counter does not see (spaces.Ledger counts it)")
             springs.append(spring)
         elif name in _WORKLESS and type(c).__module__.startswith("pymunk"):
-            continue
+            moves = []
+            if name in ("SlideJoint", "RotaryLimitJoint", "RatchetJoint"):
+                moves.append("a stop: reached, it takes energy out")
+            if math.isfinite(c.max_force):
+                moves.append(f"max_force {c.max_force:g}: slipping, it takes energy out")
+            if moves:
+                notes.append(f"{label}: {'; '.join(moves)} (spaces.Ledger counts it)")
         elif isinstance(c, pymunk.SimpleMotor):
             unknown.append(Skipped(label, "motor: puts energy in (its work is not counted)"))
         else:
@@ -183,20 +213,89 @@ def _constraints(space: Any, index: Callable[[Any], int]
     return springs, unknown, notes
 
 
-def _skipped_bodies(space: Any, dyn: list[Any], labels: list[str]) -> list[Skipped]:
+def _kinds(bodies: list[Any]) -> tuple[list[int], list[float], list[float]]:
+    """Each body's type, mass and moment: read from pymunk's structs in one pass (the type as
+    Chipmunk's cpBodyGetType decides it: static when its idle time is infinite, kinematic
+    when its mass is), or through pymunk's getters when the structs cannot be read."""
+    import pymunk
+
+    from . import _memory as mem
+
+    if not bodies or not mem.readable():
+        return ([b.body_type for b in bodies], [b.mass for b in bodies],
+                [b.moment for b in bodies])
+    at = mem.addresses(bodies, "_body")
+    m, i, idle = mem.Span.over(at, mem.size("body")).f(at, np.array(
+        [mem.offset("body", f) for f in ("m", "i", "idle_time")], dtype=np.uint64)[:, None])
+    kind = np.where(idle == np.inf, pymunk.Body.STATIC,
+                    np.where(m == np.inf, pymunk.Body.KINEMATIC, pymunk.Body.DYNAMIC))
+    return kind.tolist(), m.tolist(), i.tolist()
+
+
+def check_finite(space: Any) -> None:
+    """Refuse a space whose non-static bodies have a non-finite position, angle, velocity or
+    spin, or a dynamic body pymunk cannot step (mass or moment not > 0): a
+    :class:`~dumbbell.errors.DumbbellError` naming the body and what is wrong, so that a NaN
+    energy is never reported as a number."""
+    import pymunk
+
+    bodies = [b for b in space.bodies if b.body_type != pymunk.Body.STATIC]
+    if not bodies:
+        return
+    dyn = [b.body_type == pymunk.Body.DYNAMIC for b in bodies]
+    inv = Inventory(bodies=tuple(bodies), labels=(), dynamic=len(bodies),
+                    mass=np.zeros(0), moment=np.zeros(0), gravity=(0.0, 0.0), springs=(),
+                    skipped=(), unknown=(), notes=())
+    place = {id(b): i for i, b in enumerate(space.bodies)}
+    refuse_bad_state([f"body {place[id(b)]}" for b in bodies], read_state(inv),
+                     [b.mass if d else 1.0 for b, d in zip(bodies, dyn, strict=True)],
+                     [b.moment if d else 1.0 for b, d in zip(bodies, dyn, strict=True)])
+
+
+def refuse_bad_state(labels: list[str], st: State, mass: Any, moment: Any) -> None:
+    """Raise a :class:`~dumbbell.errors.DumbbellError` naming the first body (``labels``, in
+    the order of the state's columns) whose state is not finite, or whose mass or moment
+    (given for the dynamic ones, 1 for others) is not > 0."""
+    from ..errors import DumbbellError
+    from ..model import args
+
+    n = len(labels)
+    cols = (("position", (st.x, st.y)), ("velocity", (st.vx, st.vy)), ("angle", (st.angle,)),
+            ("angular_velocity", (st.omega,)))
+    mass = np.asarray(mass, dtype=float)[:n]
+    moment = np.asarray(moment, dtype=float)[:n]
+    bad = ~(np.isfinite(mass) & (mass > 0) & (moment > 0))
+    for _, parts in cols:
+        for part in parts:
+            bad |= ~np.isfinite(part[0, :n])
+    if not bad.any():
+        return
+    i = int(np.argmax(bad))
+    for name, parts in cols:
+        values = tuple(float(part[0, i]) for part in parts)
+        if not all(math.isfinite(v) for v in values):
+            shown = values[0] if len(values) == 1 else values
+            raise DumbbellError(f"{labels[i]}: {name} = {args.show(shown)}: must be finite")
+    raise DumbbellError(f"{labels[i]} is dynamic with mass {mass[i]:g} and moment "
+                        f"{moment[i]:g}: pymunk cannot step it (give it a mass > 0, or shapes "
+                        "with a density)")
+
+
+def _skipped_bodies(bodies: list[Any], types: list[int], dyn: list[Any], moments: list[float],
+                    labels: list[str], name: Callable[[Any], str]) -> list[Skipped]:
     """The bodies (or parts of their motion) whose energy is not counted: static and
     kinematic bodies, and the spin of a dynamic body of infinite moment."""
     import pymunk
 
     skipped: list[Skipped] = []
-    for b in space.bodies:
-        if b.body_type == pymunk.Body.STATIC:
-            skipped.append(Skipped(body_label(space, b), "static: holds no energy"))
-        elif b.body_type == pymunk.Body.KINEMATIC:
-            skipped.append(Skipped(body_label(space, b),
+    for b, kind in zip(bodies, types, strict=True):
+        if kind == pymunk.Body.STATIC:
+            skipped.append(Skipped(name(b), "static: holds no energy"))
+        elif kind == pymunk.Body.KINEMATIC:
+            skipped.append(Skipped(name(b),
                                    "kinematic: moved by the user, its energy is not counted"))
-    for b, label in zip(dyn, labels, strict=True):
-        if math.isinf(b.moment) and b.angular_velocity != 0.0:
+    for b, moment, label in zip(dyn, moments, labels, strict=True):
+        if math.isinf(moment) and b.angular_velocity != 0.0:
             skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
                                           "rad/s: rotational energy left out"))
     return skipped
@@ -241,10 +340,19 @@ class State:
 
 
 def read_state(inv: Inventory) -> State:
-    """The present state of the tracked bodies, as one sample."""
+    """The present state of the tracked bodies, as one sample: read from pymunk's body
+    structs in one pass (the centre of gravity as pymunk holds it), or through pymunk's
+    getters on a pymunk build whose structs :mod:`._memory` cannot read."""
     from ..model import args
+    from . import _memory as mem
 
     args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
+    if inv.bodies and mem.readable():
+        at = mem.addresses(inv.bodies, "_body")
+        a = mem.Span.over(at, mem.size("body")).f(
+            at, np.array([mem.offset("body", *f.split(".")) for f in
+                          ("p.x", "p.y", "v.x", "v.y", "a", "w")], dtype=np.uint64)[:, None])
+        return State(*a[:, None, :])
     rows = []
     for b in inv.bodies:
         cg = b.local_to_world(b.center_of_gravity)
@@ -252,6 +360,11 @@ def read_state(inv: Inventory) -> State:
         rows.append((cg[0], cg[1], v[0], v[1], b.angle, b.angular_velocity))
     a = np.array(rows, dtype=float).reshape(len(inv.bodies), 6).T[:, None, :]
     return State(*a)
+
+
+def _ordered(values: np.ndarray) -> np.ndarray:
+    """Sum over the last axis in order, left to right: ((v0 + v1) + v2) + ..."""
+    return np.cumsum(values, axis=-1)[..., -1]
 
 
 def _rotate(angle: np.ndarray, p: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -287,13 +400,11 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
                                          "py", "L_cm", "L_about", "X", "Y")}
         out.update(body_K_trans=empty, body_K_rot=empty, body_U_g=empty, body_L_about=empty)
     else:
-        M = m[0]
-        px, py = m[0] * st.vx[:, 0], m[0] * st.vy[:, 0]
-        mx, my = m[0] * st.x[:, 0], m[0] * st.y[:, 0]
-        for i in range(1, n):
-            M = M + m[i]
-            px, py = px + m[i] * st.vx[:, i], py + m[i] * st.vy[:, i]
-            mx, my = mx + m[i] * st.x[:, i], my + m[i] * st.y[:, i]
+        # Sums over bodies in their order, left to right (cumsum: no pairwise regrouping),
+        # so that two bodies add as they always have.
+        M = _ordered(m[:n])
+        px, py = _ordered(m[:n] * st.vx[:, :n]), _ordered(m[:n] * st.vy[:, :n])
+        mx, my = _ordered(m[:n] * st.x[:, :n]), _ordered(m[:n] * st.y[:, :n])
         X, Y, Vx, Vy = mx / M, my / M, px / M, py / M
         spin = np.isfinite(moment[:n])
         kt = translational_ke(m[:n], st.vx[:, :n], st.vy[:, :n])
@@ -301,16 +412,11 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
         own = np.where(spin, np.where(spin, moment[:n], 0.0) * st.omega[:, :n], 0.0)
         lo = angular_momentum(m[:n], st.x[:, :n], st.y[:, :n], st.vx[:, :n], st.vy[:, :n],
                               ox, oy) + own
-        K_int = translational_ke(m[0], st.vx[:, 0] - Vx, st.vy[:, 0] - Vy)
-        L_cm = angular_momentum(m[0], st.x[:, 0], st.y[:, 0], st.vx[:, 0], st.vy[:, 0], X, Y)
-        for i in range(1, n):
-            K_int = K_int + translational_ke(m[i], st.vx[:, i] - Vx, st.vy[:, i] - Vy)
-            L_cm = L_cm + angular_momentum(m[i], st.x[:, i], st.y[:, i], st.vx[:, i],
-                                           st.vy[:, i], X, Y)
-        for i in range(n):
-            if spin[i]:
-                K_int = K_int + kr[:, i]
-                L_cm = L_cm + own[:, i]
+        rel = translational_ke(m[:n], st.vx[:, :n] - Vx[:, None], st.vy[:, :n] - Vy[:, None])
+        K_int = _ordered(np.concatenate([rel, kr[:, spin]], axis=1))
+        arm = angular_momentum(m[:n], st.x[:, :n], st.y[:, :n], st.vx[:, :n], st.vy[:, :n],
+                               X[:, None], Y[:, None])
+        L_cm = _ordered(np.concatenate([arm, own[:, spin]], axis=1))
         K_cm = translational_ke(M, Vx, Vy)
         out = {
             "K_trans": kt.sum(axis=1), "K_rot": kr.sum(axis=1), "K_cm": K_cm, "K_int": K_int,
@@ -402,20 +508,20 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
     args.space(space)
     ox, oy = args.pair(about, "about", "m")
     inv = inventory(space)
-    terms = evaluate(inv, read_state(inv), (ox, oy))
+    st = read_state(inv)
+    n = inv.dynamic
+    refuse_bad_state(list(inv.labels[:n]), st, inv.mass, inv.moment)
+    terms = evaluate(inv, st, (ox, oy))
 
     def f(name: str) -> float:
         return float(terms[name][0])
 
-    bodies = tuple(
-        BodyEnergy(inv.labels[i], float(inv.mass[i]), float(inv.moment[i]),
-                   float(terms["body_K_trans"][0, i]), float(terms["body_K_rot"][0, i]),
-                   float(terms["body_U_g"][0, i]),
-                   (float(inv.mass[i] * inv.bodies[i].velocity[0]),
-                    float(inv.mass[i] * inv.bodies[i].velocity[1])),
-                   float(terms["body_L_about"][0, i]))
-        for i in range(inv.dynamic)
-    )
+    columns = (inv.labels[:n], inv.mass[:n].tolist(), inv.moment[:n].tolist(),
+               terms["body_K_trans"][0].tolist(), terms["body_K_rot"][0].tolist(),
+               terms["body_U_g"][0].tolist(), (inv.mass[:n] * st.vx[0, :n]).tolist(),
+               (inv.mass[:n] * st.vy[0, :n]).tolist(), terms["body_L_about"][0].tolist())
+    bodies = tuple(BodyEnergy(label, m, i, kt, kr, ug, (px, py), lo)
+                   for label, m, i, kt, kr, ug, px, py, lo in zip(*columns, strict=True))
     springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]))
                     for j, s in enumerate(inv.springs))
     return SpaceEnergy(

@@ -18,61 +18,77 @@ What is left, E(0) - E(t) - heat, is the method's error. For pymunk's step under
 is -1/2 M g^2 dt per second of flight (positions move with the velocity before gravity's
 kick), so it shrinks with dt.
 
-The counter listens on the space's wildcard handler (``on_collision(None, None)``) with
-``pre_solve`` and ``post_solve``; callbacks already there are kept and called after it with
-their own data, and handlers the user sets for particular collision types keep firing.
+The counters of a space listen on its wildcard handler (``on_collision(None, None)``)
+through one dispatcher (``pre_solve`` and ``post_solve``): callbacks already there are kept
+and called after the counters with their own data, handlers the user sets for particular
+collision types keep firing, and when the last counter detaches (in any order; dropping a
+counter detaches it) the handler is exactly as it was. Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards
+stops the counters: each warns once (a ``RuntimeWarning`` naming what stopped counting) and
+says so in ``stopped``. ``Space.copy()`` and pickling work with counters attached; the copy
+has the callbacks the space had before them, and no counter.
 Impulses are read from pymunk's contact structs (``Arbiter._arbiter``; pymunk 7).
+:class:`dumbbell.spaces.Ledger` counts the same contact heat per pair of bodies, with every
+other source of energy.
 """
 
 from __future__ import annotations
 
+import warnings
+import weakref
 from typing import Any
 
 __all__ = ["HeatCounter"]
 
+_PHASES = ("pre_solve", "post_solve")
+
 
 class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
-    the contact-steps counted. ``detach()`` restores the callbacks that were there before."""
+    the contact-steps counted. ``detach()`` stops counting; ``stopped`` says why counting
+    stopped (None while it counts)."""
 
     def __init__(self, space: Any) -> None:
-        from pymunk._chipmunk_cffi import ffi
-
         from ..model import args
 
         self.space = args.space(space)
         self.total = 0.0
         self.steps = 0
-        self._ffi = ffi
+        self.stopped: str | None = None
         self._before: dict[int, list[tuple[float, float, float, float]]] = {}
         self._last_dt: float | None = None
-        old = space._handlers.get((None, None))
-        self._user = {
-            phase: (getattr(old, phase), old.data.get(phase)) if old is not None
-            and getattr(old, phase) is not None else None
-            for phase in ("pre_solve", "post_solve")
-        }
-        space.on_collision(None, None, pre_solve=self._pre_solve, post_solve=self._post_solve)
-        self._handler = space._handlers[(None, None)]
+        _Dispatch.of(space).add(self)
 
     @property
     def attached(self) -> bool:
-        """False once someone replaced the counter's callbacks on the wildcard handler (then
-        ``total`` stops counting)."""
-        h = self._handler
-        return h.pre_solve == self._pre_solve and h.post_solve == self._post_solve
+        """True while the counter counts (False after ``detach()`` or once its callbacks
+        were replaced)."""
+        d = self.space.__dict__.get(_KEY)
+        return self.stopped is None and d is not None and self in d.counters
 
     def detach(self) -> None:
-        """Stop counting and put back the wildcard callbacks that were there before."""
-        from pymunk import empty_callback
+        """Stop counting. When the space's last counter detaches, its wildcard callbacks are
+        the ones it had before the first counter attached."""
+        d = self.space.__dict__.get(_KEY)
+        if d is not None:
+            d.remove(self)
+        if self.stopped is None:
+            self.stopped = "detached"
 
-        if not self.attached:
-            return
-        for phase, saved in self._user.items():
-            if saved is None:
-                self.space.on_collision(None, None, **{phase: empty_callback})
-            else:
-                self.space.on_collision(None, None, data=saved[1], **{phase: saved[0]})
+    def __del__(self) -> None:
+        # A counter dropped without detach() leaves the handler as the others need it.
+        try:
+            if "space" in self.__dict__ and self.stopped is None:
+                self.detach()
+        except Exception:  # noqa: BLE001, S110 - never raise from a finalizer
+            pass
+
+    def __getstate__(self) -> dict[str, Any]:
+        # A copy of a counter keeps its counts and does not count (no callbacks point to it).
+        state = dict(self.__dict__)
+        state["_before"] = {}
+        if state["stopped"] is None:
+            state["stopped"] = "a copy: it does not count"
+        return state
 
     def _relative(self, arbiter: Any) -> tuple[Any, Any, Any]:
         raw = arbiter._arbiter
@@ -91,7 +107,9 @@ class HeatCounter:
                         (vb.y + wb * r2.x) - (va.y + wa * r1.x)))
         return out
 
-    def _pre_solve(self, arbiter: Any, space: Any, data: Any) -> None:
+    def _pre_solve(self, arbiter: Any, space: Any) -> None:
+        from pymunk._chipmunk_cffi import ffi
+
         raw, ba, bb = self._relative(arbiter)
         # pymunk starts a step from the impulse accumulated in the last one, applied scaled by
         # dt / previous dt ("warm starting"); on a first contact it keeps an impulse cached
@@ -99,16 +117,13 @@ class HeatCounter:
         # accumulator's growth from here plus the part applied at the start.
         carried = 0.0 if arbiter.is_first_contact else (
             space.current_time_step / self._last_dt if self._last_dt else 1.0)
-        self._before[int(self._ffi.cast("uintptr_t", raw))] = [
+        self._before[int(ffi.cast("uintptr_t", raw))] = [
             (ux, uy, raw.contacts[i].jnAcc * (1.0 - carried),
              raw.contacts[i].jtAcc * (1.0 - carried))
             for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb))
         ]
         # A contact whose post_solve never comes (the user rejected it) must not linger.
         space.add_post_step_callback(self._end_step, self)
-        user = self._user["pre_solve"]
-        if user is not None:
-            user[0](arbiter, space, user[1])
 
     def _end_step(self, space: Any, key: Any) -> None:
         self._before.clear()
@@ -116,9 +131,11 @@ class HeatCounter:
         # is the 'previous dt' pymunk scales them by.
         self._last_dt = space.current_time_step
 
-    def _post_solve(self, arbiter: Any, space: Any, data: Any) -> None:
+    def _post_solve(self, arbiter: Any, space: Any) -> None:
+        from pymunk._chipmunk_cffi import ffi
+
         raw, ba, bb = self._relative(arbiter)
-        before = self._before.pop(int(self._ffi.cast("uintptr_t", raw)), None)
+        before = self._before.pop(int(ffi.cast("uintptr_t", raw)), None)
         if before is not None and len(before) == raw.count:
             nx, ny = raw.n.x, raw.n.y
             work = 0.0
@@ -131,6 +148,133 @@ class HeatCounter:
                 work += 0.5 * (jx * (ux0 + ux1) + jy * (uy0 + uy1))
             self.total -= work
             self.steps += 1
-        user = self._user["post_solve"]
-        if user is not None:
-            user[0](arbiter, space, user[1])
+
+
+#: Where a space keeps its counters' dispatcher (a name pymunk's copy and pickle leave out).
+_KEY = "_dumbbell_heat"
+
+
+def _same(value: Any) -> Any:
+    return value
+
+
+class _Phase:
+    """The callback a space's wildcard handler calls for one phase: every counter, then
+    the user's callback that was there before. Copied or pickled, it is that callback
+    (or nothing): a copy of the space has no counter."""
+
+    def __init__(self, dispatch: _Dispatch, phase: str, user: Any) -> None:
+        self.dispatch = dispatch
+        self.phase = phase
+        self.user = user
+
+    def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
+        for counter in self.dispatch.counters:
+            if counter.stopped is None:
+                getattr(counter, f"_{self.phase}")(arbiter, space)
+        if self.user is not None:
+            return self.user(arbiter, space, data)
+        return None
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_same, (self.user,)) if self.user is not None else (type(None), ())
+
+
+class _Dispatch:
+    """The counters of one space and the wildcard handler they share. It holds the space
+    and the counters weakly: the user's references keep the counters, dropping one detaches
+    it, and no cycle runs through the space."""
+
+    def __init__(self, space: Any) -> None:
+        self._space = weakref.ref(space)
+        self._counters: list[weakref.ref[HeatCounter]] = []
+        self.created = (None, None) not in space._handlers
+        space.on_collision(None, None)  # make sure the wildcard handler exists
+        self.handler = space._handlers[(None, None)]
+        self.phases = {phase: _Phase(self, phase, getattr(self.handler, phase))
+                       for phase in _PHASES}
+        # pymunk passes the handler's data for the phase: the user's, or None if none.
+        self.no_data = [phase for phase in _PHASES if phase not in self.handler.data]
+        for phase, callback in self.phases.items():
+            self.handler.data.setdefault(phase, None)
+            setattr(self.handler, phase, callback)  # the property: data stays the user's
+        self.kind = type(self.handler)
+        self.handler.__class__ = _watched(self.kind)
+        self.handler._dumbbell_dispatch = self
+
+    @classmethod
+    def of(cls, space: Any) -> _Dispatch:
+        d = space.__dict__.get(_KEY)
+        if d is None:
+            d = space.__dict__[_KEY] = cls(space)
+        return d
+
+    @property
+    def counters(self) -> list[HeatCounter]:
+        """The counters attached, still alive."""
+        return [c for c in (ref() for ref in self._counters) if c is not None]
+
+    def add(self, counter: HeatCounter) -> None:
+        self._counters.append(weakref.ref(counter))
+
+    def remove(self, counter: HeatCounter) -> None:
+        self._counters = [ref for ref in self._counters if ref() not in (None, counter)]
+        if not self._counters:
+            self.uninstall()
+
+    def uninstall(self) -> None:
+        """Put back the handler as it was (phases the user replaced since stay theirs)."""
+        h = self.handler
+        h.__class__ = self.kind
+        del h._dumbbell_dispatch
+        for phase, callback in self.phases.items():
+            if getattr(h, phase) is callback:
+                setattr(h, phase, callback.user)
+                if phase in self.no_data:
+                    h.data.pop(phase, None)
+        space = self._space()
+        if space is None:
+            return
+        if self.created and h.begin is None and h.separate is None and not any(
+                getattr(h, phase) for phase in _PHASES) and not h.data:
+            # pymunk keeps the C handler; the Python side is as before the first counter.
+            del space._handlers[(None, None)]
+        space.__dict__.pop(_KEY, None)
+
+    def replaced(self, phase: str, new: Any) -> None:
+        """The user set the wildcard ``phase`` callback: the counters stop, each warning
+        once."""
+        if new is self.phases[phase]:
+            return
+        for counter in self.counters:
+            if counter.stopped is None:
+                counter.stopped = (f"the space's wildcard {phase} callback was replaced "
+                                   f"(by {getattr(new, '__name__', repr(new))}) after "
+                                   f"{counter.steps} contact-steps: contact heat after that "
+                                   "is not counted")
+                warnings.warn(f"dumbbell.spaces.HeatCounter stopped counting: {counter.stopped}",
+                              RuntimeWarning, stacklevel=4)
+
+
+_WATCHED: dict[type, type] = {}
+
+
+def _watched(kind: type) -> type:
+    """A subclass of pymunk's CollisionHandler that tells the dispatcher when a wildcard
+    ``pre_solve`` or ``post_solve`` is set over the counters'."""
+    sub = _WATCHED.get(kind)
+    if sub is None:
+        def make(phase: str) -> property:
+            base = getattr(kind, phase)
+
+            def setter(self: Any, func: Any) -> None:
+                base.fset(self, func)
+                d = self.__dict__.get("_dumbbell_dispatch")
+                if d is not None:
+                    d.replaced(phase, func)
+
+            return property(base.fget, setter, doc=base.__doc__)
+
+        sub = _WATCHED[kind] = type(f"Watched{kind.__name__}", (kind,),
+                                    {phase: make(phase) for phase in _PHASES})
+    return sub
