@@ -7,7 +7,6 @@ file level.
 from __future__ import annotations
 
 from ..model.trajectory import Verdict
-from .kernels import REST_SPEED  # the stepping kernels end a run at the same speed
 
 #: Nothing public: tolerances and a verdict the closed-form solvers share.
 __all__: list[str] = []

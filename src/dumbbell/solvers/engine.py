@@ -254,9 +254,9 @@ def _energy(
 ) -> dict[str, np.ndarray]:
     """The energy columns (J) from the general accounting of pymunk's own bodies, springs and
     gravity (:mod:`dumbbell.spaces.accounting`), evaluated over all samples at once."""
-    from ..spaces.accounting import State, evaluate, inventory
+    from ..spaces.accounting import State, _evaluate, _inventory
 
-    inv = inventory(world.space)
+    inv = _inventory(world.space)
     n = len(t)
     zero = np.zeros(n)
     if world.rigid_body is not None:
@@ -276,7 +276,7 @@ def _energy(
     extra = len(inv.bodies) - len(omega)
     pad = [zero] * extra
     st = State(*(np.column_stack(c + pad) for c in (*cols, [zero] * len(omega), omega)))
-    return partition_from_terms(scene, t, state, events, evaluate(inv, st))
+    return partition_from_terms(scene, t, state, events, _evaluate(inv, st))
 
 
 #: A touch of the floor that approaches slower than what gravity builds in this many steps
@@ -422,7 +422,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     # Heat of the contacts, from their impulses step by step (friction included).
     from ..spaces.heat import HeatCounter
 
-    counter = HeatCounter(space)
+    counter = HeatCounter._on(space)
     heat = np.zeros(options.n_samples)
     i = 0  # step index; the floor log reads it (a closure cell), so the loop pays nothing
     log = _FloorLog(world, dt, scene.system.g, lambda: i) if world.floors else None

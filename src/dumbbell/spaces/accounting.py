@@ -121,11 +121,15 @@ def constraint_label(space: Any, constraint: Any) -> str:
 
 def inventory(space: Any) -> Inventory:
     """Take stock of ``space`` (see the module docstring for what is counted and reported)."""
-    import pymunk
-
     from ..model import args
 
-    args.space(space)
+    return _inventory(args.space(space))
+
+
+def _inventory(space: Any) -> Inventory:
+    """:func:`inventory` of a space already checked (the pymunk solver's own)."""
+    import pymunk
+
     bodies = space.bodies
     place = {id(b): i for i, b in enumerate(bodies)}
     types, masses, moments_all = _kinds(bodies)
@@ -387,7 +391,12 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
 
     args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
     args.instance(st, "st", State, "a State (from read_state(inv))")
-    about = args.pair(about, "about", "m")
+    return _evaluate(inv, st, args.pair(about, "about", "m"))
+
+
+def _evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
+              ) -> dict[str, np.ndarray]:
+    """:func:`evaluate` of checked values."""
     n = inv.dynamic
     m, moment = inv.mass, inv.moment
     gx, gy = inv.gravity

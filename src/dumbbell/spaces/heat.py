@@ -50,7 +50,17 @@ class HeatCounter:
     def __init__(self, space: Any) -> None:
         from ..model import args
 
-        self.space = args.space(space)
+        self._start(args.space(space))
+
+    @classmethod
+    def _on(cls, space: Any) -> HeatCounter:
+        """A counter on a space already checked (the pymunk solver's own)."""
+        self = cls.__new__(cls)
+        self._start(space)
+        return self
+
+    def _start(self, space: Any) -> None:
+        self.space = space
         self.total = 0.0
         self.steps = 0
         self.stopped: str | None = None
