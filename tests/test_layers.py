@@ -11,7 +11,7 @@ import dumbbell
 ROOT = Path(dumbbell.__file__).parent
 
 #: Modules every layer may use.
-SHARED = {"errors", "progress", "parallel", "io.frames"}
+SHARED = {"errors", "progress", "parallel", "io.frames", "_install"}
 #: Layer of each package: ``spaces`` (any pymunk space: energy, heat, step guard) sits with
 #: the model, except its recorder, which paints like the animation.
 LAYERS = {"model": 1, "spaces": 1, "spaces.recorder": 4, "solvers": 2,

@@ -68,8 +68,12 @@ def run(args: argparse.Namespace) -> int:
     from ..analysis.bench import run_bench
     from ..io.bench import write_all
     from ..model.scene import load_scene
+    from .app import plan_outputs
 
     scene = load_scene(args.scene)
+    stem = Path(args.out) / f"bench-{scene.name}"
+    plan_outputs(args, [Path(f"{stem}{end}") for end in (
+        ".csv", ".json", ".md", "-work-precision.png", "-convergence.png")])
     result = run_bench(scene, solvers=args.solvers, dts=args.dts, window=args.window,
                        repeat=args.repeat, t_end=args.t_end, budget=args.budget,
                        spacing=args.sample_spacing, quiet=args.quiet)
@@ -77,7 +81,6 @@ def run(args: argparse.Namespace) -> int:
     from ..io.figures import save_figure
     from ..plot.bench import convergence, work_precision
 
-    stem = Path(args.out) / f"bench-{result.scene}"
     # The figures keep their own resolution ("figure": the dpi they were made with).
     written += [save_figure(work_precision(result).figure, f"{stem}-work-precision.png",
                             dpi="figure"),

@@ -54,6 +54,11 @@ def run(args: argparse.Namespace) -> int:
         if unknown or not solvers:
             raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
                              + ", ".join(available()))
+    from .app import plan_outputs
+
+    stem = Path(args.out) / f"{scene.name}-compare"
+    plan_outputs(args, [Path(f"{stem}{end}") for end in (
+        ".csv", "-impacts.csv", "-errors.csv", "-positions.png", "-error.png", "-energy.png")])
     try:
         result = compare(scene, solvers, args.dt, args.window, args.t_end, quiet=args.quiet)
     except UsageError as exc:
@@ -66,7 +71,6 @@ def run(args: argparse.Namespace) -> int:
     from .. import plot
     from ..io.figures import save_figure
 
-    stem = Path(args.out) / f"{scene.name}-compare"
     for name, draw in (("positions", plot.compare_positions), ("error", plot.compare),
                        ("energy", plot.compare_energy)):
         paths.append(save_figure(draw(result).figure, f"{stem}-{name}.png"))

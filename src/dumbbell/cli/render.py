@@ -72,6 +72,10 @@ def run(args: argparse.Namespace) -> int:
         from ..errors import UsageError
 
         raise UsageError(f"-o {out}: must end in .gif")
+    from .app import plan_outputs
+
+    if not args.output:  # -o itself was checked with the other flags
+        plan_outputs(args, [out], "the default -o")
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")

@@ -97,13 +97,16 @@ def run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     if args.elasticity is not None and scene.system.floor is not None:
         scene = scene.with_values({"floor.elasticity": args.elasticity})
+    from .app import plan_outputs
+
+    out = Path(args.out)
+    csv, png = plan_outputs(args, [out / f"{scene.name}-restitution.csv",
+                                   out / f"{scene.name}-restitution.png"])
     runs = len(args.theta) * (1 + len(args.stiffness))
     with bar(runs, "restitution", unit="run", quiet=args.quiet) as progress:
         result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
                              progress=progress.update)
-    out = Path(args.out)
-    csv = write_csv(result, out / f"{scene.name}-restitution.csv")
-    png = out / f"{scene.name}-restitution.png"
+    write_csv(result, csv)
     fig = draw(result)[0].figure
     fig.tight_layout()
     save_figure(fig, png)

@@ -35,7 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
            workers: int | None = None, quiet: bool = True,
-           note: str | None = None) -> dict[str, Any]:
+           note: str | None = None, args: argparse.Namespace | None = None
+           ) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
     Everything is validated before anything runs, and only then is ``note`` (a line about
     the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
@@ -57,12 +58,17 @@ def report(cases: str | Path | None, solvers: list[str] | None, out: str | Path,
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
+    from .app import plan_outputs
+
+    steppers = map_solvers(solvers)
+    plan_outputs(args or argparse.Namespace(out=out),
+                 [out / "stability.md", out / "stability.csv"]
+                 + ([out / "stability-map.png"] if steppers else []))
     if note:
         sys.stderr.write(f"dumbbell stability: {note}\n")
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
                              tuple(guard_lines(runs)))
     written = write(result, out)
-    steppers = map_solvers(solvers)
     if steppers:
         maps = {name: map_rows(name, workers, quiet) for name in steppers}
         panels = stability_map(maps)
@@ -75,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
 
     # Jobs are many (cases x solvers); the CPUs are the cap that binds.
     note = cap_note("--workers", args.workers, 1 << 30)
-    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note)
+    result = report(args.cases, args.solvers, args.out, args.workers, args.quiet, note, args)
     if not args.quiet:
         rows = result["rows"]
         bad = sum(not r.agrees for r in rows)

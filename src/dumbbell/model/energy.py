@@ -168,7 +168,7 @@ def partition_1d(
 def _loop_1d():
     """The 1D partition as one compiled pass: a million rows cost milliseconds, not the tenths
     of a second that two dozen numpy temporaries do. Compiled on first use only."""
-    from numba import njit
+    from .._install import njit
 
     @njit(cache=True, nogil=True)
     def loop(mA, mB, k, b, g, xA, vA, xB, vB, out):  # pragma: no cover

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from ..._install import njit
 
 from . import BIG, BLOWUP, OK, TUNNEL_A, TUNNEL_B
 

@@ -13,7 +13,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from ..._install import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
 _N = _dop.N_STAGES
