@@ -598,6 +598,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.io.files.OutputTransaction": lambda f: {"inputs": [(f.scene_file, "the scene")]},
     "dumbbell.io.files.OutputTransaction.claim": lambda f: {"path": f.tmp / "o.csv",
                                                            "what": "-o o.csv"},
+    "dumbbell.io.files.OutputTransaction.plan": lambda f: {"paths": [f.tmp / "p.csv"],
+                                                          "flag": "--out o"},
     "dumbbell.io.files.atomic_output": lambda f: {"path": f.tmp / "a.csv"},
     "dumbbell.io.files.check_writable": lambda f: {"path": f.tmp / "w.csv", "flag": "-o",
                                                    "folder": False},
@@ -714,6 +716,8 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
     "dumbbell.io.files.OutputTransaction.claim":
+        lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
+    "dumbbell.io.files.OutputTransaction.plan":
         lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),

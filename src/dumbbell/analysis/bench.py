@@ -263,6 +263,12 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
             raise UsageError(f"solvers {name}: cannot run {scene.source}: {reason}", param="solvers")
     if not solvers:
         raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
+    from .budget import check_runs
+
+    steppers = sum(solver_class(n).has_step for n in solvers)
+    check_runs(steppers * len(dts) + len(solvers) - steppers + 1,
+               f"{steppers} stepping solvers x {len(dts)} steps (+ the others and the truth)",
+               ["fewer steps ({dts})"] + (["fewer {solvers}"] if len(solvers) > 1 else []))
     for dt in dts:
         try:
             make_options(scene, dt=dt, t_end=t_end)

@@ -167,6 +167,7 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
             raise UsageError(f"solvers: {name!r} cannot run {scene.source}: {reason}", param="solvers")
     if not (window > 0 and math.isfinite(window)):
         raise UsageError(f"window = {window!r}: must be a finite number > 0 (s)", param="window")
+    _check_work(solvers, dts, t_end)
     spacing = _spacing(scene, dts, t_end)
     # Every run's own work budget (the exact truth's impacts), before the first run.
     from ..solvers import make_options
@@ -191,6 +192,19 @@ def compare(scene: Scene | str | Path, solvers: list[str] | None = None,
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
     return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes)
 
+
+
+def _check_work(solvers: list[str], dts: list[float], t_end: float) -> None:
+    """UsageError before any run when solvers x steps pass the budget of runs, or their
+    steps together the budget of steps (:mod:`.budget`)."""
+    from .budget import check_runs, check_steps
+
+    fixes = [f for f, n in (("fewer steps ({dts})", len(dts)),
+                            ("fewer {solvers}", len(solvers))) if n > 1]
+    check_runs(len(solvers) * len(dts), f"{len(solvers)} solvers x {len(dts)} steps", fixes)
+    steps = len(solvers) * sum(t_end / dt for dt in dts)
+    check_steps(steps, f"{len(solvers)} solvers x {len(dts)} steps over {t_end:g} s",
+                [*fixes, "larger steps ({dts})", "a shorter {t_end}"])
 
 
 def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:

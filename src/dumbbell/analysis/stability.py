@@ -230,7 +230,7 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
 
     for name in solvers or ():
         solver_class(name)
-    runs, skipped = [], []
+    runs, skipped, steps = [], [], 0
     for path in paths:
         scene = load_scene(path)
         try:
@@ -244,8 +244,14 @@ def plan_cases(paths: list[Path], solvers: list[str] | None) -> tuple[list[tuple
             reason = solver_class(name).supports(scene)
             if reason is None:
                 runs.append((str(path), name))
+                steps += make_options(scene).n_steps
             else:
                 skipped.append(f"{scene.name} with {name}: {reason}")
+    from .budget import check_runs, check_steps
+
+    fixes = ["fewer scene files in {cases}"] + (["fewer {solvers}"] if solvers and len(solvers) > 1 else [])
+    check_runs(len(runs), f"{len(paths)} cases x their solvers", fixes)
+    check_steps(steps, f"the {len(runs)} runs of {len(paths)} cases", fixes)
     return runs, skipped
 
 

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float, read_scene
+from .app import _shown, add_quiet, positive_float, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
         solvers = [s.strip() for item in args.solvers for s in item.split(",") if s.strip()]
         unknown = [s for s in solvers if s not in available()]
         if unknown or not solvers:
-            raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
+            raise UsageError(f"--solvers {_shown(' '.join(args.solvers))}: must name solvers among "
                              + ", ".join(available()))
     from .app import plan_outputs
 

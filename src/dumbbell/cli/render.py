@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..animation.render import MAX_FRAMES
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
+from .app import EXIT_VERDICT, _shown, add_quiet, positive_float, positive_int, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -51,7 +51,7 @@ def _whole(text: str) -> int:
     try:
         return int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be a whole number") from None
+        raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a whole number") from None
 
 
 def run(args: argparse.Namespace) -> int:

@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from .app import add_quiet, positive_float
+from .app import _shown, add_quiet, positive_float
 
 #: Largest number of tilts in one call: each costs several runs.
 MAX_TILTS = 91
@@ -16,7 +16,7 @@ MAX_TILTS = 91
 def tilt_range(text: str) -> list[float]:
     """An argparse type: START:STOP:N (N tilts in degrees from START to STOP inclusive) or a
     list A,B,C; every tilt in [0, 90) degrees."""
-    message = (f"{text!r}: must be START:STOP:N or a list A,B,...: degrees in [0, 90), with "
+    message = (f"{_shown(text)}: must be START:STOP:N or a list A,B,...: degrees in [0, 90), with "
                f"START <= STOP and N a whole number from 1 to {MAX_TILTS} (N = 1 needs "
                "START = STOP)")
     try:
@@ -48,7 +48,7 @@ def restitution_coefficient(text: str) -> float:
     except ValueError:
         value = math.nan
     if not 0 <= value <= 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be a number from 0 to 1")
+        raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a number from 0 to 1")
     return value
 
 
@@ -83,7 +83,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default="renders",
                    help="folder for the CSV and PNG (default: renders)")
     add_quiet(p)
-    p.set_defaults(func=run)
+    # The library's thetas and stiffnesses are --theta and --stiffness here.
+    p.set_defaults(func=run, names={"thetas": "--theta", "stiffnesses": "--stiffness"})
 
 
 def run(args: argparse.Namespace) -> int:

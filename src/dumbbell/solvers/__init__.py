@@ -57,7 +57,7 @@ def solver_class(solver: str) -> type[Solver]:
         raise UsageError(f"solver = {args.show(solver)}: must be a solver name, one of "
                          f"{', '.join(available())}", param="solver")
     if solver not in METHODS:
-        raise UsageError(f"solver {solver!r}: must be one of {', '.join(available())}")
+        raise UsageError(f"solver {args.show(solver)}: must be one of {', '.join(available())}")
     return METHODS[solver]
 
 
@@ -67,7 +67,7 @@ def scene_solver(scene: Scene) -> type[Solver]:
     scene = args.scene(scene)
     name = scene.run.solver
     if name not in METHODS:
-        raise SceneError(f"{scene.source}: run.solver = {name!r}: must be one of "
+        raise SceneError(f"{scene.source}: run.solver = {args.show(name)}: must be one of "
                          f"{', '.join(available())}")
     return METHODS[name]
 

@@ -8,7 +8,6 @@ Imported only when the solver runs, so ``import dumbbell`` does not load numba.
 from __future__ import annotations
 
 from ..._install import njit
-
 from . import BIG, BLOWUP, OK, TUNNEL_A, TUNNEL_B
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 from ..._install import njit
-
 from . import BIG, BLOWUP, OK, TUNNEL_A, TUNNEL_B
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 from ..._install import njit
-
 from . import BIG, BLOWUP, OK, REST, TUNNEL_A, TUNNEL_B
 
 #: An impact slower than this (m/s), or more impacts than MAX_HITS in one step, means a
