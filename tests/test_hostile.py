@@ -1333,7 +1333,7 @@ def numba_cache(tmp_path_factory):
 def test_any_mplbackend_leaves_the_figures_alone(read_only, numba_cache, backend):
     """The command writes files only: Agg, whatever MPLBACKEND says; with HOME unwritable
     matplotlib gets a private folder instead of its two-line warning."""
-    pkg, home, tmpdir, cwd = read_only
+    pkg, home, _, cwd = read_only
     with open(cwd / "short.toml", "a", encoding="utf-8") as fh:
         fh.write('[outputs]\nfigures = ["positions"]\n')
     os.chmod(cwd / "short.toml", 0o644)
@@ -1405,6 +1405,10 @@ def test_restitution_fixes_are_the_ones_that_help(tmp_path, monkeypatch):
     ("compare", ["--dt", "1e-9", "2e-9", "--t-end", "10"], "--t-end"),
     ("compare", ["--solvers", *["pymunk"] * 600, "--dt", "1e-4", "2e-4"], "--solvers"),
     ("bench", ["--dts", *[f"{1e-3 / (1 + i * 1e-4):.10g}" for i in range(600)]], "--dts"),
+    # Memory: the runs a result keeps whole, all together, hold at most one run's samples.
+    ("compare", ["--dt", "1e-3", "5e-4", "2.5e-4", "--t-end", "2000"], "--t-end"),
+    ("bench", ["--dts", "1e-4", "5e-5", "--sample-spacing", "1e-4", "--t-end", "400",
+               "--window", "1"], "--sample-spacing"),
 ])
 def test_steps_times_solvers_are_capped_before_any_run(work, monkeypatch, command, flags, fix):
     scene, out = work

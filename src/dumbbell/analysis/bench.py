@@ -290,6 +290,15 @@ def check_request(scene: Scene, solvers: list[str], dts: list[float], window: fl
         raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: a run would "
                          f"keep {count}, past the budget of {MAX_SAMPLES:,}",
                          fixes=("keep fewer with a larger {spacing}", "a shorter {t_end}"))
+    # The truth is kept for each step (its samples fall on that step's grid): all together
+    # they may hold no more than one run may.
+    truths = sum(dict(zip(dts, counts, strict=True)).values()) if truth_solver(scene) else 0
+    if truths > MAX_SAMPLES:
+        raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: the truth "
+                         f"kept for each of {len(dts)} steps would hold {truths:,} samples in "
+                         f"all, past the budget of {MAX_SAMPLES:,}",
+                         fixes=(["fewer steps ({dts})"] if len(set(dts)) > 1 else [])
+                         + ["a larger {spacing}", "a shorter {t_end}"])
     # Every solver's own work budget (the exact solver's impacts), before the first run.
     truth = truth_solver(scene)
     for name in [*solvers, *([truth] if truth else [])]:
