@@ -619,6 +619,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.io.files.OutputTransaction": lambda f: {"inputs": [(f.scene_file, "the scene")]},
     "dumbbell.io.files.OutputTransaction.claim": lambda f: {"path": f.tmp / "o.csv",
                                                            "what": "-o o.csv"},
+    "dumbbell.io.files.OutputTransaction.plan": lambda f: {"paths": [f.tmp / "p.csv"],
+                                                          "flag": "--out o"},
     "dumbbell.io.files.atomic_output": lambda f: {"path": f.tmp / "a.csv"},
     "dumbbell.io.files.check_writable": lambda f: {"path": f.tmp / "w.csv", "flag": "-o",
                                                    "folder": False},
@@ -792,6 +794,8 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.io.files.OutputTransaction.claim":
         lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: f.recorder(),
+    "dumbbell.io.files.OutputTransaction.plan":
+        lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":

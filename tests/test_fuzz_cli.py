@@ -129,8 +129,10 @@ PLAUSIBLE = {
     "E": ["0", "0.5", "1", "0.9"],
     "NAME": ["euler-cromer", "exact", "verlet", "pymunk", "reference", "euler-cromer-2d",
              "exact,verlet", "nope"],
-    "DIR": ["out", "sub/dir", ".", "cases", "short.toml", "/dev/null", "out/../out2"],
-    "FILE": ["x.csv", "y.csv", "short.toml", "-", "/dev/null", "sub/x.csv", "x.csv/"],
+    "DIR": ["out", "sub/dir", ".", "cases", "short.toml", "/dev/null", "out/../out2",
+            "dangling", "out/"],
+    "FILE": ["x.csv", "y.csv", "short.toml", "-", "/dev/null", "sub/x.csv", "x.csv/",
+             "dangling/x.csv", "newdir/"],
     "FILE.gif": ["a.gif", "b.GIF", "x.csv", "short.toml", "/dev/null"],
     "WxH": ["64x36", "640x360", "9x9", "0x0", "64X36", "1x99999"],
     "ADDRESS": ["tcp://127.0.0.1:{closed}", "tcp://10.255.255.1:8786", "tcp://127.0.0.1:0",
@@ -151,6 +153,9 @@ hostile_text = st.one_of(
         "x.csv", "sub/y.csv", "a.gif", "/dev/null", "/dev/zero", "/dev/full", ".", "..", "~",
         "a\x00b", "\u00e9.csv", "/", "//", "../escape", "nope/deeper/x.csv", "/proc/version",
         "k=1,2", "exact", "nope", "640x360", "local",
+        # second round: huge values to echo, names of folders, links to nowhere
+        "9" * 5000, ",".join(str(i % 90) for i in range(10_000)), "x" * 5000,
+        "d/" * 2100 + "x.csv", "newdir/", "sub/", "out/.", "dangling/x.csv", "dangling",
     ]),
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
     st.floats(min_value=0, max_value=1e-300, allow_subnormal=True).map(repr),
@@ -226,6 +231,7 @@ def _folder(root: Path) -> list[str]:
     (root / "short2d.toml").write_text(SHORT_2D, encoding="utf-8")
     (root / "cases").mkdir()
     short_scene(root / "cases", "short.toml")
+    (root / "dangling").symlink_to(root / "nowhere")
     return files_in(root)
 
 
@@ -286,6 +292,10 @@ def test_random_flags_never_give_a_traceback(tiny_budgets, args):
         assert time.monotonic() - t0 < HANG, args
         assert "Traceback" not in err, (args, err)
         assert status in (0, 2, 3), (args, status, err)
+        # No value echoed past 200 characters, no temporary file left, whatever the outcome.
+        assert all(len(w) <= 200 for line in err.splitlines() for w in line.split(" ")), \
+            (args, err[:300])
+        assert not [n for n in files_in(root) if ".part" in n or n.endswith(".old")], args
         if status == 2:
             assert len(err.strip().splitlines()) == 1, (args, err)
             assert files_in(root) == ["cwd"] + [f"cwd/{p}" for p in inputs], (args, err)

@@ -345,6 +345,13 @@ def check_request(scene: Scene, plan: _Plan) -> None:
         raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
     t_end, window, spacing = options.t_end, options.window, options.spacing
     assert t_end is not None and spacing is not None  # filled in by the plan
+    from .budget import check_runs
+
+    steppers = sum(cls.has_step for cls in plan.solvers)
+    check_runs(steppers * len(options.dts) + len(plan.solvers) - steppers + 1,
+               f"{steppers} stepping solvers x {len(options.dts)} steps (+ the others and the "
+               "truth)",
+               ["fewer steps ({dts})"] + (["fewer {solvers}"] if len(plan.solvers) > 1 else []))
     for dt in options.dts:
         try:
             run_options(scene, dt, t_end)
@@ -367,6 +374,16 @@ def check_request(scene: Scene, plan: _Plan) -> None:
         raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: a run would "
                          f"keep {count}, past the budget of {MAX_SAMPLES:,}",
                          fixes=("keep fewer with a larger {spacing}", "a shorter {t_end}"))
+    # The truth is kept for each step (its samples fall on that step's grid): all together
+    # they may hold no more than one run may.
+    dts = options.dts
+    truths = sum(dict(zip(dts, counts, strict=True)).values()) if plan.truth else 0
+    if truths > MAX_SAMPLES:
+        raise UsageError(f"t_end = {t_end:g} s with samples every {spacing:g} s: the truth "
+                         f"kept for each of {len(dts)} steps would hold {truths:,} samples in "
+                         f"all, past the budget of {MAX_SAMPLES:,}",
+                         fixes=(["fewer steps ({dts})"] if len(set(dts)) > 1 else [])
+                         + ["a larger {spacing}", "a shorter {t_end}"])
     # Every solver's own work budget (the exact solver's impacts), before the first run.
     for cls in [*plan.solvers, *([plan.truth] if plan.truth else [])]:
         cls._check_work(scene, run_options(scene, spacing, t_end))

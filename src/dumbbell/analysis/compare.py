@@ -248,7 +248,9 @@ def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
         if reason is not None:
             raise UsageError(f"solvers: {cls.name!r} cannot run {scene.source}: {reason}",
                              param="solvers")
+    _check_work(solvers, dts, t_end)
     spacing = _spacing(scene, dts, t_end)
+    _check_kept(len(solvers), len(dts), round(t_end / spacing) + 1, spacing, t_end)
     # Every run's own work budget (the exact truth's impacts), before the first run.
     truth_cls = truth_class(scene)
     for cls in [*solvers, *([truth_cls] if truth_cls else [])]:
@@ -301,6 +303,35 @@ def _timed(scene: Scene, cls: type[Solver], options: RunOptions) -> tuple[Trajec
     parts = [p for p in (max(0.0, first.wall_time - seconds) if again else math.nan, compiled)
              if not math.isnan(p)]
     return first, Timing(seconds, sum(parts) if parts else math.nan, 1 + len(again))
+
+
+def _check_work(solvers: list[str], dts: list[float], t_end: float) -> None:
+    """UsageError before any run when solvers x steps pass the budget of runs, or their
+    steps together the budget of steps (:mod:`.budget`)."""
+    from .budget import check_runs, check_steps
+
+    fixes = [f for f, n in (("fewer steps ({dts})", len(dts)),
+                            ("fewer {solvers}", len(solvers))) if n > 1]
+    check_runs(len(solvers) * len(dts), f"{len(solvers)} solvers x {len(dts)} steps", fixes)
+    steps = len(solvers) * sum(t_end / dt for dt in dts)
+    check_steps(steps, f"{len(solvers)} solvers x {len(dts)} steps over {t_end:g} s",
+                [*fixes, "larger steps ({dts})", "a shorter {t_end}"])
+
+
+def _check_kept(solvers: int, dts: int, samples: int, spacing: float, t_end: float) -> None:
+    """UsageError before any run when ``solvers`` x ``dts`` runs and the truth, which the
+    result keeps whole, would hold more samples in all than one run may keep
+    (:data:`~dumbbell.solvers.MAX_SAMPLES`): memory bounded by the output, not by the
+    number of steps asked for."""
+    from ..solvers import MAX_SAMPLES
+
+    runs = solvers * dts + 1
+    if runs * samples > MAX_SAMPLES:
+        raise UsageError(f"t_end = {t_end:g} s: {runs:,} runs of {samples:,} samples (one every "
+                         f"{spacing:g} s) would keep {runs * samples:,} samples in all, past "
+                         f"the budget of {MAX_SAMPLES:,}", param="t_end",
+                         fixes=(["fewer steps ({dts})"] if dts > 1 else [])
+                         + (["fewer {solvers}"] if solvers > 1 else []) + ["a shorter {t_end}"])
 
 
 def _spacing(scene: Scene, dts: list[float], t_end: float) -> float:

@@ -118,6 +118,14 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     not bias them; the run must continue ``gap`` s past the cluster."""
     traj = args.trajectory(traj)
     gap = args.real(gap, "gap", "s")
+    return _bounce(traj, gap, cluster=True)
+
+
+def _bounce(traj: Trajectory, gap: float, cluster: bool) -> Bounce:
+    """:func:`bounce`; without ``cluster`` only the first impact is measured (``e_cluster``
+    and ``share_cluster`` then repeat ``e_first`` and ``share_first``), so the run may end
+    right after it: a rigid drop on a nearly inelastic floor comes to rest in a cluster
+    that never ends, and the exact solver stops there."""
     if traj.scene.system.dimensions != 2:
         raise UsageError(f"traj: {traj.scene.source} is 1D; a tilted drop is measured in 2D",
                          param="traj")
@@ -130,11 +138,19 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     n = 1
     while n < len(times) and times[n] - times[n - 1] <= gap:
         n += 1
+    if not cluster:
+        n = 1
     t_last = times[n - 1]
-    if float(traj.t[-1]) < t_last + gap:
-        raise UsageError(f"{s.source}: the run ends before the first impact cluster is over "
-                         f"(last impact at {t_last:g} s, then gap = {gap:g} s without one); "
-                         "run longer")
+    at_rest = False
+    if cluster and float(traj.t[-1]) < t_last + gap:
+        # No flight of gap s after the last impact before the run ends: the cluster is over
+        # only if the dumbbell can no longer make one (it is coming to rest on the floor).
+        at_rest = _settled(traj, gap)
+        if not at_rest:
+            raise UsageError(f"{s.source}: the dumbbell still has the energy to leave the floor "
+                             f"for {gap:g} s when the drop's run ends at "
+                             f"{float(traj.t[-1]):g} s (last impact at {t_last:g} s), so the "
+                             "end of its first cluster of impacts is not known")
     vy = _cm_vy(traj)
     g = s.system.g
     i_before = int(np.searchsorted(traj.t, t0, side="left")) - 1
@@ -154,16 +170,33 @@ def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
         i = int(np.searchsorted(traj.t, t_imp + 1.5 * spacing, side="right"))
         if i >= len(traj.t) or traj.t[i] >= t_next:
             i = int(np.searchsorted(traj.t, t_imp, side="right"))
+        if i >= len(traj.t):
+            raise UsageError(f"{s.source}: the run ends at the impact at {t_imp:g} s "
+                             f"({traj.verdict}), so the velocity after it is not known")
         return i, float(vy[i] + g * (traj.t[i] - t_imp))
 
-    t_next_first = times[1] if n > 1 else math.inf
+    t_next_first = times[1] if n > 1 or (not cluster and len(times) > 1) else math.inf
     i_f, v_first = after(t0, t_next_first)
-    i_c, v_cluster = after(t_last, times[n] if n < len(times) else math.inf)
+    if at_rest:  # it does not leave the floor again: V after the cluster is 0
+        i_c, v_cluster = len(traj.t) - 1, 0.0
+    else:
+        i_c, v_cluster = after(t_last, times[n] if n < len(times) else math.inf)
     if v_before >= 0:
         raise UsageError(f"{s.source}: the centre of mass is not falling at the first impact")
     K_rot = traj["K_rot"]
     return Bounce(-v_first / v_before, -v_cluster / v_before, n,
                   float(K_rot[i_f]) / K_before, float(K_rot[i_c]) / K_before)
+
+
+def _settled(traj: Trajectory, gap: float) -> bool:
+    """Whether the dumbbell of ``traj`` can no longer leave the floor for ``gap`` s after its
+    last sample: a flight that long needs the centre of mass to rise at g gap / 2 or faster,
+    kinetic energy M (g gap)^2 / 8, which must come out of E above its least value on the
+    floor, M g y_rest with both particles resting on it (y_rest = (mA rA + mB rB) / M)."""
+    s = traj.scene.system
+    y_rest = (s.A.mass * s.A.radius + s.B.mass * s.B.radius) / s.M
+    spare = float(traj["E"][-1]) - s.M * s.g * y_rest
+    return spare < s.M * (s.g * gap) ** 2 / 8
 
 
 def tilted(scene: Scene, theta_deg: float, stiffness: float | None = None) -> Scene:
@@ -278,6 +311,68 @@ def _check_samples(rigid: Scene, dt: float, t_end: float) -> None:
                              fixes=(fix,))
 
 
+#: Most pymunk steps one :func:`restitution` call may take in all: about 2.5 minutes of CPU
+#: on the 2-core test machine at its measured 3.5e5 steps/s (91 tilts with the default
+#: springs take 3.1e7 steps; docs/hardening.md).
+MAX_PYMUNK_STEPS = 5 * 10**7
+
+
+def _check_work(scene: Scene, thetas: np.ndarray, stiffnesses: tuple[float, ...],
+                dt: float, t_end: float) -> None:
+    """UsageError before any run when the drops (tilts x (the rigid dumbbell + the
+    springs)) would be more than :data:`~.budget.MAX_RUNS` runs or take more than
+    :data:`MAX_PYMUNK_STEPS` pymunk steps in all (a spring of stiffness k steps at
+    min(dt, 0.02 / w), w = sqrt(k / mu)); each fix offered lowers the larger part."""
+    from .budget import check_runs, check_steps
+
+    n, m = len(thetas), len(stiffnesses)
+    fewer = ["fewer tilts ({thetas})"] if n > 1 else []
+    check_runs(n * (1 + m), f"{n} tilts x (the rigid dumbbell + {m} springs)",
+               fewer + (["fewer {stiffnesses}"] if m else []))
+    s = scene.system
+    mu = s.A.mass * s.B.mass / s.M
+    # Pymunk steps per tilt: at dt (the rigid run, and springs soft enough), or at 0.02/w.
+    at_dt, stiff = t_end / dt, {}
+    for k in stiffnesses:
+        step = 0.02 / math.sqrt(k / mu)
+        if step < dt:
+            stiff[k] = t_end / step
+        else:
+            at_dt += t_end / dt
+    total = n * (at_dt + sum(stiff.values()))
+    if total <= MAX_PYMUNK_STEPS:
+        return
+    drops = f"{n} drop{'s' if n > 1 else ''}"
+    fixes = [f for f in fewer if total / n <= MAX_PYMUNK_STEPS]
+    if sum(stiff.values()) > at_dt:
+        k = max(stiff, key=stiff.get)
+        what = (f"{drops} (the stiffest spring, {k:g} N/m, steps at 0.02/w = "
+                f"{t_end / stiff[k]:.3g} s)")
+        fixes.append("smaller {stiffnesses}")
+    else:
+        what = f"{drops} at dt = {dt:g} s"
+        fixes.append("a larger {dt}")
+    check_steps(total, what, fixes, budget=MAX_PYMUNK_STEPS)
+
+
+def _check_elasticity(scene: Scene) -> None:
+    """UsageError when the floor is so inelastic that an end leaves it slower than the exact
+    solver's rest speed: the truth then stops at the first impact, before it can be
+    measured."""
+    from ..solvers.exact_rigid import REST_SPEED
+
+    s = scene.system
+    e = s.floor.elasticity
+    v = math.sqrt(s.B.vy**2 + 2 * s.g * s.B.height)  # the drop's speed at the floor
+    least = 10 * REST_SPEED / v
+    if e < least:
+        raise UsageError(
+            f"elasticity = {e:g}: an end leaves this floor at about {e:g} x {v:.3g} m/s, "
+            f"slower than the {REST_SPEED:g} m/s at which the exact solver (the truth) "
+            "takes it to rest and stops, so the first impact cannot be measured",
+            param="elasticity", fixes=(f"use an {{elasticity}} of at least {least:.2g}",))
+
+
 def restitution(scene: Scene, thetas: np.ndarray | list[float],
                 stiffnesses: tuple[float, ...] = STIFFNESSES, dt: float = 1e-5,
                 progress=None) -> RestitutionResult:
@@ -294,6 +389,8 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
         args.function(progress, "progress", "a function called once per run, or None")
     _check_scene(scene)
     t_end = drop_duration(scene)
+    _check_work(scene, thetas, stiffnesses, dt, t_end)
+    _check_elasticity(scene)
     e = scene.system.floor.elasticity
     q = rigid_q(scene)
     truth, pm, shares, impacts = [], [], [], []
@@ -304,7 +401,7 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
     for th in thetas:
         rigid = tilted(scene, float(th))
         tr = simulate(rigid, truth_name, t_end=t_end, every=1)
-        truth.append(bounce(tr).e_first)
+        truth.append(_bounce(tr, CLUSTER_GAP, cluster=False).e_first)
         b = bounce(simulate(rigid, "pymunk", dt=dt, t_end=t_end, every=1))
         pm.append(b.e_first)
         shares.append(b.share_first)

@@ -260,7 +260,7 @@ def plan_cases(paths: list[Path], solvers: list[type[Solver]] | None
     from ..solvers.base import run_options
 
     solvers = solver_classes(solvers)
-    runs, skipped = [], []
+    runs, skipped, steps = [], [], 0
     for path in paths:
         scene = load_scene(path)
         try:
@@ -273,8 +273,15 @@ def plan_cases(paths: list[Path], solvers: list[type[Solver]] | None
             reason = cls._supports(scene)
             if reason is None:
                 runs.append((str(path), cls))
+                steps += run_options(scene).n_steps
             else:
                 skipped.append(f"{scene.name} with {cls.name}: {reason}")
+    from .budget import check_runs, check_steps
+
+    fixes = ["fewer scene files in {cases}"] + (["fewer {solvers}"] if solvers and
+                                                len(solvers) > 1 else [])
+    check_runs(len(runs), f"{len(paths)} cases x their solvers", fixes)
+    check_steps(steps, f"the {len(runs)} runs of {len(paths)} cases", fixes)
     return runs, skipped
 
 

@@ -70,13 +70,21 @@ class Axis:
         return all(isinstance(v, int | float) and not isinstance(v, bool) for v in self.values)
 
 
+def _show(value: Any) -> str:
+    """A value of the grid for a message: quoted, at most 60 characters (a 10,000-value
+    list is not echoed whole)."""
+    from ..model import args
+
+    return args.show(value)
+
+
 def _number(text: str, flag: str) -> float:
     try:
         value = float(text)
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise UsageError(f"grid {flag!r}: {text!r} is not a finite number", param="grid")
+        raise UsageError(f"grid {_show(flag)}: {_show(text)} is not a finite number", param="grid")
     return value
 
 
@@ -105,10 +113,10 @@ def parse_axis(text: str) -> Axis:
     name, sep, spec = text.partition("=")
     name, spec = name.strip(), spec.strip()
     if not sep or not name or not spec:
-        raise UsageError(f"grid {text!r}: must be {form}", param="grid")
+        raise UsageError(f"grid {_show(text)}: must be {form}", param="grid")
     key = SHORT_NAMES.get(name, name)
     if not all(part.isidentifier() or part in ("A", "B") for part in key.split(".")):
-        raise UsageError(f"grid {text!r}: {name!r} is not a dotted scene key such as "
+        raise UsageError(f"grid {_show(text)}: {_show(name)} is not a dotted scene key such as "
                          "spring.stiffness, bodies.A.mass or run.dt (k and dt are short names)", param="grid")
     kind = spec.split(":", 1)[0]
     if kind in ("log", "lin"):
@@ -121,20 +129,20 @@ def _spaced_values(text: str, name: str, kind: str, spec: str) -> tuple[float, .
     grid item ``text`` for the key ``name``."""
     parts = spec.split(":")
     if len(parts) != 4:
-        raise UsageError(f"grid {text!r}: must be {name}={kind}:A:B:N", param="grid")
+        raise UsageError(f"grid {_show(text)}: must be {name}={kind}:A:B:N", param="grid")
     a, b = _number(parts[1], text), _number(parts[2], text)
     try:
         n = int(parts[3])
     except ValueError:
         n = 0
     if not 2 <= n <= MAX_AXIS_VALUES:
-        raise UsageError(f"grid {text!r}: N = {parts[3]!r} must be a whole number from 2 "
+        raise UsageError(f"grid {_show(text)}: N = {_show(parts[3])} must be a whole number from 2 "
                          f"to {MAX_AXIS_VALUES}", param="grid")
     if a == b:
-        raise UsageError(f"grid {text!r}: A and B must differ", param="grid")
+        raise UsageError(f"grid {_show(text)}: A and B must differ", param="grid")
     if kind == "log":
         if a <= 0 or b <= 0:
-            raise UsageError(f"grid {text!r}: log spacing needs A > 0 and B > 0", param="grid")
+            raise UsageError(f"grid {_show(text)}: log spacing needs A > 0 and B > 0", param="grid")
         return tuple(float(v) for v in np.geomspace(a, b, n))
     return tuple(float(v) for v in np.linspace(a, b, n))
 
@@ -143,12 +151,12 @@ def _listed_values(text: str, spec: str, form: str) -> tuple[Any, ...]:
     """The values of ``spec`` = ``V1,V2,...`` of the grid item ``text``, each once."""
     items = [s for s in spec.split(",")]
     if any(not s.strip() for s in items):
-        raise UsageError(f"grid {text!r}: an empty value in the list; must be {form}", param="grid")
+        raise UsageError(f"grid {_show(text)}: an empty value in the list; must be {form}", param="grid")
     if len(items) > MAX_AXIS_VALUES:
-        raise UsageError(f"grid {text!r}: at most {MAX_AXIS_VALUES} values", param="grid")
+        raise UsageError(f"grid {_show(text)}: at most {MAX_AXIS_VALUES} values", param="grid")
     values = tuple(_list_value(s) for s in items)
     if len(set(map(repr, values))) != len(values):
-        raise UsageError(f"grid {text!r}: a value is listed twice", param="grid")
+        raise UsageError(f"grid {_show(text)}: a value is listed twice", param="grid")
     return values
 
 
@@ -165,7 +173,7 @@ def check_axes(axes: Sequence[Axis]) -> None:
         raise UsageError(f"grid: give one or two axes (got {len(axes)}), e.g. "
                          "k=log:1e2:1e7:50 dt=log:1e-6:1e-2:50", param="grid")
     if len(axes) == 2 and axes[0].key == axes[1].key:
-        raise UsageError(f"grid: {axes[0].text!r} and {axes[1].text!r} sweep the same key "
+        raise UsageError(f"grid: {_show(axes[0].text)} and {_show(axes[1].text)} sweep the same key "
                          f"{axes[0].key}", param="grid")
     if math.prod(len(a.values) for a in axes) > MAX_POINTS:
         raise UsageError(f"grid: {math.prod(len(a.values) for a in axes)} points; a sweep "
@@ -200,7 +208,7 @@ def _plan(scene: Scene, axes: Sequence[Axis], cls: type[Solver], t_end: float | 
     points, total = [], 0
     for index, combo in enumerate(itertools.product(*(a.values for a in axes))):
         values = {**fixed, **{a.key: v for a, v in zip(axes, combo, strict=True)}}
-        where = ", ".join(f"{a.key} = {v!r}" for a, v in zip(axes, combo, strict=True))
+        where = ", ".join(f"{a.key} = {_show(v)}" for a, v in zip(axes, combo, strict=True))
         try:
             point_scene = scene.with_values(values)
         except DumbbellError as exc:

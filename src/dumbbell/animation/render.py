@@ -74,7 +74,9 @@ def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, i
     try:
         return parse_size(size)
     except ValueError:
-        raise UsageError(f"{where}: {size!r}: {SIZE_RULE}",
+        from ..model import args
+
+        raise UsageError(f"{where}: {args.show(size)}: {SIZE_RULE}",
                          param=where.lstrip("-") if isinstance(where, str) else None) from None
 
 

@@ -3,8 +3,9 @@ cursor (time ticks and labels move with it; faint lines mark the impacts, and a 
 particle's colour along the strip's foot the time it rests or rolls on the floor), on the
 energy panel's fixed scale.
 
-The curves of the whole animation are drawn once on a long 'tape'; a frame pastes the window
-it shows, its time labels and the cursor.
+The curves of the whole animation lie on a long 'tape', drawn in pieces as the frames reach
+them (only the pieces under the current window are kept, so memory does not grow with the
+run's length); a frame pastes the window it shows, its time labels and the cursor.
 """
 
 from __future__ import annotations
@@ -46,9 +47,9 @@ IMPACT = (216, 216, 216)   # the impacts' faint lines
 PAD = 4          # between the strip's frame and the highest and lowest energy
 TICK = 3         # length of a time tick under the strip (at least 2 px)
 LABEL_GAP = 4    # between the strip and its tick labels
-IMPACT_TICK = 4  # an impact's tick at the foot of the strip
 CONTACT_BAR = 1  # height of a lasting contact's bar at the foot (B lowest, A above it), below
 #                  the zero line of the curves (PAD above the foot, LINE wide)
+IMPACT_TICK = 4  # an impact's tick at the foot of the strip
 LINE = 2         # width of the curves (at least 1 px)
 CURSOR = 1.5     # width of the cursor (at least 1 px)
 LABEL_OVERHANG = 3  # time labels may start this far left of the strip's frame
@@ -122,87 +123,12 @@ class Strip:
         d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), "t (s)", font=fs,
                fill=GREY, anchor="rt")
 
-    def tape(self, frames: Frames, names: Sequence[str]) -> Image.Image:
-        """The energy time series ``names`` of the whole animation on one long palette image
-        at the strip's time scale (grid, bottom edge, time and impact ticks included); each
-        frame pastes the window it shows. Drawn in pieces so long runs need little memory.
+    def tape(self, frames: Frames, names: Sequence[str]) -> Tape:
+        """The energy time series ``names`` of the whole animation as a :class:`Tape` at the
+        strip's time scale, from which each frame crops the window it shows."""
+        return Tape(self, frames, names)
 
-        Drawn without supersampling, unlike the rest: the strip scrolls, so its every line
-        pixel is encoded again in every frame, and smooth edges make those pixels cost ~60 %
-        more bytes (the textbook GIF would exceed 2 MB)."""
-        fr, u, S = frames, self.u, 1
-        p, h = self.px_per_s, self.tape_h
-        tape = Image.new("P", (self.tape_w, h))
-        y_of = [(self.y(v) - self.tape_y) * S for v in self.scale.ticks()]
-        edge = (self.box[3] - self.tape_y) * S
-        ticks = [k * self.t_step for k in range(math.floor(fr.t_end / self.t_step + 1e-9) + 1)]
-        impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
-        bar = max(1, round(CONTACT_BAR * u)) * S
-        contacts = [(edge - (1 if body == "B" else 2) * bar, TERM_RGB[body], t0,
-                     min(t1, fr.t_end)) for body, t0, t1 in fr.contacts if t0 <= fr.t_end]
-        # Fast terms as pale bands, the others as lines; E on top.
-        order = [n for n in names if n != "E"] + ["E"]
-        t = fr.series_t
-        cols_all = np.floor(t * p * S).astype(np.int64)
-        series, band = {}, {}
-        for name in order:
-            ys = (self.y(fr.series[name]) - self.tape_y) * S
-            ok = np.isfinite(ys)
-            if ok.sum() < 2:
-                continue
-            c, y = cols_all[ok], ys[ok]
-            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-            series[name] = (t[ok], c, y)
-            band[name] = bool(np.median(np.maximum.reduceat(y, starts)
-                                        - np.minimum.reduceat(y, starts)) > BAND_PX * S)
-        width = max(1, round(LINE * u))
-        for c0 in range(0, self.tape_w, TAPE_CHUNK):
-            c1 = min(self.tape_w, c0 + TAPE_CHUNK)
-            img = Image.new("RGB", ((c1 - c0) * S, h * S), WHITE)
-            d = ImageDraw.Draw(img)
-            for y in y_of:
-                d.line([(0, y), ((c1 - c0) * S, y)], fill=GRID, width=S)
-            d.rectangle([0, edge, (c1 - c0) * S, edge + S - 1], fill=LIGHT)
-            for ti in ticks:
-                x = (ti * p - c0) * S
-                if -S <= x <= (c1 - c0 + 1) * S:
-                    d.line([(x, edge), (x, edge + (self.tick_len + 1) * S)], fill=GREY, width=S)
-            for ti in impacts:  # a faint line through the strip, a tick at its foot
-                x = (ti * p - c0) * S
-                if -S <= x <= (c1 - c0 + 1) * S:
-                    d.line([(x, 0), (x, edge)], fill=IMPACT, width=S)
-                    d.line([(x, edge - IMPACT_TICK * u * S), (x, edge)], fill=GREY, width=S)
-            lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
-            lines = []
-            for name, (ts, c, y) in series.items():
-                i0 = max(0, int(np.searchsorted(ts, lo_t)) - 1)
-                i1 = min(len(ts), int(np.searchsorted(ts, hi_t, side="right")) + 1)
-                if i1 - i0 < 2:
-                    continue
-                cc, yy = c[i0:i1] - c0 * S, y[i0:i1]
-                if band[name]:
-                    starts = np.flatnonzero(np.r_[True, cc[1:] != cc[:-1]])
-                    top = np.minimum.reduceat(yy, starts)
-                    bot = np.maximum.reduceat(yy, starts)
-                    mask = Image.new("L", img.size, 0)
-                    dm = ImageDraw.Draw(mask)
-                    for x, a, b in zip(cc[starts].tolist(), top.tolist(), bot.tolist(),
-                                       strict=True):
-                        dm.line([(x, a), (x, b)], fill=255, width=1)
-                    img.paste(blend(TERM_RGB.get(name, GREY), BAND_ALPHA), (0, 0), mask)
-                else:
-                    xs = (ts[i0:i1] * p - c0) * S
-                    lines.append((name, list(zip(xs.tolist(), yy.tolist(), strict=True))))
-            for name, pts in lines:
-                d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
-            for y, colour, t0, t1 in contacts:  # resting or rolling on the floor: a bar
-                x0, x1 = (t0 * p - c0) * S, (t1 * p - c0) * S
-                if x1 >= -S and x0 <= (c1 - c0 + 1) * S:
-                    d.rectangle([x0, y, x1, y + bar - 1], fill=colour)
-            tape.paste(to_palette(img), (c0, 0))
-        return tape
-
-    def draw(self, img: Image.Image, t: float, tape: Image.Image,
+    def draw(self, img: Image.Image, t: float, tape: Tape,
              patch: Callable[[tuple[int, int, int, int]], Patch], stamps: Stamps) -> None:
         """The window of ``tape`` a frame at ``t`` (s) shows, its time labels (on a crop from
         ``patch``, reaching to the frame's right edge) and the cursor."""
@@ -227,3 +153,109 @@ class Strip:
         xc = self.inner_x + x - left
         ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=term_inks()["ink"],
                                  width=max(1, round(CURSOR * u)))
+
+
+class Tape:
+    """The energy time series ``names`` of the whole animation on one long palette strip at
+    the ``strip``'s time scale (grid, bottom edge, time and impact ticks included), drawn
+    :data:`TAPE_CHUNK` columns at a time when a frame first needs them: only the pieces
+    under the latest window are kept, so a 600 s animation 4096 px wide needs a few MB, not
+    the 2 GB of the whole tape. Each piece is what the whole tape held in those columns.
+
+    Drawn without supersampling, unlike the rest: the strip scrolls, so its every line
+    pixel is encoded again in every frame, and smooth edges make those pixels cost ~60 %
+    more bytes (the textbook GIF would exceed 2 MB)."""
+
+    def __init__(self, strip: Strip, frames: Frames, names: Sequence[str]):
+        fr, S = frames, 1
+        self.strip, self.width, self.height = strip, strip.tape_w, strip.tape_h
+        p = strip.px_per_s
+        self.grid_y = [(strip.y(v) - strip.tape_y) * S for v in strip.scale.ticks()]
+        self.edge = (strip.box[3] - strip.tape_y) * S
+        self.ticks = [k * strip.t_step
+                      for k in range(math.floor(fr.t_end / strip.t_step + 1e-9) + 1)]
+        self.impacts = [ti for ti in fr.impacts if ti <= fr.t_end]
+        self.bar = max(1, round(CONTACT_BAR * strip.u)) * S
+        self.contacts = [(self.edge - (1 if body == "B" else 2) * self.bar, TERM_RGB[body], t0,
+                          min(t1, fr.t_end)) for body, t0, t1 in fr.contacts if t0 <= fr.t_end]
+        # Fast terms as pale bands, the others as lines; E on top.
+        order = [n for n in names if n != "E"] + ["E"]
+        t = fr.series_t
+        cols_all = np.floor(t * p * S).astype(np.int64)
+        self.series: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.band: dict[str, bool] = {}
+        for name in order:
+            ys = (strip.y(fr.series[name]) - strip.tape_y) * S
+            ok = np.isfinite(ys)
+            if ok.sum() < 2:
+                continue
+            c, y = cols_all[ok], ys[ok]
+            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+            self.series[name] = (t[ok], c, y)
+            self.band[name] = bool(np.median(np.maximum.reduceat(y, starts)
+                                             - np.minimum.reduceat(y, starts)) > BAND_PX * S)
+        self.pieces: dict[int, Image.Image] = {}
+
+    def piece(self, c0: int) -> Image.Image:
+        """Columns ``c0`` to ``c0 + TAPE_CHUNK`` (or the tape's end) as a palette image."""
+        strip, S = self.strip, 1
+        u, p, h, edge = strip.u, strip.px_per_s, self.height, self.edge
+        c1 = min(self.width, c0 + TAPE_CHUNK)
+        img = Image.new("RGB", ((c1 - c0) * S, h * S), WHITE)
+        d = ImageDraw.Draw(img)
+        for y in self.grid_y:
+            d.line([(0, y), ((c1 - c0) * S, y)], fill=GRID, width=S)
+        d.rectangle([0, edge, (c1 - c0) * S, edge + S - 1], fill=LIGHT)
+        for ti in self.ticks:
+            x = (ti * p - c0) * S
+            if -S <= x <= (c1 - c0 + 1) * S:
+                d.line([(x, edge), (x, edge + (strip.tick_len + 1) * S)], fill=GREY, width=S)
+        for ti in self.impacts:  # a faint line through the strip, a tick at its foot
+            x = (ti * p - c0) * S
+            if -S <= x <= (c1 - c0 + 1) * S:
+                d.line([(x, 0), (x, edge)], fill=IMPACT, width=S)
+                d.line([(x, edge - IMPACT_TICK * u * S), (x, edge)], fill=GREY, width=S)
+        lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
+        lines = []
+        for name, (ts, c, y) in self.series.items():
+            i0 = max(0, int(np.searchsorted(ts, lo_t)) - 1)
+            i1 = min(len(ts), int(np.searchsorted(ts, hi_t, side="right")) + 1)
+            if i1 - i0 < 2:
+                continue
+            cc, yy = c[i0:i1] - c0 * S, y[i0:i1]
+            if self.band[name]:
+                starts = np.flatnonzero(np.r_[True, cc[1:] != cc[:-1]])
+                top = np.minimum.reduceat(yy, starts)
+                bot = np.maximum.reduceat(yy, starts)
+                mask = Image.new("L", img.size, 0)
+                dm = ImageDraw.Draw(mask)
+                for x, a, b in zip(cc[starts].tolist(), top.tolist(), bot.tolist(),
+                                   strict=True):
+                    dm.line([(x, a), (x, b)], fill=255, width=1)
+                img.paste(blend(TERM_RGB.get(name, GREY), BAND_ALPHA), (0, 0), mask)
+            else:
+                xs = (ts[i0:i1] * p - c0) * S
+                lines.append((name, list(zip(xs.tolist(), yy.tolist(), strict=True))))
+        width = max(1, round(LINE * u))
+        for name, pts in lines:
+            d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
+        for y, colour, t0, t1 in self.contacts:  # resting or rolling on the floor: a bar
+            x0, x1 = (t0 * p - c0) * S, (t1 * p - c0) * S
+            if x1 >= -S and x0 <= (c1 - c0 + 1) * S:
+                d.rectangle([x0, y, x1, y + self.bar - 1], fill=colour)
+        return to_palette(img)
+
+    def crop(self, box: tuple[int, int, int, int]) -> Image.Image:
+        """The tape's columns ``box[0]`` to ``box[2]`` (rows ``box[1]`` to ``box[3]``), as
+        ``Image.crop`` of the whole tape would give them; the pieces left of ``box[0]`` are
+        dropped (frames move forward)."""
+        left, top, right, bottom = box
+        first = max(0, left) // TAPE_CHUNK * TAPE_CHUNK
+        out = Image.new("P", (right - left, bottom - top))
+        for c0 in range(first, min(right, self.width), TAPE_CHUNK):
+            if c0 not in self.pieces:
+                self.pieces[c0] = self.piece(c0)
+            out.paste(self.pieces[c0], (c0 - left, -top))
+        for c0 in [c for c in self.pieces if c < first]:
+            del self.pieces[c0]
+        return out

@@ -31,10 +31,24 @@ EXIT_USAGE = 2
 EXIT_VERDICT = 3
 
 
+#: Longest run of characters without a space a message may echo (a value, a path): longer
+#: ones keep their start and end around '...'.
+MAX_ECHO = 200
+
+
+def clip(text: str, limit: int = MAX_ECHO) -> str:
+    """``text`` with every word (a run without spaces) longer than ``limit`` characters cut
+    to its first ``limit - 23`` and last 20 around '...': a message echoing a huge value
+    (10,000 tilts, a 5,000-digit number, a 4,000-character path) stays short."""
+    return " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
+                    for w in str(text).split(" "))
+
+
 def one_line(text: str) -> str:
     """``text`` with every character that is not printable (newlines, control characters,
-    line and record separators) escaped, so that a message echoing user input stays one line."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+    line and record separators) escaped, so that a message echoing user input stays one line,
+    and no word longer than :data:`MAX_ECHO` characters (:func:`clip`)."""
+    return clip("".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text)))
 
 
 class Parser(argparse.ArgumentParser):
@@ -192,12 +206,26 @@ def read_scene(path, stdin: bool = True):
         return path
     if path != "-" or not stdin:
         return load_scene(path)
+    if sys.stdin is None:  # started with standard input closed (<&-)
+        raise SceneError(f"{STDIN_SCENE}: standard input is closed, so SCENE - has nothing "
+                         "to read; give the scene file's path instead")
     try:
         data = sys.stdin.buffer.read(MAX_SCENE_BYTES + 1)
     except (OSError, AttributeError, ValueError) as exc:
         raise SceneError(f"{STDIN_SCENE}: cannot read a scene from standard input: "
                          f"{getattr(exc, 'strerror', None) or exc}") from None
     return load_scene_bytes(data, STDIN_SCENE)
+
+
+def plan_outputs(args: argparse.Namespace, paths, flag: str | None = None) -> list:
+    """Before the work: check and reserve every output ``paths`` the command will write
+    (each can be created or replaced, none is an input or another output), else a
+    UsageError naming ``flag`` (default ``--out DIR``) and the file. Returns the paths."""
+    from ..io.files import OutputTransaction
+
+    flag = flag or f"--out {args.out}"
+    transaction = getattr(args, "outputs", None) or OutputTransaction()
+    return transaction.plan(paths, flag)
 
 
 def _check_paths(args: argparse.Namespace, transaction) -> None:
@@ -259,32 +287,61 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status: 0 done, 2 bad
     input, 3 a verdict other than ok, 128+N stopped by signal N (SIGINT 130, SIGTERM 143,
     SIGHUP 129)."""
-    # The command only writes files: matplotlib's file-only backend, unless the user chose one.
-    os.environ.setdefault("MPLBACKEND", "Agg")
     command = "dumbbell"
-    with _stop_signals():
+    state: dict[str, object] = {}
+    with _stop_signals(), _file_backend():
         try:
             parser = build_parser()
             args = parser.parse_args(argv)
             command = f"dumbbell {args.command}"
-            return _run(args, command)
+            return _run(args, command, state)
         except KeyboardInterrupt as exc:
             signum = getattr(exc, "signum", signal.SIGINT)
-            sys.stderr.write(f"{command}: stopped by {signal.Signals(signum).name}; no output "
-                             "was kept\n")
+            kept = getattr(state.get("outputs"), "committed", False)
+            sys.stderr.write(f"{command}: stopped by {signal.Signals(signum).name}; "
+                             + ("its outputs were already written\n" if kept
+                                else "no output was kept\n"))
             return 128 + signum
 
 
-def _run(args: argparse.Namespace, command: str) -> int:
+@contextlib.contextmanager
+def _file_backend() -> Iterator[None]:
+    """The command only writes files: matplotlib's file-only backend (Agg) whatever
+    MPLBACKEND says (a backend that does not exist, or needs a display, would fail); and a
+    private MPLCONFIGDIR when matplotlib's own folders cannot be written (HOME = /). The
+    environment is given back afterwards."""
+    from .._install import matplotlib_folder
+
+    settings = {"MPLBACKEND": "Agg"}
+    folder = matplotlib_folder()
+    if folder is not None:
+        settings["MPLCONFIGDIR"] = folder
+    before = {name: os.environ.get(name) for name in settings}
+    os.environ.update(settings)
+    try:
+        yield
+    finally:
+        for name, value in before.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+
+
+def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> int:
     from ..io.files import output_transaction
+
+    def error(text: str) -> int:
+        sys.stderr.write(one_line(f"{command}: error: {text}") + "\n")
+        return EXIT_USAGE
 
     try:
         with output_transaction() as transaction:
+            state["outputs"] = args.outputs = transaction
             _check_paths(args, transaction)
             return int(args.func(args) or 0)
     except DumbbellError as exc:
-        sys.stderr.write(one_line(f"{command}: error: {as_flags(exc, args)}") + "\n")
-        return EXIT_USAGE
+        return error(as_flags(exc, args))
     except BrokenPipeError:
         # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep
         # Python from complaining again when it flushes stdout at exit.
@@ -292,11 +349,13 @@ def _run(args: argparse.Namespace, command: str) -> int:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except OSError as exc:
-        # Backstop: an output that still cannot be written is one line, not a traceback.
-        where = exc.filename or "an output file"
-        sys.stderr.write(one_line(f"{command}: error: cannot write {where}: "
-                                  f"{exc.strerror or exc}") + "\n")
-        return EXIT_USAGE
+        # Backstop: a file that still cannot be written or read is one line, not a traceback.
+        if exc.filename:
+            return error(f"{exc.filename}: {exc.strerror or exc}; nothing was written")
+        return error(f"{exc.strerror or exc}; nothing was written")
+    except MemoryError:
+        return error("ran out of memory; nothing was written: ask for less (a shorter "
+                     "--t-end, a smaller --size, fewer values) or allow the process more "
+                     "memory")
     except RecursionError:
-        sys.stderr.write(f"{command}: error: an input is nested too deeply\n")
-        return EXIT_USAGE
+        return error("an input is nested too deeply")

@@ -66,14 +66,17 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..analysis.bench import BenchOptions, run_bench
     from ..io.bench import write_all
+    from .app import plan_outputs
 
     scene = read_scene(args.scene, stdin=False)
+    stem = Path(args.out) / f"bench-{scene.name}"
+    plan_outputs(args, [Path(f"{stem}{end}") for end in (
+        ".csv", ".json", ".md", "-work-precision.png", "-convergence.png")])
     result = run_bench(scene, options(BenchOptions, args, spacing="sample_spacing"))
     written = write_all(result, Path(args.out))
     from ..io.figures import save_figure
     from ..plot.bench import convergence, work_precision
 
-    stem = Path(args.out) / f"bench-{result.scene}"
     # The figures keep their own resolution ("figure": the dpi they were made with).
     written += [save_figure(work_precision(result).figure, f"{stem}-work-precision.png",
                             dpi="figure"),

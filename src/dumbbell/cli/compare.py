@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float, read_scene
+from .app import _shown, add_out, add_quiet, positive_float, read_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -51,8 +51,13 @@ def run(args: argparse.Namespace) -> int:
         solvers = [s.strip() for item in args.solvers for s in item.split(",") if s.strip()]
         unknown = [s for s in solvers if s not in available()]
         if unknown or not solvers:
-            raise UsageError(f"--solvers {' '.join(args.solvers)!r}: must name solvers among "
+            raise UsageError(f"--solvers {_shown(' '.join(args.solvers))}: must name solvers among "
                              + ", ".join(available()))
+    from .app import plan_outputs
+
+    stem = Path(args.out) / f"{scene.name}-compare"
+    plan_outputs(args, [Path(f"{stem}{end}") for end in (
+        ".csv", "-impacts.csv", "-errors.csv", "-positions.png", "-error.png", "-energy.png")])
     try:
         result = compare(scene, CompareOptions(solvers, args.dt, args.window, args.t_end,
                                                args.quiet))
@@ -66,7 +71,6 @@ def run(args: argparse.Namespace) -> int:
     from .. import plot
     from ..io.figures import save_figure
 
-    stem = Path(args.out) / f"{scene.name}-compare"
     for name, draw in (("positions", plot.compare_positions), ("error", plot.compare),
                        ("energy", plot.compare_energy)):
         paths.append(save_figure(draw(result).figure, f"{stem}-{name}.png"))

@@ -7,7 +7,15 @@ import sys
 from pathlib import Path
 
 from ..animation.render import MAX_FRAMES
-from .app import DEFAULT_OUT, EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
+from .app import (
+    DEFAULT_OUT,
+    EXIT_VERDICT,
+    _shown,
+    add_quiet,
+    positive_float,
+    positive_int,
+    read_scene,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -51,7 +59,7 @@ def _whole(text: str) -> int:
     try:
         return int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be a whole number") from None
+        raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a whole number") from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -71,6 +79,10 @@ def run(args: argparse.Namespace) -> int:
         from ..errors import UsageError
 
         raise UsageError(f"-o {out}: must end in .gif")
+    from .app import plan_outputs
+
+    if not args.output:  # -o itself was checked with the other flags
+        plan_outputs(args, [out], "the default -o")
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")

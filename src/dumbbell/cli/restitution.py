@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from .app import add_out, add_quiet, positive_float, read_scene
+from .app import _shown, add_out, add_quiet, positive_float, read_scene
 
 #: Largest number of tilts in one call: each costs several runs.
 MAX_TILTS = 91
@@ -16,7 +16,7 @@ MAX_TILTS = 91
 def tilt_range(text: str) -> list[float]:
     """An argparse type: START:STOP:N (N tilts in degrees from START to STOP inclusive) or a
     list A,B,C; every tilt in [0, 90) degrees."""
-    message = (f"{text!r}: must be START:STOP:N or a list A,B,...: degrees in [0, 90), with "
+    message = (f"{_shown(text)}: must be START:STOP:N or a list A,B,...: degrees in [0, 90), with "
                f"START <= STOP and N a whole number from 1 to {MAX_TILTS} (N = 1 needs "
                "START = STOP)")
     try:
@@ -48,7 +48,7 @@ def restitution_coefficient(text: str) -> float:
     except ValueError:
         value = math.nan
     if not 0 <= value <= 1:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be a number from 0 to 1")
+        raise argparse.ArgumentTypeError(f"{_shown(text)}: must be a number from 0 to 1")
     return value
 
 
@@ -82,7 +82,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "20000)")
     add_out(p, "the CSV and PNG")
     add_quiet(p)
-    p.set_defaults(func=run)
+    # The library's thetas and stiffnesses are --theta and --stiffness here.
+    p.set_defaults(func=run, names={"thetas": "--theta", "stiffnesses": "--stiffness"})
 
 
 def run(args: argparse.Namespace) -> int:
@@ -95,13 +96,16 @@ def run(args: argparse.Namespace) -> int:
     scene = read_scene(args.scene, stdin=False)
     if args.elasticity is not None and scene.system.floor is not None:
         scene = scene.with_values({"floor.elasticity": args.elasticity})
+    from .app import plan_outputs
+
+    out = Path(args.out)
+    csv, png = plan_outputs(args, [out / f"{scene.name}-restitution.csv",
+                                   out / f"{scene.name}-restitution.png"])
     runs = len(args.theta) * (1 + len(args.stiffness))
     with bar(runs, "restitution", unit="run", quiet=args.quiet) as progress:
         result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
                              progress=progress.update)
-    out = Path(args.out)
-    csv = write_csv(result, out / f"{scene.name}-restitution.csv")
-    png = out / f"{scene.name}-restitution.png"
+    write_csv(result, csv)
     fig = draw(result)[0].figure
     fig.tight_layout()
     save_figure(fig, png)

@@ -63,6 +63,9 @@ def run(args: argparse.Namespace) -> int:
     if args.all:
         return run_pieces(Path(args.out), quiet=args.quiet, max_samples=args.max_samples,
                           max_frames=args.max_frames)
+    from .app import plan_outputs
+
+    plan_outputs(args, list(outputs(scenes[0], Path(args.out)).values()))
     return run_scene(scenes[0], Path(args.out), quiet=args.quiet,
                      max_samples=args.max_samples, max_frames=args.max_frames)
 
@@ -101,6 +104,19 @@ def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = Fa
                                  "fps": "outputs.gif.fps"}) from None
 
 
+def outputs(scene, out: Path) -> dict[str, Path]:
+    """Every file :func:`run_scene` writes for ``scene`` in ``out``, by what it is: each
+    figure's name, 'csv', 'impacts', 'gif'."""
+    names = {name: out / f"{scene.name}-{name}.png" for name in scene.outputs.figures}
+    if scene.outputs.csv:
+        names["csv"] = out / f"{scene.name}.csv"
+        if scene.system.floor is not None:
+            names["impacts"] = out / f"{scene.name}-impacts.csv"
+    if scene.outputs.gif is not None:
+        names["gif"] = out / f"{scene.name}.gif"
+    return names
+
+
 def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMPLES,
               max_frames: int = MAX_FRAMES) -> int:
     """Make every output ``scene`` asks for in ``out``, refusing a run that would keep more
@@ -110,19 +126,20 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     from .app import EXIT_VERDICT
 
     traj = simulate(scene, quiet=quiet, max_samples=max_samples)
+    names = outputs(scene, out)
     written: list[Path] = []
     if scene.outputs.figures:
         from ..io.figures import save_figure
 
         for name in scene.outputs.figures:
             ax = _figure(name, traj)
-            written.append(save_figure(ax.figure, out / f"{scene.name}-{name}.png"))
+            written.append(save_figure(ax.figure, names[name]))
     if scene.outputs.csv:
         from ..io.trajectory import write_csv, write_events
 
-        written.append(write_csv(traj, out / f"{scene.name}.csv"))
-        if scene.system.floor is not None:
-            written.append(write_events(traj, out / f"{scene.name}-impacts.csv"))
+        written.append(write_csv(traj, names["csv"]))
+        if "impacts" in names:
+            written.append(write_events(traj, names["impacts"]))
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
         from .render import gif_trajectory
@@ -130,7 +147,7 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
         gif = scene.outputs.gif
         # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
         drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
-        written.append(render_gif(drawn, out / f"{scene.name}.gif", quiet=quiet, fps=gif.fps,
+        written.append(render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps,
                                   size=gif.size, strip=gif.strip, t_end=gif.t_end,
                                   max_frames=max_frames))
     if not quiet:

@@ -112,7 +112,14 @@ def run_pieces(out: Path, quiet: bool = False, max_samples: int | None = None,
     """Run every piece into ``out``; returns the worst exit status. Every piece's command
     line and scene are read before the first one runs. ``max_samples`` and ``max_frames``
     are the budgets of the ``run`` pieces (their defaults when None)."""
+    from ..io.files import check_writable
+
     pieces = [(piece, parse(piece, out, quiet)) for piece in PIECES]
+    # Every showcase file can be written, before the first piece runs (each piece then
+    # checks and reserves all of its own outputs, as its command does).
+    for piece in PIECES:
+        for name in piece.writes:
+            check_writable(out / name, f"--out {out}:", within=True)
     status = 0
     for piece, args in pieces:
         if piece.argv[0] == "run":

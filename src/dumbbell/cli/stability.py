@@ -36,13 +36,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def report(options: StabilityOptions, out: str | Path, note: str | None = None
+def report(options: StabilityOptions, out: str | Path, note: str | None = None,
+           args: argparse.Namespace | None = None
            ) -> dict[str, Any]:
     """Run the catalogue and the map; write OUT/stability.md, .csv and stability-map.png.
     Everything is validated before anything runs, and only then is ``note`` (a line about
     the workers) printed, so that a refusal stays one line. Returns rows, paths and skipped
     runs."""
-    from ..analysis.stability import StabilityResult, guard_lines, plan_runs, run_cases
+    from ..analysis.stability import (
+        StabilityResult,
+        guard_lines,
+        map_solvers,
+        plan_runs,
+        run_cases,
+    )
     from ..errors import UsageError
     from ..io.stability import write
 
@@ -51,6 +58,12 @@ def report(options: StabilityOptions, out: str | Path, note: str | None = None
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a folder")
+    from .app import plan_outputs
+
+    steppers = map_solvers(options.solvers)
+    plan_outputs(args or argparse.Namespace(out=out),
+                 [out / "stability.md", out / "stability.csv"]
+                 + ([out / "stability-map.png"] if steppers else []))
     if note:
         sys.stderr.write(f"dumbbell stability: {note}\n")
     result = StabilityResult(tuple(run_cases(runs, workers, quiet)), tuple(skipped),
@@ -83,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
 
     # Jobs are many (cases x solvers); the CPUs are the cap that binds.
     note = cap_note("--workers", args.workers, 1 << 30)
-    result = report(options(StabilityOptions, args), args.out, note)
+    result = report(options(StabilityOptions, args), args.out, note, args)
     if not args.quiet:
         rows = result["rows"]
         bad = sum(not r.agrees for r in rows)

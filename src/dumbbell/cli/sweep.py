@@ -75,6 +75,10 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {args.out}: exists and is not a folder")
     points = plan(scene, axes, solver, args.t_end)
+    from .app import plan_outputs
+
+    csv_path, png_path = plan_outputs(args, [out / f"{scene.name}-sweep.csv",
+                                             out / f"{scene.name}-sweep.png"])
     note = cap_note("--workers", args.workers, len(points), "grid points")
     if note:
         sys.stderr.write(f"dumbbell sweep: {note}\n")
@@ -84,10 +88,10 @@ def run(args: argparse.Namespace) -> int:
     from ..io.figures import save_figure
     from ..io.sweep import write_csv
 
-    csv_path = write_csv(result, out / f"{scene.name}-sweep.csv")
+    write_csv(result, csv_path)
     from ..plot.maps import sweep_map
 
-    png_path = save_figure(sweep_map(result).figure, out / f"{scene.name}-sweep.png", dpi=100)
+    save_figure(sweep_map(result).figure, png_path, dpi=100)
     if not args.quiet:
         counts = ", ".join(f"{n} {v}" for v, n in sorted(result.counts().items()))
         sys.stderr.write(f"{len(result.rows)} runs ({counts}) in {result.wall_time:.2f} s on "

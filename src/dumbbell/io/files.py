@@ -5,16 +5,31 @@ name as a hidden ``.part`` file and renamed into place; a device, a FIFO (or any
 is not a regular file) is written directly, because a rename would replace it.
 
 Inside :func:`output_transaction` (the command line opens one around each command) the renames
-wait until the whole command has succeeded: a failure or a signal then leaves nothing behind,
-not even the outputs that were already complete, and no output may land on an input or on
-another output of the same command.
+wait until the whole command has succeeded, and then happen together: every output is the new
+file, or (when one rename fails) every output is what was there before. A failure or a signal
+before that leaves nothing behind, not even the outputs that were already complete, and no
+output may land on an input or on another output of the same command. Before any work, the
+command checks every name it will write (:func:`check_writable`, :meth:`OutputTransaction.plan`).
+
+No temporary file outlives its process: each is registered while it exists and removed at
+interpreter exit (``atexit``), and a stop signal whose action is the default one (SIGTERM,
+SIGHUP, SIGINT set to ``SIG_DFL``: the process would die without running any Python code) is
+given, while a temporary file exists, a handler that removes them, puts the default action
+back and sends the signal again, so that the process still ends by that signal. A handler of
+the program's own is left alone (an exception it raises removes the files on its way out, as
+any exception does), and an ignored signal stays ignored. Not covered: SIGKILL and
+``os._exit``, which run no code at all.
 """
 
 from __future__ import annotations
 
+import atexit
 import os
+import secrets
+import signal
 import stat
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -67,6 +82,96 @@ def _under_system(path: Path) -> bool:
     return False
 
 
+# --- temporary files: registered while they exist, removed at exit or on a stop signal ----
+
+#: Temporary file -> the process that made it (a forked child must not remove its parent's).
+_temporary: dict[str, int] = {}
+_lock = threading.Lock()
+#: Signals given :func:`_remove_and_resend` while temporary files exist.
+_armed: set[int] = set()
+_STOP = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGINT") if hasattr(signal, n))
+
+
+def _remove_temporary() -> None:
+    """Remove every temporary file this process registered (at exit, or on a stop signal)."""
+    with _lock:
+        mine = [p for p, pid in _temporary.items() if pid == os.getpid()]
+        for p in mine:
+            _temporary.pop(p, None)
+    for p in mine:
+        try:
+            os.unlink(p)
+        except OSError:
+            pass
+
+
+atexit.register(_remove_temporary)
+
+
+def _remove_and_resend(signum: int, frame: object) -> None:
+    """A stop signal with the default action: remove the temporary files, then die by it."""
+    _remove_temporary()
+    signal.signal(signum, signal.SIG_DFL)
+    _armed.discard(signum)
+    os.kill(os.getpid(), signum)
+
+
+def _in_main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+def _register(path: Path) -> None:
+    with _lock:
+        _temporary[str(path)] = os.getpid()
+    if not _in_main_thread():
+        return
+    for signum in _STOP:
+        if signum not in _armed and signal.getsignal(signum) is signal.SIG_DFL:
+            signal.signal(signum, _remove_and_resend)
+            _armed.add(signum)
+
+
+def _forget(path: Path) -> None:
+    with _lock:
+        _temporary.pop(str(path), None)
+        left = any(pid == os.getpid() for pid in _temporary.values())
+    if left or not _in_main_thread():
+        return
+    for signum in list(_armed):
+        if signal.getsignal(signum) is _remove_and_resend:  # still ours: give it back
+            signal.signal(signum, signal.SIG_DFL)
+        _armed.discard(signum)
+
+
+def _unlink(path: Path) -> None:
+    """Remove the temporary file ``path`` (if still there) and forget it."""
+    try:
+        path.unlink(missing_ok=True)
+    except OSError:
+        pass
+    _forget(path)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold the stop signals back for a block of renames (main thread), so that they all
+    happen or none; a signal that arrives meanwhile is delivered right after."""
+    held = _in_main_thread() and hasattr(signal, "pthread_sigmask")
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP) if held else None
+    try:
+        yield
+    finally:
+        if held:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+# --- the transaction ------------------------------------------------------------------------
+
+
+class CommitError(OSError):
+    """A rename of the commit failed; every output is back to what it was before."""
+
+
 class OutputTransaction:
     """The outputs of one command: claimed names, finished ``.part`` files waiting for their
     rename, folders created on the way (removed again if the command fails)."""
@@ -75,8 +180,14 @@ class OutputTransaction:
         #: real path -> how the user named it ("the scene x.toml", "-o x.csv").
         self.inputs = {_key(Path(p)): what for p, what in _inputs(inputs)}
         self.claimed: dict[str, str] = {}
-        self.pending: list[tuple[Path, Path]] = []
+        #: Real paths of the outputs checked before the work (:meth:`plan`, claimed flags).
+        self.planned: set[str] = set()
+        #: Outputs written that were not planned (a command that forgot one: a test finds it).
+        self.unplanned: list[Path] = []
+        #: (finished temporary file, final path, the name the user gave): renamed at commit.
+        self.pending: list[tuple[Path, Path, str]] = []
         self.created: list[Path] = []
+        self.committed = False
 
     def _same(self, key: str, among: dict[str, str]) -> str | None:
         """How ``among`` names the file ``key`` (same real path, or same inode), or None."""
@@ -106,19 +217,70 @@ class OutputTransaction:
             raise UsageError(f"{label}: is the same file as {clash}; give another name")
         if what:
             self.claimed[key] = what
+            self.planned.add(key)
+        elif key not in self.planned and not is_special(path) and not _under_system(path):
+            self.unplanned.append(path)
+
+    def plan(self, paths: Iterable[str | Path], flag: str) -> list[Path]:
+        """Before the work: check every output name a command will write (each can be
+        created or replaced, :func:`check_writable`) and reserve it, refusing one that is an
+        input or another output. ``flag`` is how the user set them (``'--out r'``): a
+        refusal names it, then the file. Returns the paths."""
+        from ..model import args
+
+        flag = args.text(flag, "flag", "how the user set these outputs (str), e.g. '--out r'")
+        if isinstance(paths, str | bytes | os.PathLike) or not isinstance(paths, Iterable):
+            raise UsageError(f"paths = {args.show(paths)}: must be a list of paths",
+                             param="paths")
+        out = [args.path(p, "paths") for p in paths]
+        for path in out:
+            check_writable(path, f"{flag}:", within=True)
+            self.claim(path, f"{flag}: {path}")
+        return out
 
     def commit(self) -> None:
-        """Rename every finished output into place."""
-        while self.pending:
-            tmp, path = self.pending.pop(0)
-            os.replace(tmp, path)
-        self.created.clear()
+        """Rename every finished output into place, all or none: each existing file is first
+        linked (or, where links are not allowed, renamed) to a hidden backup beside it; if a
+        rename fails, every earlier one is undone from its backup and the error (a
+        :class:`CommitError` naming the output as the user gave it) is raised; else the
+        backups are removed. The stop signals wait until it is over."""
+        with _signals_held():
+            done: list[tuple[Path, Path | None]] = []
+            try:
+                for tmp, path, shown in self.pending:
+                    try:
+                        done.append((path, _replace(tmp, path)))
+                    except OSError as exc:
+                        raise CommitError(exc.errno, exc.strerror or str(exc), shown) from None
+            except BaseException:
+                self._undo(done)
+                raise
+            for tmp, _, _ in self.pending:
+                _forget(tmp)
+            self.pending.clear()
+            for _, backup in done:
+                if backup is not None:
+                    _unlink(backup)
+            self.created.clear()
+            self.committed = True
+
+    def _undo(self, done: list[tuple[Path, Path | None]]) -> None:
+        """Put back what was there before each rename of ``done`` (newest first)."""
+        for path, backup in reversed(done):
+            try:
+                if backup is None:
+                    path.unlink(missing_ok=True)
+                else:
+                    os.replace(backup, path)
+                    _forget(backup)
+            except OSError:
+                pass  # the backup stays (registered), so at least the old content exists
 
     def rollback(self) -> None:
         """Remove every unfinished or uncommitted ``.part`` file and the folders made for
         them (only if empty)."""
-        for tmp, _ in self.pending:
-            tmp.unlink(missing_ok=True)
+        for tmp, _, _ in self.pending:
+            _unlink(tmp)
         self.pending.clear()
         for folder in reversed(self.created):
             try:
@@ -128,15 +290,46 @@ class OutputTransaction:
         self.created.clear()
 
 
+def _replace(tmp: Path, path: Path) -> Path | None:
+    """Rename ``tmp`` onto ``path``, keeping what was there as a registered hidden backup
+    beside it (returned; None when ``path`` did not exist)."""
+    if not os.path.lexists(path):
+        os.replace(tmp, path)
+        return None
+    backup = path.parent / f".{path.name}.{secrets.token_hex(4)}.old"
+    _register(backup)
+    try:
+        os.link(path, backup)          # path stays in place meanwhile
+        linked = True
+    except OSError:
+        try:
+            os.replace(path, backup)   # no hard links here: move it aside
+        except OSError:
+            _forget(backup)
+            raise
+        linked = False
+    try:
+        os.replace(tmp, path)
+    except OSError:
+        if linked:
+            _unlink(backup)
+        else:
+            os.replace(backup, path)
+            _forget(backup)
+        raise
+    return backup
+
+
 _active: ContextVar[OutputTransaction | None] = ContextVar("dumbbell_outputs", default=None)
 
 
 @contextmanager
 def output_transaction(inputs: Iterable[tuple[str | Path, str]] = ()
                        ) -> Iterator[OutputTransaction]:
-    """Defer every :func:`atomic_output` rename inside the block to its successful end; on
-    any exception (a KeyboardInterrupt or a signal too) remove the outputs instead.
-    ``inputs``: (path, how to name it) pairs that no output may replace."""
+    """Defer every :func:`atomic_output` rename inside the block to its successful end, then
+    make them all or none (:meth:`OutputTransaction.commit`); on any exception (a
+    KeyboardInterrupt or a signal too) remove the outputs instead. ``inputs``: (path, how to
+    name it) pairs that no output may replace."""
     transaction = OutputTransaction(_inputs(inputs))
     token = _active.set(transaction)
     try:
@@ -166,7 +359,8 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     ``path`` only if the block succeeds (and, inside :func:`output_transaction`, only once the
     whole command has); or ``path`` itself when it is a device or a FIFO.
 
-    An interrupted or failed write leaves no half-written file behind, and an error names
+    An interrupted or failed write leaves no half-written file behind (nor does a stop
+    signal or the end of the interpreter: see the module's notes), and an error names
     ``path``, not the temporary file.
 
     >>> with atomic_output("out.csv") as tmp:        # doctest: +SKIP
@@ -175,6 +369,10 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     from ..model import args
 
     path = args.path(path, "path")
+    if "\0" in str(path):
+        raise UsageError(f"path = {args.show(str(path))}: a path cannot hold a NUL character",
+                         param="path")
+    shown = path
     transaction = _active.get()
     if transaction is not None:
         transaction.claim(path)
@@ -198,6 +396,7 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
                                     dir=path.parent)
         os.close(fd)
         tmp = Path(name)
+        _register(tmp)
         yield tmp
         if tmp.exists():
             # mkstemp makes private files; outputs get the usual permissions.
@@ -205,20 +404,97 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
             os.umask(umask)
             os.chmod(tmp, 0o666 & ~umask)
         if transaction is not None:
-            transaction.pending.append((tmp, path))
+            transaction.pending.append((tmp, path, str(shown)))
             deferred = True
         else:
             os.replace(tmp, path)
     except OSError as exc:
-        raise _user_error(exc, path, tmp) from None
+        raise _user_error(exc, shown, tmp) from None
     finally:
-        if tmp is not None and not deferred and tmp.exists():
-            tmp.unlink()
+        if tmp is not None and not deferred:
+            _unlink(tmp)
 
 
-def check_writable(path: str | Path, flag: str, folder: bool = False) -> None:
+def _cwd_gone() -> bool:
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        return True
+    return False
+
+
+def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
+    """Why ``path`` (spelt ``text`` by the user; a folder if ``folder``) could not be
+    created or replaced, or None when it can. ``within``: a name the command chose inside
+    the user's folder, so the way out is another folder, not another name."""
+    if "\0" in text:
+        return "a path cannot hold a NUL character"
+    if not folder and text.endswith(("/", os.sep)):
+        return "ends in '/', so it names a folder; give a file name"
+    if not folder and (path.name in ("", ".", "..") or text.endswith(("/.", "/.."))):
+        return "names a folder; give a file name"
+    if not path.is_absolute() and _cwd_gone():
+        return "the working folder no longer exists; give an absolute path"
+    try:
+        os.stat(path)
+    except FileNotFoundError:
+        if os.path.islink(path):
+            target = os.readlink(path)
+            if folder:
+                return f"is a link to {target}, which does not exist"
+    except OSError as exc:  # a loop of links, a name too long, ...
+        return f"cannot be used ({exc.strerror})"
+    if not folder and os.path.islink(path):
+        path = Path(os.path.realpath(path))  # the file the link names is written
+    if not folder and is_special(path):
+        if not os.access(path, os.W_OK):
+            return "cannot write it (permission denied)"
+        return None
+    if folder and path.exists() and not path.is_dir():
+        return "exists and is not a folder"
+    if not folder and path.is_dir():
+        return ("is a folder, where this command writes a file: remove it or write into "
+                "another folder") if within else "is a folder; give a file name"
+    here = path if folder else path.parent
+    here = here if str(here) else Path(".")
+    while not here.exists() and here != here.parent:
+        if os.path.islink(here):
+            return f"{here} is a link to {os.readlink(here)}, which does not exist"
+        here = here.parent
+    if not here.is_dir():
+        return f"{here} is a file, not a folder"
+    if not os.access(here, os.W_OK | os.X_OK):
+        return f"cannot write in {here} (permission denied)"
+    if not folder and path.exists():
+        return _sticky(path)
+    return None
+
+
+def _sticky(path: Path) -> str | None:
+    """Why the existing file ``path`` cannot be replaced in its sticky folder (another user
+    owns both the folder and the file), or None."""
+    try:
+        folder, own = os.stat(path.parent), os.stat(path)
+    except OSError:
+        return None
+    me = os.geteuid()
+    if folder.st_mode & stat.S_ISVTX and me not in (0, folder.st_uid, own.st_uid):
+        return (f"belongs to another user (uid {own.st_uid}) in the sticky folder "
+                f"{path.parent}, so it cannot be replaced; give another name")
+    return None
+
+
+def check_writable(path: str | Path, flag: str, folder: bool = False, *,
+                   within: bool = False) -> None:
     """Raise UsageError naming ``flag`` unless ``path`` (a folder if ``folder``, else a file)
-    could be created or replaced: called before any work, so nothing is half written."""
+    could be created or replaced: called before any work, so nothing is half written.
+
+    Refused: a NUL character; a file name ending in '/' (a folder); a relative path when the
+    working folder was deleted; a link to nothing (as a folder); a folder given as a file or
+    a file as a folder; a missing folder under a file or a dangling link; a folder without
+    write permission; an existing file another user owns in a sticky folder that is not ours.
+    With ``within``, ``flag`` is a prefix (``'--out r:'``) and the message names ``path``
+    after it."""
     from ..model import args
 
     args.text(flag, "flag", "the flag or argument that names the path (str)")
@@ -226,23 +502,11 @@ def check_writable(path: str | Path, flag: str, folder: bool = False) -> None:
         raise UsageError(f"{flag} = {args.show(path)}: must be a path (str or pathlib.Path)",
                          param="path")
     folder = args.flag(folder, "folder")
-    text = str(path)
-    if "\0" in text:
-        raise UsageError(f"{flag} {text!r}: a path cannot hold a NUL character")
-    path = Path(path)
-    if not folder and is_special(path):
-        if not os.access(path, os.W_OK):
-            raise UsageError(f"{flag} {path}: cannot write it (permission denied)")
-        return
-    if folder and path.exists() and not path.is_dir():
-        raise UsageError(f"{flag} {path}: exists and is not a folder")
-    if not folder and path.is_dir():
-        raise UsageError(f"{flag} {path}: is a folder; give a file name")
-    here = path if folder else path.parent
-    here = here if str(here) else Path(".")
-    while not here.exists() and here != here.parent:
-        here = here.parent
-    if not here.is_dir():
-        raise UsageError(f"{flag} {path}: {here} is a file, not a folder")
-    if not os.access(here, os.W_OK | os.X_OK):
-        raise UsageError(f"{flag} {path}: cannot write in {here} (permission denied)")
+    within = args.flag(within, "within")
+    text = os.fspath(path)
+    if not isinstance(text, str):
+        text = os.fsdecode(text)
+    why = _why_not(Path(text.replace("\0", "")), text, folder, within)
+    if why is not None:
+        shown = args.show(text) if "\0" in text else text
+        raise UsageError(f"{flag} {shown}: {why}")

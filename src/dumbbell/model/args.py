@@ -45,17 +45,28 @@ def _range(unit: str, positive: bool, lo: float | None, hi: float | None) -> str
     return f"a finite number{bounds} ({unit})"
 
 
+def _is_real(value: Any) -> bool:
+    """A real number: ``numbers.Real`` (numpy scalars, Fraction), or another number that is
+    not complex (``decimal.Decimal``, which converts to the nearest float); not a bool."""
+    return not isinstance(value, bool) and (
+        isinstance(value, numbers.Real)
+        or (isinstance(value, numbers.Number) and not isinstance(value, numbers.Complex)))
+
+
 def real(value: Any, name: str, unit: str, positive: bool = True, *, lo: float | None = None,
          hi: float | None = None) -> float:
     """``value`` as a finite float, in ``unit``: > 0 if ``positive``, or between the
-    inclusive bounds ``lo`` and ``hi`` when either is given (``positive`` is then unused)."""
+    inclusive bounds ``lo`` and ``hi`` when either is given (``positive`` is then unused).
+    A Decimal is taken as the float nearest to it."""
     allowed = f"must be {_range(unit, positive, lo, hi)}"
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not _is_real(value):
         raise UsageError(f"{name} = {show(value)}: {allowed}", param=name)
     try:
         number = float(value)
     except (OverflowError, ValueError, TypeError):
         number = math.nan
+    if number == 0 and value != 0:
+        allowed += " (it rounds to 0 as a float)"
     if lo is not None or hi is not None:
         bad = (lo is not None and number < lo) or (hi is not None and number > hi)
     else:
@@ -69,7 +80,7 @@ def reals(values: Any, name: str, unit: str, positive: bool = True, *, lo: float
           hi: float | None = None, empty: bool = False) -> list[float]:
     """``values`` (a list, tuple or 1-d numpy array; one number is a list of one) as a list
     of floats that :func:`real` accepts; an empty list only if ``empty``."""
-    if isinstance(values, numbers.Real) and not isinstance(values, bool):
+    if _is_real(values):
         values = [values]
     elif type(values).__name__ == "ndarray" and getattr(values, "ndim", 0) == 1:
         values = values.tolist()

@@ -175,7 +175,7 @@ def partition_1d(system: System, xA: np.ndarray, vA: np.ndarray, xB: np.ndarray,
 def _loop_1d():
     """The 1D partition as one compiled pass: a million rows cost milliseconds, not the tenths
     of a second that two dozen numpy temporaries do. Compiled on first use only."""
-    from numba import njit
+    from .._install import njit
 
     @njit(cache=True, nogil=True)
     def loop(constants, xA, vA, xB, vB):  # pragma: no cover

@@ -71,7 +71,8 @@ def solver_class(solver: str | type[Solver]) -> type[Solver]:
     name or an ``OdeSolver`` subclass); UsageError naming the choices otherwise."""
     if isinstance(solver, str):
         if solver not in METHODS:
-            raise UsageError(f"solver {solver!r}: must be one of {', '.join(available())}")
+            raise UsageError(f"solver {args.show(solver)}: must be one of "
+                             f"{', '.join(available())}")
         return METHODS[solver]
     return _solver(solver, "solver")
 
@@ -114,7 +115,7 @@ def scene_class(scene: Scene) -> type[Solver]:
     """:func:`scene_solver` of a Scene."""
     name = scene.run.solver
     if name not in METHODS:
-        raise SceneError(f"{scene.source}: run.solver = {name!r}: must be one of "
+        raise SceneError(f"{scene.source}: run.solver = {args.show(name)}: must be one of "
                          f"{', '.join(available())}")
     return METHODS[name]
 

@@ -16,7 +16,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from ..._install import njit
 
 #: Search status codes: the run ended at ``t_end``; a particle came to rest on the floor; the
 #: impact budget or the search's work budget was reached; the root finder failed.

@@ -13,8 +13,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop
+
+from ..._install import njit
 
 _N = _dop.N_STAGES
 _A = np.ascontiguousarray(_dop.A[:_N, :_N])

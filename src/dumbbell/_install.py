@@ -1,0 +1,143 @@
+"""Running from any install, as any user: numba's cache and matplotlib's folders.
+
+numba caches a compiled function beside its source (``__pycache__``) or, when that folder
+cannot be written, under the user's home (``~/.cache``); with neither (a read-only install
+run by a user whose HOME is ``/`` or not writable: the usual ``docker --user`` set-up)
+``njit(cache=True)`` raises ``RuntimeError: cannot cache function ...: no locator available``
+as the module is imported. :func:`njit` here tries numba's own places first, then a private
+folder of this user's in the temporary folder (``dumbbell-numba-UID``, mode 0700, used only
+if it is a real folder this user owns), and only then compiles without a cache. The user is
+told once, in one line on stderr, when the cache is not the usual one and what that costs
+(when the private folder is made, and in every process when nothing can be written). Every
+module that compiles with numba imports ``njit`` from here (``tests/test_hostile.py``
+checks).
+
+matplotlib, in the same set-up, makes a new temporary folder in every process (rebuilding
+its font cache each time) and says so in two lines; :func:`matplotlib_folder` gives the
+command line a private folder (``dumbbell-matplotlib-UID``) to use instead.
+"""
+
+import os
+import stat
+import sys
+import tempfile
+from collections.abc import Callable
+from typing import Any
+
+__all__: list[str] = []
+
+#: Seconds a solver's first run takes to compile its kernels on the 2-core test machine
+#: (0.9 s for exact to 2.2 s for the 2D reference; docs/hardening.md), said when they
+#: cannot be cached.
+COMPILE_SECONDS = "1-2 s"
+#: Set in the environment once the line has been said, so that pool workers stay quiet.
+_SAID = "DUMBBELL_NUMBA_CACHE_NOTE"
+
+_mode: str | None = None  # "numba" (its own places), "private", "none": decided once
+
+
+def _private_folder(kind: str) -> tuple[str, bool] | None:
+    """This user's own folder ``dumbbell-KIND-UID`` in the temporary folder and whether it
+    was just made; None when it cannot be made or is not safely ours (a link, another
+    owner, open to others)."""
+    try:
+        path = os.path.join(tempfile.gettempdir(), f"dumbbell-{kind}-{os.geteuid()}")
+        try:
+            os.mkdir(path, 0o700)
+            made = True
+        except FileExistsError:
+            made = False
+        info = os.lstat(path)
+        if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.geteuid() \
+                or info.st_mode & 0o077:
+            return None
+        tempfile.TemporaryFile(dir=path).close()
+        return path, made
+    except OSError:  # FileNotFoundError too: no usable temporary folder at all
+        return None
+
+
+def _writable(folder: str) -> bool:
+    """Whether ``folder`` exists, or can be made, and can be written."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError:
+        return False
+    return os.access(folder, os.W_OK | os.X_OK)
+
+
+def matplotlib_folder() -> str | None:
+    """A folder for MPLCONFIGDIR when matplotlib's own (``$XDG_CONFIG_HOME/matplotlib`` and
+    ``$XDG_CACHE_HOME/matplotlib``, under HOME by default) cannot be written and
+    MPLCONFIGDIR is not set: this user's private one; else None (matplotlib's own do)."""
+    if os.environ.get("MPLCONFIGDIR"):
+        return None
+    home = os.path.expanduser("~")
+    config = os.environ.get("XDG_CONFIG_HOME") or os.path.join(home, ".config")
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(home, ".cache")
+    if all(_writable(os.path.join(base, "matplotlib")) for base in (config, cache)):
+        return None
+    found = _private_folder("matplotlib")
+    return found[0] if found else None
+
+
+def _say(text: str) -> None:
+    if os.environ.get(_SAID):
+        return
+    os.environ[_SAID] = "1"
+    sys.stderr.write(f"dumbbell: {text}\n")
+
+
+def _cache_error(exc: RuntimeError) -> bool:
+    return "no locator available" in str(exc)
+
+
+def njit(cache: bool = True, **options: Any) -> Callable[[Callable], Any]:
+    """``numba.njit(cache=cache, **options)`` (used as ``@njit(cache=True, nogil=True)``),
+    cached wherever this user can write (see the module's notes); compiled without a cache
+    when nowhere can be written."""
+    import numba
+    from numba.core import config
+
+    def decorate(func: Callable) -> Any:
+        global _mode
+        if not cache:
+            return numba.njit(cache=False, **options)(func)
+        if _mode in (None, "numba"):
+            try:
+                compiled = numba.njit(cache=True, **options)(func)
+                _mode = "numba"
+                return compiled
+            except RuntimeError as exc:
+                if not _cache_error(exc):
+                    raise
+                _mode = None
+        if _mode in (None, "private"):
+            found = _private_folder("numba")
+            if found is not None:
+                folder, made = found
+                before = config.CACHE_DIR
+                config.CACHE_DIR = folder  # read when the locator is made, right here
+                try:
+                    compiled = numba.njit(cache=True, **options)(func)
+                except RuntimeError as exc:
+                    if not _cache_error(exc):
+                        raise
+                else:
+                    if _mode is None and made:
+                        _say(f"numba cannot cache beside the package or in HOME "
+                             f"({os.path.expanduser('~')}): caching the compiled kernels in "
+                             f"{folder}; this first run compiles them, about "
+                             f"{COMPILE_SECONDS} a solver")
+                    _mode = "private"
+                    return compiled
+                finally:
+                    config.CACHE_DIR = before
+        if _mode is None:
+            _say(f"numba cannot cache anywhere (the package's folder, HOME "
+                 f"{os.path.expanduser('~')} and the temporary folder cannot be written): "
+                 f"compiling the kernels in every run, about {COMPILE_SECONDS} a solver")
+        _mode = "none"
+        return numba.njit(cache=False, **options)(func)
+
+    return decorate
