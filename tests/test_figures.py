@@ -78,8 +78,7 @@ def test_run_figures(runs, scene, name):
 @pytest.mark.parametrize("scene", ["textbook-1d", "tilted-2d", "rigid-2d", "topple-2d"] if SHIPPED
                          else ["textbook-1d", "tilted-2d"])
 def test_compare_figures(scene):
-    from dumbbell import plot
-    from dumbbell import compare
+    from dumbbell import compare, plot
 
     s = load_scene(SCENES / f"{scene}.toml")
     result = (compare(s) if SHIPPED

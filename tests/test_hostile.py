@@ -1405,7 +1405,8 @@ def test_restitution_fixes_are_the_ones_that_help(tmp_path, monkeypatch):
 @pytest.mark.parametrize("command,flags,fix", [
     ("compare", ["--dt", *[f"{1e-3 / (1 + i * 1e-4):.10g}" for i in range(600)]], "--dt"),
     ("compare", ["--dt", "1e-9", "2e-9", "--t-end", "10"], "--t-end"),
-    ("compare", ["--solvers", *["pymunk"] * 600, "--dt", "1e-4", "2e-4"], "--solvers"),
+    ("compare", ["--solvers", "pymunk", "euler-cromer", "verlet", "--dt",
+                 *[f"{1e-3 / (1 + i * 1e-4):.10g}" for i in range(400)]], "--solvers"),
     ("bench", ["--dts", *[f"{1e-3 / (1 + i * 1e-4):.10g}" for i in range(600)]], "--dts"),
     # Memory: the runs a result keeps whole, all together, hold at most one run's samples.
     ("compare", ["--dt", "1e-3", "5e-4", "2.5e-4", "--t-end", "2000"], "--t-end"),
@@ -1423,17 +1424,24 @@ def test_steps_times_solvers_are_capped_before_any_run(work, monkeypatch, comman
 
 @pytest.mark.parametrize("many", ["cases", "solvers"])
 def test_stability_caps_cases_times_solvers_before_any_run(tmp_path, monkeypatch, many):
+    # 300 cases x 4 solvers, or 1,001 cases x 1 solver: past the 1,000 runs of the budget.
     cases = tmp_path / "cases"
     cases.mkdir()
-    for i in range(300 if many == "cases" else 2):
-        short_scene(cases, f"c{i:03d}.toml")
-    solvers = ["euler-cromer", "verlet", "pymunk", "exact"] * (1 if many == "cases" else 200)
+    for i in range(300 if many == "solvers" else 1001):
+        short_scene(cases, f"c{i:04d}.toml")
+    solvers = ["euler-cromer", "verlet", "pymunk", "exact"] if many == "solvers" else ["verlet"]
     _stepping_forbidden(monkeypatch)
     status, _, err = cli("stability", "--cases", cases, "--solvers", *solvers,
                          "--out", tmp_path / "o")
     line = refused(status, err)
     assert "runs" in line and "budget" in line and "--cases" in line, line
-    assert "--solvers" in line  # several solvers: fewer of them is a way out
+    # Several solvers: fewer of them is a way out; one solver: it is not.
+    assert ("--solvers" in line) is (many == "solvers")
+
+
+def test_a_solver_named_many_times_runs_once(textbook):
+    result = dumbbell.compare(textbook, solvers=["verlet"] * 600, t_end=0.05)
+    assert [r.label for r in result.rows] == ["verlet"]
 
 
 def test_the_strip_is_drawn_in_pieces_that_match_the_whole_tape():
@@ -1606,8 +1614,6 @@ def test_restitution_on_a_floor_the_truth_cannot_leave_is_refused_up_front(tmp_p
     assert least < 1e-6  # a value the flag takes, and no more than the solver needs
 
 
-@pytest.mark.xfail(reason="one-line reprs of the result types are the front helper's "
-                          "(issue 24); this checks their length", strict=False)
 def test_the_repr_of_a_big_result_is_short():
     from dumbbell.analysis.sweep import Axis, PointResult, SweepResult
 

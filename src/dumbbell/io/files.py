@@ -437,7 +437,7 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
         return "the working folder no longer exists; give an absolute path"
     try:
         os.stat(path)
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # the latter: a file on the way, below
         if os.path.islink(path):
             target = os.readlink(path)
             if folder:

@@ -51,6 +51,7 @@ __all__ = [
     "METHODS",
     "REGISTRY",
     "Kernel",
+    "PymunkSettings",
     "RunOptions",
     "Solver",
     "Stepper",

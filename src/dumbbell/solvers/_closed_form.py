@@ -7,6 +7,7 @@ file level.
 from __future__ import annotations
 
 from ..model.trajectory import Verdict
+from .kernels import REST_SPEED  # noqa: F401 - the stepping kernels end a run at this speed
 
 #: Nothing public: tolerances and a verdict the closed-form solvers share.
 __all__: list[str] = []

@@ -25,7 +25,7 @@ def arbiters() -> Any:
     when it has one, with weight 0 in ``weight_out``; 0 when it has none), its pair's slot
     (the pair key min(uid) * 2**31 + max(uid) looked up in the sorted ``keys``; -1 when
     new), and the sign of the push on its dynamic ends. Returns (lowest contact address, highest, first contacts present)."""
-    from numba import njit
+    from .._install import njit
 
     @njit(cache=True, nogil=True)
     def read(arb, i64, u32, f64, lo, o_contacts, o_body_a, o_body_b, o_count, o_state, o_n,
@@ -105,7 +105,7 @@ def contacts() -> Any:
     impulses into ``imp`` (3, rows), the work of driven ends into ``drive`` (rows), and the
     bias impulse along the normal on the dynamic ends into ``push`` (arbiters). Returns the
     total (J)."""
-    from numba import njit
+    from .._install import njit
 
     @njit(cache=True, nogil=True)
     def work(at, weight2, f64, lo, o_jn, o_jt, o_jb, o_r1, o_r2, j0, has_j0, first, coef, n,

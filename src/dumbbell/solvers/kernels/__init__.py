@@ -58,8 +58,9 @@ class Params(NamedTuple):
 
 class Kernel(NamedTuple):
     """A stepping solver's compiled part. Each function is plain Python that numba compiles
-    (undecorated, or ``numba.njit``; what it calls must be ``numba.njit`` or
-    ``numba.extending.register_jitable``); the driver inlines it into its loop.
+    (undecorated, or compiled by numba's njit; what it calls must be compiled by njit or
+    registered by numba's ``extending.register_jitable``); the driver inlines it into its
+    loop.
 
     ``floor`` names the rule at the floor, which the driver applies or records:
 

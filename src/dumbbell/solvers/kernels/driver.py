@@ -23,11 +23,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..._install import njit
 from numba.cpython.unsafe.tuple import tuple_setitem
 from numba.extending import register_jitable
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
+from ..._install import njit
 from ...errors import UsageError
 from . import BIG, BLOWUP, FLOOR_RULES, MAX_HITS, OK, REST, REST_SPEED, TUNNEL_A, TUNNEL_B, Kernel
 

@@ -16,6 +16,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+
 from ..._install import njit
 
 #: Search status codes: the run ended at ``t_end``; a particle came to rest on the floor; the

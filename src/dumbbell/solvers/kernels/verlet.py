@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 from ..._install import njit
-
 from . import Kernel
 
 
