@@ -67,8 +67,7 @@ if TYPE_CHECKING:
     import pandas
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
-__all__ = ["BenchOptions", "BenchResult", "Fit", "Point", "default_solvers",
-           "default_spacing", "dt_label", "fit_order", "run_bench", "time_for_error"]
+__all__ = ["BenchResult", "Fit", "Point"]
 
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
 #: Default window of the position error (s): the textbook figures' 0-2 s.

@@ -29,9 +29,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .rotation import variant
 
-__all__ = ["Bounce", "RestitutionResult", "bounce", "drop_duration", "e_eff_rigid",
-           "k_rot_share_rigid", "restitution", "rigid_q", "sign_change_deg", "tilted",
-           "truth_for"]
+__all__ = ["Bounce", "RestitutionResult", "bounce", "e_eff_rigid", "restitution"]
 
 #: Impacts closer together than this (s) belong to one cluster.
 CLUSTER_GAP = 0.1

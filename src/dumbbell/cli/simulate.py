@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..solvers import MAX_SAMPLES, MAX_STEPS
+from ..solvers.base import MAX_SAMPLES, MAX_STEPS
 from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
 
 

@@ -37,8 +37,8 @@ from pathlib import Path
 
 from ..errors import UsageError
 
-__all__ = ["OutputTransaction", "atomic_output", "check_writable", "is_special",
-           "output_transaction"]
+#: No public names: the one way every writer of the package writes a file.
+__all__: list[str] = []
 
 
 def _inputs(inputs: object) -> list[tuple[str | Path, str]]:

@@ -29,10 +29,7 @@ from typing import Any
 
 from ..errors import SceneError, UsageError
 
-__all__ = [
-    "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "load_scene_bytes",
-    "packaged_scene", "parse_size", "scene_from_dict", "scenes_dir",
-]
+__all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
 
 #: Figure names ``[outputs] figures`` may list.
 FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")

@@ -22,7 +22,6 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .base import (
     MAX_SAMPLES,
-    MAX_STEPS,
     RunOptions,
     Solver,
     contract_problems,
@@ -33,7 +32,6 @@ from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
 from .exact import Exact
 from .kernels import Kernel
-from .pymunk_settings import PymunkSettings
 from .reference import Reference
 from .stepping import Stepper
 from .verlet import Verlet
@@ -42,28 +40,8 @@ from .verlet import Verlet
 METHODS: dict[str, type[Solver]] = {
     cls.name: cls for cls in (EulerCromer, Exact, Verlet, Pymunk, Reference, EulerCromer2D)
 }
-#: Another name for :data:`METHODS`.
-REGISTRY = METHODS
 
-__all__ = [
-    "MAX_SAMPLES",
-    "MAX_STEPS",
-    "METHODS",
-    "REGISTRY",
-    "Kernel",
-    "PymunkSettings",
-    "RunOptions",
-    "Solver",
-    "Stepper",
-    "available",
-    "make_options",
-    "no_truth_reason",
-    "scene_solver",
-    "simulate",
-    "solver_class",
-    "supported",
-    "truth_solver",
-]
+__all__ = ["METHODS", "Kernel", "RunOptions", "Solver", "Stepper", "available", "simulate"]
 
 
 def solver_class(solver: str | type[Solver]) -> type[Solver]:

@@ -34,7 +34,7 @@ MAX_IMPACTS = 100_000
 MAX_SEARCH_WORK = 10_000_000
 BLOCK_WORK = 10
 
-__all__ = ["MAX_SAMPLES", "MAX_STEPS", "RunOptions", "Solver", "make_options"]
+__all__ = ["RunOptions", "Solver"]
 
 #: Samples :func:`~dumbbell.solvers.simulate` keeps unless told otherwise (``max_samples``,
 #: ``--max-samples``): 5e6 rows of about ten float64 columns are about 400 MB.

@@ -38,7 +38,8 @@ from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget
 from .verdicts import RawRun, conclude
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["Exact"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 NAME = "exact"
 #: The state columns, in the order the sampling kernel writes them.

@@ -39,9 +39,7 @@ from ..model.energy import (
     translational_ke,
 )
 
-__all__ = ["BodyEnergy", "Inventory", "Skipped", "SpaceEnergy", "Spring", "SpringEnergy",
-           "State", "body_label", "constraint_label", "energy", "evaluate", "inventory",
-           "read_state"]
+__all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
 #: Joints that hold no energy and, ideally, do no work.
 _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
@@ -93,41 +91,9 @@ class Inventory:
     notes: tuple[str, ...]
 
 
-def body_label(space: Any, body: Any) -> str:
-    """A body's name in reports: 'body N' by its place in ``space.bodies``, or 'static body'."""
-    from ..model import args
-
-    args.space(space)
-    args.pymunk_object(body, "body", ("Body",))
-    if body is space.static_body:
-        return "static body"
-    for i, other in enumerate(space.bodies):
-        if other is body:
-            return f"body {i}"
-    return "body (not in the space)"
-
-
-def constraint_label(space: Any, constraint: Any) -> str:
-    """A constraint's name in reports: its class and place in ``space.constraints``."""
-    from ..model import args
-
-    args.space(space)
-    args.pymunk_object(constraint, "constraint", ("Constraint",))
-    for i, other in enumerate(space.constraints):
-        if other is constraint:
-            return f"{type(constraint).__name__} {i}"
-    return type(constraint).__name__
-
-
 def inventory(space: Any) -> Inventory:
-    """Take stock of ``space`` (see the module docstring for what is counted and reported)."""
-    from ..model import args
-
-    return _inventory(args.space(space))
-
-
-def _inventory(space: Any) -> Inventory:
-    """:func:`inventory` of a space already checked (the pymunk solver's own)."""
+    """Take stock of a checked ``space`` (see the module docstring for what is counted and
+    reported)."""
     import pymunk
 
     bodies = space.bodies
@@ -347,10 +313,8 @@ def read_state(inv: Inventory) -> State:
     """The present state of the tracked bodies, as one sample: read from pymunk's body
     structs in one pass (the centre of gravity as pymunk holds it), or through pymunk's
     getters on a pymunk build whose structs :mod:`._memory` cannot read."""
-    from ..model import args
     from . import _memory as mem
 
-    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
     if inv.bodies and mem.readable():
         at = mem.addresses(inv.bodies, "_body")
         a = mem.Span.over(at, mem.size("body")).f(
@@ -387,16 +351,6 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
 
     K_int is summed as each body's motion relative to the centre of mass plus its spin
     (Koenig's theorem), which equals K_trans + K_rot - K_cm without the cancellation."""
-    from ..model import args
-
-    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
-    args.instance(st, "st", State, "a State (from read_state(inv))")
-    return _evaluate(inv, st, args.pair(about, "about", "m"))
-
-
-def _evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
-              ) -> dict[str, np.ndarray]:
-    """:func:`evaluate` of checked values."""
     n = inv.dynamic
     m, moment = inv.mass, inv.moment
     gx, gy = inv.gravity
