@@ -113,7 +113,7 @@ def inventory(space: Any) -> Inventory:
     moments = [i for i, kind in zip(moments_all, types, strict=True)
                if kind == pymunk.Body.DYNAMIC]
     dyn_mass = [m for m, kind in zip(masses, types, strict=True) if kind == pymunk.Body.DYNAMIC]
-    skipped = _skipped_bodies(bodies, types, dyn, moments, labels, name)
+    skipped = _skipped_bodies(bodies, types, name) + _skipped_spins(dyn, moments, labels)
 
     def index(body: Any) -> int:
         i = where.get(id(body))
@@ -251,10 +251,9 @@ def refuse_bad_state(labels: list[str], st: State, mass: Any, moment: Any) -> No
                         "with a density)")
 
 
-def _skipped_bodies(bodies: list[Any], types: list[int], dyn: list[Any], moments: list[float],
-                    labels: list[str], name: Callable[[Any], str]) -> list[Skipped]:
-    """The bodies (or parts of their motion) whose energy is not counted: static and
-    kinematic bodies, and the spin of a dynamic body of infinite moment."""
+def _skipped_bodies(bodies: list[Any], types: list[int], name: Callable[[Any], str]
+                    ) -> list[Skipped]:
+    """The bodies whose energy is not counted: static and kinematic bodies."""
     import pymunk
 
     skipped: list[Skipped] = []
@@ -264,11 +263,15 @@ def _skipped_bodies(bodies: list[Any], types: list[int], dyn: list[Any], moments
         elif kind == pymunk.Body.KINEMATIC:
             skipped.append(Skipped(name(b),
                                    "kinematic: moved by the user, its energy is not counted"))
-    for b, moment, label in zip(dyn, moments, labels, strict=True):
-        if math.isinf(moment) and b.angular_velocity != 0.0:
-            skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
-                                          "rad/s: rotational energy left out"))
     return skipped
+
+
+def _skipped_spins(dyn: list[Any], moments: list[float], labels: list[str]) -> list[Skipped]:
+    """The spins not counted: of the dynamic bodies of infinite moment that spin."""
+    return [Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} rad/s: "
+                           "rotational energy left out")
+            for b, moment, label in zip(dyn, moments, labels, strict=True)
+            if math.isinf(moment) and b.angular_velocity != 0.0]
 
 
 def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped:
