@@ -206,7 +206,6 @@ def spring_omega(spring: Any) -> float:
 def shape_size(shape: Any) -> float:
     """The thinnest extent of a shape (length units): a circle's diameter, a segment's
     thickness (2 x radius), a polygon's least width across an edge plus 2 x radius."""
-
     args.pymunk_object(shape, "shape", ("Shape",))
     return float(_shapes([shape], np.zeros(1, dtype=int), np.zeros((1, 2)))[1][0])
 
