@@ -13,6 +13,7 @@ runs.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -159,7 +160,10 @@ def simulate(
     scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)
-    return cls._solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))
+    options = make_options(scene, dt, t_end, every, max_samples)
+    if quiet is not True:
+        options = replace(options, quiet=args.flag(quiet, "quiet"))
+    return cls._solve(scene, options)
 
 
 def runnable(cls: type[Solver], scene: Scene) -> None:
