@@ -125,10 +125,10 @@ def critical_ratio(scene, solver: str, lo: float = 1.5, hi: float = 2.5, steps: 
 def bisected_boundary() -> None:
     """The blow-up boundary by bisection, per solver, k and mass ratio (no floor)."""
     from dumbbell.model.scene import load_scene
-    from dumbbell.solvers import REGISTRY
+    from dumbbell.solvers import METHODS
 
     base = load_scene(ROOT / "scenes" / "extreme" / "stiff-wdt-1.9.toml")
-    solvers = [s for s in ("euler-cromer", "verlet", "pymunk") if s in REGISTRY]
+    solvers = [s for s in ("euler-cromer", "verlet", "pymunk") if s in METHODS]
     print("## Blow-up boundary by bisection (no floor, no gravity, 2000 steps per run)\n")
     print("w*dt at which the verdict turns from ok to unstable. 'growth only': "
           "run.unstable_energy = 1e12, so only a growing solution counts; 'threshold 100': "

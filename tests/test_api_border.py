@@ -16,6 +16,7 @@ import inspect
 import io
 import math
 import pkgutil
+import re
 import sys
 import types
 from collections.abc import Callable
@@ -314,18 +315,6 @@ class Fixtures:
                                self.tmp / "rec.gif", fps=10, size="64x64")
 
     @functools.cached_property
-    def inventory(self) -> Any:
-        from dumbbell.spaces.accounting import inventory
-
-        return inventory(self.space())
-
-    @functools.cached_property
-    def state(self) -> Any:
-        from dumbbell.spaces.accounting import read_state
-
-        return read_state(self.inventory)
-
-    @functools.cached_property
     def space_energy(self) -> Any:
         from dumbbell import spaces
 
@@ -367,72 +356,25 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     # dumbbell.model
     "dumbbell.model.energy.angular_momentum_cm": lambda f: {"scene": f.rigid_2d,
                                                            "state": dict(f.traj_2d.state)},
-    "dumbbell.model.energy.column_unit": lambda f: {"name": "vA"},
-    "dumbbell.model.energy.disc_inertia": lambda f: {"mass": 0.1, "radius": 0.02},
-    "dumbbell.model.energy.energy_columns": lambda f: {"scene": f.scene},
-    "dumbbell.model.energy.energy_scale": lambda f: {"E0": 1.0,
-                                                    "terms_at_start": {"K_cm": 1.0}},
     "dumbbell.model.energy.heat": lambda f: {
         "scene": f.scene, "t": f.traj.t, "state": dict(f.traj.state), "events": f.traj.events},
-    "dumbbell.model.energy.impact_heat": lambda f: {"mass": 0.1, "v_before": -1.0,
-                                                   "v_after": 0.9},
-    "dumbbell.model.energy.momentum_columns": lambda f: {"scene": f.scene_2d},
     "dumbbell.model.energy.partition": lambda f: {
         "scene": f.scene, "t": f.traj.t, "state": dict(f.traj.state), "events": f.traj.events},
-    "dumbbell.model.energy.relative_energy_error": lambda f: {"energy": dict(f.traj.energy)},
-    "dumbbell.model.energy.rigid_moment": lambda f: {"scene": f.rigid_2d},
-    "dumbbell.model.energy.spins": lambda f: {"scene": f.scene_2d},
-    "dumbbell.model.energy.state_columns": lambda f: {"scene": f.scene},
-    "dumbbell.model.scene.Floor": lambda f: {"elasticity": 0.9, "friction": 0.0},
-    "dumbbell.model.scene.GifSettings": lambda f: {"t_end": 1.0, "fps": 25, "size": "64x64",
-                                                   "strip": True},
-    "dumbbell.model.scene.OutputSettings": lambda f: fields(f.scene.outputs),
-    "dumbbell.model.scene.Particle": lambda f: fields(f.scene.system.A),
-    "dumbbell.model.scene.Rigid": lambda f: {"length": 0.3},
-    "dumbbell.model.scene.RunSettings": lambda f: fields(f.scene.run),
-    "dumbbell.model.scene.Spring": lambda f: {"stiffness": 200.0, "rest_length": 0.2},
-    "dumbbell.model.scene.System": lambda f: fields(f.scene.system),
-    "dumbbell.model.scene.load_scene_bytes": lambda f: {"data": f.scene_file.read_bytes(),
-                                                       "source": "x.toml"},
-    "dumbbell.model.scene.packaged_scene": lambda f: {"name": "textbook-1d"},
-    "dumbbell.model.scene.parse_size": lambda f: {"text": "64x64"},
     "dumbbell.model.scene.scene_from_dict": lambda f: {"data": f.scene.to_dict(),
                                                       "source": "x.toml"},
     "dumbbell.model.scene.scenes_dir": lambda f: {},
-    "dumbbell.model.trajectory.read_only": lambda f: {"values": np.zeros(3)},
-    # dumbbell.solvers: the registered classes are found (:func:`_solver_rows`), their modules
+    # dumbbell.solvers: the registered classes' contract methods are found (:func:`_solver_rows`)
     "dumbbell.solvers.kernels.Kernel": lambda f: {
         "step": _module("dumbbell.solvers.kernels.euler_cromer").step,
         "floor": "flip", "start": None, "through_at_radius": False},
     "dumbbell.solvers.stepping.Stepper": lambda f: {},
-    "dumbbell.solvers.pymunk_settings.PymunkSettings": lambda f: fields(f.scene.pymunk),
     "dumbbell.solvers.exact_rigid.first_impact_state": lambda f: {
         "tilt": 30.0, "elasticity": 0.5, "mA": 0.1, "mB": 0.2, "length": 0.2, "height": 1.0,
         "g": 9.8},
-    # dumbbell.parallel, dumbbell.progress
-    "dumbbell.parallel.batches": lambda f: {"n": 10, "workers": 2},
-    "dumbbell.parallel.cap_note": lambda f: {"flag": "--workers", "workers": 4, "jobs": 3,
-                                             "what": "runs"},
-    "dumbbell.parallel.cap_workers": lambda f: {"workers": 2, "jobs": 3},
-    "dumbbell.parallel.Backend": lambda f: {
-        "workers": 1, "scheduler": None, "processes": True, "initializer": None, "initargs": (),
-        "quiet": True, "desc": "", "unit": "run", "connect_timeout": 1.0},
-    "dumbbell.parallel.ordered_map": lambda f: {
-        "func": _arity, "jobs": [(1,), (2, 3)], "backend": None, "shared": 0},
-    "dumbbell.progress.bar": lambda f: {"total": 10, "desc": "d", "unit": "it", "quiet": True},
-    "dumbbell.progress.progress_wanted": lambda f: {"quiet": True},
     "dumbbell.solvers.simulate": lambda f: {
         "scene": f.scene, "solver": "exact", "dt": 1e-2, "t_end": 0.05, "every": 1,
         "quiet": True, "max_samples": 1000},
     "dumbbell.solvers.available": lambda f: {},
-    "dumbbell.solvers.base.make_options": lambda f: {
-        "scene": f.scene, "dt": 1e-3, "t_end": 0.5, "every": 10, "quiet": True,
-        "max_samples": 10_000},
-    "dumbbell.solvers.no_truth_reason": lambda f: {"scene": f.scene_2d},
-    "dumbbell.solvers.scene_solver": lambda f: {"scene": f.scene},
-    "dumbbell.solvers.solver_class": lambda f: {"solver": "verlet"},
-    "dumbbell.solvers.supported": lambda f: {"scene": f.scene_2d},
-    "dumbbell.solvers.truth_solver": lambda f: {"scene": f.rigid_2d},
     "dumbbell.solvers.base.RunOptions": lambda f: {"dt": 1e-3, "t_end": 1.0, "every": 1,
                                                   "quiet": True},
     "dumbbell.solvers.base.Solver": lambda f: {},
@@ -467,179 +409,57 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.analysis.bench.Fit": lambda f: {"solver": "verlet", "order": 2.0,
                                               "log10_c": 1.0, "dts": [1e-3, 1e-4]},
     "dumbbell.analysis.bench.Point": lambda f: fields(f.bench_result.points[0]),
-    "dumbbell.analysis.bench.default_solvers": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.bench.default_spacing": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.bench.dt_label": lambda f: {"dt": 3.2e-6},
-    "dumbbell.analysis.bench.fit_order": lambda f: {"points": f.bench_result.points},
-    "dumbbell.analysis.bench.BenchOptions": lambda f: {
-        "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02, "repeat": 1,
-        "t_end": 0.02, "budget": 10.0, "spacing": None, "quiet": True},
-    "dumbbell.analysis.bench.run_bench": lambda f: {
-        "scene": f.scene, "options": _module("dumbbell.analysis.bench").BenchOptions(
-            solvers=["euler-cromer"], dts=[1e-3], window=0.02, repeat=1, t_end=0.02)},
-    "dumbbell.analysis.bench.time_for_error": lambda f: {
-        "line": [(0.1, 1e-3), (1.0, 1e-5)], "target": 1e-4},
     # dumbbell.analysis.compare
     "dumbbell.analysis.compare.Comparison": lambda f: fields(f.comparison),
     "dumbbell.analysis.compare.Row": lambda f: fields(f.comparison.rows[0]),
-    "dumbbell.analysis.compare.CompareOptions": lambda f: {
-        "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02, "t_end": 0.02,
-        "quiet": True},
-    "dumbbell.analysis.compare.compare": lambda f: {
-        "scene": f.scene, "options": _module("dumbbell.analysis.compare").CompareOptions(
-            ["euler-cromer"], [1e-3], 0.02, 0.02)},
-    "dumbbell.analysis.compare.default_solvers": lambda f: {"scene": f.scene},
     "dumbbell.analysis.compare.Timing": lambda f: {"seconds": 0.01, "warm_up": 0.5, "runs": 3},
-    "dumbbell.analysis.compare.timed_run": lambda f: {"scene": f.scene, "name": "exact"},
-
-    # dumbbell.analysis.contact, extended, metrics
+    # dumbbell.analysis.contact
     "dumbbell.analysis.contact.ContactMomentum": lambda f: fields(f.contact),
     "dumbbell.analysis.contact.about_contact": lambda f: {"traj": f.traj_2d, "index": 0,
                                                          "window": 0.01},
-    "dumbbell.analysis.extended.extended_precision_exact": lambda f: {"traj": f.traj,
-                                                                     "window": 0.3},
-    "dumbbell.analysis.extended.extended_precision_rigid": lambda f: {"traj": f.traj_2d,
-                                                                     "window": 0.3},
-    "dumbbell.analysis.metrics.position_error_series": lambda f: {"run": f.run,
-                                                                 "truth": f.traj},
-    "dumbbell.analysis.metrics.energy_error": lambda f: {"traj": f.run, "truth": f.traj},
-    "dumbbell.analysis.metrics.impact_time_error": lambda f: {"traj": f.run, "truth": f.traj,
-                                                             "window": 0.3},
-    "dumbbell.analysis.metrics.position_error": lambda f: {"run": f.run, "truth": f.traj,
-                                                          "window": 0.3},
     # dumbbell.analysis.restitution
     "dumbbell.analysis.restitution.Bounce": lambda f: {
         "e_first": 0.9, "e_cluster": 0.8, "impacts": 2, "share_first": 0.1,
         "share_cluster": 0.2},
     "dumbbell.analysis.restitution.RestitutionResult": lambda f: fields(f.restitution),
     "dumbbell.analysis.restitution.bounce": lambda f: {"traj": f.traj_2d, "gap": 0.05},
-    "dumbbell.analysis.restitution.drop_duration": lambda f: {"scene": f.rigid_2d},
     "dumbbell.analysis.restitution.e_eff_rigid": lambda f: {"theta_deg": [0.0, 30.0],
                                                            "e": 1.0, "q": 1.0},
-    "dumbbell.analysis.restitution.k_rot_share_rigid": lambda f: {"theta_deg": 30.0,
-                                                                 "e": 0.5, "q": 1.0},
     "dumbbell.analysis.restitution.restitution": lambda f: {
         "scene": f.rigid_2d, "thetas": [10.0], "stiffnesses": (), "dt": 1e-3,
         "progress": lambda: None},
-    "dumbbell.analysis.restitution.rigid_q": lambda f: {"scene": f.scene_2d},
-    "dumbbell.analysis.restitution.sign_change_deg": lambda f: {"e": 0.5, "q": 1.0},
-    "dumbbell.analysis.restitution.tilted": lambda f: {"scene": f.rigid_2d, "theta_deg": 20.0,
-                                                      "stiffness": 500.0},
-    "dumbbell.analysis.restitution.truth_for": lambda f: {"scene": f.rigid_2d},
     # dumbbell.analysis.rotation
     "dumbbell.analysis.rotation.Series": lambda f: fields(f.series),
-    "dumbbell.analysis.rotation.mean_after_first_cluster": lambda f: {
-        "traj": f.traj_2d, "name": "K_rot", "gap": 0.1},
-    "dumbbell.analysis.rotation.preview": lambda f: {"traj": f.traj_2d, "window": 0.02},
     "dumbbell.analysis.rotation.series": lambda f: {
         "scene": f.scene_2d, "solver": "pymunk", "dt": 1e-4, "t_end": 0.02,
         "stiffnesses": (200.0,)},
-    "dumbbell.analysis.rotation.variant": lambda f: {"scene": f.scene_2d, "stiffness": 500.0,
-                                                    "tilt": 10.0},
-    "dumbbell.analysis.rotation.variants": lambda f: {"scene": f.scene_2d,
-                                                     "stiffnesses": (100.0, 1e3)},
     # dumbbell.analysis.stability
-    "dumbbell.analysis.stability.Prediction": lambda f: {"status": "ok", "why": "w*dt < 2"},
     "dumbbell.analysis.stability.StabilityResult": lambda f: fields(f.stability_result),
     "dumbbell.analysis.stability.StabilityRow": lambda f: fields(f.stability_result.rows[0]),
-
-    "dumbbell.analysis.stability.default_cases": lambda f: {},
-    "dumbbell.analysis.stability.default_solvers": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.stability.find_cases": lambda f: {"folder": f.scene_file.parent},
-    "dumbbell.analysis.stability.map_scene": lambda f: {},
-    "dumbbell.analysis.stability.map_solvers": lambda f: {"solvers": ["verlet", "exact"]},
-
-    "dumbbell.analysis.stability.predict": lambda f: {
-        "scene": f.scene, "solver": "verlet", "dt": 1e-3, "t_end": 1.0},
-    "dumbbell.analysis.stability.rest_time": lambda f: {"scene": f.scene},
-    "dumbbell.analysis.stability.StabilityOptions": lambda f: {
-        "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
-        "quiet": True},
-    "dumbbell.analysis.stability.run_stability": lambda f: {
-        "options": _module("dumbbell.analysis.stability").StabilityOptions(
-            f.scene_file.parent, ["euler-cromer"], 1)},
     # dumbbell.analysis.sweep
     "dumbbell.analysis.sweep.Axis": lambda f: fields(f.sweep_result.axes[0]),
-    "dumbbell.analysis.sweep.Point": lambda f: {"index": 0, "values": {"run.dt": 1e-3}},
     "dumbbell.analysis.sweep.PointResult": lambda f: fields(f.sweep_result.rows[0]),
     "dumbbell.analysis.sweep.SweepResult": lambda f: fields(f.sweep_result),
-
-    "dumbbell.analysis.sweep.check_axes": lambda f: {"axes": f.sweep_result.axes},
-    "dumbbell.analysis.sweep.evaluate": lambda f: {
-        "scene": f.scene, "values": {"spring.stiffness": 300.0}, "solver": "euler-cromer"},
-    "dumbbell.analysis.sweep.parse_axis": lambda f: {"text": "k=log:1e2:1e4:3"},
-    "dumbbell.analysis.sweep.plan": lambda f: {
-        "scene": f.scene, "axes": f.sweep_result.axes, "solver": "euler-cromer",
-        "t_end": 0.02},
-    "dumbbell.analysis.sweep.SweepOptions": lambda f: {
-        "solver": "euler-cromer", "t_end": 0.02, "workers": 1, "scheduler": None,
-        "quiet": True, "processes": False, "connect_timeout": 1.0},
-    "dumbbell.analysis.sweep.run_sweep": lambda f: {
-        "scene": f.scene, "axes": f.sweep_result.axes[:1],
-        "options": _module("dumbbell.analysis.sweep").SweepOptions("euler-cromer", 0.02),
-        "points": None},
-    "dumbbell.analysis.sweep.warm_up": lambda f: {"solver": "euler-cromer"},
     # dumbbell.analysis.topple
     "dumbbell.analysis.topple.ToppleClosedForm": lambda f: fields(f.topple_cf),
     "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: {"theta": [0.1, 0.5]},
     "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: {"n": 5},
-    "dumbbell.analysis.topple.ToppleClosedForm.cm_height": lambda f: {"theta": 0.3},
     "dumbbell.analysis.topple.ToppleClosedForm.normal_force": lambda f: {"theta": 0.3},
     "dumbbell.analysis.topple.ToppleClosedForm.omega": lambda f: {"theta": np.array([0.2])},
     "dumbbell.analysis.topple.ToppleMeasure": lambda f: fields(f.topple_measure),
     "dumbbell.analysis.topple.closed_form": lambda f: {"scene": f.topple_scene},
     "dumbbell.analysis.topple.measure": lambda f: {"traj": f.topple_traj},
-    # dumbbell.animation
-    "dumbbell.animation.render.check_fps": lambda f: {"fps": 25, "where": "fps"},
-    "dumbbell.animation.render.check_size": lambda f: {"size": (64, 64), "where": "size"},
-    "dumbbell.animation.render.check_frames": lambda f: {"t_end": 1.0, "fps": 25,
-                                                        "max_frames": 100, "where": "t_end"},
-    "dumbbell.animation.render.delays_cs": lambda f: {"n": 4, "fps": 30},
-    "dumbbell.animation.render.frame_count": lambda f: {"t_end": 1.0, "fps": 25},
-    "dumbbell.animation.render.frames_of": lambda f: {"traj": f.traj, "fps": 10, "t_end": 0.3},
-    "dumbbell.animation.render.sample_every": lambda f: {"dt": 1e-4, "fps": 25, "t_end": 1.0},
     # dumbbell.io
     "dumbbell.io.bench.markdown": lambda f: {"result": f.bench_result},
-    "dumbbell.io.bench.to_json": lambda f: {"result": f.bench_result},
     "dumbbell.io.bench.write_all": lambda f: {"result": f.bench_result, "out": f.tmp / "b"},
-    "dumbbell.io.bench.write_csv": lambda f: {"result": f.bench_result,
-                                              "path": f.tmp / "b.csv"},
-    "dumbbell.io.bench.write_json": lambda f: {"result": f.bench_result,
-                                               "path": f.tmp / "b.json"},
-    "dumbbell.io.bench.write_markdown": lambda f: {"result": f.bench_result,
-                                                   "path": f.tmp / "b.md"},
-    "dumbbell.io.compare.impacts_csv": lambda f: {"result": f.comparison},
-    "dumbbell.io.compare.summary_csv": lambda f: {"result": f.comparison},
     "dumbbell.io.compare.write": lambda f: {"result": f.comparison, "out": f.tmp / "c"},
     "dumbbell.io.compare.text": lambda f: {"result": f.comparison},
-    "dumbbell.io.compare.write_errors": lambda f: {"result": f.comparison,
-                                                  "path": f.tmp / "e.csv"},
-    "dumbbell.io.figures.save_figure": lambda f: {"fig": f.ax().figure, "path": f.tmp / "f.png",
-                                                  "dpi": 20},
-    "dumbbell.io.files.OutputTransaction": lambda f: {"inputs": [(f.scene_file, "the scene")]},
-    "dumbbell.io.files.OutputTransaction.claim": lambda f: {"path": f.tmp / "o.csv",
-                                                           "what": "-o o.csv"},
-    "dumbbell.io.files.OutputTransaction.plan": lambda f: {"paths": [f.tmp / "p.csv"],
-                                                          "flag": "--out o"},
-    "dumbbell.io.files.atomic_output": lambda f: {"path": f.tmp / "a.csv"},
-    "dumbbell.io.files.check_writable": lambda f: {"path": f.tmp / "w.csv", "flag": "-o",
-                                                   "folder": False},
-    "dumbbell.io.files.is_special": lambda f: {"path": "/dev/null"},
-    "dumbbell.io.files.output_transaction": lambda f: {"inputs": [(f.scene_file, "scene")]},
-    "dumbbell.frames.data_frame": lambda f: {"columns": {"t": [0.0, 1.0], "x": [1.0, 2.0]},
-                                                "index": "t", "units": {"t": "s", "x": "m"}},
-    "dumbbell.frames.pandas_module": lambda f: {"what": "to_pandas()"},
     "dumbbell.io.restitution.markdown": lambda f: {"result": f.restitution},
     "dumbbell.io.restitution.write_csv": lambda f: {"result": f.restitution,
                                                     "path": f.tmp / "r.csv"},
-    "dumbbell.io.stability.csv_text": lambda f: {"result": f.stability_result},
     "dumbbell.io.stability.markdown": lambda f: {"result": f.stability_result},
     "dumbbell.io.stability.write": lambda f: {"result": f.stability_result, "out": f.tmp / "s"},
-    "dumbbell.io.sweep.csv_text": lambda f: {"result": f.sweep_result},
     "dumbbell.io.sweep.write_csv": lambda f: {"result": f.sweep_result, "path": f.tmp / "s.csv"},
-    "dumbbell.io.tables.cell": lambda f: {"value": 1.5},
-    "dumbbell.io.tables.csv_text": lambda f: {"header": ["a", "b"], "rows": [[1, 2.5]]},
-    "dumbbell.io.tables.write_text": lambda f: {"path": f.tmp / "t.txt", "text": "x\n"},
     "dumbbell.io.trajectory.dump_csv": lambda f: {"traj": f.traj, "stream": io.StringIO()},
     "dumbbell.io.trajectory.events_csv": lambda f: {"traj": f.traj},
     "dumbbell.io.trajectory.write_csv": lambda f: {"traj": f.traj, "path": f.tmp / "t.csv"},
@@ -650,9 +470,6 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.plot.trajectory.potential": lambda f: {"traj": f.traj, "ax": f.ax(), "window": 0.3},
     "dumbbell.plot.trajectory.energy": lambda f: {"traj": f.traj_2d, "ax": f.ax(),
                                                   "window": 0.6},
-    "dumbbell.plot.trajectory.heights": lambda f: {"traj": f.traj},
-    "dumbbell.plot.trajectory.momentum_panel": lambda f: {
-        "traj": f.traj_2d, "ax": f.ax(), "window": 0.5},
     "dumbbell.plot.compare.compare": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_positions": lambda f: {"result": f.comparison, "ax": f.ax()},
     "dumbbell.plot.compare.compare_energy": lambda f: {"result": f.comparison, "ax": f.ax()},
@@ -660,7 +477,6 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.plot.bench.convergence": lambda f: {"result": f.bench_result, "ax": f.ax()},
     "dumbbell.plot.maps.sweep_map": lambda f: {"result": f.sweep_result, "ax": f.ax()},
     "dumbbell.plot.maps.stability_map": lambda f: {"maps": f.maps},
-    "dumbbell.plot.maps.axis_label": lambda f: {"key": "spring.stiffness"},
     "dumbbell.plot.rotation.rotation": lambda f: {"s": f.series, "ax": f.ax()},
     "dumbbell.plot.rotation_chapter.restitution": lambda f: {"result": f.restitution,
                                                              "ax": f.ax(3)},
@@ -668,25 +484,12 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "cf": f.topple_cf, "measured": f.topple_measure, "ax": f.ax(3), "solver": "pymunk"},
     "dumbbell.plot.rotation_chapter.contact_momentum": lambda f: {
         "cm": f.contact, "ax": f.ax(), "solver": "exact"},
-    "dumbbell.plot.style.solver_style": lambda f: {"name": "verlet", "i": 0},
-    "dumbbell.plot.style.pyplot": lambda f: {},
     # dumbbell.spaces.accounting
     "dumbbell.spaces.accounting.energy": lambda f: {"space": f.space(), "about": (0.0, 0.0)},
-    "dumbbell.spaces.accounting.inventory": lambda f: {"space": f.space()},
-    "dumbbell.spaces.accounting.read_state": lambda f: {"inv": f.inventory},
-    "dumbbell.spaces.accounting.evaluate": lambda f: {"inv": f.inventory, "st": f.state,
-                                                      "about": (0.0, 1.0)},
-    "dumbbell.spaces.accounting.body_label": lambda f: {
-        "space": f.space(), "body": next(iter(f.space().bodies))},
-    "dumbbell.spaces.accounting.constraint_label": lambda f: {
-        "space": f.space(), "constraint": next(iter(f.space().constraints))},
     "dumbbell.spaces.accounting.SpaceEnergy": lambda f: fields(f.space_energy),
     "dumbbell.spaces.accounting.BodyEnergy": lambda f: fields(f.space_energy.bodies[0]),
     "dumbbell.spaces.accounting.SpringEnergy": lambda f: fields(f.space_energy.springs[0]),
     "dumbbell.spaces.accounting.Skipped": lambda f: {"subject": "body 0", "reason": "static"},
-    "dumbbell.spaces.accounting.Spring": lambda f: fields(f.inventory.springs[0]),
-    "dumbbell.spaces.accounting.Inventory": lambda f: fields(f.inventory),
-    "dumbbell.spaces.accounting.State": lambda f: fields(f.state),
     # dumbbell.spaces.guard
     "dumbbell.spaces.guard.check": lambda f: {"space": f.space(), "dt": 1e-3, "speeds": "both",
                                               "tolerance": 0.01, "units": "m"},
@@ -734,20 +537,8 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of": lambda f: {
         "body": next(iter(f.space().bodies))},
     "dumbbell.spaces.recorder.draw_options": lambda f: {},
-    # dumbbell.examples
-    "dumbbell.examples.newtons_cradle.build": lambda f: {},
-    "dumbbell.examples.newtons_cradle.measure": lambda f: {
-        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder()},
-    "dumbbell.examples.pendulum.build": lambda f: {"theta0": 0.1},
-    "dumbbell.examples.pendulum.small_angle_period": lambda f: {},
-    "dumbbell.examples.pendulum.amplitude_corrected_period": lambda f: {"theta0": 0.1},
-    "dumbbell.examples.pendulum.measure": lambda f: {
-        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder()},
-    "dumbbell.examples.slope.build": lambda f: {},
-    "dumbbell.examples.slope.measure": lambda f: {
-        "dt": 2e-3, "seconds": 0.04, "fps": 25, "space": None, "recorder": f.recorder(),
-        "heat": None},
 }
+
 
 def _solver_rows() -> dict[str, Callable[[Fixtures], dict[str, Any]]]:
     """Valid arguments of every registered solver class and of its contract methods: a
@@ -764,7 +555,6 @@ def _solver_rows() -> dict[str, Callable[[Fixtures], dict[str, Any]]]:
     for cls in _solvers():
         key, scene = f"{cls.__module__}.{cls.__qualname__}", scene_for(cls)
         extra = {"estimate_error": False} if cls.estimates_error else {}
-        rows[key] = lambda f: {}
         for method in ("supports", "truth_for", "catch_depth"):
             rows[f"{key}.{method}"] = lambda f, scene=scene: {"scene": scene(f)}
         rows[f"{key}.solve"] = (lambda f, scene=scene, extra=extra:
@@ -791,11 +581,7 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
-    "dumbbell.io.files.OutputTransaction.claim":
-        lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: f.recorder(),
-    "dumbbell.io.files.OutputTransaction.plan":
-        lambda f: __import__("dumbbell.io.files").io.files.OutputTransaction(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
@@ -805,10 +591,8 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
     "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,
-
     "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: f.topple_cf,
-    "dumbbell.analysis.topple.ToppleClosedForm.cm_height": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.normal_force": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.omega": lambda f: f.topple_cf,
 }
@@ -816,6 +600,28 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
 
 def test_every_public_module_declares_its_api():
     assert [m.__name__ for m in _modules() if not hasattr(m, "__all__")] == []
+
+
+#: The documents of the public API: every public callable is named in code in one of them.
+API_DOCS = ("docs/api.md", "docs/spaces.md")
+
+
+def _code_in(path: Path) -> str:
+    """The code of a Markdown file: its fenced blocks and its inline code spans."""
+    text = path.read_text(encoding="utf-8")
+    blocks = re.findall(r"^```[^\n]*\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)
+    prose = re.sub(r"^```[^\n]*\n.*?^```", "", text, flags=re.MULTILINE | re.DOTALL)
+    return "\n".join(blocks + re.findall(r"`([^`\n]+)`", prose))
+
+
+def test_every_public_callable_is_documented():
+    """Each public callable's name (a method's too) stands in code in docs/api.md or
+    docs/spaces.md; ``__getitem__`` is documented as ``traj[name]``."""
+    root = Path(__file__).resolve().parent.parent
+    code = "\n".join(_code_in(root / doc) for doc in API_DOCS)
+    names = {key.rsplit(".", 1)[1] for key in public()} - {"__getitem__"}
+    assert sorted(n for n in names if not re.search(rf"\b{re.escape(n)}\b", code)) == []
+    assert "traj[" in code
 
 
 def test_every_public_callable_has_valid_arguments():
@@ -904,7 +710,7 @@ def test_numpy_scalars_are_taken_wherever_numbers_are(tmp_path, monkeypatch):
         finally:
             _close_figures()
     assert not failures, "\n".join(failures)
-    assert len(checked) >= 90, checked
+    assert len(checked) >= 75, checked
 
 
 def test_numpy_scalars_give_what_the_equal_python_numbers_give(tmp_path):

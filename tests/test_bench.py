@@ -23,7 +23,7 @@ from dumbbell.analysis.extended import extended_precision_exact
 from dumbbell.cli import main
 from dumbbell.io.bench import markdown, write_all
 from dumbbell.model.scene import load_scene
-from dumbbell.solvers import REGISTRY, simulate
+from dumbbell.solvers import METHODS, simulate
 from tests.conftest import SCENES, make_scene
 
 TEXTBOOK = str(SCENES / "textbook-1d.toml")
@@ -175,7 +175,7 @@ def test_time_for_an_error_interpolates_in_log_log():
     assert time_for_error(line, 1e-7) is None
 
 
-@pytest.mark.skipif("reference" not in REGISTRY, reason="needs the 2D reference solver")
+@pytest.mark.skipif("reference" not in METHODS, reason="needs the 2D reference solver")
 def test_2d_scene_uses_the_reference_as_truth():
     scene = load_scene(SCENES / "tilted-2d.toml")
     result = run_bench(scene, BenchOptions(solvers=["verlet"], dts=[1e-3, 1e-4], window=0.5,

@@ -9,8 +9,8 @@ import shutil
 
 import pytest
 
-from dumbbell.cli import build_parser, main
-from dumbbell.cli.app import arguments, subcommands
+from dumbbell.cli import main
+from dumbbell.cli.app import arguments, build_parser, subcommands
 from tests.conftest import SCENES
 
 TEXTBOOK = str(SCENES / "textbook-1d.toml")

@@ -15,8 +15,8 @@ import sys
 
 import pytest
 
-from dumbbell.cli import build_parser, main
-from dumbbell.cli.app import DEFAULT_OUT, subcommands
+from dumbbell.cli import main
+from dumbbell.cli.app import DEFAULT_OUT, build_parser, subcommands
 from tests.conftest import SCENES
 
 HEAVY = ("numpy", "matplotlib", "pymunk", "numba", "scipy", "pandas", "PIL", "imageio", "dask")

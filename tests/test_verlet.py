@@ -10,7 +10,7 @@ import pytest
 
 from dumbbell.model.energy import relative_energy_error
 from dumbbell.model.scene import load_scene
-from dumbbell.solvers import REGISTRY, RunOptions, simulate, solver_class, supported
+from dumbbell.solvers import METHODS, RunOptions, simulate, solver_class, supported
 from tests.conftest import SCENES, make_scene
 
 #: A heavy A on a soft spring: A reaches the floor too (exact: B, A, B, A, B in [0, 1] s).
@@ -132,7 +132,7 @@ def test_2d_upright_is_the_1d_motion():
     assert [e.body for e in two.events] == [e.body for e in one.events]
 
 
-@pytest.mark.skipif("reference" not in REGISTRY, reason="needs the 2D reference solver")
+@pytest.mark.skipif("reference" not in METHODS, reason="needs the 2D reference solver")
 def test_2d_tilted_second_order_against_the_reference():
     # Tilted 30 degrees: B hits, the impulse sets the dumbbell turning, then A hits (0.498 s).
     scene = load_scene(SCENES / "tilted-2d.toml")

@@ -9,8 +9,6 @@ from collections.abc import Iterable, Sequence
 from html import escape
 from typing import Any
 
-__all__ = ["MAX_REPR", "MAX_ROWS", "html_table", "number", "one_line"]
-
 #: Longest ``repr`` of a result (characters).
 MAX_REPR = 200
 #: Most table rows ``_repr_html_`` shows; the rest are counted.

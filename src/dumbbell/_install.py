@@ -97,42 +97,28 @@ def njit(cache: bool = True, **options: Any) -> Callable[[Callable], Any]:
     cached wherever this user can write (see the module's notes); compiled without a cache
     when nowhere can be written."""
     import numba
-    from numba.core import config
 
     def decorate(func: Callable) -> Any:
         global _mode
         if not cache:
             return numba.njit(cache=False, **options)(func)
         if _mode in (None, "numba"):
-            try:
-                compiled = numba.njit(cache=True, **options)(func)
+            compiled = _cached(func, options, None)
+            if compiled is not None:
                 _mode = "numba"
                 return compiled
-            except RuntimeError as exc:
-                if not _cache_error(exc):
-                    raise
-                _mode = None
+            _mode = None
         if _mode in (None, "private"):
             found = _private_folder("numba")
-            if found is not None:
-                folder, made = found
-                before = config.CACHE_DIR
-                config.CACHE_DIR = folder  # read when the locator is made, right here
-                try:
-                    compiled = numba.njit(cache=True, **options)(func)
-                except RuntimeError as exc:
-                    if not _cache_error(exc):
-                        raise
-                else:
-                    if _mode is None and made:
-                        _say(f"numba cannot cache beside the package or in HOME "
-                             f"({os.path.expanduser('~')}): caching the compiled kernels in "
-                             f"{folder}; this first run compiles them, about "
-                             f"{COMPILE_SECONDS} a solver")
-                    _mode = "private"
-                    return compiled
-                finally:
-                    config.CACHE_DIR = before
+            compiled = None if found is None else _cached(func, options, found[0])
+            if compiled is not None:
+                if _mode is None and found[1]:
+                    _say(f"numba cannot cache beside the package or in HOME "
+                         f"({os.path.expanduser('~')}): caching the compiled kernels in "
+                         f"{found[0]}; this first run compiles them, about "
+                         f"{COMPILE_SECONDS} a solver")
+                _mode = "private"
+                return compiled
         if _mode is None:
             _say(f"numba cannot cache anywhere (the package's folder, HOME "
                  f"{os.path.expanduser('~')} and the temporary folder cannot be written): "
@@ -141,3 +127,22 @@ def njit(cache: bool = True, **options: Any) -> Callable[[Callable], Any]:
         return numba.njit(cache=False, **options)(func)
 
     return decorate
+
+
+def _cached(func: Callable, options: dict[str, Any], folder: str | None) -> Any:
+    """``func`` compiled by numba with a cache, in ``folder`` (None: numba's own places);
+    None when numba finds nowhere to write it."""
+    import numba
+    from numba.core import config
+
+    before = config.CACHE_DIR
+    if folder is not None:
+        config.CACHE_DIR = folder  # read when the locator is made, right here
+    try:
+        return numba.njit(cache=True, **options)(func)
+    except RuntimeError as exc:
+        if not _cache_error(exc):
+            raise
+        return None
+    finally:
+        config.CACHE_DIR = before

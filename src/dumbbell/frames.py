@@ -11,7 +11,8 @@ from typing import TYPE_CHECKING, Any
 
 from .errors import MissingExtraError, UsageError
 
-__all__ = ["data_frame", "pandas_module"]
+#: No public names: the results' ``to_pandas()`` methods are the API.
+__all__: list[str] = []
 
 if TYPE_CHECKING:
     import pandas
@@ -23,11 +24,8 @@ def _show(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def pandas_module(what: str = "to_pandas()") -> Any:
+def _pandas_module(what: str = "to_pandas()") -> Any:
     """The pandas module, or a MissingExtraError naming the extra that installs it."""
-    if not isinstance(what, str):
-        raise UsageError(f"what = {_show(what)}: must be a str (what needs pandas)",
-                         param="what")
     try:
         import pandas
     except ImportError:
@@ -48,7 +46,7 @@ def data_frame(columns: Mapping[str, Sequence[Any]], index: str | None = None,
     if units is not None and not isinstance(units, Mapping):
         raise UsageError(f"units = {_show(units)}: must be a dict of column name to unit, or "
                          "None", param="units")
-    pd = pandas_module()
+    pd = _pandas_module()
     df = pd.DataFrame({name: columns[name] for name in columns})
     if index is not None:
         df = df.set_index(index)

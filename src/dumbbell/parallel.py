@@ -23,7 +23,8 @@ from typing import Any, NamedTuple
 
 from .errors import UsageError
 
-__all__ = ["Backend", "batches", "cap_note", "cap_workers", "ordered_map"]
+#: No public names: the analyses run their work through :func:`ordered_map`.
+__all__: list[str] = []
 
 def _check(ok: bool, name: str, value: Any, allowed: str) -> None:
     """UsageError naming ``name`` unless ``ok``. (This module sits below the model, so it
@@ -89,10 +90,8 @@ def worker_init(initializer: Callable[..., Any] | None = None, *initargs: Any) -
         initializer(*initargs)
 
 
-def batches(n: int, workers: int) -> list[list[int]]:
+def _batches(n: int, workers: int) -> list[list[int]]:
     """Job indices 0..n-1 in interleaved batches: a few per worker, at most 64 jobs each."""
-    n = _whole(n, "n", "jobs", 0)
-    workers = _whole(workers, "workers", "processes", 1)
     size = max(1, min(64, n // (8 * max(1, workers))))
     count = math.ceil(n / size) if n else 0
     return [list(range(i, n, count)) for i in range(count)]
@@ -213,7 +212,7 @@ def _on_pool(work: _Work, backend: Backend, workers: int, results: list[Any], pb
     import multiprocessing
 
     items = [(work.func, work.lead, [work.indexed[i] for i in b])
-             for b in batches(len(work.indexed), workers)]
+             for b in _batches(len(work.indexed), workers)]
     # A signal that lands between a worker's fork and its worker_init would run the parent's
     # stop handler inside the worker and print a traceback. So the stop signals stay blocked
     # while the pool forks (its helper threads, which fork replacements, inherit the mask);
@@ -261,7 +260,7 @@ def _on_dask(work: _Work, backend: Backend, workers: int, results: list[Any], pb
         sent = [client.scatter(value, broadcast=True) for value in work.lead]
         futures = [client.submit(_run_dask_batch, work.func, *sent,
                                  batch=[work.indexed[i] for i in b], pure=False)
-                   for b in batches(len(work.indexed), n_workers)]
+                   for b in _batches(len(work.indexed), n_workers)]
         try:
             _collect(futures, as_completed, results, pb)
         except BaseException:

@@ -10,10 +10,11 @@ from typing import Any, Self
 
 from .errors import UsageError
 
-__all__ = ["bar", "progress_wanted"]
+#: No public names: the commands and analyses draw their bars with :func:`bar`.
+__all__: list[str] = []
 
 
-def progress_wanted(quiet: bool = False) -> bool:
+def _progress_wanted(quiet: bool = False) -> bool:
     """True when a progress bar should be drawn: stderr is a terminal, not CI, not quiet."""
     if not isinstance(quiet, bool) and type(quiet).__name__ != "bool_":
         raise UsageError(f"quiet = {quiet!r:.60}: must be True or False", param="quiet")
@@ -54,7 +55,7 @@ def bar(total: float | None, desc: str, unit: str = "it", quiet: bool = False, *
     for name, value in (("desc", desc), ("unit", unit)):
         if not isinstance(value, str):
             raise UsageError(f"{name} = {value!r:.60}: must be a str", param=name)
-    if not progress_wanted(quiet):
+    if not _progress_wanted(quiet):
         return _NoBar()
     from tqdm import tqdm
 

@@ -67,8 +67,7 @@ if TYPE_CHECKING:
     import pandas
 
 #: Default step sizes (s): half-decades from 1e-3 down to 1e-6.
-__all__ = ["BenchOptions", "BenchResult", "Fit", "Point", "default_solvers",
-           "default_spacing", "dt_label", "fit_order", "run_bench", "time_for_error"]
+__all__ = ["BenchResult", "Fit", "Point"]
 
 DEFAULT_DTS = tuple(float(f"{10.0 ** (-k / 2):.3g}") for k in range(6, 13))
 #: Default window of the position error (s): the textbook figures' 0-2 s.
@@ -336,13 +335,7 @@ class _Plan:
 def check_request(scene: Scene, plan: _Plan) -> None:
     """UsageError naming the argument and what is allowed, before anything runs."""
     options = plan.options
-    for cls in plan.solvers:
-        reason = cls._supports(scene)
-        if reason is not None:
-            raise UsageError(f"solvers {cls.name}: cannot run {scene.source}: {reason}",
-                             param="solvers")
-    if not plan.solvers:
-        raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
+    _check_solvers(scene, plan)
     t_end, window, spacing = options.t_end, options.window, options.spacing
     assert t_end is not None and spacing is not None  # filled in by the plan
     from .budget import check_runs
@@ -363,6 +356,29 @@ def check_request(scene: Scene, plan: _Plan) -> None:
     if not 0 < spacing <= window:
         raise UsageError(f"sample_spacing {spacing:g}: must be > 0 and <= the window "
                          f"{window:g} (s)", param="sample_spacing")
+    _check_samples(scene, plan)
+    # Every solver's own work budget (the exact solver's impacts), before the first run.
+    for cls in [*plan.solvers, *([plan.truth] if plan.truth else [])]:
+        cls._check_work(scene, run_options(scene, spacing, t_end))
+
+
+def _check_solvers(scene: Scene, plan: _Plan) -> None:
+    """UsageError naming ``solvers`` unless there are some and each can run ``scene``."""
+    for cls in plan.solvers:
+        reason = cls._supports(scene)
+        if reason is not None:
+            raise UsageError(f"solvers {cls.name}: cannot run {scene.source}: {reason}",
+                             param="solvers")
+    if not plan.solvers:
+        raise UsageError(f"solvers: no solver to benchmark for {scene.source}", param="solvers")
+
+
+def _check_samples(scene: Scene, plan: _Plan) -> None:
+    """UsageError unless the samples one run keeps, and the truths kept for every step,
+    fit in the budget of :data:`MAX_SAMPLES`."""
+    options = plan.options
+    t_end, spacing = options.t_end, options.spacing
+    assert t_end is not None and spacing is not None  # filled in by the plan
     # The samples one run keeps, before anything runs: a stepping solver keeps every
     # round(spacing / dt)-th step, a solver without a step one sample per spacing.
     ratio = t_end / spacing  # a float: inf when the quotient passes the largest float
@@ -384,9 +400,6 @@ def check_request(scene: Scene, plan: _Plan) -> None:
                          f"all, past the budget of {MAX_SAMPLES:,}",
                          fixes=(["fewer steps ({dts})"] if len(set(dts)) > 1 else [])
                          + ["a larger {spacing}", "a shorter {t_end}"])
-    # Every solver's own work budget (the exact solver's impacts), before the first run.
-    for cls in [*plan.solvers, *([plan.truth] if plan.truth else [])]:
-        cls._check_work(scene, run_options(scene, spacing, t_end))
 
 
 def run_bench(scene: Scene | str | Path, options: BenchOptions) -> BenchResult:

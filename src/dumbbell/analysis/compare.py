@@ -47,8 +47,7 @@ if TYPE_CHECKING:
 #: Default window (s) for position errors.
 WINDOW = 2.0
 
-__all__ = ["CompareOptions", "Comparison", "Row", "Timing", "compare", "default_solvers",
-           "timed_run"]
+__all__ = ["Comparison", "Row", "Timing"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3

@@ -26,7 +26,8 @@ from ..model import args
 from ..model.energy import _relative_energy_error, _start_scale
 from ..model.trajectory import Trajectory
 
-__all__ = ["energy_error", "impact_time_error", "position_error", "position_error_series"]
+#: No public names: the measures :func:`dumbbell.compare` reports.
+__all__: list[str] = []
 
 
 def _pair(run: Any, truth: Any, name: str = "run") -> tuple[Trajectory, Trajectory]:

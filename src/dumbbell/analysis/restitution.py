@@ -29,9 +29,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .rotation import variant
 
-__all__ = ["Bounce", "RestitutionResult", "bounce", "drop_duration", "e_eff_rigid",
-           "k_rot_share_rigid", "restitution", "rigid_q", "sign_change_deg", "tilted",
-           "truth_for"]
+__all__ = ["Bounce", "RestitutionResult", "bounce", "e_eff_rigid", "restitution"]
 
 #: Impacts closer together than this (s) belong to one cluster.
 CLUSTER_GAP = 0.1
@@ -131,26 +129,8 @@ def _bounce(traj: Trajectory, gap: float, cluster: bool) -> Bounce:
                          param="traj")
     s = traj.scene
     times = [e.t for e in traj.events]
-    if not times:
-        raise UsageError(f"{s.source}: no impact in this run (t_end = {float(traj.t[-1]):g} "
-                         "s); run longer")
-    t0 = times[0]
-    n = 1
-    while n < len(times) and times[n] - times[n - 1] <= gap:
-        n += 1
-    if not cluster:
-        n = 1
-    t_last = times[n - 1]
-    at_rest = False
-    if cluster and float(traj.t[-1]) < t_last + gap:
-        # No flight of gap s after the last impact before the run ends: the cluster is over
-        # only if the dumbbell can no longer make one (it is coming to rest on the floor).
-        at_rest = _settled(traj, gap)
-        if not at_rest:
-            raise UsageError(f"{s.source}: the dumbbell still has the energy to leave the floor "
-                             f"for {gap:g} s when the drop's run ends at "
-                             f"{float(traj.t[-1]):g} s (last impact at {t_last:g} s), so the "
-                             "end of its first cluster of impacts is not known")
+    n, at_rest = _first_cluster(traj, gap, cluster)
+    t0, t_last = times[0], times[n - 1]
     vy = _cm_vy(traj)
     g = s.system.g
     i_before = int(np.searchsorted(traj.t, t0, side="left")) - 1
@@ -186,6 +166,33 @@ def _bounce(traj: Trajectory, gap: float, cluster: bool) -> Bounce:
     K_rot = traj["K_rot"]
     return Bounce(-v_first / v_before, -v_cluster / v_before, n,
                   float(K_rot[i_f]) / K_before, float(K_rot[i_c]) / K_before)
+
+
+def _first_cluster(traj: Trajectory, gap: float, cluster: bool) -> tuple[int, bool]:
+    """How many impacts the first cluster of ``traj`` holds (impacts less than ``gap`` s
+    apart; 1 without ``cluster``), and whether the dumbbell comes to rest on the floor
+    after it before the run ends; a UsageError when that is not known."""
+    s = traj.scene
+    times = [e.t for e in traj.events]
+    if not times:
+        raise UsageError(f"{s.source}: no impact in this run (t_end = {float(traj.t[-1]):g} "
+                         "s); run longer")
+    if not cluster:
+        return 1, False
+    n = 1
+    while n < len(times) and times[n] - times[n - 1] <= gap:
+        n += 1
+    t_last = times[n - 1]
+    if float(traj.t[-1]) >= t_last + gap:
+        return n, False
+    # No flight of gap s after the last impact before the run ends: the cluster is over
+    # only if the dumbbell can no longer make one (it is coming to rest on the floor).
+    if not _settled(traj, gap):
+        raise UsageError(f"{s.source}: the dumbbell still has the energy to leave the floor "
+                         f"for {gap:g} s when the drop's run ends at "
+                         f"{float(traj.t[-1]):g} s (last impact at {t_last:g} s), so the "
+                         "end of its first cluster of impacts is not known")
+    return n, True
 
 
 def _settled(traj: Trajectory, gap: float) -> bool:

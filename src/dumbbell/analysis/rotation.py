@@ -32,7 +32,7 @@ from ..model import args
 from ..model.scene import Scene, scene_from_dict
 from ..model.trajectory import Trajectory
 
-__all__ = ["Series", "mean_after_first_cluster", "preview", "series", "variant", "variants"]
+__all__ = ["Series", "series"]
 
 #: Spring constants of the preview (N/m).
 STIFFNESSES = (200.0, 2e3, 2e4)

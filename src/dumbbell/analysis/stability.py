@@ -44,9 +44,7 @@ if TYPE_CHECKING:
 
     from .sweep import PointResult
 
-__all__ = ["AGREES", "COLUMNS", "Prediction", "StabilityOptions", "StabilityResult",
-           "StabilityRow", "default_cases", "default_solvers", "find_cases", "map_scene",
-           "map_solvers", "predict", "rest_time", "run_stability"]
+__all__ = ["StabilityResult", "StabilityRow"]
 
 #: :attr:`StabilityRow.agreement` when the verdict is the one the theory expects; any other
 #: value says what differs.

@@ -38,8 +38,7 @@ from ._fields import check
 if TYPE_CHECKING:
     import pandas
 
-__all__ = ["Axis", "Point", "PointResult", "SweepOptions", "SweepResult", "check_axes",
-           "evaluate", "parse_axis", "plan", "run_sweep", "warm_up"]
+__all__ = ["Axis", "PointResult", "SweepResult"]
 
 #: Short names accepted on the command line for the most swept keys.
 SHORT_NAMES = {"k": "spring.stiffness", "dt": "run.dt"}

@@ -94,10 +94,6 @@ class ToppleClosedForm:
         num = 2.0 * M * g * a * (math.cos(self.theta0) - c)
         return 0.5 * (2.0 * M * g * a * s * den - num * 2.0 * M * a * a * s * c) / den**2
 
-    def cm_height(self, theta: np.ndarray | float) -> np.ndarray:
-        """Height of the centre of mass (m) at ``theta`` (rad), B on the floor."""
-        return self.a * np.cos(args.array(theta, "theta", "rad"))
-
     def normal_force(self, theta: np.ndarray | float) -> np.ndarray:
         """The floor's push on B (N) at ``theta`` (rad): M (g + Y''). It must stay >= 0 for B
         to keep touching the floor; :meth:`check` says where it does not."""

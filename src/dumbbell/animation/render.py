@@ -39,8 +39,7 @@ from ..model.trajectory import Trajectory
 if TYPE_CHECKING:
     from .frames import Frames
 
-__all__ = ["MAX_FPS", "MAX_FRAMES", "Gif", "check_fps", "check_frames", "check_size",
-           "delays_cs", "frame_count", "frames_of", "render_gif", "sample_every"]
+__all__ = ["Gif", "render_gif"]
 
 #: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
 MAX_FPS = 50

@@ -1,6 +1,7 @@
 """Layer 5, the command line: parse arguments, call analysis, then io / plot / animation to
 write the outputs, and map errors to exit codes. ``dumbbell.cli:main`` is the console script."""
 
-from .app import EXIT_USAGE, EXIT_VERDICT, build_parser, main
+from .app import main as main  # the console script; the package has no API of its own
 
-__all__ = ["EXIT_USAGE", "EXIT_VERDICT", "build_parser", "main"]
+#: No public names: the command line is the ``dumbbell`` console script.
+__all__: list[str] = []

@@ -109,6 +109,12 @@ def positive_int(what: str, hi: int = MAX_COUNT):
 DEFAULT_OUT = "renders"
 
 
+def add_scene(parser: argparse.ArgumentParser) -> None:
+    """The SCENE argument: a scene file, or - for standard input."""
+    parser.add_argument("scene", metavar="SCENE",
+                        help="scene file (TOML); - reads it from standard input")
+
+
 def add_out(parser: argparse.ArgumentParser, what: str) -> None:
     """The ``--out DIR`` flag: the folder for ``what``, :data:`DEFAULT_OUT` by default."""
     parser.add_argument("--out", metavar="DIR", default=DEFAULT_OUT,

@@ -7,22 +7,25 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import _shown, add_out, add_quiet, positive_float, read_scene
+from .app import _shown, add_out, add_quiet, add_scene, positive_float, read_scene
+
+#: What ``dumbbell compare --help`` says the command does.
+DESCRIPTION = """\
+Run SCENE with pymunk and the hand-written method (or --solvers) and with the most accurate
+solution there is (exact in 1D and for the rigid 2D dumbbell, the RK8 reference for a 2D
+spring), then print and write: impact times side by side, the largest position error over a
+window before the chaotic motion parts the runs, each solver's energy error over the whole
+run, and run times. Writes SCENE-compare.csv, -compare-impacts.csv, -compare-errors.csv and
+three PNG figures (positions, error, energy) into DIR.
+"""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "compare", help="solvers against the exact solution or the 2D reference",
-        description="Run SCENE with pymunk and the hand-written method (or --solvers) and with "
-                    "the most accurate solution there is (exact in 1D and for the rigid 2D "
-                    "dumbbell, the RK8 reference for a 2D spring), then print and write: impact times side by side, the largest position "
-                    "error over a window before the chaotic motion parts the runs, each "
-                    "solver's energy error over the whole run, and run times. Writes "
-                    "SCENE-compare.csv, -compare-impacts.csv, -compare-errors.csv and three "
-                    "PNG figures (positions, error, energy) into DIR.",
+        description=DESCRIPTION,
     )
-    p.add_argument("scene", metavar="SCENE",
-                   help="scene file (TOML); - reads it from standard input")
+    add_scene(p)
     add_out(p, "the outputs")
     p.add_argument("--dt", type=positive_float("s"), nargs="+", metavar="DT",
                    help="time step(s) in s for the compared solvers (default: the scene's "

@@ -12,27 +12,30 @@ from .app import (
     EXIT_VERDICT,
     _shown,
     add_quiet,
+    add_scene,
     positive_float,
     positive_int,
     read_scene,
 )
 
+#: What ``dumbbell render --help`` says the command does.
+DESCRIPTION = """\
+Run SCENE and write an animated GIF (looping forever): the floor, the particles at their
+true radius, the spring as a zig-zag (a rod when rigid), the centre of mass, the time and in
+2D the axis angle; bars of every energy term on one fixed scale with a marker at the total;
+and a strip of the energy time series (a 1 s window scrolling under a cursor). Settings come
+from the flags, else the scene's [outputs.gif] table, else fps 25, 640x360, strip on, the
+scene's run.t_end. A run that ends badly still writes its GIF up to the failure, prints why
+and exits 3.
+"""
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "render", help="animate a scene as a GIF with live energy bars",
-        description="Run SCENE and write an animated GIF (looping forever): the floor, the "
-                    "particles at their true radius, the spring as a zig-zag (a rod when "
-                    "rigid), the centre of mass, the time and in 2D the axis angle; bars of "
-                    "every energy term on one fixed scale with a marker at the total; and a "
-                    "strip of the energy time series (a 1 s window scrolling under a "
-                    "cursor). Settings come from the flags, else the scene's [outputs.gif] "
-                    "table, else fps 25, 640x360, strip on, the scene's run.t_end. A run "
-                    "that ends badly still writes its GIF up to the failure, prints why and "
-                    "exits 3.",
+        description=DESCRIPTION,
     )
-    p.add_argument("scene", metavar="SCENE",
-                   help="scene file (TOML); - reads it from standard input")
+    add_scene(p)
     p.add_argument("--solver", metavar="NAME",
                    help="solver (default: the scene's run.solver)")
     p.add_argument("-o", "--output", metavar="FILE.gif",

@@ -55,15 +55,20 @@ def restitution_coefficient(text: str) -> float:
 restitution_coefficient.__name__ = "restitution"
 
 
+#: What ``dumbbell restitution --help`` says the command does.
+DESCRIPTION = """\
+Drop SCENE's dumbbell (2D, frictionless floor) at each tilt and measure e_eff =
+-V_after/V_before of its centre of mass: rigid in the truth and in pymunk (first impact,
+against the impulse law's formula), and as spring dumbbells of three stiffnesses in pymunk
+(after the first cluster of impacts). Writes SCENE-restitution.csv (one row per tilt) and
+SCENE-restitution.png into DIR and prints the table.
+"""
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "restitution", help="apparent restitution of a tilted dumbbell against its tilt",
-        description="Drop SCENE's dumbbell (2D, frictionless floor) at each tilt and measure "
-                    "e_eff = -V_after/V_before of its centre of mass: rigid in the truth and "
-                    "in pymunk (first impact, against the impulse law's formula), and as "
-                    "spring dumbbells of three stiffnesses in pymunk (after the first cluster "
-                    "of impacts). Writes SCENE-restitution.csv (one row per tilt) and "
-                    "SCENE-restitution.png into DIR and prints the table.",
+        description=DESCRIPTION,
     )
     p.add_argument("scene", metavar="SCENE", help="scene file (TOML), 2D with a spring or rod")
     p.add_argument("--theta", type=tilt_range, default=tilt_range("0:80:9"),

@@ -6,21 +6,25 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..solvers import MAX_SAMPLES, MAX_STEPS
-from .app import EXIT_VERDICT, add_quiet, positive_float, positive_int, read_scene
+from ..solvers.base import MAX_SAMPLES, MAX_STEPS
+from .app import EXIT_VERDICT, add_quiet, add_scene, positive_float, positive_int, read_scene
+
+#: What ``dumbbell simulate --help`` says the command does.
+DESCRIPTION = """\
+Run SCENE and write a CSV with a header row: for 1D scenes
+t,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E (s, m, m/s, J; x vertical); for 2D scenes positions
+and velocities in x and y, then the energy terms the scene can have. A run that ends badly
+(unstable, tunnelled, failed) keeps its samples up to the failure, prints one line saying
+why, and exits 3.
+"""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "simulate", help="run one scene and write its trajectory as CSV",
-        description="Run SCENE and write a CSV with a header row: for 1D scenes "
-                    "t,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E (s, m, m/s, J; x vertical); for 2D "
-                    "scenes positions and velocities in x and y, then the energy terms the "
-                    "scene can have. A run that ends badly (unstable, tunnelled, failed) keeps "
-                    "its samples up to the failure, prints one line saying why, and exits 3.",
+        description=DESCRIPTION,
     )
-    p.add_argument("scene", metavar="SCENE",
-                   help="scene file (TOML); - reads it from standard input")
+    add_scene(p)
     p.add_argument("--solver", metavar="NAME",
                    help="solver: euler-cromer, exact, pymunk, ... (default: the scene's "
                         "run.solver)")

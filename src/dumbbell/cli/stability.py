@@ -14,15 +14,20 @@ if TYPE_CHECKING:
     from ..solvers import Solver
 
 
+#: What ``dumbbell stability --help`` says the command does.
+DESCRIPTION = """\
+Run every scene in DIR (default: the shipped scenes/extreme catalogue) with every solver
+that can run it, and write OUT/stability.md (a table: verdict, w*dt, the largest relative
+energy error, the time of failure, the verdict theory expects and whether they agree),
+OUT/stability.csv and OUT/stability-map.png (log10 of the largest relative energy error over
+(w*dt, mass ratio) for each time-stepping solver, with the line w*dt = 2).
+"""
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "stability", help="run the extreme scenes with every solver and compare with theory",
-        description="Run every scene in DIR (default: the shipped scenes/extreme catalogue) "
-                    "with every solver that can run it, and write OUT/stability.md (a table: "
-                    "verdict, w*dt, the largest relative energy error, the time of failure, "
-                    "the verdict theory expects and whether they agree), OUT/stability.csv and "
-                    "OUT/stability-map.png (log10 of the largest relative energy error over "
-                    "(w*dt, mass ratio) for each time-stepping solver, with the line w*dt = 2).",
+        description=DESCRIPTION,
     )
     p.add_argument("--cases", metavar="DIR",
                    help="folder of scene files (default: the shipped scenes/extreme)")

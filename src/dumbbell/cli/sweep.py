@@ -8,16 +8,19 @@ from pathlib import Path
 
 from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
+#: What ``dumbbell sweep --help`` says the command does.
+DESCRIPTION = """\
+Run SCENE at every point of a grid of one or two scene keys and write OUT/SCENE-sweep.csv
+(one row per point: the values, w*dt, the verdict, the time of failure and the largest
+relative energy error) and OUT/SCENE-sweep.png (a map of log10 of that error, failures
+marked by verdict, the line w*dt = 2 on top). The CSV is the same whichever backend runs it.
+"""
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "sweep", help="run one scene over a grid of parameters (process pool or Dask)",
-        description="Run SCENE at every point of a grid of one or two scene keys and write "
-                    "OUT/SCENE-sweep.csv (one row per point: the values, w*dt, the verdict, "
-                    "the time of failure and the largest relative energy error) and "
-                    "OUT/SCENE-sweep.png (a map of log10 of that error, failures marked by "
-                    "verdict, the line w*dt = 2 on top). The CSV is the same whichever backend "
-                    "runs it.",
+        description=DESCRIPTION,
         epilog="Example: dumbbell sweep scenes/textbook-1d.toml --grid k=log:1e2:1e7:50 "
                "dt=log:1e-6:1e-2:50 --t-end 1. On a Dask cluster (pip install "
                "'dumbbell[dask]'; dask scheduler; dask worker tcp://HOST:8786): add "

@@ -18,7 +18,8 @@ from typing import Any
 
 from . import arguments, check_run, print_guard
 
-__all__ = ["build", "measure"]
+#: No public names: a program, run as ``python -m dumbbell.examples.newtons_cradle``.
+__all__: list[str] = []
 
 #: Ball radius (m), mass (kg), pin length (m), gap between hanging balls (m), start angle.
 RADIUS, MASS, LENGTH, GAP, LIFT = 0.025, 0.5, 0.3, 1e-4, math.radians(30)

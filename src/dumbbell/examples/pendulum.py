@@ -22,7 +22,8 @@ from typing import Any
 
 from . import arguments, check_run, print_guard
 
-__all__ = ["amplitude_corrected_period", "build", "measure", "small_angle_period"]
+#: No public names: a program, run as ``python -m dumbbell.examples.pendulum``.
+__all__: list[str] = []
 
 #: Rod mass (kg), length (m), width (m), spring stiffness (N m/rad), pivot height (m: the rod
 #: hangs with its centre of gravity at y = 0, where U_g is zero), starting angle (rad).

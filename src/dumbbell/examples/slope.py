@@ -18,7 +18,8 @@ from typing import Any
 
 from . import arguments, check_run, print_guard
 
-__all__ = ["build", "measure"]
+#: No public names: a program, run as ``python -m dumbbell.examples.slope``.
+__all__: list[str] = []
 
 #: Slope angle (rad), friction coefficient, restitution, box size (m), mass (kg), spin (rad/s).
 ANGLE, MU, ELASTICITY, SIZE, MASS, SPIN = math.radians(30), 0.4, 0.2, (0.2, 0.1), 1.0, -12.0

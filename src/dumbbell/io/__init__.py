@@ -4,6 +4,9 @@ from .._lazy import attach
 
 #: The writers, one module per result, and what they share; each is imported when first
 #: read (``dumbbell.io.trajectory.write_csv``).
-__getattr__, __dir__, __all__ = attach(__name__, [
+__getattr__, __dir__, _ = attach(__name__, [
     "bench", "compare", "figures", "files", "restitution", "stability", "sweep",
     "tables", "trajectory"])
+#: The public modules: one per command's files (``figures``, ``files`` and ``tables`` serve
+#: the commands and the other writers).
+__all__ = ["bench", "compare", "restitution", "stability", "sweep", "trajectory"]

@@ -21,7 +21,7 @@ from ..analysis.bench import (
 from ..model import args
 from .tables import csv_text, write_text
 
-__all__ = ["markdown", "to_json", "write_all", "write_csv", "write_json", "write_markdown"]
+__all__ = ["markdown", "write_all"]
 
 
 def _checked(result: Any) -> BenchResult:

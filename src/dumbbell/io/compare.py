@@ -15,7 +15,7 @@ from ..model import args
 from .files import atomic_output
 from .tables import csv_text, write_text
 
-__all__ = ["SUMMARY_COLUMNS", "impacts_csv", "summary_csv", "text", "write", "write_errors"]
+__all__ = ["text", "write"]
 
 
 def _checked(result: Any) -> Comparison:

@@ -9,7 +9,8 @@ from ..errors import UsageError
 from ..model import args
 from .files import atomic_output
 
-__all__ = ["DPI", "MAX_DPI", "save_figure"]
+#: No public names: the commands save the figures that :mod:`dumbbell.plot` draws.
+__all__: list[str] = []
 
 #: Resolution of saved figures (dots per inch), and the most allowed (past it the image of a
 #: figure of a few inches runs into the renderer's size limit).

@@ -37,8 +37,8 @@ from pathlib import Path
 
 from ..errors import UsageError
 
-__all__ = ["OutputTransaction", "atomic_output", "check_writable", "is_special",
-           "output_transaction"]
+#: No public names: the one way every writer of the package writes a file.
+__all__: list[str] = []
 
 
 def _inputs(inputs: object) -> list[tuple[str | Path, str]]:
@@ -388,15 +388,7 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     tmp: Path | None = None
     deferred = False
     try:
-        missing = [p for p in (path.parent, *path.parent.parents) if not p.exists()]
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if transaction is not None:
-            transaction.created.extend(reversed(missing))
-        fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix,
-                                    dir=path.parent)
-        os.close(fd)
-        tmp = Path(name)
-        _register(tmp)
+        tmp = _part_file(path, transaction)
         yield tmp
         if tmp.exists():
             # mkstemp makes private files; outputs get the usual permissions.
@@ -415,6 +407,21 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
             _unlink(tmp)
 
 
+def _part_file(path: Path, transaction: OutputTransaction | None) -> Path:
+    """A new temporary file beside ``path`` (its folders made, and kept in ``transaction``
+    to be removed if it fails), registered to be removed at exit."""
+    missing = [p for p in (path.parent, *path.parent.parents) if not p.exists()]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if transaction is not None:
+        transaction.created.extend(reversed(missing))
+    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part" + path.suffix,
+                                dir=path.parent)
+    os.close(fd)
+    tmp = Path(name)
+    _register(tmp)
+    return tmp
+
+
 def _cwd_gone() -> bool:
     try:
         os.getcwd()
@@ -427,6 +434,23 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
     """Why ``path`` (spelt ``text`` by the user; a folder if ``folder``) could not be
     created or replaced, or None when it can. ``within``: a name the command chose inside
     the user's folder, so the way out is another folder, not another name."""
+    why = _misspelt(path, text, folder) or _unusable(path, folder)
+    if why:
+        return why
+    if not folder and os.path.islink(path):
+        path = Path(os.path.realpath(path))  # the file the link names is written
+    if not folder and is_special(path):
+        return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
+    if folder and path.exists() and not path.is_dir():
+        return "exists and is not a folder"
+    if not folder and path.is_dir():
+        return ("is a folder, where this command writes a file: remove it or write into "
+                "another folder") if within else "is a folder; give a file name"
+    return _unwritable(path, folder)
+
+
+def _misspelt(path: Path, text: str, folder: bool) -> str | None:
+    """What is wrong with the spelling ``text`` of ``path``, or None."""
     if "\0" in text:
         return "a path cannot hold a NUL character"
     if not folder and text.endswith(("/", os.sep)):
@@ -435,6 +459,12 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
         return "names a folder; give a file name"
     if not path.is_absolute() and _cwd_gone():
         return "the working folder no longer exists; give an absolute path"
+    return None
+
+
+def _unusable(path: Path, folder: bool) -> str | None:
+    """Why ``path`` cannot be looked at (a loop of links, a name too long, ...) or, as a
+    folder, is a link to nothing; else None."""
     try:
         os.stat(path)
     except (FileNotFoundError, NotADirectoryError):  # the latter: a file on the way, below
@@ -444,17 +474,12 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
                 return f"is a link to {target}, which does not exist"
     except OSError as exc:  # a loop of links, a name too long, ...
         return f"cannot be used ({exc.strerror})"
-    if not folder and os.path.islink(path):
-        path = Path(os.path.realpath(path))  # the file the link names is written
-    if not folder and is_special(path):
-        if not os.access(path, os.W_OK):
-            return "cannot write it (permission denied)"
-        return None
-    if folder and path.exists() and not path.is_dir():
-        return "exists and is not a folder"
-    if not folder and path.is_dir():
-        return ("is a folder, where this command writes a file: remove it or write into "
-                "another folder") if within else "is a folder; give a file name"
+    return None
+
+
+def _unwritable(path: Path, folder: bool) -> str | None:
+    """Why the folder ``path`` (or the one of the file ``path``) cannot be written in, or
+    the file not replaced; else None."""
     here = path if folder else path.parent
     here = here if str(here) else Path(".")
     while not here.exists() and here != here.parent:

@@ -12,7 +12,7 @@ from ..analysis.stability import AGREES, COLUMNS, StabilityResult
 from .tables import csv_text as _csv_text
 from .tables import write_text
 
-__all__ = ["csv_text", "markdown", "write"]
+__all__ = ["markdown", "write"]
 
 
 def _checked(result: Any) -> StabilityResult:

@@ -11,7 +11,7 @@ from ..analysis.sweep import SweepResult
 from .tables import csv_text as _csv_text
 from .tables import write_text
 
-__all__ = ["csv_text", "write_csv"]
+__all__ = ["write_csv"]
 
 
 def _checked(result: Any) -> SweepResult:

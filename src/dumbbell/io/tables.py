@@ -16,7 +16,8 @@ from ..errors import UsageError
 from ..model import args
 from .files import atomic_output
 
-__all__ = ["cell", "csv_text", "write_text"]
+#: No public names: the table cells every writer shares.
+__all__: list[str] = []
 
 
 def cell(value: Any) -> str:

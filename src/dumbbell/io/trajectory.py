@@ -21,7 +21,7 @@ from ..model.trajectory import Trajectory
 from .files import atomic_output
 from .tables import csv_text, write_text
 
-__all__ = ["EVENT_COLUMNS", "dump_csv", "events_csv", "write_csv", "write_events"]
+__all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
 
 #: Columns of the impacts' CSV (s, -, m/s, m/s).
 EVENT_COLUMNS = ("t", "body", "v_before", "v_after")

@@ -3,5 +3,7 @@
 
 from .._lazy import attach
 
-#: The package's own names: none; the API is in its modules, imported when first read.
-__getattr__, __dir__, __all__ = attach(__name__, ["args", "energy", "scene", "trajectory"])
+#: The package's own names: none; the API is in its modules, imported when first read
+#: (``args``, the checks, is the package's own).
+__getattr__, __dir__, _ = attach(__name__, ["args", "energy", "scene", "trajectory"])
+__all__ = ["energy", "scene", "trajectory"]

@@ -47,11 +47,7 @@ Columns = Mapping[str, np.ndarray]
 
 #: The public functions; the elementwise formulas below them (translational_ke, ...) are
 #: building blocks that take numbers or arrays as they come, unchecked.
-__all__ = [
-    "BOOKKEEPING", "angular_momentum_cm", "column_unit", "disc_inertia", "energy_columns",
-    "energy_scale", "heat", "impact_heat", "momentum_columns", "partition", "relative_energy_error",
-    "rigid_moment", "spins", "state_columns",
-]
+__all__ = ["angular_momentum_cm", "heat", "partition"]
 
 
 def _number(value: Any, name: str, unit: str) -> float:

@@ -29,10 +29,7 @@ from typing import Any
 
 from ..errors import SceneError, UsageError
 
-__all__ = [
-    "FIGURE_NAMES", "Floor", "GifSettings", "OutputSettings", "Particle", "Rigid", "RunSettings", "Scene", "Spring", "System", "load_scene", "load_scene_bytes",
-    "packaged_scene", "parse_size", "scene_from_dict", "scenes_dir",
-]
+__all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
 
 #: Figure names ``[outputs] figures`` may list.
 FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")
@@ -521,9 +518,11 @@ def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
     rigid = _rigid(top, dims, spring)
     if tilt is not None and spring is None and rigid is None:
         top.fail("tilt", tilt, "needs a [spring] or [rigid] to set the distance from B to A")
-    A, B = _particles(cA, cB, dims, tilt, spring, rigid, source)
+    length = rigid.length if rigid else spring.rest_length if spring else None
+    A, B = _particles(cA, cB, dims, tilt, length)
     floor = _floor(top, dims)
-    _check_placement(A, B, dims, floor, rigid, source)
+    _check_placement(A, B, dims, floor, source)
+    _check_rod(A, B, rigid, source)
     g = _gravity(top)
     run = _run(top, source)
     outputs = _outputs(top, dims, floor is not None, rigid is not None, run.t_end)
@@ -573,18 +572,18 @@ def _rigid(top: _Checker, dims: int, spring: Spring | None) -> Rigid | None:
 
 
 def _particles(cA: _Checker, cB: _Checker, dims: int, tilt: float | None,
-               spring: Spring | None, rigid: Rigid | None, source: str
-               ) -> tuple[Particle, Particle]:
-    """A and B; with ``tilt`` (degrees from vertical) A is placed from B along the axis."""
+               length: float | None) -> tuple[Particle, Particle]:
+    """A and B; with ``tilt`` (degrees from vertical) A is placed from B along the axis, at
+    ``length`` (m: the rod's or the spring's rest length) from it."""
     B = _particle(cB, "B", dims, placed=False)
     A = _particle(cA, "A", dims, placed=tilt is not None)
     M = A.mass + B.mass
     if not (math.isfinite(M) and A.mass * B.mass / M > 0):
-        raise SceneError(f"{source}: bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
+        raise SceneError(f"{cB.source}: bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
                          f"{_show(B.mass)}: their total and reduced mass must be finite and "
                          "> 0 (kg)")
     if tilt is not None:
-        length = rigid.length if rigid else spring.rest_length  # type: ignore[union-attr]
+        assert length is not None  # a tilt needs a spring or a rod (checked before)
         theta = math.radians(tilt)
         A = Particle(
             "A", A.mass, B.x + length * math.sin(theta), B.height + length * math.cos(theta),
@@ -607,8 +606,8 @@ def _floor(top: _Checker, dims: int) -> Floor | None:
 
 
 def _check_placement(A: Particle, B: Particle, dims: int, floor: Floor | None,
-                     rigid: Rigid | None, source: str) -> None:
-    """Both particles above the floor, A above B in 1D, and a rod as long as A is from B."""
+                     source: str) -> None:
+    """Both particles above the floor, and A above B in 1D."""
     if floor is not None:
         for p in (A, B):
             if p.height < 0:
@@ -621,6 +620,10 @@ def _check_placement(A: Particle, B: Particle, dims: int, floor: Floor | None,
             f"{source}: bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
             f"{_show(B.height)} (A is the top particle in 1D)"
         )
+
+
+def _check_rod(A: Particle, B: Particle, rigid: Rigid | None, source: str) -> None:
+    """A rod as long as A is from B."""
     if rigid is not None:
         dist = math.hypot(A.x - B.x, A.height - B.height)
         if abs(dist - rigid.length) > 1e-9 * max(1.0, rigid.length):

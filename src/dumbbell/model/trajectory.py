@@ -39,7 +39,7 @@ VERDICTS = ("ok", "unstable", "tunnelled", "failed")
 
 _FINITE = math.isfinite
 
-__all__ = ["FIRST_IMPACTS", "VERDICTS", "Contact", "Impact", "Trajectory", "Verdict", "read_only"]
+__all__ = ["Contact", "Impact", "Trajectory", "Verdict"]
 
 
 def _time(value: Any, name: str, optional: bool = False) -> None:
@@ -140,12 +140,8 @@ class Verdict:
         return f"{self.status} at t = {self.t:.6g} s: {self.reason}"
 
 
-def read_only(values: np.ndarray) -> np.ndarray:
-    """A read-only view of the array ``values``; the caller's own array stays writeable."""
-    return _view(args.instance(values, "values", np.ndarray, "a numpy array"))
-
-
 def _view(values: np.ndarray) -> np.ndarray:
+    """A read-only view of the array ``values``; the caller's own array stays writeable."""
     view = values.view()
     view.flags.writeable = False
     return view
@@ -261,7 +257,7 @@ class Trajectory:
         """L_cm (kg m^2/s), computed on first use (2D only)."""
         from .energy import angular_momentum_cm
 
-        return read_only(angular_momentum_cm(self.scene, self.state))
+        return _view(angular_momentum_cm(self.scene, self.state))
 
     def __getitem__(self, name: str) -> np.ndarray:
         if not isinstance(name, str):

@@ -15,7 +15,7 @@ from ..errors import UsageError
 from ..model import args
 from .style import FAIL_COLOURS, legend_outside, pyplot
 
-__all__ = ["axis_label", "stability_map", "sweep_map"]
+__all__ = ["stability_map", "sweep_map"]
 
 
 def _edges(values: np.ndarray, log: bool) -> np.ndarray:

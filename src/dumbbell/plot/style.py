@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["COLOURS", "FAIL_COLOURS", "HEAT_COLOUR", "LABELS", "MOMENTUM_COLOUR", "ROW_COLOURS",
-           "ROW_DASHES", "SOLVER_STYLES", "pyplot", "solver_style"]
+#: No public names: the colours every figure shares.
+__all__: list[str] = []
 
 #: Colour of each particle, the centre of mass and each energy term.
 COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",

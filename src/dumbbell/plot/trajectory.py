@@ -24,7 +24,7 @@ from ..model import args
 from ..model.trajectory import Trajectory
 from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, legend_outside, pyplot
 
-__all__ = ["WINDOW", "energy", "heights", "kinetic", "momentum_panel", "positions", "potential"]
+__all__ = ["energy", "kinetic", "positions", "potential"]
 
 #: The textbook's time window (s).
 WINDOW = 2.0

@@ -13,6 +13,7 @@ runs.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,6 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .base import (
     MAX_SAMPLES,
-    MAX_STEPS,
     RunOptions,
     Solver,
     contract_problems,
@@ -33,7 +33,6 @@ from .euler_cromer import EulerCromer
 from .euler_cromer_2d import EulerCromer2D
 from .exact import Exact
 from .kernels import Kernel
-from .pymunk_settings import PymunkSettings
 from .reference import Reference
 from .stepping import Stepper
 from .verlet import Verlet
@@ -42,28 +41,8 @@ from .verlet import Verlet
 METHODS: dict[str, type[Solver]] = {
     cls.name: cls for cls in (EulerCromer, Exact, Verlet, Pymunk, Reference, EulerCromer2D)
 }
-#: Another name for :data:`METHODS`.
-REGISTRY = METHODS
 
-__all__ = [
-    "MAX_SAMPLES",
-    "MAX_STEPS",
-    "METHODS",
-    "REGISTRY",
-    "Kernel",
-    "PymunkSettings",
-    "RunOptions",
-    "Solver",
-    "Stepper",
-    "available",
-    "make_options",
-    "no_truth_reason",
-    "scene_solver",
-    "simulate",
-    "solver_class",
-    "supported",
-    "truth_solver",
-]
+__all__ = ["METHODS", "Kernel", "RunOptions", "Solver", "Stepper", "available", "simulate"]
 
 
 def solver_class(solver: str | type[Solver]) -> type[Solver]:
@@ -181,7 +160,10 @@ def simulate(
     scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)
-    return cls._solve(scene, make_options(scene, dt, t_end, every, quiet, max_samples))
+    options = make_options(scene, dt, t_end, every, max_samples)
+    if quiet is not True:
+        options = replace(options, quiet=args.flag(quiet, "quiet"))
+    return cls._solve(scene, options)
 
 
 def runnable(cls: type[Solver], scene: Scene) -> None:

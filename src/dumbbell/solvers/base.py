@@ -13,7 +13,7 @@ import functools
 import inspect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
@@ -34,7 +34,7 @@ MAX_IMPACTS = 100_000
 MAX_SEARCH_WORK = 10_000_000
 BLOCK_WORK = 10
 
-__all__ = ["MAX_SAMPLES", "MAX_STEPS", "RunOptions", "Solver", "make_options"]
+__all__ = ["RunOptions", "Solver"]
 
 #: Samples :func:`~dumbbell.solvers.simulate` keeps unless told otherwise (``max_samples``,
 #: ``--max-samples``): 5e6 rows of about ten float64 columns are about 400 MB.
@@ -381,12 +381,12 @@ def point_particle_limits(scene: Scene, name: str) -> str | None:
 
 def make_options(
     scene: Scene, dt: float | None = None, t_end: float | None = None, every: int | None = None,
-    quiet: bool = True, max_samples: int | None = None,
+    max_samples: int | None = None,
 ) -> RunOptions:
-    """Fill run options from the scene's ``[run]`` table and check them (UsageError): ``dt``
-    and ``t_end`` in s, ``every`` in steps (each checked if given; None: the scene's). The
-    step count is checked against :data:`MAX_STEPS` and, when ``max_samples`` is given, the
-    samples kept against it, both as exact integers before anything is allocated."""
+    """Fill (quiet) run options from the scene's ``[run]`` table and check them (UsageError):
+    ``dt`` and ``t_end`` in s, ``every`` in steps (each checked if given; None: the scene's).
+    The step count is checked against :data:`MAX_STEPS` and, when ``max_samples`` is given,
+    the samples kept against it, both as exact integers before anything is allocated."""
     from ..model import args
 
     scene = args.scene(scene)
@@ -397,8 +397,6 @@ def make_options(
     if every is not None:
         every = args.whole(every, "every", "steps", hi=MAX_STEPS)
     options = run_options(scene, dt, t_end, every)
-    if quiet is not True:
-        options = replace(options, quiet=args.flag(quiet, "quiet"))
     if max_samples is not None:
         # The default needs no check (simulate's budget, MAX_SAMPLES).
         budget = (max_samples if max_samples is MAX_SAMPLES

@@ -63,7 +63,8 @@ from .base import ExplicitSpring, RunOptions, Solver
 from .verdicts import RawRun, Sinking, conclude, nonfinite_reason, tunnel_reason
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["Pymunk"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 NAME = "pymunk"
 
@@ -254,9 +255,9 @@ def _energy(
 ) -> dict[str, np.ndarray]:
     """The energy columns (J) from the general accounting of pymunk's own bodies, springs and
     gravity (:mod:`dumbbell.spaces.accounting`), evaluated over all samples at once."""
-    from ..spaces.accounting import State, _evaluate, _inventory
+    from ..spaces.accounting import State, evaluate, inventory
 
-    inv = _inventory(world.space)
+    inv = inventory(world.space)
     n = len(t)
     zero = np.zeros(n)
     if world.rigid_body is not None:
@@ -276,7 +277,7 @@ def _energy(
     extra = len(inv.bodies) - len(omega)
     pad = [zero] * extra
     st = State(*(np.column_stack(c + pad) for c in (*cols, [zero] * len(omega), omega)))
-    return partition_from_terms(scene, t, state, events, _evaluate(inv, st))
+    return partition_from_terms(scene, t, state, events, evaluate(inv, st))
 
 
 #: A touch of the floor that approaches slower than what gravity builds in this many steps

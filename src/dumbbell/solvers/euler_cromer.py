@@ -23,7 +23,8 @@ from .kernels import Kernel
 from .stepping import Stepper
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["EulerCromer"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 
 class EulerCromer(ExplicitSpring, Stepper):

@@ -26,7 +26,8 @@ from .kernels import Kernel
 from .stepping import Stepper
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["EulerCromer2D"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 
 class EulerCromer2D(ExplicitSpring, Stepper):

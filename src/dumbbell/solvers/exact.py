@@ -38,7 +38,8 @@ from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget
 from .verdicts import RawRun, conclude
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["Exact"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 NAME = "exact"
 #: The state columns, in the order the sampling kernel writes them.
@@ -79,12 +80,12 @@ def _kernels(rigid: bool = False) -> Any:
 
     if rigid:  # an end falling onto the floor, then sampled
         end = kernels.End(0.1, 1.0, 0.0, 0.0, 9.8, 1.0)
-        kernels.end_contact(end, 0.0, 1.0, 0.05, 9.9, 0.1, ROOT_XTOL, MIN_SPLIT,
-                            np.array([0.0, math.inf]), 10)
+        kernels.end_contact(end, (0.0, 1.0, 0.05), (9.9, 0.1, ROOT_XTOL, MIN_SPLIT),
+                            (np.array([0.0, math.inf]), 10))
         kernels.rigid_sample(np.zeros((1, 7)), np.linspace(0.0, 1.0, 3), 0.1, -0.1, 9.8)
         return kernels
     m = kernels.Motion(9.8, 63.0, 3969.0, 0.5, 0.5, 0.2, 1.0, ROOT_XTOL, MIN_SPLIT, REST_SPEED)
-    segs = kernels.impacts(np.array([0.0, 1.1, 0.0, 0.0, 0.0]), m, 1.0, True, 10, 10**6, 10)[0]
+    segs = kernels.impacts(np.array([0.0, 1.1, 0.0, 0.0, 0.0]), m, (1.0, 10, 10**6, 10), True)[0]
     kernels.sample(segs, np.linspace(0.0, 1.0, 3), m)
     return kernels
 
@@ -132,8 +133,8 @@ def _segments(scene: Scene, t_end: float) -> tuple[np.ndarray, list[Impact], Ver
     def search(blocks: list[np.ndarray], events: list[Impact]
                ) -> tuple[list[np.ndarray], list[Impact], Verdict]:
         rows, hits, status, rest, work = kernels.impacts(
-            first, m, float(t_end), floor is not None, int(limit), int(work_limit),
-            int(base.BLOCK_WORK))
+            first, m, (float(t_end), int(limit), int(work_limit), int(base.BLOCK_WORK)),
+            floor is not None)
         blocks.append(rows)
         events += [Impact(t, "AB"[int(body)], v, after) for t, body, v, after in hits.tolist()]
         if status == kernels.REST:

@@ -193,8 +193,9 @@ class RigidBody:
         # Without a run's budget, one search still stops: at a run's whole budget.
         allowed = base.MAX_SEARCH_WORK if budget is None else budget.limit - budget.work
         work = np.array([0.0, float(allowed)])
-        root, status = kernels.end_contact(self._end(s, body), float(lo), float(stop), h, C, D,
-                                           ROOT_XTOL, MIN_SPLIT, work, base.BLOCK_WORK)
+        root, status = kernels.end_contact(self._end(s, body), (float(lo), float(stop), h),
+                                           (C, D, ROOT_XTOL, MIN_SPLIT),
+                                           (work, base.BLOCK_WORK))
         if budget is not None:
             budget.spend(int(work[0]))  # raises OverBudget where the search stopped for it
         if status == kernels.ROOT_FAILED or status == kernels.OVER_BUDGET:

@@ -14,7 +14,8 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 #: The public API: the settings record.
-__all__ = ["PymunkSettings"]
+#: No public names: the pymunk solver's settings are ``scene.pymunk``.
+__all__: list[str] = []
 
 
 @dataclass(frozen=True)

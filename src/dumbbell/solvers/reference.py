@@ -60,7 +60,8 @@ from .kernels import REST_SPEED
 from .verdicts import RawRun, head, judge
 
 #: The public API: the solver class (its supports and solve); the rest serves it.
-__all__ = ["Reference"]
+#: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
+__all__: list[str] = []
 
 NAME = "reference"
 

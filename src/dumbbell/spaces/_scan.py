@@ -149,8 +149,6 @@ def _motion(space: Any, bodies: list[Any]) -> np.ndarray:
 
 def scan(space: Any) -> Scan:
     """Read ``space`` (a pymunk.Space, already checked) into a :class:`Scan`."""
-    import pymunk
-
     bodies = list(space.bodies)
     in_space = len(bodies)
     shapes = list(space.shapes)
@@ -173,7 +171,7 @@ def scan(space: Any) -> Scan:
     kinds = np.array([int(b.body_type) for b in bodies], dtype=int)
     owner = np.array([index[id(s.body)] for s in shapes], dtype=int)
     cg = _to_world(pos, angle, cog)
-    geometry = _shapes(shapes, owner, cog, pymunk, pos, angle)
+    geometry = _shapes(shapes, owner, cog, pos, angle)
     filters = [s.filter for s in shapes]
     return Scan(
         space=space, bodies=bodies, in_space=in_space, kind=kinds,
@@ -191,12 +189,14 @@ def scan(space: Any) -> Scan:
     )
 
 
-def _shapes(shapes: list[Any], owner: np.ndarray, cog: np.ndarray, pymunk: Any,
+def _shapes(shapes: list[Any], owner: np.ndarray, cog: np.ndarray,
             pos: np.ndarray | None = None, angle: np.ndarray | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Bounding boxes in world coordinates (from each shape's geometry and its body's ``pos``
     and ``angle`` now, read without touching pymunk's cached ones; nan without them), thinnest
     extents and reaches of ``shapes``."""
+    import pymunk
+
     m = len(shapes)
     size = np.zeros(m)
     reach = np.zeros(m)
@@ -365,16 +365,20 @@ def best_other(sc: Scan, value: np.ndarray, candidate: np.ndarray, idx: np.ndarr
         i = int(idx[k])
         for ca in f.own.get(i, ()):
             for cb, ranked in order.items():
-                if not f.compatible[ca, cb]:
-                    continue
-                for j in ranked:
-                    o = int(sc.owner[j])
-                    if o == i or (i, o) in f.kept_apart:
-                        continue
-                    if which_shape[k] < 0 or better(value[j], out[k]):
-                        out[k], which_shape[k] = value[j], j
-                    break
+                j = _first_other(sc, f, i, ranked) if f.compatible[ca, cb] else -1
+                if j >= 0 and (which_shape[k] < 0 or better(value[j], out[k])):
+                    out[k], which_shape[k] = value[j], j
     return out, which_shape
+
+
+def _first_other(sc: Scan, f: _Filters, i: int, ranked: np.ndarray) -> int:
+    """The first of the shapes ``ranked`` that belongs to a body other than ``i`` and not
+    kept apart from it, or -1."""
+    for j in ranked:
+        o = int(sc.owner[j])
+        if o != i and (i, o) not in f.kept_apart:
+            return int(j)
+    return -1
 
 
 def hittable_in(sc: Scan, i: int, box: np.ndarray) -> np.ndarray:

@@ -39,9 +39,7 @@ from ..model.energy import (
     translational_ke,
 )
 
-__all__ = ["BodyEnergy", "Inventory", "Skipped", "SpaceEnergy", "Spring", "SpringEnergy",
-           "State", "body_label", "constraint_label", "energy", "evaluate", "inventory",
-           "read_state"]
+__all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
 #: Joints that hold no energy and, ideally, do no work.
 _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
@@ -93,41 +91,9 @@ class Inventory:
     notes: tuple[str, ...]
 
 
-def body_label(space: Any, body: Any) -> str:
-    """A body's name in reports: 'body N' by its place in ``space.bodies``, or 'static body'."""
-    from ..model import args
-
-    args.space(space)
-    args.pymunk_object(body, "body", ("Body",))
-    if body is space.static_body:
-        return "static body"
-    for i, other in enumerate(space.bodies):
-        if other is body:
-            return f"body {i}"
-    return "body (not in the space)"
-
-
-def constraint_label(space: Any, constraint: Any) -> str:
-    """A constraint's name in reports: its class and place in ``space.constraints``."""
-    from ..model import args
-
-    args.space(space)
-    args.pymunk_object(constraint, "constraint", ("Constraint",))
-    for i, other in enumerate(space.constraints):
-        if other is constraint:
-            return f"{type(constraint).__name__} {i}"
-    return type(constraint).__name__
-
-
 def inventory(space: Any) -> Inventory:
-    """Take stock of ``space`` (see the module docstring for what is counted and reported)."""
-    from ..model import args
-
-    return _inventory(args.space(space))
-
-
-def _inventory(space: Any) -> Inventory:
-    """:func:`inventory` of a space already checked (the pymunk solver's own)."""
+    """Take stock of a checked ``space`` (see the module docstring for what is counted and
+    reported)."""
     import pymunk
 
     bodies = space.bodies
@@ -147,7 +113,7 @@ def _inventory(space: Any) -> Inventory:
     moments = [i for i, kind in zip(moments_all, types, strict=True)
                if kind == pymunk.Body.DYNAMIC]
     dyn_mass = [m for m, kind in zip(masses, types, strict=True) if kind == pymunk.Body.DYNAMIC]
-    skipped = _skipped_bodies(bodies, types, dyn, moments, labels, name)
+    skipped = _skipped_bodies(bodies, types, name) + _skipped_spins(dyn, moments, labels)
 
     def index(body: Any) -> int:
         i = where.get(id(body))
@@ -285,10 +251,9 @@ def refuse_bad_state(labels: list[str], st: State, mass: Any, moment: Any) -> No
                         "with a density)")
 
 
-def _skipped_bodies(bodies: list[Any], types: list[int], dyn: list[Any], moments: list[float],
-                    labels: list[str], name: Callable[[Any], str]) -> list[Skipped]:
-    """The bodies (or parts of their motion) whose energy is not counted: static and
-    kinematic bodies, and the spin of a dynamic body of infinite moment."""
+def _skipped_bodies(bodies: list[Any], types: list[int], name: Callable[[Any], str]
+                    ) -> list[Skipped]:
+    """The bodies whose energy is not counted: static and kinematic bodies."""
     import pymunk
 
     skipped: list[Skipped] = []
@@ -298,11 +263,15 @@ def _skipped_bodies(bodies: list[Any], types: list[int], dyn: list[Any], moments
         elif kind == pymunk.Body.KINEMATIC:
             skipped.append(Skipped(name(b),
                                    "kinematic: moved by the user, its energy is not counted"))
-    for b, moment, label in zip(dyn, moments, labels, strict=True):
-        if math.isinf(moment) and b.angular_velocity != 0.0:
-            skipped.append(Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} "
-                                          "rad/s: rotational energy left out"))
     return skipped
+
+
+def _skipped_spins(dyn: list[Any], moments: list[float], labels: list[str]) -> list[Skipped]:
+    """The spins not counted: of the dynamic bodies of infinite moment that spin."""
+    return [Skipped(label, f"infinite moment spinning at {b.angular_velocity:g} rad/s: "
+                           "rotational energy left out")
+            for b, moment, label in zip(dyn, moments, labels, strict=True)
+            if math.isinf(moment) and b.angular_velocity != 0.0]
 
 
 def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped:
@@ -347,10 +316,8 @@ def read_state(inv: Inventory) -> State:
     """The present state of the tracked bodies, as one sample: read from pymunk's body
     structs in one pass (the centre of gravity as pymunk holds it), or through pymunk's
     getters on a pymunk build whose structs :mod:`._memory` cannot read."""
-    from ..model import args
     from . import _memory as mem
 
-    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
     if inv.bodies and mem.readable():
         at = mem.addresses(inv.bodies, "_body")
         a = mem.Span.over(at, mem.size("body")).f(
@@ -387,16 +354,6 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
 
     K_int is summed as each body's motion relative to the centre of mass plus its spin
     (Koenig's theorem), which equals K_trans + K_rot - K_cm without the cancellation."""
-    from ..model import args
-
-    args.instance(inv, "inv", Inventory, "an Inventory (from inventory(space))")
-    args.instance(st, "st", State, "a State (from read_state(inv))")
-    return _evaluate(inv, st, args.pair(about, "about", "m"))
-
-
-def _evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
-              ) -> dict[str, np.ndarray]:
-    """:func:`evaluate` of checked values."""
     n = inv.dynamic
     m, moment = inv.mass, inv.moment
     gx, gy = inv.gravity

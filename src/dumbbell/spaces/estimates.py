@@ -55,7 +55,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -199,173 +199,294 @@ def estimate(sc: Scan, dt: float, unit: str = "units") -> Estimates:
     """The reach estimates of every dynamic body of ``sc`` at steps of ``dt`` (s)."""
     import pymunk
 
-    idx = sc.dynamic
-    n = len(idx)
-    pos_of = {int(i): k for k, i in enumerate(idx)}
-    m = sc.mass[idx]
-    inertia = sc.moment[idx]
-    with np.errstate(over="ignore", invalid="ignore"):
-        own_reach = _body_reach(sc, idx)
-        speed_cg = np.hypot(sc.v[idx, 0], sc.v[idx, 1])
-        now = speed_cg + np.abs(sc.w[idx]) * own_reach
-        spin = np.where(np.isfinite(inertia), rotational_ke(np.where(np.isfinite(inertia),
-                                                                       inertia, 0.0),
-                                                              sc.w[idx]), 0.0)
-        kinetic = translational_ke(m, sc.v[idx, 0], sc.v[idx, 1]) + spin
-    down = sc.down()
-    g = sc.g
-    depth_cg = sc.cg @ down
-    labels = {id(c): f"{type(c).__name__} {j}" for j, c in enumerate(sc.space.constraints)}
-    springs = np.zeros(n)
-    pumped: list[list[str]] = [[] for _ in range(n)]
-    held_level = np.full(n, np.nan)
-    held_by = [""] * n
-    region = np.full((n, 4), np.nan)
-    loose = np.zeros(n, dtype=bool)
-    pivot = np.zeros(n, dtype=bool)
-    pivot_inertia = np.array(inertia, dtype=float)
-    pivot_reach = np.array(own_reach, dtype=float)
-    edges: list[tuple[int, int]] = []
-    motor = np.zeros(n)
-    dragged = np.zeros(n)
-    for c in sc.space.constraints:
-        ia, ib = sc.number(c.a), sc.number(c.b)
-        label = labels[id(c)]
-        ka, kb = pos_of.get(ia), pos_of.get(ib)
-        if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
-            u, custom = _spring_energy(c, pymunk)
-            inert = sc.moment if isinstance(c, pymunk.DampedRotarySpring) else sc.mass
-            for k, here, there in ((ka, ia, ib), (kb, ib, ia)):
-                if k is not None:
-                    # Released from rest, a spring gives its end the share m_other / (m +
-                    # m_other) (momentum is shared equally); all of it against a fixed end.
-                    other = inert[there] if sc.kind[there] == DYNAMIC else math.inf
-                    share = 1.0 if math.isinf(other) else other / (inert[here] + other)
-                    springs[k] += u * share
-                    if custom:
-                        pumped[k].append(f"{label} has a custom force: its energy is unknown")
-        if ka is not None and kb is not None:
-            edges.append((ka, kb))
-        if isinstance(c, pymunk.SimpleMotor):
-            for k in (ka, kb):
-                if k is not None:
-                    motor[k] = max(motor[k], abs(float(c.rate)))
-                    pumped[k].append(f"{label} turns it (rate {abs(c.rate):.4g} rad/s)")
-            continue
-        for k, fixed, mine in ((ka, ib, "a"), (kb, ia, "b")):
-            if k is None or sc.kind[fixed] == DYNAMIC:
-                continue
-            if sc.kind[fixed] == KINEMATIC:
-                vk = _anchor_speed(sc, fixed, c, "b" if mine == "a" else "a")
-                if vk > 0:
-                    dragged[k] = max(dragged[k], vk)
-                    pumped[k].append(f"{label} ties it to kinematic {sc.label(fixed)} moving "
-                                     f"at {vk:.4g} {unit}/s")
-            if type(c).__name__ not in HOLDERS or math.isfinite(c.max_force):
-                continue
-            hold = _hold(sc, c, int(idx[k]), fixed, mine, down, float(own_reach[k]), pymunk)
-            if hold is None:
-                continue
-            level, r_pivot, box = hold
-            if r_pivot is not None and not isinstance(c, pymunk.PivotJoint):
-                # A pin or slide of length 0 has no direction to pull along: gravity's kick
-                # each step is undone only by its error correction, a step late.
-                loose[k] = True
-                pumped[k].append(f"{label} has length 0: pymunk cannot tell which way to "
-                                 "pull (a PivotJoint can)")
-            if math.isnan(held_level[k]) or level < held_level[k]:
-                held_level[k] = level
-                held_by[k] = label
-            region[k] = box if np.isnan(region[k]).all() else np.concatenate(
-                [np.maximum(region[k, :2], box[:2]), np.minimum(region[k, 2:], box[2:])])
-            if r_pivot is not None:
-                pivot[k] = True
-                pivot_inertia[k] = inertia[k] + m[k] * r_pivot**2
-                pivot_reach[k] = r_pivot + own_reach[k]
-    # The fall of each body's centre of gravity along gravity.
-    fall = np.zeros(n)
-    level = np.full(n, np.nan)
-    source_fall = [""] * n
-    if g > 0:
+    bodies = _Bodies.of(sc, unit)
+    joints = _Joints.empty(bodies)
+    for j, c in enumerate(sc.space.constraints):
+        joints.add(bodies, _Link.of(sc, bodies, c, j), pymunk)
+    fall, level, source_fall = bodies.falls(joints, pymunk)
+    speed, speeds = bodies.speeds(joints, fall, dt)
+    source, bound = bodies.sources(joints, speed, speeds, source_fall)
+    idx, pivot = bodies.idx, joints.pivot
+    points = np.where(pivot, speed, speed + np.abs(sc.w[idx]) * bodies.own_reach)
+    return Estimates(idx=idx, speed=speed, now=bodies.now, point=pivot, fall=fall, level=level,
+                     held=joints.held_by, source=source, bound=bound, points=points,
+                     kin=speeds.kin, radius=bodies.own_reach, region=joints.region)
+
+
+@dataclass
+class _Bodies:
+    """The dynamic bodies ``idx`` of ``sc`` as the estimate reads them (arrays in that
+    order): mass, moment, the reach of their shapes, the speed of their centre of gravity and
+    of their fastest point now, their kinetic energy; ``down`` the unit vector along gravity
+    and ``unit`` the length unit's name for the texts."""
+
+    sc: Scan
+    unit: str
+    idx: np.ndarray
+    m: np.ndarray
+    inertia: np.ndarray
+    own_reach: np.ndarray
+    speed_cg: np.ndarray
+    now: np.ndarray
+    kinetic: np.ndarray
+    down: np.ndarray
+    places: dict[int, int]
+
+    @classmethod
+    def of(cls, sc: Scan, unit: str) -> _Bodies:
+        idx = sc.dynamic
+        m = sc.mass[idx]
+        inertia = sc.moment[idx]
+        with np.errstate(over="ignore", invalid="ignore"):
+            own_reach = _body_reach(sc, idx)
+            speed_cg = np.hypot(sc.v[idx, 0], sc.v[idx, 1])
+            now = speed_cg + np.abs(sc.w[idx]) * own_reach
+            spin = np.where(np.isfinite(inertia), rotational_ke(
+                np.where(np.isfinite(inertia), inertia, 0.0), sc.w[idx]), 0.0)
+            kinetic = translational_ke(m, sc.v[idx, 0], sc.v[idx, 1]) + spin
+        return cls(sc, unit, idx, m, inertia, own_reach, speed_cg, now, kinetic, sc.down(),
+                   {int(i): k for k, i in enumerate(idx)})
+
+    def falls(self, joints: _Joints, pymunk: Any) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """How far each centre of gravity can fall along gravity (length units), the depth
+        it reaches (nan without gravity) and the text saying so ('' for none)."""
+        sc, idx, n, unit = self.sc, self.idx, len(self.idx), self.unit
+        depth_cg = sc.cg @ self.down
+        fall = np.zeros(n)
+        level = np.full(n, np.nan)
+        source_fall = [""] * n
+        if not sc.g > 0:
+            return fall, level, source_fall
+        held_level = joints.held_level
         held = ~np.isnan(held_level)
         fall[held] = np.maximum(0.0, held_level[held] - depth_cg[idx[held]])
         level[held] = np.maximum(held_level[held], depth_cg[idx[held]])
         for k in np.flatnonzero(held):
-            source_fall[k] = f"held by {held_by[k]}: falls {fall[k]:.4g} {unit}"
+            source_fall[k] = f"held by {joints.held_by[k]}: falls {fall[k]:.4g} {unit}"
         free = [k for k in range(n) if not held[k]]
-        if free:
-            floors = _Floors(sc, down, pymunk)
-            lowest = floors.lowest_reachable(sc, idx, held_level, own_reach)
-            bottoms, starts, radii, filters = _columns(sc, idx, down)
-            for k in free:
-                i = int(idx[k])
-                if filters[k] is None:
-                    continue
-                bottom = float(bottoms[k])
-                floor = floors.level(starts[k], float(radii[k]), filters[k])
-                where = "the floor under it"
-                if floor is None:
-                    floor, where = lowest, "the lowest point it could hit"
-                if floor is None:
-                    continue
-                fall[k] = max(0.0, floor - bottom)
-                level[k] = depth_cg[i] + fall[k]
-                source_fall[k] = f"falls {fall[k]:.4g} {unit} to {where}"
-    # What pumps energy in: kinematic bodies it can hit or is tied to.
-    kin, e_kin = _kinematic_obstacles(sc, idx)
-    pushed = dragged + (1.0 + np.minimum(1.0, e_kin)) * kin
-    with np.errstate(over="ignore", invalid="ignore"):
-        own = kinetic + springs + m * g * fall + translational_ke(m, pushed, 0.0)
-        budget = _pass_on(sc, idx, m, own, edges)
-        h = 0.5 * g * dt
-        free_speed = h + np.sqrt(h * h + 2.0 * budget / m + 2.0 * h * speed_cg)
-        pivot_speed = np.sqrt(2.0 * budget / np.where(pivot_inertia > 0, pivot_inertia,
-                                                        np.inf)) * pivot_reach
-        speed = np.where(pivot, pivot_speed, free_speed) + np.where(loose, g * dt, 0.0)
-        # Speeds past 1e154 overflow as squares: then add them instead (larger, finite).
-        linear = now + pushed + np.sqrt(2.0 * np.maximum(springs + m * g * fall, 0.0) / m)
-        speed = np.where(np.isfinite(speed), speed, linear)
-        speed = np.where(np.isnan(speed), np.inf, speed)
-    bound = np.ones(n, dtype=bool)
-    others = _touches_dynamic(sc, idx)
-    bouncy = _bouncy(sc, idx)
-    joined = np.zeros(n, dtype=bool)
-    for a, b in edges:
-        if a != b:
-            joined[a] = joined[b] = True
-    source = []
-    for k in range(n):
-        why = []
-        i = int(idx[k])
-        if sc.field[i]:
-            pumped[k].append("a custom velocity_func moves it: its field's energy is unknown")
-        if kin[k] > 0:
-            pumped[k].append(f"a kinematic obstacle at {kin[k]:.4g} {unit}/s")
-        if e_kin[k] > 1.0 or bouncy[k]:
-            pumped[k].append("restitution above 1")
-        if motor[k] > 0:
-            reach_k = pivot_reach[k]
-            speed[k] = max(speed[k], (abs(sc.w[i]) + motor[k]) * reach_k
-                           + (0.0 if pivot[k] else speed_cg[k]))
-        if now[k] > speed[k]:
-            speed[k] = now[k]
-            why.append("its speed now")
-        if budget[k] > own[k] * (1 + 1e-12) and not why:
-            why.append("energy passed on by other bodies")
-        elif source_fall[k] and not why:
-            why.append(source_fall[k])
-        elif springs[k] > 0 and not why:
-            why.append("its springs' energy")
-        elif not why:
-            why.append("its kinetic energy now")
-        if pumped[k]:
-            why.append("; ".join(dict.fromkeys(pumped[k])))
-        bound[k] = not (pumped[k] or others[k] or joined[k])
-        source.append("; ".join(why))
-    points = np.where(pivot, speed, speed + np.abs(sc.w[idx]) * own_reach)
-    return Estimates(idx=idx, speed=speed, now=now, point=pivot, fall=fall, level=level,
-                     held=held_by, source=source, bound=bound, points=points, kin=kin,
-                     radius=own_reach, region=region)
+        if not free:
+            return fall, level, source_fall
+        floors = _Floors(sc, self.down, pymunk)
+        lowest = floors.lowest_reachable(sc, idx, held_level, self.own_reach)
+        bottoms, starts, radii, filters = _columns(sc, idx, self.down)
+        for k in free:
+            if filters[k] is None:
+                continue
+            floor = floors.level(starts[k], float(radii[k]), filters[k])
+            where = "the floor under it"
+            if floor is None:
+                floor, where = lowest, "the lowest point it could hit"
+            if floor is None:
+                continue
+            fall[k] = max(0.0, floor - float(bottoms[k]))
+            level[k] = depth_cg[int(idx[k])] + fall[k]
+            source_fall[k] = f"falls {fall[k]:.4g} {unit} to {where}"
+        return fall, level, source_fall
+
+    def speeds(self, joints: _Joints, fall: np.ndarray, dt: float) -> tuple[np.ndarray, _Speeds]:
+        """Each body's speed estimate (length units/s; see the module docstring), before
+        motors and its speed now are counted, and what it was made of."""
+        sc, m, g = self.sc, self.m, self.sc.g
+        kin, e_kin = _kinematic_obstacles(sc, self.idx)
+        pushed = joints.dragged + (1.0 + np.minimum(1.0, e_kin)) * kin
+        springs, pivot = joints.springs, joints.pivot
+        with np.errstate(over="ignore", invalid="ignore"):
+            own = self.kinetic + springs + m * g * fall + translational_ke(m, pushed, 0.0)
+            budget = _pass_on(sc, self.idx, m, own, joints.edges)
+            h = 0.5 * g * dt
+            free_speed = h + np.sqrt(h * h + 2.0 * budget / m + 2.0 * h * self.speed_cg)
+            pivot_speed = np.sqrt(2.0 * budget / np.where(joints.pivot_inertia > 0,
+                                                            joints.pivot_inertia, np.inf)
+                                  ) * joints.pivot_reach
+            speed = np.where(pivot, pivot_speed, free_speed) + np.where(joints.loose, g * dt,
+                                                                        0.0)
+            # Speeds past 1e154 overflow as squares: then add them instead (larger, finite).
+            linear = (self.now + pushed
+                      + np.sqrt(2.0 * np.maximum(springs + m * g * fall, 0.0) / m))
+            speed = np.where(np.isfinite(speed), speed, linear)
+            speed = np.where(np.isnan(speed), np.inf, speed)
+        return speed, _Speeds(kin, e_kin, own, budget)
+
+    def sources(self, joints: _Joints, speed: np.ndarray, speeds: _Speeds,
+                source_fall: list[str]) -> tuple[list[str], np.ndarray]:
+        """Each body's final speed (``speed`` is raised in place by motors and by its speed
+        now), the text saying what sets it, and whether it is a bound."""
+        sc, idx, n, unit = self.sc, self.idx, len(self.idx), self.unit
+        pumped, motor = joints.pumped, joints.motor
+        bound = np.ones(n, dtype=bool)
+        others = _touches_dynamic(sc, idx)
+        bouncy = _bouncy(sc, idx)
+        joined = np.zeros(n, dtype=bool)
+        for a, b in joints.edges:
+            if a != b:
+                joined[a] = joined[b] = True
+        source = []
+        for k in range(n):
+            why = []
+            i = int(idx[k])
+            if sc.field[i]:
+                pumped[k].append("a custom velocity_func moves it: its field's energy is "
+                                 "unknown")
+            if speeds.kin[k] > 0:
+                pumped[k].append(f"a kinematic obstacle at {speeds.kin[k]:.4g} {unit}/s")
+            if speeds.e_kin[k] > 1.0 or bouncy[k]:
+                pumped[k].append("restitution above 1")
+            if motor[k] > 0:
+                speed[k] = max(speed[k], (abs(sc.w[i]) + motor[k]) * joints.pivot_reach[k]
+                               + (0.0 if joints.pivot[k] else self.speed_cg[k]))
+            if self.now[k] > speed[k]:
+                speed[k] = self.now[k]
+                why.append("its speed now")
+            else:
+                why.append(_what_sets(k, speeds, source_fall, joints.springs))
+            if pumped[k]:
+                why.append("; ".join(dict.fromkeys(pumped[k])))
+            bound[k] = not (pumped[k] or others[k] or joined[k])
+            source.append("; ".join(why))
+        return source, bound
+
+
+class _Speeds(NamedTuple):
+    """What the speed estimates were made of (arrays over the bodies): the fastest kinematic
+    obstacle each can hit (length units/s) and the restitution with it, its own energy and
+    its budget (J)."""
+
+    kin: np.ndarray
+    e_kin: np.ndarray
+    own: np.ndarray
+    budget: np.ndarray
+
+
+def _what_sets(k: int, speeds: _Speeds, source_fall: list[str], springs: np.ndarray) -> str:
+    """What sets body ``k``'s energy budget, in words."""
+    if speeds.budget[k] > speeds.own[k] * (1 + 1e-12):
+        return "energy passed on by other bodies"
+    if source_fall[k]:
+        return source_fall[k]
+    if springs[k] > 0:
+        return "its springs' energy"
+    return "its kinetic energy now"
+
+
+@dataclass
+class _Joints:
+    """What the space's constraints do to the dynamic bodies (arrays over them): the energy
+    of their springs (``springs``, J), what pumps energy in (``pumped``: the reasons;
+    ``motor``: a motor's rate, rad/s; ``dragged``: the speed of a kinematic body a joint ties
+    them to), how joints hold them (``held_level``, ``held_by``, ``region``, ``loose``;
+    ``pivot``: turning about a fixed pivot, with ``pivot_inertia`` and ``pivot_reach`` about
+    it), and the joints between two of them (``edges``)."""
+
+    springs: np.ndarray
+    pumped: list[list[str]]
+    held_level: np.ndarray
+    held_by: list[str]
+    region: np.ndarray
+    loose: np.ndarray
+    pivot: np.ndarray
+    pivot_inertia: np.ndarray
+    pivot_reach: np.ndarray
+    edges: list[tuple[int, int]]
+    motor: np.ndarray
+    dragged: np.ndarray
+
+    @classmethod
+    def empty(cls, bodies: _Bodies) -> _Joints:
+        n = len(bodies.idx)
+        return cls(springs=np.zeros(n), pumped=[[] for _ in range(n)],
+                   held_level=np.full(n, np.nan), held_by=[""] * n,
+                   region=np.full((n, 4), np.nan), loose=np.zeros(n, dtype=bool),
+                   pivot=np.zeros(n, dtype=bool),
+                   pivot_inertia=np.array(bodies.inertia, dtype=float),
+                   pivot_reach=np.array(bodies.own_reach, dtype=float), edges=[],
+                   motor=np.zeros(n), dragged=np.zeros(n))
+
+    def add(self, bodies: _Bodies, link: _Link, pymunk: Any) -> None:
+        """What the constraint of ``link`` does to the bodies it joins."""
+        sc, c = bodies.sc, link.c
+        if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
+            self._spring(sc, link, pymunk)
+        if link.ka is not None and link.kb is not None:
+            self.edges.append((link.ka, link.kb))
+        if isinstance(c, pymunk.SimpleMotor):
+            for k in (link.ka, link.kb):
+                if k is not None:
+                    self.motor[k] = max(self.motor[k], abs(float(c.rate)))
+                    self.pumped[k].append(f"{link.label} turns it (rate {abs(c.rate):.4g} "
+                                          "rad/s)")
+            return
+        for k, fixed, mine in ((link.ka, link.ib, "a"), (link.kb, link.ia, "b")):
+            if k is not None and sc.kind[fixed] != DYNAMIC:
+                self._fixed_end(bodies, link, (k, fixed, mine), pymunk)
+
+    def _spring(self, sc: Scan, link: _Link, pymunk: Any) -> None:
+        c = link.c
+        u, custom = _spring_energy(c, pymunk)
+        inert = sc.moment if isinstance(c, pymunk.DampedRotarySpring) else sc.mass
+        for k, here, there in ((link.ka, link.ia, link.ib), (link.kb, link.ib, link.ia)):
+            if k is not None:
+                # Released from rest, a spring gives its end the share m_other / (m +
+                # m_other) (momentum is shared equally); all of it against a fixed end.
+                other = inert[there] if sc.kind[there] == DYNAMIC else math.inf
+                share = 1.0 if math.isinf(other) else other / (inert[here] + other)
+                self.springs[k] += u * share
+                if custom:
+                    self.pumped[k].append(f"{link.label} has a custom force: its energy is "
+                                          "unknown")
+
+    def _fixed_end(self, bodies: _Bodies, link: _Link, end: tuple[int, int, str],
+                   pymunk: Any) -> None:
+        """Body ``k`` on end ``mine`` of ``link``, the other end the static or kinematic
+        body ``fixed``: dragged by a moving kinematic body, held by a holding joint."""
+        sc, c = bodies.sc, link.c
+        k, fixed, mine = end
+        if sc.kind[fixed] == KINEMATIC:
+            vk = _anchor_speed(sc, fixed, c, "b" if mine == "a" else "a")
+            if vk > 0:
+                self.dragged[k] = max(self.dragged[k], vk)
+                self.pumped[k].append(f"{link.label} ties it to kinematic {sc.label(fixed)} "
+                                      f"moving at {vk:.4g} {bodies.unit}/s")
+        if type(c).__name__ not in HOLDERS or math.isfinite(c.max_force):
+            return
+        hold = _hold(sc, c, (int(bodies.idx[k]), fixed, mine), bodies.down,
+                     float(bodies.own_reach[k]))
+        if hold is None:
+            return
+        level, r_pivot, box = hold
+        if r_pivot is not None and not isinstance(c, pymunk.PivotJoint):
+            # A pin or slide of length 0 has no direction to pull along: gravity's kick
+            # each step is undone only by its error correction, a step late.
+            self.loose[k] = True
+            self.pumped[k].append(f"{link.label} has length 0: pymunk cannot tell which way "
+                                  "to pull (a PivotJoint can)")
+        if math.isnan(self.held_level[k]) or level < self.held_level[k]:
+            self.held_level[k] = level
+            self.held_by[k] = link.label
+        self.region[k] = box if np.isnan(self.region[k]).all() else np.concatenate(
+            [np.maximum(self.region[k, :2], box[:2]), np.minimum(self.region[k, 2:], box[2:])])
+        if r_pivot is not None:
+            self.pivot[k] = True
+            self.pivot_inertia[k] = bodies.inertia[k] + bodies.m[k] * r_pivot**2
+            self.pivot_reach[k] = r_pivot + bodies.own_reach[k]
+
+
+class _Link(NamedTuple):
+    """A constraint as the estimate reads it: its label, its bodies' numbers in the scan
+    (``ia``, ``ib``) and their places among the dynamic bodies (None for others)."""
+
+    c: Any
+    label: str
+    ia: int
+    ib: int
+    ka: int | None
+    kb: int | None
+
+    @classmethod
+    def of(cls, sc: Scan, bodies: _Bodies, c: Any, j: int) -> _Link:
+        """Constraint ``c``, the ``j``-th of the space."""
+        ia, ib = sc.number(c.a), sc.number(c.b)
+        return cls(c, f"{type(c).__name__} {j}", ia, ib, bodies.places.get(ia),
+                   bodies.places.get(ib))
 
 
 def _body_reach(sc: Scan, idx: np.ndarray) -> np.ndarray:
@@ -399,12 +520,15 @@ def _anchor_speed(sc: Scan, i: int, c: Any, which: str) -> float:
     return float(math.hypot(*sc.v[i]) + abs(sc.w[i]) * r)
 
 
-def _hold(sc: Scan, c: Any, i: int, fixed: int, mine: str, down: np.ndarray,
-          own_reach: float, pymunk: Any) -> tuple[float, float | None, np.ndarray] | None:
-    """How joint ``c`` holds dynamic body ``i`` to the fixed body ``fixed``: the lowest depth
-    its centre of gravity can reach, for a pivot (a joint of length 0) the distance from the
-    pivot to the centre of gravity (else None), and the box (left, bottom, right, top) its
-    shapes cannot leave."""
+def _hold(sc: Scan, c: Any, end: tuple[int, int, str], down: np.ndarray, own_reach: float
+          ) -> tuple[float, float | None, np.ndarray] | None:
+    """How joint ``c`` holds dynamic body ``i`` on its end ``mine`` (``end`` = (i, fixed,
+    mine)) to the fixed body ``fixed``: the lowest depth its centre of gravity can reach, for
+    a pivot (a joint of length 0) the distance from the pivot to the centre of gravity (else
+    None), and the box (left, bottom, right, top) its shapes cannot leave."""
+    import pymunk
+
+    i, fixed, mine = end
     body, other = sc.bodies[i], sc.bodies[fixed]
     cog = body.center_of_gravity
 

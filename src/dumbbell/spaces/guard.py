@@ -40,7 +40,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -206,15 +206,21 @@ def spring_omega(spring: Any) -> float:
 def shape_size(shape: Any) -> float:
     """The thinnest extent of a shape (length units): a circle's diameter, a segment's
     thickness (2 x radius), a polygon's least width across an edge plus 2 x radius."""
-    import pymunk
-
     args.pymunk_object(shape, "shape", ("Shape",))
-    return float(_shapes([shape], np.zeros(1, dtype=int), np.zeros((1, 2)), pymunk)[1][0])
+    return float(_shapes([shape], np.zeros(1, dtype=int), np.zeros((1, 2)))[1][0])
 
 
-def _spring_row(kind: str, subject: str, w: float, dt: float, tolerance: float,
-                extra: str = "") -> Finding:
-    """A spring's finding: w*dt against the w*dt whose swing is ``tolerance``."""
+class _Judged(NamedTuple):
+    """The step a spring is judged at: ``dt`` (s) and the largest energy swing allowed
+    (``tolerance``, a fraction; math.inf: stability only)."""
+
+    dt: float
+    tolerance: float
+
+
+def _spring_row(kind: str, subject: str, w: float, at: _Judged, extra: str = "") -> Finding:
+    """A spring's finding: w*dt against the w*dt whose swing is ``at.tolerance``."""
+    dt, tolerance = at
     z = w * dt
     limit = _swing_limit(tolerance)
     dt_max = limit / w
@@ -241,7 +247,7 @@ def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
         if w == 0.0:
             continue
         kind = "rotary-spring" if isinstance(c, pymunk.DampedRotarySpring) else "spring"
-        rows.append(_spring_row(kind, f"{type(c).__name__} {j}", w, dt, tolerance))
+        rows.append(_spring_row(kind, f"{type(c).__name__} {j}", w, _Judged(dt, tolerance)))
     return rows
 
 
@@ -270,7 +276,7 @@ def _networks(space: Any, sc: Scan, dt: float, tolerance: float) -> list[Finding
     for body, w2, count in bound.values():
         if count >= 2:
             rows.append(_spring_row("spring-network", sc.label(sc.number(body)),
-                                    math.sqrt(w2), dt, tolerance,
+                                    math.sqrt(w2), _Judged(dt, tolerance),
                                     f"{count} springs on it, w <= bound; "))
     return rows
 

@@ -62,7 +62,7 @@ import warnings
 import weakref
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -230,6 +230,18 @@ class _Reader:
         return self.span.u64[self.pi]
 
 
+class _Members(NamedTuple):
+    """The constraints of one struct kind as the build lists them: the objects, their
+    labels, the table rows of their two bodies, and whether each (a spring) has pymunk's
+    own force."""
+
+    objs: list[Any]
+    labels: list[str]
+    a: list[int]
+    b: list[int]
+    default: list[bool]
+
+
 class _Group:
     """The constraints of one struct kind: rows of their two bodies in the table, readers,
     and running sums (J) per constraint: ``work`` (work of its impulses on the relative
@@ -237,15 +249,15 @@ class _Group:
     (a spring's potential change over the steps' moves), ``kin_a``/``kin_b`` (work of a
     driven end through it)."""
 
-    def __init__(self, kind: str, objs: list[Any], labels: list[str], a: list[int],
-                 b: list[int], default: list[bool]) -> None:
+    def __init__(self, kind: str, members: _Members) -> None:
+        objs = members.objs
         self.kind = kind
         self.objs = objs
-        self.labels = labels
+        self.labels = members.labels
         self.at = np.array([mem.address(c._constraint) for c in objs], dtype=np.uint64)
-        self.a = np.array(a, dtype=np.int64)
-        self.b = np.array(b, dtype=np.int64)
-        self.default = np.array(default, dtype=bool)
+        self.a = np.array(members.a, dtype=np.int64)
+        self.b = np.array(members.b, dtype=np.int64)
+        self.default = np.array(members.default, dtype=bool)
         self.spring = kind in ("spring", "rotary_spring")
         self.slot = -1  # place among the space's spring groups
         func = {"spring": ("force_func",), "rotary_spring": ("torque_func",)}.get(kind, ())
@@ -469,12 +481,13 @@ class _Contacts:
         self.j0 = j0
         return True
 
-    def work(self, coef: float, u: np.ndarray, imp: np.ndarray, table: _Table,
-             pairs: _Pairs, drive: np.ndarray) -> tuple[float, np.ndarray]:
+    def work(self, step: _Step, table: _Table, pairs: _Pairs, drive: np.ndarray
+             ) -> tuple[float, np.ndarray]:
         """Work (J) of the step's contact impulses (see :func:`._kernels.contacts`), and the
         bias impulse of each arbiter on its dynamic ends."""
         from . import _kernels
 
+        coef, u, imp = step.coef, step.u, step.imp
         c = self.c
         push = np.empty(len(self.ra))
         total = _kernels.contacts()(
@@ -791,6 +804,26 @@ class Ledger:
         t = self._t = _Table(self)
         n = t.n
         labels = self._row_labels = [self._labels[u] for u in t.uid]
+        self._build_groups(t)
+        custom_pos = self._build_funcs(t)
+        self._build_fields(t)
+        for i in np.nonzero(self._custom & ~self._declared)[0]:
+            self._current[labels[i]] = ("custom velocity_func and no declared potential "
+                                            "(declare_potential): its kicks are counted as "
+                                            "work, the energy of its field is not in E")
+        for i in np.nonzero(custom_pos)[0]:
+            self._current[labels[i]] = "custom position_func: its moves are not predicted"
+        sp = mem.view("space", self._space_at)
+        self._gravity = (float(sp.gravity.x), float(sp.gravity.y))
+        z = np.zeros(n)
+        self._acc = {name: z.copy() for name in ("force", "vf", "unattributed", "program")}
+        self._acc_kin = np.zeros(t.rows)
+        self._acc_field = np.zeros(len(self._fields))
+        self._push = None
+
+    def _build_groups(self, t: _Table) -> None:
+        """The constraints by struct kind (:class:`_Group`), the springs among them, and
+        the constraints the ledger cannot read or whose energy is not in E, named."""
         rows = {int(a): r for r, a in enumerate(t.at)}
         by_kind: dict[str, tuple[list[Any], ...]] = {}
         for i, c in enumerate(t.constraint_key):
@@ -811,18 +844,27 @@ class Ledger:
             for lst, value in zip(entry, (c, clabel, rows[mem.address(c.a._body)],
                                           rows[mem.address(c.b._body)], default), strict=True):
                 lst.append(value)
-        self._groups = {kind: _Group(kind, *entry) for kind, entry in by_kind.items()}
+        self._groups = {kind: _Group(kind, _Members(*entry)) for kind, entry in by_kind.items()}
         self._springs = [g for g in self._groups.values() if g.spring]
         for slot, g in enumerate(self._springs):
             g.slot = slot
+
+    def _build_funcs(self, t: _Table) -> np.ndarray:
+        """The dynamic bodies' velocity and position functions, which of them are custom;
+        returns where the position function is."""
+        n = t.n
         ptrs = t.pre.pointers()
         vel_default, pos_default = mem.default_funcs()
         self._vf, self._pf = ptrs[1, :n].copy(), ptrs[2, :n].copy()
         self._custom = ~np.isin(self._vf, np.array(sorted(vel_default), dtype=np.uint64))
         self._any_custom = bool(np.any(self._custom))
-        custom_pos = ~np.isin(self._pf, np.array(sorted(pos_default), dtype=np.uint64))
         self._vel_funcs = [t.bodies[i]._velocity_func if self._custom[i] else None
                            for i in range(n)]
+        return ~np.isin(self._pf, np.array(sorted(pos_default), dtype=np.uint64))
+
+    def _build_fields(self, t: _Table) -> None:
+        """The declared fields on the bodies they now apply to, and which bodies have one."""
+        n = t.n
         self._fields: list[tuple[np.ndarray, Callable[..., Any], str]] = []
         declared = np.zeros(n, dtype=bool)
         for key, potential, lab in self._potentials:
@@ -834,19 +876,6 @@ class Ledger:
                 self._fields.append((np.array(idx, dtype=np.int64), potential, lab))
                 declared[idx] = True
         self._declared = declared
-        for i in np.nonzero(self._custom & ~declared)[0]:
-            self._current[labels[i]] = ("custom velocity_func and no declared potential "
-                                            "(declare_potential): its kicks are counted as "
-                                            "work, the energy of its field is not in E")
-        for i in np.nonzero(custom_pos)[0]:
-            self._current[labels[i]] = "custom position_func: its moves are not predicted"
-        sp = mem.view("space", self._space_at)
-        self._gravity = (float(sp.gravity.x), float(sp.gravity.y))
-        z = np.zeros(n)
-        self._acc = {name: z.copy() for name in ("force", "vf", "unattributed", "program")}
-        self._acc_kin = np.zeros(t.rows)
-        self._acc_field = np.zeros(len(self._fields))
-        self._push = None
 
     def _changed(self, F: np.ndarray, P: np.ndarray) -> str:
         """What changed in the space since the last build ('' when nothing)."""
@@ -861,6 +890,11 @@ class Ledger:
         if not (np.array_equal(P[1, : t.n], self._vf) and np.array_equal(P[2, : t.n],
                                                                         self._pf)):
             return "a velocity_func or position_func"
+        return self._changed_settings()
+
+    def _changed_settings(self) -> str:
+        """What changed since the last build in the space's gravity, the springs' settings
+        and the custom velocity functions ('' when nothing)."""
         sp = mem.view("space", self._space_at)
         if (sp.gravity.x, sp.gravity.y) != self._gravity:
             return "space.gravity"
@@ -868,7 +902,7 @@ class Ledger:
             if g.changed():
                 return f"a {g.kind.replace('_', ' ')}'s settings"
         if self._any_custom:
-            bodies = t.bodies
+            bodies = self._t.bodies
             for i in np.nonzero(self._custom)[0]:
                 if bodies[i]._velocity_func is not self._vel_funcs[i]:
                     return "a velocity_func"
@@ -1047,7 +1081,26 @@ class Ledger:
     # -- running sums into named terms -------------------------------------------------
 
     def _fold(self) -> None:
-        t = self._t
+        """Move the running sums into the named terms (and zero them)."""
+        self._fold_bodies()
+        for j, (_, _, lab) in enumerate(self._fields):
+            if self._acc_field[j]:
+                self._add(lab, "step error", float(self._acc_field[j]),
+                          "declared field: its kicks and its potential's change over the moves")
+        self._acc_field[:] = 0.0
+        labels, n = self._row_labels, self._t.n
+        for r in np.nonzero(self._acc_kin)[0]:
+            src = (f"{labels[r]} through contacts" if r >= n else
+                   f"fixed spin of {labels[r]} through contacts")
+            self._add(src, "kinematic", float(self._acc_kin[r]),
+                      "work of a body whose motion the program imposes")
+        self._acc_kin[:] = 0.0
+        for g in self._groups.values():
+            self._fold_group(g)
+
+    def _fold_bodies(self) -> None:
+        """The per-body sums: forces, unexplained impulses (rounding apart), the program's
+        changes and custom velocity functions."""
         labels = self._row_labels
         kinds = {"force": ("force on {}", "force", "work of Body.force"),
                  "unattributed": ("{}", "unattributed", "an impulse no source explains"),
@@ -1071,37 +1124,30 @@ class Ledger:
                       "kicks of a custom velocity_func and the moves they cause (no declared "
                       "potential)")
         vf[:] = 0.0
-        for j, (_, _, lab) in enumerate(self._fields):
-            if self._acc_field[j]:
-                self._add(lab, "step error", float(self._acc_field[j]),
-                          "declared field: its kicks and its potential's change over the moves")
-        self._acc_field[:] = 0.0
-        for r in np.nonzero(self._acc_kin)[0]:
-            src = (f"{labels[r]} through contacts" if r >= t.n else
-                   f"fixed spin of {labels[r]} through contacts")
-            self._add(src, "kinematic", float(self._acc_kin[r]),
-                      "work of a body whose motion the program imposes")
-        self._acc_kin[:] = 0.0
-        for g in self._groups.values():
-            for i, lab in enumerate(g.labels):
-                if g.spring and g.default[i]:
-                    self._add(lab, "step error", float(g.work[i] + g.pot[i]),
-                              "spring: its kicks and its potential's change over the moves")
-                    self._add(f"{lab} damping", "spring damping", float(g.extra[i]))
-                elif g.spring:
-                    self._add(lab, "custom spring", float(g.work[i] + g.extra[i]),
-                              "work of a spring with a custom force function")
-                else:
-                    self._add(lab, "constraint", float(g.work[i]), _joint_note(g.objs[i]))
-                for row, acc in ((g.a[i], g.kin_a), (g.b[i], g.kin_b)):
-                    if acc[i]:
-                        who = labels[row]
-                        src = (f"{who} through {lab}" if row >= t.n else
-                               f"fixed spin of {who} through {lab}")
-                        self._add(src, "kinematic", float(acc[i]),
-                                  "work of a body whose motion the program imposes")
-            for arr in (g.work, g.extra, g.pot, g.kin_a, g.kin_b):
-                arr[:] = 0.0
+
+    def _fold_group(self, g: _Group) -> None:
+        """The sums of the constraints of ``g``: each one's work (a spring's step error and
+        damping), and what driven ends did through it."""
+        labels, n = self._row_labels, self._t.n
+        for i, lab in enumerate(g.labels):
+            if g.spring and g.default[i]:
+                self._add(lab, "step error", float(g.work[i] + g.pot[i]),
+                          "spring: its kicks and its potential's change over the moves")
+                self._add(f"{lab} damping", "spring damping", float(g.extra[i]))
+            elif g.spring:
+                self._add(lab, "custom spring", float(g.work[i] + g.extra[i]),
+                          "work of a spring with a custom force function")
+            else:
+                self._add(lab, "constraint", float(g.work[i]), _joint_note(g.objs[i]))
+            for row, acc in ((g.a[i], g.kin_a), (g.b[i], g.kin_b)):
+                if acc[i]:
+                    who = labels[row]
+                    src = (f"{who} through {lab}" if row >= n else
+                           f"fixed spin of {who} through {lab}")
+                    self._add(src, "kinematic", float(acc[i]),
+                              "work of a body whose motion the program imposes")
+        for arr in (g.work, g.extra, g.pot, g.kin_a, g.kin_b):
+            arr[:] = 0.0
 
     # -- the step ----------------------------------------------------------------------
 
@@ -1117,86 +1163,110 @@ class Ledger:
             self._restructure(reason, dt)
             t = self._t
             F, P = t.pre.floats(), t.pre.pointers()
-        s = self._snap
+        move, total = self._move(F[0:3], F[3:6], dt)
+        g_int, g_rows, corr = self._gravity_over(move)
+        pots, corr = self._potentials_over(move, corr)
+        total, corr = self._carried_push(dt, total, corr)
+        if corr:
+            self._add("position correction", "correction", corr,
+                      "potential energy the contacts' position correction adds (beyond each "
+                      "pair's part through gravity)")
         n = t.n
-        pos, vel, bias = F[0:3], F[3:6], s["bias"]
-        gx, gy = self._gravity
-        m = t.m
-        # pymunk's move: p += (v + v_bias) dt for awake dynamic and kinematic bodies.
+        force = F[6:9, :n]
+        awake = P[0, :n] == 0
+        coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
+        self._pending = {
+            "dt": dt, "coef": coef,
+            "pos": move.pos, "vel": move.vel, "force": force if force.any() else None,
+            "awake": None if awake.all() else awake, "g_int": g_int, "g_rows": g_rows,
+            "spring_int": pots.spring_int, "d_int": pots.d_int, "u_end": pots.u_end,
+            "d_end": pots.d_end,
+            "initial": [g.before.floats() for g in self._groups.values()],
+            "contacts": self._contacts.before(t, self._pairs, coef),
+            "total": total + corr,
+        }
+
+    def _move(self, pos: np.ndarray, vel: np.ndarray, dt: float) -> tuple[_Move, float]:
+        """pymunk's move, p += (v + v_bias) dt for awake dynamic and kinematic bodies, from
+        the snapshot to ``pos``: where each body started (the program may have moved it,
+        woken it or put it to sleep) and how long it moved; and the energy of what the
+        program changed since the snapshot, counted (J)."""
+        t, s = self._t, self._snap
+        n = t.n
         moving = t.moves
         if s["asleep"]:
             moving = moving.copy()
             moving[:n] &= ~s["sleeping"]
         total = 0.0
         start = s["pos"]
-        if not np.array_equal(pos, np.where(moving, start + (vel + bias) * dt, start)):
+        if not np.array_equal(pos, np.where(moving, start + (vel + s["bias"]) * dt, start)):
             moving, start = self._moved_how(pos, vel, dt, moving)
         if start is not s["pos"] or not np.array_equal(vel[:, :n], s["vel"][:, :n]):
             total += self._program(start, vel)
         step = np.where(moving, dt, 0.0) if start is not s["pos"] or s["asleep"] else dt
-        biased = s["biased"]
-        # Gravity's potential over the move: all of it, less the bias velocities' part
-        # (position correction), which leaves the velocities' part.
+        return _Move(pos, vel, start, step), total
+
+    def _gravity_over(self, move: _Move) -> tuple[float, np.ndarray | None, float]:
+        """Gravity's potential over the move (J): all of it, less the bias velocities' part
+        (position correction), which leaves the velocities' part; the same per dynamic row
+        when custom velocity functions need it (else None); and the correction's part."""
+        t, s = self._t, self._snap
+        n, m = t.n, t.m
+        gx, gy = self._gravity
+        pos, start = move.pos, move.start
         dU = -(gx * (m @ (pos[0, :n] - start[0, :n])) + gy * (m @ (pos[1, :n] - start[1, :n])))
         corr = 0.0
-        if biased:
-            b = bias[:, :n] * (step[:n] if isinstance(step, np.ndarray) else step)
+        b = None
+        if s["biased"]:
+            b = s["bias"][:, :n] * (move.step[:n] if isinstance(move.step, np.ndarray)
+                                    else move.step)
             corr = -(gx * (m @ b[0]) + gy * (m @ b[1]))
-        g_int_total = float(dU - corr)
         g_rows = None
         if self._any_custom:
             g_rows = -m * (gx * (pos[0, :n] - start[0, :n]) + gy * (pos[1, :n] - start[1, :n]))
-            if biased:
+            if b is not None:
                 g_rows = g_rows + m * (gx * b[0] + gy * b[1])
-        spring_int: list[np.ndarray] = []
-        u_end: list[np.ndarray] = []
-        d_end = s["ud"]
-        d_int = None
-        if self._springs or self._fields:
-            u_start = s["us"] if start is s["pos"] else self._spring_energy(start)
-            u_end = self._spring_energy(pos)
-            spring_int = [b2 - a2 for a2, b2 in zip(u_start, u_end, strict=True)]
-            d_start = s["ud"] if start is s["pos"] else self._field_energy(start)
-            d_end = self._field_energy(pos)
-            d_int = d_end - d_start
-            if biased:
-                mid = start + vel * step
-                end = mid + bias * step
-                u1, u2 = self._spring_energy(mid), self._spring_energy(end)
-                for j in range(len(spring_int)):
-                    spring_int[j] = spring_int[j] - (u2[j] - u1[j])
-                    corr += float(np.sum(u2[j] - u1[j]))
-                if self._fields:
-                    f1, f2 = self._field_energy(mid), self._field_energy(end)
-                    d_int = d_int - (f2 - f1)
-                    corr += float(np.sum(f2 - f1))
-        # Gravity's part of the correction per pair, from the bias impulses of the last
-        # step; the rest (springs, fields) as one term.
-        if self._push is not None:
-            slots, jx, jy = self._push
-            share = -(gx * jx + gy * jy) * dt
-            self._pairs.push += np.bincount(slots, weights=share,
-                                            minlength=len(self._pairs.push))
-            pushed = float(np.sum(share))
-            total += pushed
-            corr -= pushed
-            self._push = None
-        if corr:
-            self._add("position correction", "correction", corr,
-                      "potential energy the contacts' position correction adds (beyond each "
-                      "pair's part through gravity)")
-        force = F[6:9, :n]
-        awake = P[0, :n] == 0
-        coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
-        self._pending = {
-            "dt": dt, "coef": coef,
-            "pos": pos, "vel": vel, "force": force if force.any() else None,
-            "awake": None if awake.all() else awake, "g_int": g_int_total, "g_rows": g_rows,
-            "spring_int": spring_int, "d_int": d_int, "u_end": u_end, "d_end": d_end,
-            "initial": [g.before.floats() for g in self._groups.values()],
-            "contacts": self._contacts.before(t, self._pairs, coef),
-            "total": total + corr,
-        }
+        return float(dU - corr), g_rows, corr
+
+    def _potentials_over(self, move: _Move, corr: float) -> tuple[_Potentials, float]:
+        """The springs' and the declared fields' potentials over the move, less the bias
+        velocities' part, which is added to the correction ``corr`` (J)."""
+        s = self._snap
+        if not (self._springs or self._fields):
+            return _Potentials([], [], None, s["ud"]), corr
+        pos, start, step = move.pos, move.start, move.step
+        same = start is s["pos"]
+        u_start = s["us"] if same else self._spring_energy(start)
+        u_end = self._spring_energy(pos)
+        spring_int = [b2 - a2 for a2, b2 in zip(u_start, u_end, strict=True)]
+        d_start = s["ud"] if same else self._field_energy(start)
+        d_end = self._field_energy(pos)
+        d_int = d_end - d_start
+        if s["biased"]:
+            mid = start + move.vel * step
+            end = mid + s["bias"] * step
+            u1, u2 = self._spring_energy(mid), self._spring_energy(end)
+            for j in range(len(spring_int)):
+                spring_int[j] = spring_int[j] - (u2[j] - u1[j])
+                corr += float(np.sum(u2[j] - u1[j]))
+            if self._fields:
+                f1, f2 = self._field_energy(mid), self._field_energy(end)
+                d_int = d_int - (f2 - f1)
+                corr += float(np.sum(f2 - f1))
+        return _Potentials(spring_int, u_end, d_int, d_end), corr
+
+    def _carried_push(self, dt: float, total: float, corr: float) -> tuple[float, float]:
+        """Gravity's part of the position correction per pair, from the bias impulses of
+        the last step, moved from the correction ``corr`` to the pairs and the ``total``."""
+        if self._push is None:
+            return total, corr
+        gx, gy = self._gravity
+        slots, jx, jy = self._push
+        share = -(gx * jx + gy * jy) * dt
+        self._pairs.push += np.bincount(slots, weights=share, minlength=len(self._pairs.push))
+        pushed = float(np.sum(share))
+        self._push = None
+        return total + pushed, corr - pushed
 
     def _moved_how(self, pos: np.ndarray, vel: np.ndarray, dt: float, moving: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
@@ -1219,37 +1289,44 @@ class Ledger:
         and close the step."""
         t = self._t
         p = self._pending
-        n, rows = t.n, t.rows
         Q = t.post.floats()
-        dt, coef = p["dt"], p["coef"]
         vel0, vel1 = p["vel"], Q[0:3]
+        damping = float(mem.view("space", self._space_at).damping)
         # Velocities the sources act on: the mean of before and after (kinematic bodies
         # keep theirs; static ones have none).
-        u = (vel0 + vel1) * 0.5
-        imp = np.zeros((3, rows))    # impulses on each row: x, y, angular
-        damping = float(mem.view("space", self._space_at).damping)
-        kick = np.zeros((3, rows)) if damping != 1.0 and self._springs else None
+        step = _Step(p["dt"], p["coef"], p["pos"], vel0, vel1, (vel0 + vel1) * 0.5,
+                     np.zeros((3, t.rows)),
+                     np.zeros((3, t.rows)) if damping != 1.0 and self._springs else None,
+                     p["spring_int"])
         total = p["total"]
         for g, initial in zip(self._groups.values(), p["initial"], strict=True):
-            total += _constraint_work(t, g, g.after.floats(), initial, coef, dt, u,
-                                      p["pos"], imp, kick, p["spring_int"])
+            total += _constraint_work(t, g, g.after.floats(), initial, step)
         if p["contacts"]:
-            total += self._contact_work(coef, u, imp)
-        m = t.m
+            total += self._contact_work(step)
         kicked = p["awake"]
         if self._any_custom:
             kicked = ~self._custom if kicked is None else kicked & ~self._custom
+        ext, w_g, total = self._external(step, kicked, damping, total)
+        total = self._unexplained(step, ext, w_g, total)
+        self._close_step(Q, step.dt, total)
+
+    def _external(self, step: _Step, kicked: np.ndarray | None, damping: float,
+                  total: float) -> tuple[np.ndarray, float, float]:
+        """The impulses from outside the constraints and contacts (3, dynamic rows):
+        gravity, m g dt on every awake body the default velocity_func moves (``kicked``:
+        which, None for all), applied forces and torques (pymunk clears them after the
+        step), and ``space.damping``; gravity's work (J), and ``total`` with the others'."""
+        t = self._t
+        n, m, dt = t.n, t.m, step.dt
         gx, gy = self._gravity
-        un = u[:, :n]
-        # Gravity: impulse m g dt on every awake body the default velocity_func moves;
-        # applied forces and torques (pymunk clears them after the step); space.damping.
+        un = step.u[:, :n]
         mk = m * dt if kicked is None else np.where(kicked, m * dt, 0.0)
         ext = np.zeros((3, n))
         ext[0] = mk * gx
         ext[1] = mk * gy
         w_g = float(gx * (mk @ un[0]) + gy * (mk @ un[1]))
-        if p["force"] is not None:
-            force = p["force"] * dt
+        if self._pending["force"] is not None:
+            force = self._pending["force"] * dt
             if kicked is not None:
                 force = np.where(kicked, force, 0.0)
             force[2] = np.where(t.finite, force[2], 0.0)
@@ -1259,7 +1336,8 @@ class Ledger:
             ext += force
         if damping != 1.0:
             d = damping ** dt
-            before = vel0[:, :n] if kick is None else vel0[:, :n] + kick[:, :n] * t.inv3
+            kick = step.kick
+            before = step.vel0[:, :n] if kick is None else step.vel0[:, :n] + kick[:, :n] * t.inv3
             D = (d - 1.0) * t.mass3 * before
             if kicked is not None:
                 D = np.where(kicked, D, 0.0)
@@ -1267,9 +1345,16 @@ class Ledger:
             ext += D
             self._add("space.damping", "damping", w_d, f"space.damping = {damping:g}")
             total += w_d
-        # What no source explains: a custom velocity_func's kicks, or an impulse from
-        # outside the solver.
-        R = t.mass3 * (vel1[:, :n] - vel0[:, :n]) - imp[:, :n] - ext
+        return ext, w_g, total
+
+    def _unexplained(self, step: _Step, ext: np.ndarray, w_g: float, total: float) -> float:
+        """What no source explains, a custom velocity_func's kicks or an impulse from
+        outside the solver, and gravity's step error (``w_g`` its work): counted, and added
+        to ``total``."""
+        t, p = self._t, self._pending
+        n = t.n
+        un = step.u[:, :n]
+        R = t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) - step.imp[:, :n] - ext
         if not t.all_finite:
             R[2] = np.where(t.finite, R[2], 0.0)  # an infinite moment's spin is imposed
         w_r = np.sum(R * un, axis=0)
@@ -1296,14 +1381,13 @@ class Ledger:
                 self._acc_field[j] += own
                 total += own
         self._terms[_GRAVITY] = self._terms.get(_GRAVITY, 0.0) + step_err
-        total += step_err
-        self._close_step(Q, dt, total)
+        return total + step_err
 
-    def _contact_work(self, coef: float, u: np.ndarray, imp: np.ndarray) -> float:
+    def _contact_work(self, step: _Step) -> float:
         """Work of every contact impulse of the step, summed per pair of bodies (J); the
         bias impulses are kept for the next move (gravity's part is counted then)."""
         c = self._contacts
-        total, push = c.work(coef, u, imp, self._t, self._pairs, self._acc_kin)
+        total, push = c.work(step, self._t, self._pairs, self._acc_kin)
         if push.any():
             self._push = (c.slots, c.n[0] * push, c.n[1] * push)
         return total
@@ -1339,44 +1423,58 @@ _GRAVITY = ("gravity", "step error")
 _ROUNDING = 1e-12
 
 
+class _Move(NamedTuple):
+    """pymunk's move at the start of a step: positions after it and velocities (3, rows),
+    where each body started, and how long each moved (s; one dt for all, or per row)."""
+
+    pos: np.ndarray
+    vel: np.ndarray
+    start: np.ndarray
+    step: np.ndarray | float
+
+
+class _Potentials(NamedTuple):
+    """The springs' and declared fields' potentials over a move: each spring group's
+    change (J, less the position correction's part) and end value, the fields' change per
+    dynamic row (None without springs or fields) and end value."""
+
+    spring_int: list[np.ndarray]
+    u_end: list[np.ndarray]
+    d_int: np.ndarray | None
+    d_end: np.ndarray
+
+
+class _Step(NamedTuple):
+    """One step as the sources' work reads it: ``dt`` (s), ``coef`` (dt over the previous
+    dt: how much of the carried impulses pymunk applies), the positions after the move and
+    the velocities before and after the solver (3, rows), ``u`` their mean, which the
+    sources act on; ``imp`` collects the impulses applied to each row (3, rows), ``kick``
+    the springs' elastic ones (None unless ``space.damping`` needs them) and ``spring_int``
+    is each spring group's potential change over the move."""
+
+    dt: float
+    coef: float
+    pos: np.ndarray
+    vel0: np.ndarray
+    vel1: np.ndarray
+    u: np.ndarray
+    imp: np.ndarray
+    kick: np.ndarray | None
+    spring_int: list[np.ndarray]
+
+
 def _constraint_work(t: _Table, g: _Group, after: np.ndarray, initial: np.ndarray,
-                     coef: float, dt: float, u: np.ndarray, pos: np.ndarray,
-                     imp: np.ndarray, kick: np.ndarray, spring_int: list[np.ndarray]
-                     ) -> float:
+                     step: _Step) -> float:
     """Work (J) of the step's impulses of the constraints in ``g``. The impulse applied is
     the accumulator's end value less what it carried in and did not apply (pymunk applies
     the carried impulse scaled by dt / previous dt, and none when a stop resets it). A
     spring's impulse splits into its elastic part (its force at the step's positions,
-    applied when the step prepares it) and its damping. Adds the impulses to ``imp`` and
-    the springs' elastic kicks to ``kick`` (what ``space.damping`` then scales)."""
-    kind = g.kind
+    applied when the step prepares it) and its damping. Adds the impulses to ``step.imp``
+    and the springs' elastic kicks to ``step.kick`` (what ``space.damping`` then scales)."""
     rows = t.rows
     ra, rb = g.a, g.b
-    if kind in ("pin", "slide", "spring", "pivot", "groove"):
-        if kind in ("pivot", "groove"):
-            Px = after[0] - (1.0 - coef) * initial[0]
-            Py = after[1] - (1.0 - coef) * initial[1]
-            r1x, r1y, r2x, r2y = after[2:6]
-        else:
-            j, nx, ny, r1x, r1y, r2x, r2y = after
-            J = j if kind == "spring" else j - (1.0 - coef) * initial[0]
-            if kind == "slide":
-                J = np.where((nx == 0.0) & (ny == 0.0), 0.0, J)
-            Px, Py = nx * J, ny * J
-        Aa = -_cross(r1x, r1y, Px, Py)
-        Ab = _cross(r2x, r2y, Px, Py)
-        La = (-Px, -Py)
-        Lb = (Px, Py)
-    else:
-        j = after[0]
-        if kind == "rotary_spring":
-            J = j
-        elif kind in ("rotary_limit", "ratchet"):
-            J = np.where(after[1] == 0.0, 0.0, j - (1.0 - coef) * initial[0])
-        else:
-            J = j - (1.0 - coef) * initial[0]
-        Ab, Aa = J, -J * (after[1] if kind == "gear" else 1.0)
-        La = Lb = (0.0 * J, 0.0 * J)
+    u, imp = step.u, step.imp
+    La, Lb, Aa, Ab = _impulses(g.kind, after, initial, step.coef)
     work_a = La[0] * u[0, ra] + La[1] * u[1, ra] + Aa * u[2, ra]
     work_b = Lb[0] * u[0, rb] + Lb[1] * u[1, rb] + Ab * u[2, rb]
     rel = work_a + work_b
@@ -1394,12 +1492,59 @@ def _constraint_work(t: _Table, g: _Group, after: np.ndarray, initial: np.ndarra
     if not g.spring:
         g.work += rel
         return total
+    # The work is linear in the impulse along the spring: its elastic part, and the rest.
+    elastic = _spring_elastic(t, g, after, step)
+    g.work += elastic
+    g.extra += rel - elastic
+    if step.spring_int:
+        pot = step.spring_int[g.slot]
+        g.pot += pot
+        total += float(np.sum(pot))
+    return total
+
+
+def _impulses(kind: str, after: np.ndarray, initial: np.ndarray, coef: float
+              ) -> tuple[tuple[Any, Any], tuple[Any, Any], Any, Any]:
+    """The impulses a constraint of ``kind`` applied in the step (its accumulators
+    ``after`` the solver, ``initial`` what they carried in): linear on its body a and on b,
+    angular on a and on b."""
+    if kind in ("pin", "slide", "spring", "pivot", "groove"):
+        if kind in ("pivot", "groove"):
+            Px = after[0] - (1.0 - coef) * initial[0]
+            Py = after[1] - (1.0 - coef) * initial[1]
+            r1x, r1y, r2x, r2y = after[2:6]
+        else:
+            j, nx, ny, r1x, r1y, r2x, r2y = after
+            J = j if kind == "spring" else j - (1.0 - coef) * initial[0]
+            if kind == "slide":
+                J = np.where((nx == 0.0) & (ny == 0.0), 0.0, J)
+            Px, Py = nx * J, ny * J
+        return (-Px, -Py), (Px, Py), -_cross(r1x, r1y, Px, Py), _cross(r2x, r2y, Px, Py)
+    j = after[0]
+    if kind == "rotary_spring":
+        J = j
+    elif kind in ("rotary_limit", "ratchet"):
+        J = np.where(after[1] == 0.0, 0.0, j - (1.0 - coef) * initial[0])
+    else:
+        J = j - (1.0 - coef) * initial[0]
+    zero = (0.0 * J, 0.0 * J)
+    return zero, zero, -J * (after[1] if kind == "gear" else 1.0), J
+
+
+def _spring_elastic(t: _Table, g: _Group, after: np.ndarray, step: _Step) -> np.ndarray:
+    """The work (J) of the elastic part of the impulses of the springs in ``g`` (their
+    force at the step's positions, as the step prepares them); their kicks are added to
+    ``step.kick``."""
+    rows, kick, u, pos = t.rows, step.kick, step.u, step.pos
+    ra, rb = g.a, g.b
+    both = np.concatenate([ra, rb])
     rest, k, max_force = g.settings[0], g.settings[1], g.settings[3]
-    if kind == "spring":
+    if g.kind == "spring":
+        _, nx, ny, r1x, r1y, r2x, r2y = after
         dx = (pos[0, rb] + r2x) - (pos[0, ra] + r1x)
         dy = (pos[1, rb] + r2y) - (pos[1, ra] + r1y)
         f = np.clip((rest - np.sqrt(dx * dx + dy * dy)) * k, -max_force, max_force)
-        Jel = np.where(g.default, f * dt, 0.0)
+        Jel = np.where(g.default, f * step.dt, 0.0)
         ex, ey = nx * Jel, ny * Jel
         if kick is not None:
             kick[0] += _scatter(both, np.concatenate([-ex, ex]), rows)
@@ -1410,19 +1555,11 @@ def _constraint_work(t: _Table, g: _Group, after: np.ndarray, initial: np.ndarra
             u[1, rb] + u[2, rb] * r2x - u[1, ra] - u[2, ra] * r1x)
     else:
         f = np.clip(((pos[2, ra] - pos[2, rb]) - rest) * k, -max_force, max_force)
-        Jel = np.where(g.default, f * dt, 0.0)
+        Jel = np.where(g.default, f * step.dt, 0.0)
         if kick is not None:
             kick[2] += _scatter(both, np.concatenate([-Jel, Jel]), rows)
         unit = u[2, rb] - u[2, ra]
-    # The work is linear in the impulse along the spring: its elastic part, and the rest.
-    elastic = Jel * unit
-    g.work += elastic
-    g.extra += rel - elastic
-    if spring_int:
-        pot = spring_int[g.slot]
-        g.pot += pot
-        total += float(np.sum(pot))
-    return total
+    return Jel * unit
 
 
 class _Hook:

@@ -179,6 +179,68 @@ def _earliest(seg, body, m):  # pragma: no cover
     return gap / -V if V < 0 else math.inf
 
 
+@njit(cache=True, nogil=True)
+def _brent_ends(xpre, fpre, xcur, fcur):  # pragma: no cover
+    """scipy's ``brentq`` on the values at the ends: (done, root, ok), done where it stops
+    there (a NaN value, a root at an end, no sign change)."""
+    if math.isnan(fpre):
+        return True, xpre, False
+    if math.isnan(fcur):
+        return True, xcur, False
+    if fpre == 0:
+        return True, xpre, True
+    if fcur == 0:
+        return True, xcur, True
+    if math.copysign(1.0, fpre) == math.copysign(1.0, fcur):
+        return True, 0.0, False
+    return False, 0.0, True
+
+
+@njit(cache=True, nogil=True)
+def _brent_bracket(s):  # pragma: no cover
+    """An iteration's start: the state ``s`` = (xpre, xcur, xblk, fpre, fcur, fblk, spre,
+    scur) with [xcur, xblk] around the root and xcur the end nearer to it."""
+    xpre, xcur, xblk, fpre, fcur, fblk, spre, scur = s
+    if fpre != 0 and fcur != 0 and math.copysign(1.0, fpre) != math.copysign(1.0, fcur):
+        xblk = xpre
+        fblk = fpre
+        spre = scur = xcur - xpre
+    if abs(fblk) < abs(fcur):
+        xpre = xcur
+        xcur = xblk
+        xblk = xpre
+        fpre = fcur
+        fcur = fblk
+        fblk = fpre
+    return (xpre, xcur, xblk, fpre, fcur, fblk, spre, scur)
+
+
+@njit(cache=True, nogil=True)
+def _brent_step(s, delta, sbis):  # pragma: no cover
+    """The next (spre, scur) of the state ``s``: an interpolated or extrapolated step when
+    it is short enough, else the bisection ``sbis``."""
+    xpre, xcur, xblk, fpre, fcur, fblk, spre, scur = s
+    if not (abs(spre) > delta and abs(fcur) < abs(fpre)):
+        return sbis, sbis
+    if xpre == xblk:
+        stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
+    else:
+        dpre = (fpre - fcur) / (xpre - xcur)  # extrapolate
+        dblk = (fblk - fcur) / (xblk - xcur)
+        stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+    if 2 * abs(stry) < min(3 * abs(sbis) - delta, abs(spre)):  # C's MIN(|spre|, ...)
+        return scur, stry  # a good short step
+    return sbis, sbis
+
+
+@njit(cache=True, nogil=True)
+def _brent_move(xcur, scur, delta, sbis):  # pragma: no cover
+    """The next point: ``xcur`` moved by the step ``scur``, by at least ``delta``."""
+    if abs(scur) > delta:
+        return xcur + scur
+    return xcur + (delta if sbis > 0 else -delta)
+
+
 def brentq_of(f):
     """scipy's ``brentq`` (its C iteration, step for step) on ``f(args, x)``, compiled for this
     one ``f`` (a function passed as an argument would keep numba from caching its callers):
@@ -187,66 +249,26 @@ def brentq_of(f):
 
     @njit(cache=True, nogil=True)
     def brentq(args, xa, xb, xtol):  # pragma: no cover
-        rtol = _BRENT_RTOL
-        xpre, xcur = xa, xb
-        xblk = 0.0
-        fblk = 0.0
-        spre = 0.0
-        scur = 0.0
-        fpre = f(args, xpre)
-        if math.isnan(fpre):
-            return xpre, False
-        fcur = f(args, xcur)
-        if math.isnan(fcur):
-            return xcur, False
-        if fpre == 0:
-            return xpre, True
-        if fcur == 0:
-            return xcur, True
-        if math.copysign(1.0, fpre) == math.copysign(1.0, fcur):
-            return 0.0, False
+        fpre = f(args, xa)
+        fcur = f(args, xb)
+        done, root, ok = _brent_ends(xa, fpre, xb, fcur)
+        if done:
+            return root, ok
+        s = (xa, xb, 0.0, fpre, fcur, 0.0, 0.0, 0.0)
         for _ in range(_BRENT_ITER):
-            if fpre != 0 and fcur != 0 and math.copysign(1.0, fpre) != math.copysign(1.0, fcur):
-                xblk = xpre
-                fblk = fpre
-                spre = scur = xcur - xpre
-            if abs(fblk) < abs(fcur):
-                xpre = xcur
-                xcur = xblk
-                xblk = xpre
-                fpre = fcur
-                fcur = fblk
-                fblk = fpre
-            delta = (xtol + rtol * abs(xcur)) / 2
+            s = _brent_bracket(s)
+            xcur, xblk, fcur = s[1], s[2], s[4]
+            delta = (xtol + _BRENT_RTOL * abs(xcur)) / 2
             sbis = (xblk - xcur) / 2
             if fcur == 0 or abs(sbis) < delta:
                 return xcur, True
-            if abs(spre) > delta and abs(fcur) < abs(fpre):
-                if xpre == xblk:
-                    stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
-                else:
-                    dpre = (fpre - fcur) / (xpre - xcur)  # extrapolate
-                    dblk = (fblk - fcur) / (xblk - xcur)
-                    stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-                if 2 * abs(stry) < min(3 * abs(sbis) - delta, abs(spre)):  # C's MIN(|spre|, ...)
-                    spre = scur  # a good short step
-                    scur = stry
-                else:
-                    spre = sbis
-                    scur = sbis
-            else:
-                spre = sbis
-                scur = sbis
-            xpre = xcur
-            fpre = fcur
-            if abs(scur) > delta:
-                xcur += scur
-            else:
-                xcur += delta if sbis > 0 else -delta
-            fcur = f(args, xcur)
-            if math.isnan(fcur):
-                return xcur, False
-        return xcur, False
+            spre, scur = _brent_step(s, delta, sbis)
+            xnew = _brent_move(xcur, scur, delta, sbis)
+            fnew = f(args, xnew)
+            if math.isnan(fnew):
+                return xnew, False
+            s = (xcur, xnew, xblk, fcur, fnew, s[5], spre, scur)
+        return s[1], False
 
     return brentq
 
@@ -261,14 +283,18 @@ CLEARED, FOUND, SPLIT = 0, 1, 2
 
 def search_of(point, judge):
     """The depth-first search of one suspect interval, compiled for one height curve:
-    ``point(args, tau)`` is (height, rate) at ``tau``; ``judge(args, lo, flo, dlo, hi, fhi,
-    dhi, C)`` says what [lo, hi] holds, as (:data:`CLEARED`, :data:`FOUND` or :data:`SPLIT`,
-    root, status). Unknown intervals are split at their middle, the left half searched first,
-    each split one unit of ``work`` = [spent, allowed]. ``search(args, lo, flo, dlo, hi, fhi,
-    dhi, C, work, stack)`` is (first root or inf, status)."""
+    ``point(args, tau)`` is (height, rate) at ``tau``; ``judge(args, left, right, C)`` says
+    what [lo, hi] holds (``left`` = (lo, height, rate) at lo, ``right`` the same at hi), as
+    (:data:`CLEARED`, :data:`FOUND` or :data:`SPLIT`, root, status). Unknown intervals are
+    split at their middle, the left half searched first, each split one unit of ``work`` =
+    [spent, allowed]. ``search(args, left, right, C, budget)`` is (first root or inf,
+    status); ``budget`` = (work, block_work, stack), the stack of intervals it may hold."""
 
     @njit(cache=True, nogil=True)
-    def search(args, lo, flo, dlo, hi, fhi, dhi, C, work, stack):  # pragma: no cover
+    def search(args, left, right, C, budget):  # pragma: no cover
+        work, stack = budget[0], budget[2]
+        lo, flo, dlo = left
+        hi, fhi, dhi = right
         stack[0, 0], stack[0, 1], stack[0, 2] = lo, flo, dlo
         stack[0, 3], stack[0, 4], stack[0, 5] = hi, fhi, dhi
         top = 1
@@ -276,7 +302,7 @@ def search_of(point, judge):
             top -= 1
             lo, flo, dlo = stack[top, 0], stack[top, 1], stack[top, 2]
             hi, fhi, dhi = stack[top, 3], stack[top, 4], stack[top, 5]
-            kind, root, status = judge(args, lo, flo, dlo, hi, fhi, dhi, C)
+            kind, root, status = judge(args, (lo, flo, dlo), (hi, fhi, dhi), C)
             if kind == FOUND:
                 return root, status
             if kind == CLEARED:
@@ -301,15 +327,18 @@ def search_of(point, judge):
 
 def scan_of(point, search):
     """The scan for a first root, compiled for one height curve (``point`` and ``search`` as
-    for :func:`search_of`): ``scan(args, lo, stop, h, C, work, block_work, stack)`` walks
-    [lo, stop] in blocks of 64 intervals of ``h`` (``block_work`` units of ``work`` each),
-    clears an interval whose ends lie above the floor by more than its dip below the chord
-    (at most C h^2 / 8), searches the others in order, and returns the first root (or inf)
-    and a status. A block's points are evaluated as the scan reaches them: an interval's
-    verdict reads its two ends only, and the scan stops at the first root."""
+    for :func:`search_of`): ``scan(args, grid, C, budget)`` walks ``grid`` = (lo, stop, h),
+    [lo, stop] in blocks of 64 intervals of ``h`` (``block_work`` units of ``work`` each,
+    ``budget`` = (work, block_work, stack)), clears an interval whose ends lie above the floor
+    by more than its dip below the chord (at most C h^2 / 8), searches the others in order,
+    and returns the first root (or inf) and a status. A block's points are evaluated as the
+    scan reaches them: an interval's verdict reads its two ends only, and the scan stops at
+    the first root."""
 
     @njit(cache=True, nogil=True)
-    def scan(args, lo, stop, h, C, work, block_work, stack):  # pragma: no cover
+    def scan(args, grid, C, budget):  # pragma: no cover
+        lo, stop, h = grid
+        work, block_work = budget[0], budget[1]
         taus = np.empty(_BLOCK + 1)
         fs = np.empty(_BLOCK + 1)
         ds = np.empty(_BLOCK + 1)
@@ -326,8 +355,8 @@ def scan_of(point, search):
                 width = taus[k] - taus[j]
                 lower = _np_min(fs[j], fs[k]) - C * width * width / 8.0
                 if lower <= 0 and width > 0:
-                    root, status = search(args, taus[j], fs[j], ds[j], taus[k], fs[k], ds[k],
-                                          C, work, stack)
+                    root, status = search(args, (taus[j], fs[j], ds[j]),
+                                          (taus[k], fs[k], ds[k]), C, budget)
                     if status != DONE or root < math.inf:
                         return root, status
             lo = taus[_BLOCK]
@@ -337,11 +366,14 @@ def scan_of(point, search):
 
 
 @njit(cache=True, nogil=True)
-def _fall_judge(args, lo, flo, dlo, hi, fhi, dhi, C):  # pragma: no cover
-    """What [lo, hi] holds of the particle's downward crossing (``args`` = (seg, body, m)):
-    cleared (above the floor by more than the dip C h^2/8), one crossing (strictly
-    decreasing, as min(rate) + C h < 0 proves: refined by Brent's method), or, below
-    ``m.min_split``, a crossing at ``hi`` if it is at or below the floor."""
+def _fall_judge(args, left, right, C):  # pragma: no cover
+    """What [lo, hi] holds of the particle's downward crossing (``args`` = (seg, body, m);
+    ``left`` = (lo, height, rate) at lo, ``right`` at hi): cleared (above the floor by more
+    than the dip C h^2/8), one crossing (strictly decreasing, as min(rate) + C h < 0 proves:
+    refined by Brent's method), or, below ``m.min_split``, a crossing at ``hi`` if it is at
+    or below the floor."""
+    lo, flo, dlo = left
+    hi, fhi, dhi = right
     width = hi - lo
     if flo > 0 and fhi > 0 and min(flo, fhi) - C * width * width / 8.0 > 0:
         return CLEARED, math.inf, DONE
@@ -357,17 +389,19 @@ _fall_scan = scan_of(_fall_point, search_of(_fall_point, _fall_judge))
 
 
 @njit(cache=True, nogil=True)
-def first_root(seg, body, start, stop, m, work, block_work, stack):  # pragma: no cover
-    """First time in (start, stop] (s after the segment's start) at which ``body`` crosses the
-    floor going down, or inf, and a status: the scan (:func:`scan_of`) in steps of a
-    sixteenth of a period (at most 0.05 s) from the earliest possible time."""
+def first_root(seg, body, window, m, budget):  # pragma: no cover
+    """First time in ``window`` = (start, stop] (s after the segment's start) at which
+    ``body`` crosses the floor going down, or inf, and a status: the scan (:func:`scan_of`,
+    ``budget`` as there) in steps of a sixteenth of a period (at most 0.05 s) from the
+    earliest possible time."""
+    start, stop = window
     S = amplitude(seg, m)
     c = m.cB if body == B else m.cA
     C = m.g + (c * m.w2 * S if m.w > 0 else 0.0)
     period = 2 * math.pi / m.w if m.w > 0 else math.inf
     h = min(period / 16.0, 0.05)
     a = max(start, _earliest(seg, body, m))
-    return _fall_scan((seg, body, m), a, stop, h, C, work, block_work, stack)
+    return _fall_scan((seg, body, m), (a, stop, h), C, budget)
 
 
 @njit(cache=True, nogil=True)
@@ -382,13 +416,15 @@ def _grow(rows, count):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def impacts(first, m, t_end, floor, max_impacts, work_limit, block_work):  # pragma: no cover
+def impacts(first, m, limits, floor):  # pragma: no cover
     """The free-flight segments from the segment ``first`` up to ``t_end`` (s) and the impacts
     between them: (segments, impacts, status, rest, work). Segment rows as ``first``
     (:data:`T0`...:data:`SD0`); impact rows (t, body, v_before, v_after); ``rest`` the row of
     the impact a particle came to rest at (status :data:`REST`); ``work`` the search work spent.
-    The search ends at ``t_end``, at rest, after ``max_impacts`` impacts or ``work_limit`` units
-    of search work."""
+    ``limits`` = (t_end, max_impacts, work_limit, block_work): the search ends at ``t_end``,
+    at rest, after ``max_impacts`` impacts or ``work_limit`` units of search work (a block of
+    the scan costs ``block_work``). Without a ``floor``, the one segment."""
+    t_end, max_impacts, work_limit, block_work = limits
     segs = np.empty((32, 5))
     for j in range(5):
         segs[0, j] = first[j]
@@ -399,65 +435,94 @@ def impacts(first, m, t_end, floor, max_impacts, work_limit, block_work):  # pra
     work = np.empty(2)
     work[0] = 0.0
     work[1] = work_limit
-    stack = np.empty((_STACK, 6))
+    budget = (work, block_work, np.empty((_STACK, 6)))
     if not floor:
         return segs[:1], events[:0], DONE, rest, work[0]
-    close = m.xtol * 10
     starts = np.zeros(2)
     roots = np.empty(2)
     while n_ev < max_impacts:
         seg = segs[n_seg - 1]
         horizon = t_end - seg[T0]
-        for body in range(2):  # one call site: each is compiled in full
-            root, status = first_root(seg, body, starts[body], horizon, m, work, block_work,
-                                      stack)
-            if status != DONE:
-                return segs[:n_seg], events[:n_ev], status, rest, work[0]
-            roots[body] = root
-        root_a, root_b = roots[A], roots[B]
-        tau = min(root_a, root_b)
+        status = _first_roots(seg, m, horizon, budget, (starts, roots))
+        if status != DONE:
+            return segs[:n_seg], events[:n_ev], status, rest, work[0]
+        tau = min(roots[A], roots[B])
         if not tau <= horizon:
             return segs[:n_seg], events[:n_ev], DONE, rest, work[0]
         xA, vA, xB, vB = state(seg, tau, m)
         t_hit = seg[T0] + tau
-        hit_a = root_a - tau <= close
-        hit_b = root_b - tau <= close
+        hit_a = roots[A] - tau <= m.xtol * 10
+        hit_b = roots[B] - tau <= m.xtol * 10
         if n_ev + 2 > events.shape[0]:
             events = _grow(events, n_ev)
-        for body in range(2):
-            if not (hit_a if body == A else hit_b):
-                continue
-            v = vA if body == A else vB
-            if abs(v) < m.rest_speed:
-                rest[0], rest[1], rest[2], rest[3] = t_hit, body, v, v
-                return segs[:n_seg], events[:n_ev], REST, rest, work[0]
-            after = -m.e * v
-            if body == A:
-                vA = after
-            else:
-                vB = after
-            events[n_ev, 0], events[n_ev, 1], events[n_ev, 2], events[n_ev, 3] = (
-                t_hit, body, v, after)
-            n_ev += 1
+        n_ev, vA, vB, at_rest = _bounce(events, n_ev, (t_hit, hit_a, hit_b, vA, vB), m, rest)
+        if at_rest:
+            return segs[:n_seg], events[:n_ev], REST, rest, work[0]
         if n_seg + 1 > segs.shape[0]:
             segs = _grow(segs, n_seg)
-        mA_M, mB_M = m.cB, m.cA
-        new = segs[n_seg]
-        new[T0] = t_hit
-        new[X0] = mA_M * xA + mB_M * xB
-        new[V0] = mA_M * vA + mB_M * vB
-        new[S0] = xA - xB - m.b
-        new[SD0] = vA - vB
+        _restart(segs[n_seg], (t_hit, xA, vA, xB, vB), m, (hit_a, hit_b, horizon), starts)
         n_seg += 1
-        C = m.g + max(m.cA, m.cB) * m.w2 * amplitude(new, m)
-        # After an impact the particle is on the floor moving up: no new root before v_up / C.
-        starts[A] = (vA / C if hit_a and C > 0 else 0.0)
-        if hit_a and C == 0:
-            starts[A] = horizon  # a straight line up, never to return
-        starts[B] = (vB / C if hit_b and C > 0 else 0.0)
-        if hit_b and C == 0:
-            starts[B] = horizon
     return segs[:n_seg], events[:n_ev], IMPACT_LIMIT, rest, work[0]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _first_roots(seg, m, horizon, budget, ends):  # pragma: no cover
+    """Each body's first downward crossing of the floor in (start, ``horizon``] of ``seg``
+    into ``roots`` (``ends`` = (starts, roots), by body), and the search's status."""
+    starts, roots = ends
+    for body in range(2):  # one call site: each is compiled in full
+        root, status = first_root(seg, body, (starts[body], horizon), m, budget)
+        if status != DONE:
+            return status
+        roots[body] = root
+    return DONE
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _bounce(events, n_ev, hit, m, rest):  # pragma: no cover
+    """The bodies that hit the floor (``hit`` = (t, hit_a, hit_b, vA, vB)) bounce: each
+    impact is a row of ``events`` from ``n_ev`` on, unless the body is at rest (its row then
+    goes to ``rest``). Returns (impacts now, vA, vB after, at rest)."""
+    t_hit, hit_a, hit_b, vA, vB = hit
+    for body in range(2):
+        if not (hit_a if body == A else hit_b):
+            continue
+        v = vA if body == A else vB
+        if abs(v) < m.rest_speed:
+            rest[0], rest[1], rest[2], rest[3] = t_hit, body, v, v
+            return n_ev, vA, vB, True
+        after = -m.e * v
+        if body == A:
+            vA = after
+        else:
+            vB = after
+        events[n_ev, 0], events[n_ev, 1], events[n_ev, 2], events[n_ev, 3] = (
+            t_hit, body, v, after)
+        n_ev += 1
+    return n_ev, vA, vB, False
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _restart(new, after, m, hits, starts):  # pragma: no cover
+    """The segment row ``new`` from the state ``after`` = (t, xA, vA, xB, vB) of the
+    impacts, and into ``starts`` when each body may next cross (``hits`` = (hit_a, hit_b,
+    horizon))."""
+    t_hit, xA, vA, xB, vB = after
+    hit_a, hit_b, horizon = hits
+    mA_M, mB_M = m.cB, m.cA
+    new[T0] = t_hit
+    new[X0] = mA_M * xA + mB_M * xB
+    new[V0] = mA_M * vA + mB_M * vB
+    new[S0] = xA - xB - m.b
+    new[SD0] = vA - vB
+    C = m.g + max(m.cA, m.cB) * m.w2 * amplitude(new, m)
+    # After an impact the particle is on the floor moving up: no new root before v_up / C.
+    starts[A] = (vA / C if hit_a and C > 0 else 0.0)
+    if hit_a and C == 0:
+        starts[A] = horizon  # a straight line up, never to return
+    starts[B] = (vB / C if hit_b and C > 0 else 0.0)
+    if hit_b and C == 0:
+        starts[B] = horizon
 
 
 @njit(cache=True, nogil=True)
@@ -523,13 +588,15 @@ _brentq_end_v = brentq_of(_end_v)
 
 
 @njit(cache=True, nogil=True)
-def _end_judge(args, lo, flo, dlo, hi, fhi, dhi, C):  # pragma: no cover
+def _end_judge(args, left, right, C):  # pragma: no cover
     """What [lo, hi] holds of the end's first contact, moving down (``args`` = (end, D, xtol,
     min_split)): as :func:`_fall_judge`, and besides: an end already at the floor moving down
     at ``lo`` touches there; an interval on which the height is provably convex
     (``|y'''| <= D``) and the velocity changes sign holds one minimum, found as the root of
     the velocity, and the end touches the floor iff that minimum is <= 0."""
     end, D, xtol, min_split = args
+    lo, flo, dlo = left
+    hi, fhi, dhi = right
     if flo <= 0 and dlo < 0:
         return FOUND, lo, DONE  # at the floor moving down already (see exact_rigid)
     width = hi - lo
@@ -555,12 +622,15 @@ _end_scan = scan_of(_end_point, search_of(_end_point, _end_judge))
 
 
 @njit(cache=True, nogil=True)
-def end_contact(end, lo, stop, h, C, D, xtol, min_split, work, block_work):  # pragma: no cover
+def end_contact(end, grid, bounds, budget):  # pragma: no cover
     """First time in [lo, stop] (s after the segment's start) at which ``end`` reaches the
-    floor moving down, or inf, and a status: the scan (:func:`scan_of`) in steps of ``h``,
-    ``C`` and ``D`` bounds on the height's second and third derivatives."""
-    return _end_scan((end, D, xtol, min_split), lo, stop, h, C, work, block_work,
-                     np.empty((_STACK, 6)))
+    floor moving down, or inf, and a status: the scan (:func:`scan_of`) of ``grid`` = (lo,
+    stop, h) in steps of ``h``; ``bounds`` = (C, D, xtol, min_split): C and D bounds on the
+    height's second and third derivatives, the root tolerance (s) and the shortest interval
+    split (s); ``budget`` = (work, block_work) as for :func:`scan_of`."""
+    C, D, xtol, min_split = bounds
+    return _end_scan((end, D, xtol, min_split), grid, C,
+                     (budget[0], budget[1], np.empty((_STACK, 6))))
 
 
 @njit(cache=True, nogil=True)
