@@ -15,13 +15,21 @@ checks).
 matplotlib, in the same set-up, makes a new temporary folder in every process (rebuilding
 its font cache each time) and says so in two lines; :func:`matplotlib_folder` gives the
 command line a private folder (``dumbbell-matplotlib-UID``) to use instead.
+
+Within :func:`command_line` (the ``dumbbell`` command), two costs of those libraries that the
+command does not need are not paid: its figures only go to files, so :mod:`dumbbell.plot`
+draws them without pyplot; and its process runs only dumbbell's own compiled kernels, none of
+which calls BLAS, so numba's probe for BLAS (an import of ``scipy.linalg``, about 0.1-0.2 s,
+made when numba loads its first compiled function) is skipped (:func:`_numba_target`).
 """
 
+import contextlib
 import os
 import stat
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from typing import Any
 
 __all__: list[str] = []
@@ -81,6 +89,56 @@ def matplotlib_folder() -> str | None:
     return found[0] if found else None
 
 
+#: True while the ``dumbbell`` command runs (:func:`command_line`).
+COMMAND_LINE: ContextVar[bool] = ContextVar("dumbbell_command_line", default=False)
+
+
+@contextlib.contextmanager
+def command_line() -> Iterator[None]:
+    """Within the block, :mod:`dumbbell.plot` makes bare Figures on the Agg canvas instead of
+    pyplot's (no pyplot import, no figure manager; the pixels are the same), and numba is
+    readied without its BLAS probe (:func:`_numba_target`): for the ``dumbbell`` command,
+    whose figures are only saved and whose process runs only dumbbell's kernels."""
+    token = COMMAND_LINE.set(True)
+    try:
+        yield
+    finally:
+        COMMAND_LINE.reset(token)
+
+
+#: Whether numba's target has been readied by :func:`_numba_target`.
+_target_ready = False
+#: The module whose import is numba's BLAS probe.
+_BLAS_PROBE = "scipy.linalg.cython_blas"
+
+
+def _numba_target() -> None:
+    """Ready numba's CPU target (the registries it loads before its first compiled function
+    runs, or loads from the cache) without its BLAS probe: numba imports
+    ``scipy.linalg.cython_blas`` once to learn whether np.dot and friends may call BLAS, and
+    that import (all of ``scipy.linalg``) costs more than the rest of loading a kernel. With
+    the probe's import failing, numba takes its own loops for the few functions that would
+    have used BLAS (``np.correlate``, ``np.convolve``); linear algebra still imports scipy when
+    it is compiled. Only within :func:`command_line`, whose process compiles nothing else; a
+    no-op when scipy.linalg is loaded already or numba is laid out otherwise."""
+    global _target_ready
+    if _target_ready:
+        return
+    _target_ready = True
+    if "scipy.linalg" in sys.modules or _BLAS_PROBE in sys.modules:
+        return
+    try:
+        from numba.core.registry import cpu_target
+    except ImportError:  # pragma: no cover - another layout of numba: let it probe
+        return
+    sys.modules[_BLAS_PROBE] = None  # type: ignore[assignment]  # the import fails at once
+    try:
+        cpu_target.target_context.refresh()
+    finally:
+        if _BLAS_PROBE in sys.modules and sys.modules[_BLAS_PROBE] is None:
+            del sys.modules[_BLAS_PROBE]
+
+
 def _say(text: str) -> None:
     if os.environ.get(_SAID):
         return
@@ -98,6 +156,9 @@ def njit(cache: bool = True, **options: Any) -> Callable[[Callable], Any]:
     when nowhere can be written."""
     import numba
     from numba.core import config
+
+    if COMMAND_LINE.get():
+        _numba_target()
 
     def decorate(func: Callable) -> Any:
         global _mode
