@@ -207,3 +207,36 @@ def test_the_library_keeps_pyplot_and_the_command_does_without(tmp_path):
     assert bare.figure not in [plt.figure(n) for n in plt.get_fignums()]
     save_figure(bare.figure, tmp_path / "bare.png")
     assert (tmp_path / "pyplot.png").read_bytes() == (tmp_path / "bare.png").read_bytes()
+
+
+def test_a_slow_first_use_says_it_compiles_once(monkeypatch, capsys):
+    """The line shows when a kernel's first use outlasts a load from the cache, on a
+    terminal only, once per solver and process."""
+    import time
+
+    from dumbbell import _install, progress
+
+    monkeypatch.setattr(_install, "COMPILE_NOTE_AFTER", 0.05)
+    monkeypatch.setattr(_install, "_compiling_said", set())
+    monkeypatch.delenv(_install._SAID, raising=False)
+    watching = {"yes": True}
+    monkeypatch.setattr(progress, "progress_wanted", lambda quiet=False: watching["yes"]
+                        and not quiet)
+    with _install.compiling("the test solver's kernels", quiet=False):
+        pass  # a load from the cache: quick
+    assert capsys.readouterr().err == ""
+    with _install.compiling("the test solver's kernels", quiet=True):
+        time.sleep(0.2)  # slow, but -q
+    assert capsys.readouterr().err == ""
+    watching["yes"] = False
+    with _install.compiling("the test solver's kernels", quiet=False):
+        time.sleep(0.2)  # slow, but not on a terminal (or CI)
+    assert capsys.readouterr().err == ""
+    watching["yes"] = True
+    for _ in range(2):
+        with _install.compiling("the test solver's kernels", quiet=False):
+            time.sleep(0.2)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith("dumbbell: compiling the test solver's kernels with numba (the first "
+                          "run after an install or upgrade")
