@@ -14,8 +14,8 @@ Each measurement is a fresh process, timed from outside (wall clock), the way a 
   ``NUMBA_CACHE_DIR`` each time), so every kernel it needs is compiled;
 - peak memory of the main job: the largest resident set of any one of its processes (what
   ``/usr/bin/time -f %M`` reports; the job forks a second process for its figures), and the
-  largest sum of the resident sets of its processes, sampled every 10 ms (shared pages
-  counted in each: an upper bound of what the job holds).
+  largest sum of the proportional set sizes of its processes (each shared page counted once
+  across them), sampled every 10 ms: what the job holds at its peak.
 
 The warm runs alternate (numpy, import dumbbell, main job, numpy, ...) ``--runs`` times, so a
 change of load on the machine hits all alike; the table gives medians and, for the main job,
@@ -46,10 +46,24 @@ def dumbbell_command() -> list[str]:
     return [str(script)] if script.is_file() else [sys.executable, "-m", "dumbbell"]
 
 
+def _pss(pid: int) -> int:
+    """The proportional set size of process ``pid`` (bytes): its private pages, and its
+    share of the pages it shares (with its forked child, say); 0 once it is gone."""
+    try:
+        with open(f"/proc/{pid}/smaps_rollup") as fh:
+            for line in fh:
+                if line.startswith("Pss:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
+
+
 def timed(argv: list[str], env: dict[str, str] | None = None, watch: bool = False
           ) -> tuple[float, float]:
-    """Wall seconds of ``argv`` run to its end, and the largest sum of the resident sets of
-    its process tree (MiB, sampled every 10 ms when ``watch``, else 0)."""
+    """Wall seconds of ``argv`` run to its end, and the largest sum of the proportional set
+    sizes of its process tree (MiB, sampled every 10 ms when ``watch``; 0 otherwise, or
+    without /proc/PID/smaps_rollup)."""
     t0 = time.perf_counter()
     proc = subprocess.Popen(argv, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     peak = 0.0
@@ -59,8 +73,8 @@ def timed(argv: list[str], env: dict[str, str] | None = None, watch: bool = Fals
         root = psutil.Process(proc.pid)
         while proc.poll() is None:
             try:
-                tree = [root, *root.children(recursive=True)]
-                peak = max(peak, sum(p.memory_info().rss for p in tree) / 2**20)
+                tree = [proc.pid, *(p.pid for p in root.children(recursive=True))]
+                peak = max(peak, sum(_pss(pid) for pid in tree) / 2**20)
             except psutil.Error:
                 pass
             time.sleep(0.01)
@@ -187,7 +201,7 @@ def main() -> None:
         rows.append(("first run after an install: empty numba cache (median, range)",
                      (f"**{mid:.2f} s** ({min(first):.2f}-{max(first):.2f} s): "
                       f"{mid / job_t:.1f}x the warm run")))
-    rows.append(("peak memory of the main job: largest process / sum of its processes",
+    rows.append(("peak memory of the main job: largest process (RSS) / all its processes (PSS)",
                  f"**{rss:.0f} MiB** / {max(sums):.0f} MiB"))
     print("| measurement | result |\n|---|---|")
     for name, value in rows:

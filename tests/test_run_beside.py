@@ -117,11 +117,11 @@ def test_a_crash_in_the_child_is_raised_with_its_traceback(scene, tmp_path):
 def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
     # The child kills itself the moment it would draw: the parent draws instead.
     patch = ("import os, signal, dumbbell.cli.run as r, dumbbell.cli.beside as b\n"
-             "draw = r._write_beside\n"
+             "draw = r._draw_figures\n"
              "def dying(files, traj, alive):\n"
              "    if b._IN_CHILD: os.kill(os.getpid(), signal.SIGKILL)\n"
              "    return draw(files, traj, alive)\n"
-             "r._write_beside = dying\n")
+             "r._draw_figures = dying\n")
     died = run("run", scene, "--out", tmp_path / "died", fork=True, patch=patch)
     alone = run("run", scene, "--out", tmp_path / "alone", fork=False)
     assert died.returncode == alone.returncode == 0, died.stderr

@@ -124,44 +124,36 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
               max_frames: int = MAX_FRAMES) -> int:
     """Make every output ``scene`` asks for in ``out``, refusing a run that would keep more
     than ``max_samples`` samples or a GIF of more than ``max_frames`` frames; returns the
-    exit status (0 or 3). The figures and CSVs are made beside the GIF, in a forked process,
-    where there is a CPU for it (:mod:`.beside`); the bytes are the same either way."""
+    exit status (0 or 3). The figures are drawn beside the CSVs and the GIF, in a forked
+    process, where there is a CPU for it (:mod:`.beside`); the bytes are the same either
+    way."""
     from ..io.files import atomic_output
     from ..solvers import simulate
     from .app import EXIT_VERDICT
     from .beside import beside
 
     names = outputs(scene, out)
-    gif = scene.outputs.gif
     with contextlib.ExitStack() as stack:
-        # The files made beside first (the child writes them), then the child: leaving early
+        # The figures' files first (the child writes them), then the child: leaving early
         # stops the child before the files are removed.
-        files = {kind: stack.enter_context(atomic_output(path))
-                 for kind, path in names.items() if kind != "gif"}
-        aside = stack.enter_context(beside(
-            lambda traj, alive: _write_beside(files, traj, alive),
-            _figure_imports if scene.outputs.figures else _table_imports,
-            fork=None if scene.outputs.figures or (files and gif is not None) else False))
+        files = {name: stack.enter_context(atomic_output(names[name]))
+                 for name in scene.outputs.figures}
+        figures = stack.enter_context(beside(
+            lambda traj, alive: _draw_figures(files, traj, alive), _figure_imports,
+            fork=None if files else False))
         traj = simulate(scene, quiet=quiet, max_samples=max_samples)
         # numba, its kernels and whatever else the run imported stay until the command ends:
         # the garbage collector need not look at them again.
         gc.freeze()
-        aside.send(traj)
+        figures.send(traj)
         try:
-            if gif is not None:
-                from ..animation.render import render_gif
-                from .render import gif_trajectory
-
-                # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
-                drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
-                render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps, size=gif.size,
-                           strip=gif.strip, t_end=gif.t_end, max_frames=max_frames)
+            _write_rest(scene, traj, names, quiet, max_frames)
         except (DumbbellError, OSError):
-            # Made one after the other, the figures and CSVs would have failed first: their
-            # error is the one to tell.
-            aside.wait()
+            # Drawn one after the other, the figures would have failed first: their error is
+            # the one to tell.
+            figures.wait()
             raise
-        aside.wait()
+        figures.wait()
     if not quiet:
         for path in names.values():
             sys.stderr.write(f"wrote {path}\n")
@@ -171,41 +163,45 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     return 0
 
 
+def _write_rest(scene, traj: Any, names: dict[str, Path], quiet: bool, max_frames: int
+                ) -> None:
+    """The CSVs and the GIF of ``scene`` from ``traj``, into the files ``names`` gives."""
+    if scene.outputs.csv:
+        from ..io.trajectory import write_csv, write_events
+
+        write_csv(traj, names["csv"])
+        if "impacts" in names:
+            write_events(traj, names["impacts"])
+    if scene.outputs.gif is not None:
+        from ..animation.render import render_gif
+        from .render import gif_trajectory
+
+        gif = scene.outputs.gif
+        # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
+        drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
+        render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps, size=gif.size,
+                   strip=gif.strip, t_end=gif.t_end, max_frames=max_frames)
+
+
 def _figure_imports() -> None:
-    """What drawing the figures and writing the CSVs import, done in the child before the
-    trajectory comes."""
+    """What drawing the figures imports, done in the child before the trajectory comes."""
     import matplotlib.backends.backend_agg
     import matplotlib.figure  # noqa: F401
 
     from .. import plot  # noqa: F401
     from ..io import figures  # noqa: F401
 
-    _table_imports()
 
+def _draw_figures(files: dict[str, Path], traj: Any, alive: Any) -> None:
+    """Draw each figure ``files`` names for ``traj`` into its (temporary) file, while
+    ``alive()``."""
+    from ..io.figures import write_figure
 
-def _table_imports() -> None:
-    """What writing the CSVs imports."""
-    from ..io import trajectory  # noqa: F401
-
-
-def _write_beside(files: dict[str, Path], traj: Any, alive: Any) -> None:
-    """Write each output ``files`` holds for ``traj`` into its (temporary) file, the figures
-    first, while ``alive()``: every output :func:`outputs` names but the GIF."""
-    from ..io.trajectory import dump_csv, events_csv
-
-    for kind, path in files.items():
-        if kind == "csv":
-            with open(path, "w") as fh:
-                dump_csv(traj, fh)
-        elif kind == "impacts":
-            path.write_text(events_csv(traj))
-        else:
-            from ..io.figures import write_figure
-
-            ax = _figure(kind, traj)
-            if not alive():
-                return
-            write_figure(ax.figure, path)
+    for name, path in files.items():
+        ax = _figure(name, traj)
+        if not alive():
+            return
+        write_figure(ax.figure, path)
 
 
 def _figure(name: str, traj: Any) -> Any:
