@@ -99,16 +99,31 @@ COMMAND_LINE: ContextVar[bool] = ContextVar("dumbbell_command_line", default=Fal
 
 
 @contextlib.contextmanager
-def command_line() -> Iterator[None]:
+def command_line(process_ends: bool = False) -> Iterator[None]:
     """Within the block, :mod:`dumbbell.plot` makes bare Figures on the Agg canvas instead of
     pyplot's (no pyplot import, no figure manager; the pixels are the same), and numba is
     readied without its BLAS probe (:func:`_numba_target`): for the ``dumbbell`` command,
-    whose figures are only saved and whose process runs only dumbbell's kernels."""
+    whose figures are only saved and whose process runs only dumbbell's kernels.
+
+    The command also keeps the garbage collector off what it loaded for good (numba,
+    matplotlib: hundreds of thousands of objects), with ``gc.freeze()`` at points of its own
+    (:func:`dumbbell.cli.run.run_scene`). When the ``process_ends`` with the block, every
+    object is frozen at its end: the interpreter's exit then does not look at them all again
+    (a quarter to half a second with numba and matplotlib loaded). Otherwise (the command
+    called from Python) the block gives them back to the collector, unless something had
+    frozen objects before it."""
+    import gc
+
     token = COMMAND_LINE.set(True)
+    frozen = gc.get_freeze_count()
     try:
         yield
     finally:
         COMMAND_LINE.reset(token)
+        if process_ends:
+            gc.freeze()
+        elif frozen == 0:
+            gc.unfreeze()
 
 
 #: Whether numba's target has been readied by :func:`_numba_target`.

@@ -311,7 +311,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     SIGHUP 129)."""
     command = "dumbbell"
     state: dict[str, object] = {}
-    with _stop_signals(), _file_backend():
+    # Without argv, this is the process's own command (the console script, python -m):
+    # it ends with the command.
+    with _stop_signals(), _file_backend(process_ends=argv is None):
         try:
             argv = sys.argv[1:] if argv is None else list(argv)
             parser = _parser_for(argv)
@@ -328,12 +330,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 @contextlib.contextmanager
-def _file_backend() -> Iterator[None]:
+def _file_backend(process_ends: bool = False) -> Iterator[None]:
     """The command only writes files: matplotlib's file-only backend (Agg) whatever
     MPLBACKEND says (a backend that does not exist, or needs a display, would fail); and a
     private MPLCONFIGDIR when matplotlib's own folders cannot be written (HOME = /); figures
-    drawn without pyplot, numba without its BLAS probe (:func:`dumbbell._install.command_line`).
-    The environment is given back afterwards."""
+    drawn without pyplot, numba without its BLAS probe, the garbage collector's work
+    (:func:`dumbbell._install.command_line`; ``process_ends``: the process ends with the
+    command). The environment is given back afterwards."""
     from .._install import command_line, matplotlib_folder
 
     settings = {"MPLBACKEND": "Agg"}
@@ -343,7 +346,7 @@ def _file_backend() -> Iterator[None]:
     before = {name: os.environ.get(name) for name in settings}
     os.environ.update(settings)
     try:
-        with command_line():
+        with command_line(process_ends):
             yield
     finally:
         for name, value in before.items():
