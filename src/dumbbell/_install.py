@@ -15,13 +15,21 @@ checks).
 matplotlib, in the same set-up, makes a new temporary folder in every process (rebuilding
 its font cache each time) and says so in two lines; :func:`matplotlib_folder` gives the
 command line a private folder (``dumbbell-matplotlib-UID``) to use instead.
+
+Within :func:`command_line` (the ``dumbbell`` command), two costs of those libraries that the
+command does not need are not paid: its figures only go to files, so :mod:`dumbbell.plot`
+draws them without pyplot; and its process runs only dumbbell's own compiled kernels, none of
+which calls BLAS, so numba's probe for BLAS (an import of ``scipy.linalg``, about 0.1-0.2 s,
+made when numba readies itself) is skipped (:func:`_numba_target`).
 """
 
+import contextlib
 import os
 import stat
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from typing import Any
 
 __all__: list[str] = []
@@ -32,6 +40,11 @@ __all__: list[str] = []
 COMPILE_SECONDS = "1-2 s"
 #: Set in the environment once the line has been said, so that pool workers stay quiet.
 _SAID = "DUMBBELL_NUMBA_CACHE_NOTE"
+#: Seconds the first use of a solver's kernels may take before :func:`compiling` says that
+#: they compile: loading them from numba's cache takes a tenth of that.
+COMPILE_NOTE_AFTER = 0.4
+#: What :func:`compiling` has said in this process (each once).
+_compiling_said: set[str] = set()
 
 _mode: str | None = None  # "numba" (its own places), "private", "none": decided once
 
@@ -81,11 +94,115 @@ def matplotlib_folder() -> str | None:
     return found[0] if found else None
 
 
+#: True while the ``dumbbell`` command runs (:func:`command_line`).
+COMMAND_LINE: ContextVar[bool] = ContextVar("dumbbell_command_line", default=False)
+
+
+@contextlib.contextmanager
+def command_line(process_ends: bool = False) -> Iterator[None]:
+    """Within the block, :mod:`dumbbell.plot` makes bare Figures on the Agg canvas instead of
+    pyplot's (no pyplot import, no figure manager; the pixels are the same), and numba is
+    readied without its BLAS probe (:func:`_numba_target`): for the ``dumbbell`` command,
+    whose figures are only saved and whose process runs only dumbbell's kernels.
+
+    The command also keeps the garbage collector off what it loaded for good (numba,
+    matplotlib: hundreds of thousands of objects), with ``gc.freeze()`` at points of its own
+    (:func:`dumbbell.cli.run.run_scene`). When the ``process_ends`` with the block, every
+    object is frozen at its end: the interpreter's exit then does not look at them all again
+    (a quarter to half a second with numba and matplotlib loaded). Otherwise (the command
+    called from Python) the block gives them back to the collector, unless something had
+    frozen objects before it."""
+    import gc
+
+    token = COMMAND_LINE.set(True)
+    frozen = gc.get_freeze_count()
+    try:
+        yield
+    finally:
+        COMMAND_LINE.reset(token)
+        if process_ends:
+            gc.freeze()
+        elif frozen == 0:
+            gc.unfreeze()
+
+
+#: Whether numba's target has been readied by :func:`_numba_target`.
+_target_ready = False
+#: The module whose import is numba's BLAS probe.
+_BLAS_PROBE = "scipy.linalg.cython_blas"
+
+
+def _numba_target() -> None:
+    """Ready numba's CPU target once per process: the registries numba loads before its first
+    compiled function runs or is loaded from the cache (a few tenths of a second, whether it
+    then compiles or not). Within :func:`command_line`, without numba's BLAS probe: numba
+    imports ``scipy.linalg.cython_blas`` once to learn whether np.dot and friends may call
+    BLAS, and that import (all of ``scipy.linalg``) costs more than the rest of loading a
+    kernel. With the probe's import failing at once, numba takes its own loops for the few
+    functions that would have used BLAS (``np.correlate``, ``np.convolve``); linear algebra
+    still imports scipy when compiled. The command's process compiles only dumbbell's
+    kernels, none of which calls BLAS; anywhere else numba probes as usual."""
+    global _target_ready
+    if _target_ready:
+        return
+    _target_ready = True
+    try:
+        from numba.core.registry import cpu_target
+    except ImportError:  # pragma: no cover - another layout of numba: it readies itself
+        return
+    skip = (COMMAND_LINE.get() and "scipy.linalg" not in sys.modules
+            and _BLAS_PROBE not in sys.modules)
+    if skip:
+        sys.modules[_BLAS_PROBE] = None  # type: ignore[assignment]  # the import fails at once
+    try:
+        cpu_target.target_context.refresh()
+    finally:
+        if skip and sys.modules.get(_BLAS_PROBE, 0) is None:
+            del sys.modules[_BLAS_PROBE]
+
+
 def _say(text: str) -> None:
     if os.environ.get(_SAID):
         return
     os.environ[_SAID] = "1"
     sys.stderr.write(f"dumbbell: {text}\n")
+
+
+@contextlib.contextmanager
+def compiling(what: str, quiet: bool = True) -> Iterator[None]:
+    """Around the first use of ``what`` (a solver's compiled kernels) in a process: loaded
+    from numba's cache that takes a few hundredths of a second once numba is ready (timed
+    from then); compiled (the first run after an install or an upgrade, or an empty cache) a
+    second or two. When it takes longer than
+    :data:`COMPILE_NOTE_AFTER` s and the user is watching (stderr a terminal, not ``quiet``,
+    no CI: as a progress bar), one line on stderr says what is compiling and why, once per
+    process; not again after the line about the cache's place (:func:`njit`), which says it.
+    """
+    from .progress import progress_wanted
+
+    if what in _compiling_said or not progress_wanted(quiet) or os.environ.get(_SAID):
+        yield
+        return
+    _numba_target()  # numba's own start-up, compiling or not: not timed
+    import threading
+
+    done = threading.Event()
+
+    def note() -> None:
+        if not done.wait(COMPILE_NOTE_AFTER):
+            _compiling_said.add(what)
+            sys.stderr.write(f"dumbbell: compiling {what} with numba (the first run after an "
+                             f"install or upgrade, about {COMPILE_SECONDS}; cached for the "
+                             "next runs)\n")
+            sys.stderr.flush()
+
+    timer = threading.Thread(target=note, name="dumbbell-compiling", daemon=True)
+    timer.start()
+    try:
+        yield
+    finally:
+        done.set()
+        timer.join()
 
 
 def _cache_error(exc: RuntimeError) -> bool:
@@ -97,6 +214,9 @@ def njit(cache: bool = True, **options: Any) -> Callable[[Callable], Any]:
     cached wherever this user can write (see the module's notes); compiled without a cache
     when nowhere can be written."""
     import numba
+
+    if COMMAND_LINE.get():
+        _numba_target()
 
     def decorate(func: Callable) -> Any:
         global _mode

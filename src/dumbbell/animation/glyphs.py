@@ -72,9 +72,16 @@ class Stamps:
         elif anchor[0] == "m":
             x -= self.width(text) / 2
         base = {"m": y + self.cap / 2, "t": y + self.cap, "s": y}[anchor[1]]
+        core = None
         for ch in text:
             mask, gx, gy, adv = self._glyph(ch)
-            img.paste(ink, (round(x + gx), round(base + gy)), mask)
+            left, top = round(x + gx), round(base + gy)
+            if core is None:
+                img.paste(ink, (left, top), mask)  # readies img (loaded, writable) once
+                core = img.im
+            else:
+                # What Image.paste does then, without its checks for every glyph.
+                core.paste(ink, (left, top, left + mask.width, top + mask.height), mask.im)
             x += adv
 
 

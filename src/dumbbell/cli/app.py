@@ -127,22 +127,44 @@ def add_quiet(parser: argparse.ArgumentParser) -> None:
                              "or CI is set)")
 
 
-def build_parser() -> Parser:
+class _Version(argparse._VersionAction):
+    """``--version``: the installed version, looked up only when asked for (reading the
+    package's metadata costs more than the rest of a parser)."""
+
+    @property
+    def version(self) -> str:
+        from .. import __version__
+
+        return f"dumbbell {__version__}"
+
+    @version.setter
+    def version(self, value: object) -> None:
+        pass
+
+
+def build_parser(commands: Sequence[str] = COMMANDS) -> Parser:
+    """The ``dumbbell`` parser with the subcommands ``commands`` (default: all of them)."""
     parser = Parser(
         prog="dumbbell",
         description="How a body's mechanical energy is shared between centre-of-mass and "
                     "internal motion: the bouncing dumbbell of textbook section 13.5.1.",
         epilog="Exit status: 0 done, 2 bad input, 3 a run ended with a verdict other than ok.",
     )
-    from .. import __version__
-
-    parser.add_argument("--version", action="version", version=f"dumbbell {__version__}",
-                        help="print the installed version and exit")
+    parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     sub.required = True
-    for name in COMMANDS:
+    for name in commands:
         importlib.import_module(f"dumbbell.cli.{name}").register(sub)
     return parser
+
+
+def _parser_for(argv: Sequence[str]) -> Parser:
+    """The parser that parses ``argv``: with only the subcommand ``argv`` starts with, when it
+    names one (its modules alone are imported: ``dumbbell run`` does not wait for the others);
+    else with every subcommand (``--help``, ``--version``, a misspelt command)."""
+    if argv and argv[0] in COMMANDS:
+        return build_parser((argv[0],))
+    return build_parser()
 
 
 def subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -295,9 +317,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     SIGHUP 129)."""
     command = "dumbbell"
     state: dict[str, object] = {}
-    with _stop_signals(), _file_backend():
+    # Without argv, this is the process's own command (the console script, python -m):
+    # it ends with the command.
+    with _stop_signals(), _file_backend(process_ends=argv is None):
         try:
-            parser = build_parser()
+            argv = sys.argv[1:] if argv is None else list(argv)
+            parser = _parser_for(argv)
             args = parser.parse_args(argv)
             command = f"dumbbell {args.command}"
             return _run(args, command, state)
@@ -311,12 +336,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 @contextlib.contextmanager
-def _file_backend() -> Iterator[None]:
+def _file_backend(process_ends: bool = False) -> Iterator[None]:
     """The command only writes files: matplotlib's file-only backend (Agg) whatever
     MPLBACKEND says (a backend that does not exist, or needs a display, would fail); and a
-    private MPLCONFIGDIR when matplotlib's own folders cannot be written (HOME = /). The
-    environment is given back afterwards."""
-    from .._install import matplotlib_folder
+    private MPLCONFIGDIR when matplotlib's own folders cannot be written (HOME = /); figures
+    drawn without pyplot, numba without its BLAS probe, the garbage collector's work
+    (:func:`dumbbell._install.command_line`; ``process_ends``: the process ends with the
+    command). The environment is given back afterwards."""
+    from .._install import command_line, matplotlib_folder
 
     settings = {"MPLBACKEND": "Agg"}
     folder = matplotlib_folder()
@@ -325,7 +352,8 @@ def _file_backend() -> Iterator[None]:
     before = {name: os.environ.get(name) for name in settings}
     os.environ.update(settings)
     try:
-        yield
+        with command_line(process_ends):
+            yield
     finally:
         for name, value in before.items():
             if value is None:

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import gc
 import sys
 from pathlib import Path
 from typing import Any
 
 from ..animation.render import MAX_FRAMES
+from ..errors import DumbbellError
 from ..solvers import MAX_SAMPLES
 from .app import add_out, add_quiet, positive_int
 from .showcase import PIECES
@@ -121,25 +124,54 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
               max_frames: int = MAX_FRAMES) -> int:
     """Make every output ``scene`` asks for in ``out``, refusing a run that would keep more
     than ``max_samples`` samples or a GIF of more than ``max_frames`` frames; returns the
-    exit status (0 or 3)."""
+    exit status (0 or 3). The figures are drawn beside the CSVs and the GIF, in a forked
+    process, where there is a CPU for it (:mod:`.beside`); the bytes are the same either
+    way."""
+    from ..io.files import atomic_output
     from ..solvers import simulate
     from .app import EXIT_VERDICT
+    from .beside import beside
 
-    traj = simulate(scene, quiet=quiet, max_samples=max_samples)
     names = outputs(scene, out)
-    written: list[Path] = []
-    if scene.outputs.figures:
-        from ..io.figures import save_figure
+    with contextlib.ExitStack() as stack:
+        # The figures' files first (the child writes them), then the child: leaving early
+        # stops the child before the files are removed.
+        files = {name: stack.enter_context(atomic_output(names[name]))
+                 for name in scene.outputs.figures}
+        figures = stack.enter_context(beside(
+            lambda traj, alive: _draw_figures(files, traj, alive), _figure_imports,
+            fork=None if files else False))
+        traj = simulate(scene, quiet=quiet, max_samples=max_samples)
+        # numba, its kernels and whatever else the run imported stay until the command ends:
+        # the garbage collector need not look at them again.
+        gc.freeze()
+        figures.send(traj)
+        try:
+            _write_rest(scene, traj, names, quiet, max_frames)
+        except (DumbbellError, OSError):
+            # Drawn one after the other, the figures would have failed first: their error is
+            # the one to tell.
+            figures.wait()
+            raise
+        figures.wait()
+    if not quiet:
+        for path in names.values():
+            sys.stderr.write(f"wrote {path}\n")
+    if not traj.verdict.ok:
+        sys.stderr.write(f"dumbbell run: {scene.name}: {traj.solver}: {traj.verdict}\n")
+        return EXIT_VERDICT
+    return 0
 
-        for name in scene.outputs.figures:
-            ax = _figure(name, traj)
-            written.append(save_figure(ax.figure, names[name]))
+
+def _write_rest(scene, traj: Any, names: dict[str, Path], quiet: bool, max_frames: int
+                ) -> None:
+    """The CSVs and the GIF of ``scene`` from ``traj``, into the files ``names`` gives."""
     if scene.outputs.csv:
         from ..io.trajectory import write_csv, write_events
 
-        written.append(write_csv(traj, names["csv"]))
+        write_csv(traj, names["csv"])
         if "impacts" in names:
-            written.append(write_events(traj, names["impacts"]))
+            write_events(traj, names["impacts"])
     if scene.outputs.gif is not None:
         from ..animation.render import render_gif
         from .render import gif_trajectory
@@ -147,16 +179,29 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
         gif = scene.outputs.gif
         # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
         drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
-        written.append(render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps,
-                                  size=gif.size, strip=gif.strip, t_end=gif.t_end,
-                                  max_frames=max_frames))
-    if not quiet:
-        for path in written:
-            sys.stderr.write(f"wrote {path}\n")
-    if not traj.verdict.ok:
-        sys.stderr.write(f"dumbbell run: {scene.name}: {traj.solver}: {traj.verdict}\n")
-        return EXIT_VERDICT
-    return 0
+        render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps, size=gif.size,
+                   strip=gif.strip, t_end=gif.t_end, max_frames=max_frames)
+
+
+def _figure_imports() -> None:
+    """What drawing the figures imports, done in the child before the trajectory comes."""
+    import matplotlib.backends.backend_agg
+    import matplotlib.figure  # noqa: F401
+
+    from .. import plot  # noqa: F401
+    from ..io import figures  # noqa: F401
+
+
+def _draw_figures(files: dict[str, Path], traj: Any, alive: Any) -> None:
+    """Draw each figure ``files`` names for ``traj`` into its (temporary) file, while
+    ``alive()``."""
+    from ..io.figures import write_figure
+
+    for name, path in files.items():
+        ax = _figure(name, traj)
+        if not alive():
+            return
+        write_figure(ax.figure, path)
 
 
 def _figure(name: str, traj: Any) -> Any:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -21,8 +22,6 @@ MAX_DPI = 2000
 def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
     """Write ``fig`` to ``path`` (format from its suffix) at ``dpi`` (dots per inch, or
     "figure" for the figure's own) and close it; returns the path."""
-    import matplotlib.pyplot as plt
-
     fig = args.figure(fig)
     path = args.path(path, "path")
     formats = fig.canvas.get_supported_filetypes()
@@ -35,6 +34,23 @@ def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
                              "'figure'", param="dpi")
         args.real(dpi, "dpi", "dots per inch", lo=1, hi=MAX_DPI)
     with atomic_output(path) as tmp:
-        fig.savefig(tmp, dpi=dpi)
-    plt.close(fig)
+        write_figure(fig, tmp, dpi)
     return path
+
+
+def write_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> None:
+    """Write the checked figure ``fig`` to the file ``path`` itself (format from its suffix),
+    then close it: :func:`save_figure` past its checks, for a caller that already holds the
+    file to write (a temporary file of :func:`~.files.atomic_output`)."""
+    from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
+        # What tight_layout() leaves behind: it lays nothing out, but savefig would draw the
+        # whole figure once more for it, without rendering, before drawing it for real.
+        fig.set_layout_engine(None)
+    fig.savefig(path, dpi=dpi)
+    # Only pyplot keeps figures open (a bare Figure is freed with its last reference); its
+    # import is not paid for a figure it never made.
+    plt = sys.modules.get("matplotlib.pyplot")
+    if plt is not None:
+        plt.close(fig)

@@ -14,8 +14,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import IO, Any
 
-import numpy as np
-
 from ..model import args
 from ..model.trajectory import Trajectory
 from .files import atomic_output
@@ -25,6 +23,8 @@ __all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
 
 #: Columns of the impacts' CSV (s, -, m/s, m/s).
 EVENT_COLUMNS = ("t", "body", "v_before", "v_after")
+#: Rows of the samples' CSV formatted at once (a few MB of text).
+CSV_BLOCK = 8192
 
 
 def _checked(traj: Any) -> Trajectory:
@@ -40,8 +40,14 @@ def dump_csv(traj: Trajectory, stream: IO[str]) -> None:
 
         raise UsageError(f"stream = {args.show(stream)}: must be an open text file "
                          "(with a write method)", param="stream")
-    np.savetxt(stream, traj.table(), delimiter=",", header=",".join(traj.columns),
-               comments="", fmt="%.17g")
+    table = traj.table()
+    stream.write(",".join(traj.columns) + "\n")
+    # np.savetxt's text (fmt "%.17g", "," between cells), formatted a block of rows at a time
+    # rather than row by row.
+    row = ",".join(["%.17g"] * table.shape[1]) + "\n"
+    for start in range(0, len(table), CSV_BLOCK):
+        block = table[start:start + CSV_BLOCK]
+        stream.write((row * len(block)) % tuple(block.ravel().tolist()))
 
 
 def write_csv(traj: Trajectory, path: str | Path) -> Path:

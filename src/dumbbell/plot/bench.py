@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
 from ..model import args
 from ..solvers import solver_class
-from .style import legend_outside, pyplot, solver_style
+from .style import _subplots, legend_outside, solver_style
 
 __all__ = ["convergence", "work_precision"]
 
@@ -28,7 +28,7 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(7.2, 6.0), dpi=100)
+        fig, ax = _subplots(figsize=(7.2, 6.0), dpi=100)
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]
     top = max(finite) * 8 if finite else 1.0
     names = list(dict.fromkeys(p.solver for p in result.points))
@@ -135,7 +135,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(9.6, 5.0), dpi=100)
+        fig, ax = _subplots(figsize=(9.6, 5.0), dpi=100)
     names = [n for n in dict.fromkeys(p.solver for p in result.points)
              if any(p.dt is not None for p in result.points if p.solver == n)]
     finite = [p.error for p in result.points if p.ran and math.isfinite(p.error) and p.error > 0]

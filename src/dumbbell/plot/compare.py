@@ -13,7 +13,7 @@ import numpy as np
 from ..analysis.compare import DIVERGED, Comparison
 from ..analysis.metrics import energy_error
 from ..model import args
-from .style import ROW_COLOURS, ROW_DASHES, legend_outside, pyplot
+from .style import ROW_COLOURS, ROW_DASHES, _subplots, legend_outside
 
 __all__ = ["compare", "compare_energy", "compare_positions"]
 
@@ -57,7 +57,7 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
         ax.set_xlabel("t [s]")
         ax.set_xlim(0, _shown(result))
         return ax
-    fig, axes = pyplot().subplots(2, 1, figsize=(11, 6.4), sharex=True)
+    fig, axes = _subplots(2, 1, figsize=(11, 6.4), sharex=True)
     for panel, body in zip(axes, "AB", strict=True):
         _heights_panel(panel, result, body)
     axes[-1].set_xlabel("t [s]")
@@ -73,7 +73,7 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(11, 4.6))
+        fig, ax = _subplots(figsize=(11, 4.6))
     scene, truth = result.scene, result.truth
     for colour, row in zip(ROW_COLOURS, result.rows, strict=False):
         t = row.traj.t[: len(row.error)]
@@ -114,7 +114,7 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(11, 4.6))
+        fig, ax = _subplots(figsize=(11, 4.6))
     scene, truth = result.scene, result.truth
     E0 = float(truth["E"][0]) or 1.0
     for colour, row in zip(ROW_COLOURS, result.rows, strict=False):

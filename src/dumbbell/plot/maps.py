@@ -13,7 +13,7 @@ from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
-from .style import FAIL_COLOURS, legend_outside, pyplot
+from .style import FAIL_COLOURS, _subplots, legend_outside
 
 __all__ = ["stability_map", "sweep_map"]
 
@@ -65,7 +65,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     ax = args.axes(ax)
     own = ax is None
     if own:
-        fig, ax = pyplot().subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
+        fig, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
     title = (f"Sweep of {result.scene.name}: {result.solver}, t_end = {result.t_end:g} s, "
              f"{len(result.rows)} runs")
     if len(result.axes) == 2:
@@ -199,7 +199,7 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     w*dt = 2. Makes its own figure (the panels share one colour bar); returns the panels."""
     _check_maps(maps)
     n = len(maps)
-    fig, axes = pyplot().subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
+    fig, axes = _subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
     y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
     errs = [r.max_rel_energy_error for rows in maps.values() for r in rows

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.rotation import Series, mean_after_first_cluster
-from .style import COLOURS, legend_outside, pyplot
+from .style import COLOURS, _subplots, legend_outside
 
 __all__ = ["rotation"]
 
@@ -81,7 +81,7 @@ def rotation(s: Series, ax: Any = None) -> Any:
         return ax
     momentum = all("L_cm" in r.columns for r in s.runs.values())
     rows = len(labels) + (1 if momentum else 0)
-    fig, axes = pyplot().subplots(
+    fig, axes = _subplots(
         rows, 1, figsize=(10.5, 2.4 * len(labels) + (1.8 if momentum else 0) + 1.0),
         sharex=True, gridspec_kw={"height_ratios": [1] * len(labels) + ([0.8] if momentum
                                                                          else [])})

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import legend_outside
+from .style import _subplots, legend_outside
 
 if TYPE_CHECKING:
     from ..analysis.contact import ContactMomentum
@@ -26,9 +26,7 @@ SPRING_COLOURS = ("#9ecae1", "#4292c6", "#08519c")
 def _axes(ax: Any, nrows: int = 1, **fig_kw: Any) -> Any:
     if ax is not None:
         return ax
-    import matplotlib.pyplot as plt
-
-    _, axes = plt.subplots(nrows, 1, **fig_kw)
+    _, axes = _subplots(nrows, 1, **fig_kw)
     return axes
 
 

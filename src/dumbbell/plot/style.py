@@ -1,7 +1,11 @@
 """The one place colours, labels and line styles are defined, for figures and animations.
 
-Also :func:`pyplot`, the lazy import of matplotlib's pyplot. It never chooses a backend: a
-notebook keeps its own, and the ``dumbbell`` command picks the file-only backend itself.
+Also :func:`pyplot`, the lazy import of matplotlib's pyplot, and how the package's figures are
+made (:func:`_figure`, :func:`_subplots`): through pyplot, so that a notebook shows them and
+``plt.show()`` opens them; but within :func:`dumbbell._install.command_line` (the ``dumbbell``
+command, which only writes files), as a bare ``matplotlib.figure.Figure`` on the Agg canvas,
+without importing pyplot. The pixels are the same either way. None of this chooses
+a backend: a notebook keeps its own.
 """
 
 from __future__ import annotations
@@ -66,3 +70,27 @@ def pyplot() -> Any:
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def _figure(**kwargs: Any) -> Any:
+    """A new figure (``kwargs`` as ``Figure`` takes them): pyplot's, or within
+    :func:`dumbbell._install.command_line` a bare one on the Agg canvas."""
+    from .._install import COMMAND_LINE
+
+    if not COMMAND_LINE.get():
+        return pyplot().figure(**kwargs)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _subplots(nrows: int = 1, ncols: int = 1, *, sharex: bool | str = False,
+              sharey: bool | str = False, squeeze: bool = True,
+              gridspec_kw: dict[str, Any] | None = None, **fig_kw: Any) -> tuple[Any, Any]:
+    """``pyplot.subplots`` by way of :func:`_figure`: the figure and its grid of axes."""
+    fig = _figure(**fig_kw)
+    return fig, fig.subplots(nrows, ncols, sharex=sharex, sharey=sharey, squeeze=squeeze,
+                             gridspec_kw=gridspec_kw)

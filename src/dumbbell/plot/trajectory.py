@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ..model.trajectory import Trajectory
-from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, legend_outside, pyplot
+from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, _figure, _subplots, legend_outside
 
 __all__ = ["energy", "kinetic", "positions", "potential"]
 
@@ -124,7 +124,7 @@ def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
         _positions_panel(ax, traj, window)
         _frame([ax], traj, window)
         return ax
-    fig, ax = pyplot().subplots(figsize=(9.5, 4.2))
+    fig, ax = _subplots(figsize=(9.5, 4.2))
     _positions_panel(ax, traj, window)
     _title(fig, [ax], traj, window,
            "the centre of mass falls on parabolas; the particles oscillate about it")
@@ -139,7 +139,7 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
         _energy_panel(ax, traj, names, window)
         _frame([ax], traj, window)
         return ax
-    fig, (top, bottom) = pyplot().subplots(2, 1, figsize=(9.5, 6.4), sharex=True)
+    fig, (top, bottom) = _subplots(2, 1, figsize=(9.5, 6.4), sharex=True)
     _positions_panel(top, traj, window)
     _energy_panel(bottom, traj, names, window)
     _title(fig, [top, bottom], traj, window, subtitle)
@@ -236,7 +236,7 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     spin = wide and "L_cm" in cols and bool(inner)
     # Constrained layout: the time panels stay aligned in one column whatever their legends
     # (outside, on the right) need; in 2D the motion in the plane sits right of the legends.
-    fig = pyplot().figure(figsize=(11.5 if wide else 10.0, 10.8 if spin else 8.8),
+    fig = _figure(figsize=(11.5 if wide else 10.0, 10.8 if spin else 8.8),
                           layout="constrained")
     rows = 4 if spin else 3
     grid = fig.add_gridspec(rows, 2 if wide else 1, width_ratios=[3.2, 1] if wide else None,

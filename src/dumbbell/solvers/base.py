@@ -85,8 +85,10 @@ class RunOptions:
         if count is not None and count < 0:
             raise UsageError(f"count = {count}: must be a whole number >= 0 (samples)",
                              param="count")
-        steps = np.arange(self.n_samples if count is None else count, dtype=np.int64)
-        return (steps * self.every) * self.dt
+        count = self.n_samples if count is None else count
+        # The step indices j * every, made whole (one array), then times dt.
+        steps = np.arange(0, count * self.every, self.every, dtype=np.int64)
+        return steps * self.dt
 
 
 #: The class methods of the contract whose arguments a call from outside has checked (the

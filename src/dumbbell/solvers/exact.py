@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from .._install import compiling
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
@@ -180,7 +181,8 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     check_work(scene, options)
     if scene.system.rigid is not None:
         return _solve_rigid(scene, options)
-    kernels = _kernels()  # compiled or loaded before the clock starts
+    with compiling("the exact solution's kernels", options.quiet):
+        kernels = _kernels()  # compiled or loaded before the clock starts
     t0 = time.perf_counter()
     rows, events, verdict = _segments(scene, options.t_end)
     t = options.sample_times()
@@ -198,7 +200,8 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
     from ..model.energy import rigid_moment
     from .exact_rigid import flight, sample
 
-    _kernels(rigid=True)  # compiled or loaded before the clock starts
+    with compiling("the exact solution's kernels", options.quiet):
+        _kernels(rigid=True)  # compiled or loaded before the clock starts
     t0 = time.perf_counter()
     segs, events, verdict = flight(scene, options.t_end)
     t = options.sample_times()

@@ -20,6 +20,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from .._install import compiling
 from ..model.energy import _partition, state_columns
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
@@ -68,7 +69,10 @@ class Stepper(Solver):
     def solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
         """Run ``scene`` at step ``options.dt`` (s). ``wall_time`` covers the kernel calls
         and the impact list, not the compiling, the array set-up, the verdict or the energy."""
-        run = _Steps.of(cls, scene, options.dt)
+        with compiling(f"the {cls.name} solver's kernels", options.quiet):
+            run = _Steps.of(cls, scene, options.dt)
+            if scene.system.dimensions == 1:
+                _ready_partition()  # used once the run is done: compiled (or loaded) with it
         columns = state_columns(scene)
         # One contiguous row per column, so the Trajectory's columns are views, not copies.
         out = np.empty((len(columns), options.n_samples))
@@ -100,10 +104,15 @@ class Stepper(Solver):
             if cls.kernel(dimensions) is not None:
                 _ready(_loop(cls, dimensions), params, width)
         if cls.kernel(1) is not None:
-            from ..model.energy import _loop_1d
-
-            _loop_1d()((0.1, 0.1, 200.0, 0.2, 9.8), *np.ones((4, 1)))
+            _ready_partition()
         return time.perf_counter() - t0
+
+
+def _ready_partition() -> None:
+    """Compile (or load) the 1D energy partition's loop."""
+    from ..model.energy import _loop_1d
+
+    _loop_1d()((0.1, 0.1, 200.0, 0.2, 9.8), *np.ones((4, 1)))
 
 
 def _loop(cls: type[Stepper], dimensions: int) -> Callable[..., Any]:

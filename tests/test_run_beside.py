@@ -1,0 +1,242 @@
+"""``dumbbell run`` makes its figures and CSVs in a forked process beside the GIF
+(:mod:`dumbbell.cli.beside`): the same bytes as one process making all, one after the other;
+the child's errors are the command's; a child that dies leaves its work to the parent; a stop
+signal stops both and leaves nothing; the command imports neither pyplot nor scipy.linalg."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import psutil
+import pytest
+
+from tests.hostile import SHORT_SCENE, SRC, files_in, refused, send_when
+
+#: A short run of the textbook scene with every output: three figures, the CSVs, a GIF.
+SCENE = SHORT_SCENE.replace("t_end = 0.05\ndt = 1e-4", "t_end = 2.0\ndt = 1e-4") + """
+[outputs]
+figures = ["positions", "kinetic", "potential"]
+csv = true
+gif = { fps = 10, size = "320x180", strip = true, t_end = 1.0 }
+"""
+
+#: Runs ``dumbbell ARGV`` in a fresh process, the fork forced on or off (FORK=1/0), after
+#: PATCH (Python code) and prints which of the modules named in CHECK were imported.
+RUNNER = """
+import os, sys
+import dumbbell.cli.beside as beside
+if os.environ.get("FORK"):
+    beside.side_by_side = lambda: os.environ["FORK"] == "1"
+exec(os.environ.get("PATCH", ""))
+from dumbbell.cli import main
+status = main(sys.argv[1:])
+for name in os.environ.get("CHECK", "").split():
+    print(name, name in sys.modules)
+sys.exit(status)
+"""
+
+
+def run(*argv: object, fork: bool | None = None, patch: str = "", check: str = "",
+        cwd: Path | None = None) -> subprocess.CompletedProcess:
+    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", "PATCH": patch, "CHECK": check,
+           "FORK": "" if fork is None else str(int(fork))}
+    return subprocess.run([sys.executable, "-c", RUNNER, *map(str, argv)], env=env, cwd=cwd,
+                          check=False,
+                          capture_output=True, text=True, timeout=120)
+
+
+@pytest.fixture
+def scene(tmp_path):
+    path = tmp_path / "beside.toml"
+    path.write_text(SCENE)
+    return path
+
+
+def outputs_of(folder: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+
+
+def test_forked_and_one_process_write_the_same_bytes(scene, tmp_path):
+    forked = run("run", scene, "--out", tmp_path / "forked", fork=True)
+    alone = run("run", scene, "--out", tmp_path / "alone", fork=False)
+    assert forked.returncode == alone.returncode == 0, (forked.stderr, alone.stderr)
+    a, b = outputs_of(tmp_path / "forked"), outputs_of(tmp_path / "alone")
+    assert sorted(a) == ["beside-impacts.csv", "beside-kinetic.png", "beside-positions.png",
+                         "beside-potential.png", "beside.csv", "beside.gif"]
+    assert a == b
+    # The same lines on stderr, in the order of the outputs.
+    assert forked.stderr.replace("/forked/", "/alone/") == alone.stderr
+    assert [line.split("/")[-1] for line in forked.stderr.splitlines()] == [
+        "beside-positions.png", "beside-kinetic.png", "beside-potential.png", "beside.csv",
+        "beside-impacts.csv", "beside.gif"]
+
+
+def test_the_command_loads_neither_pyplot_nor_scipy_linalg(scene, tmp_path):
+    for fork in (True, False):
+        done = run("run", scene, "-q", "--out", tmp_path / str(fork), fork=fork,
+                   check="matplotlib.pyplot scipy.linalg numba matplotlib")
+        assert done.returncode == 0, done.stderr
+        loaded = dict(line.split() for line in done.stdout.splitlines())
+        assert loaded["matplotlib.pyplot"] == loaded["scipy.linalg"] == "False"
+        assert loaded["numba"] == "True"
+        # Forked, this process never draws: matplotlib stays in the child.
+        assert loaded["matplotlib"] == str(not fork)
+
+
+@pytest.mark.parametrize("fork", [True, False])
+def test_an_error_drawing_a_figure_is_the_commands_own(scene, tmp_path, fork):
+    patch = ("import dumbbell.cli.run as r\n"
+             "from dumbbell.errors import UsageError\n"
+             "def bad(name, traj): raise UsageError(f'cannot draw {name}')\n"
+             "r._figure = bad\n")
+    out = tmp_path / "out"
+    done = run("run", scene, "--out", out, fork=fork, patch=patch)
+    line = refused(done.returncode, done.stderr, code=2)
+    assert line == "dumbbell run: error: cannot draw positions"
+    assert not out.exists() or files_in(out) == []
+
+
+def test_a_crash_in_the_child_is_raised_with_its_traceback(scene, tmp_path):
+    patch = ("import dumbbell.cli.run as r\n"
+             "def bad(name, traj): raise ZeroDivisionError('a bug in a figure')\n"
+             "r._figure = bad\n")
+    out = tmp_path / "out"
+    done = run("run", scene, "--out", out, fork=True, patch=patch)
+    assert done.returncode == 1
+    assert "ZeroDivisionError: a bug in a figure" in done.stderr
+    assert "in the process that drew the figures" in done.stderr
+    assert not out.exists() or files_in(out) == []
+
+
+def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
+    # The child kills itself the moment it would draw: the parent draws instead.
+    patch = ("import os, signal, dumbbell.cli.run as r, dumbbell.cli.beside as b\n"
+             "draw = r._draw_figures\n"
+             "def dying(files, traj, alive):\n"
+             "    if b._IN_CHILD: os.kill(os.getpid(), signal.SIGKILL)\n"
+             "    return draw(files, traj, alive)\n"
+             "r._draw_figures = dying\n")
+    died = run("run", scene, "--out", tmp_path / "died", fork=True, patch=patch)
+    alone = run("run", scene, "--out", tmp_path / "alone", fork=False)
+    assert died.returncode == alone.returncode == 0, died.stderr
+    assert outputs_of(tmp_path / "died") == outputs_of(tmp_path / "alone")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_stop_signal_stops_the_child_and_leaves_nothing(tmp_path, sig):
+    # A long GIF keeps the parent busy while the child waits to be reaped.
+    path = tmp_path / "long.toml"
+    path.write_text(SCENE.replace('t_end = 1.0 }', 't_end = 2.0 }').replace(
+        "fps = 10", "fps = 50").replace('"320x180"', '"1280x720"'))
+    out = tmp_path / "out"
+    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", "FORK": "1", "PATCH": "", "CHECK": ""}
+    proc = subprocess.Popen([sys.executable, "-c", RUNNER, "run", str(path), "--out", str(out)],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    children = lambda: psutil.Process(proc.pid).children()
+    send_when(proc, lambda: bool(children()) and out.exists()
+              and any(n.endswith(".gif") for n in os.listdir(out)), sig)
+    _, err = proc.communicate(timeout=60)
+    line = refused(proc.returncode, err, out, code=128 + sig)
+    assert signal.Signals(sig).name in line
+
+
+def test_one_cpu_or_another_thread_means_no_fork(monkeypatch):
+    from dumbbell.cli import beside
+
+    monkeypatch.setattr(beside, "_IN_CHILD", False)
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    if sys.platform.startswith("linux") and threading.active_count() == 1:
+        assert beside.side_by_side()
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0})
+    assert not beside.side_by_side()
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    stop = threading.Event()
+    worker = threading.Thread(target=stop.wait)
+    worker.start()
+    try:
+        assert not beside.side_by_side()
+    finally:
+        stop.set()
+        worker.join()
+
+
+def test_the_pipe_carries_a_trajectory_whole():
+    from dumbbell.cli.beside import _receive, _send
+    from dumbbell.model.scene import load_scene, packaged_scene
+    from dumbbell.solvers import simulate
+
+    traj = simulate(load_scene(packaged_scene()), "exact", t_end=1.0, every=10)
+    r, w = os.pipe()
+    sender = threading.Thread(target=_send, args=(w, traj))
+    sender.start()
+    got = _receive(r)
+    sender.join()
+    assert got.columns == traj.columns and got.events == traj.events
+    assert got.verdict == traj.verdict and got.solver == traj.solver
+    for name in traj.columns:
+        assert np.array_equal(got[name], traj[name])
+    # Nothing sent (the parent gave up): None.
+    r, w = os.pipe()
+    os.close(w)
+    assert _receive(r) is None
+
+
+def test_the_library_keeps_pyplot_and_the_command_does_without(tmp_path):
+    """Outside the command a figure is pyplot's (a notebook shows it); within it, a bare
+    Figure; saved, the two are the same bytes."""
+    plt = pytest.importorskip("matplotlib.pyplot")
+    from dumbbell import plot
+    from dumbbell._install import command_line
+    from dumbbell.io.figures import save_figure
+    from dumbbell.model.scene import load_scene, packaged_scene
+    from dumbbell.solvers import simulate
+
+    traj = simulate(load_scene(packaged_scene()), "exact", t_end=2.0, every=100)
+    ax = plot.kinetic(traj)
+    assert ax.figure.number in plt.get_fignums()
+    save_figure(ax.figure, tmp_path / "pyplot.png")
+    assert ax.figure.number not in plt.get_fignums()  # closed once saved
+    with command_line():
+        bare = plot.kinetic(traj)
+    assert bare.figure not in [plt.figure(n) for n in plt.get_fignums()]
+    save_figure(bare.figure, tmp_path / "bare.png")
+    assert (tmp_path / "pyplot.png").read_bytes() == (tmp_path / "bare.png").read_bytes()
+
+
+def test_a_slow_first_use_says_it_compiles_once(monkeypatch, capsys):
+    """The line shows when a kernel's first use outlasts a load from the cache, on a
+    terminal only, once per solver and process."""
+    import time
+
+    from dumbbell import _install, progress
+
+    monkeypatch.setattr(_install, "COMPILE_NOTE_AFTER", 0.05)
+    monkeypatch.setattr(_install, "_compiling_said", set())
+    monkeypatch.delenv(_install._SAID, raising=False)
+    watching = {"yes": True}
+    monkeypatch.setattr(progress, "progress_wanted", lambda quiet=False: watching["yes"]
+                        and not quiet)
+    with _install.compiling("the test solver's kernels", quiet=False):
+        pass  # a load from the cache: quick
+    assert capsys.readouterr().err == ""
+    with _install.compiling("the test solver's kernels", quiet=True):
+        time.sleep(0.2)  # slow, but -q
+    assert capsys.readouterr().err == ""
+    watching["yes"] = False
+    with _install.compiling("the test solver's kernels", quiet=False):
+        time.sleep(0.2)  # slow, but not on a terminal (or CI)
+    assert capsys.readouterr().err == ""
+    watching["yes"] = True
+    for _ in range(2):
+        with _install.compiling("the test solver's kernels", quiet=False):
+            time.sleep(0.2)
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith("dumbbell: compiling the test solver's kernels with numba (the first "
+                          "run after an install or upgrade")
