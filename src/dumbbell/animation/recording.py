@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import itertools
 import math
 import os
 import signal
@@ -120,6 +121,10 @@ class Group:
     at: np.ndarray
     local: np.ndarray
     r: np.ndarray
+    #: Each shape's body (its row in a frame's poses), and whether all the group's points
+    #: are their bodies' origins (circles centred on their bodies: placed without turning).
+    rows: np.ndarray
+    origin: bool
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,13 +147,14 @@ class Shapes:
         by: dict[tuple[str, int], list[int]] = {}
         for j, (kind, pts) in enumerate(zip(kinds, local, strict=True)):
             by.setdefault((kind, len(pts)), []).append(j)
-        groups = tuple(
-            Group(kind, np.array(idx, dtype=np.intp),
-                  np.array([local[j] for j in idx], dtype=float).reshape(len(idx), p, 2),
-                  np.array([r[j] for j in idx], dtype=float))
-            for (kind, p), idx in by.items())
-        return cls(np.array(body, dtype=np.intp), np.array(ink, dtype=int),
-                   np.array(number, dtype=int), groups)
+        rows = np.array(body, dtype=np.intp)
+        groups = []
+        for (kind, p), idx in by.items():
+            pts = np.array([local[j] for j in idx], dtype=float).reshape(len(idx), p, 2)
+            at = np.array(idx, dtype=np.intp)
+            groups.append(Group(kind, at, pts, np.array([r[j] for j in idx], dtype=float),
+                                rows[at], bool(p) and not pts.any()))
+        return cls(rows, np.array(ink, dtype=int), np.array(number, dtype=int), tuple(groups))
 
     @property
     def n(self) -> int:
@@ -157,8 +163,10 @@ class Shapes:
     def place(self, pose: np.ndarray, g: Group) -> tuple[np.ndarray, np.ndarray]:
         """Group ``g``'s points in the world (..., m, p, 2) and its bodies' angles (..., m), at
         ``pose`` (..., bodies, 3: x, y, angle; leading axes: frames)."""
-        p = pose[..., self.body[g.at], :]
+        p = pose[..., g.rows, :]
         angle = p[..., 2]
+        if g.origin:  # x + cos 0 - sin 0 is x
+            return p[..., None, :2], angle
         c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
         lx, ly = g.local[..., 0], g.local[..., 1]
         x = p[..., 0, None] + c * lx - s * ly
@@ -481,18 +489,18 @@ def shape_pixels(kind: str, pts: np.ndarray, r: np.ndarray, angle: np.ndarray, v
     ok = ~np.isnan(pts).reshape(m, -1).any(axis=1) if p else np.zeros(m, dtype=bool)
     if kind == "circle":
         XY = P[:, 0]
-        radius = np.fmin(np.maximum(r * (view.s * S), 1.5 * u * S), CLIP)
-        ok &= ~np.isnan(radius)
-        R = np.rint(np.where(ok, radius, 0.0)).astype(np.int64)
+        R, known = _radii(r, view, u)
+        ok &= known
         turns = np.isfinite(angle)
-        a = np.where(turns, angle, 0.0)
+        every = bool(turns.all())
+        a = angle if every else np.where(turns, angle, 0.0)
         end = _snap(XY + R[:, None] * np.stack([np.cos(a), view.flip * np.sin(a)], axis=1))
-        end[~turns] = XY[~turns]  # no radius line
+        if not every:
+            end[~turns] = XY[~turns]  # no radius line
         ints = np.concatenate([XY, end, R[:, None]], axis=1)
         lo, hi = XY - (R + line)[:, None], XY + (R + line)[:, None]
     elif kind == "seg":
-        wide = np.rint(np.fmin(2 * np.where(np.isnan(r), 0.0, r) * (view.s * S), CLIP))
-        W = np.maximum(line, wide).astype(np.int64)
+        W = _widths(r, view, u)
         ints = np.concatenate([P.reshape(m, 4), W[:, None]], axis=1)
         reach = (W / 2 + line)[:, None]
         lo, hi = P.min(axis=1) - reach, P.max(axis=1) + reach
@@ -504,8 +512,42 @@ def shape_pixels(kind: str, pts: np.ndarray, r: np.ndarray, angle: np.ndarray, v
         else:
             lo = hi = np.zeros((m, 2))
     boxes = np.concatenate([lo / S - 1, hi / S + 1], axis=1)
-    boxes[~ok] = math.nan
+    if not ok.all():
+        boxes[~ok] = math.nan
     return ints, boxes, ok
+
+
+def _radii(r: np.ndarray, view: View, u: float) -> tuple[np.ndarray, np.ndarray]:
+    """Circles' radii (whole pixels at :data:`SS` times the size; at least 1.5 u) and which
+    are numbers; the same for a set of shapes and a view, so kept for the last few."""
+    key = ("radii", id(r), view, u)
+    got = _KEPT.get(key)
+    if got is None or got[0] is not r:
+        radius = np.fmin(np.maximum(r * (view.s * SS), 1.5 * u * SS), CLIP)
+        known = ~np.isnan(radius)
+        got = _keep(key, (r, (np.rint(np.where(known, radius, 0.0)).astype(np.int64), known)))
+    return got[1]
+
+
+def _widths(r: np.ndarray, view: View, u: float) -> np.ndarray:
+    """Segments' widths (whole pixels at :data:`SS` times the size; at least a line's)."""
+    key = ("widths", id(r), view, u)
+    got = _KEPT.get(key)
+    if got is None or got[0] is not r:
+        wide = np.rint(np.fmin(2 * np.where(np.isnan(r), 0.0, r) * (view.s * SS), CLIP))
+        got = _keep(key, (r, np.maximum(line_width(u), wide).astype(np.int64)))
+    return got[1]
+
+
+#: What :func:`_radii` and :func:`_widths` keep (their arrays held, so an id is not reused).
+_KEPT: dict[tuple, tuple] = {}
+
+
+def _keep(key: tuple, value: tuple) -> tuple:
+    if len(_KEPT) >= 64:
+        _KEPT.clear()
+    _KEPT[key] = value
+    return value
 
 
 def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
@@ -1030,6 +1072,8 @@ class Painter(Backdrop):
                                    == white).all())
                        for name, box in (("label", self.label_box),
                                          ("values", self._values_box()))}
+        if self.energy:
+            self._band_of = self._bands()
         return True
 
     def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
@@ -1119,7 +1163,9 @@ class Painter(Backdrop):
         them (left, top, right, bottom)."""
         whole = _whole(box, self.W, self.H)
         if whole[2] > whole[0] and whole[3] > whole[1]:
-            self._canvas.paste(self.bg.crop(whole), whole[:2])  # type: ignore[union-attr]
+            # Through Pillow's core (both "P", the canvas a copy of its own): no per-call
+            # checks.
+            self._canvas.im.paste(self.bg.im.crop(whole), whole)  # type: ignore[union-attr]
         return whole
 
     def _label(self, img: Image.Image, k: int, scene: list[tuple[float, float, float, float]]
@@ -1154,45 +1200,67 @@ class Painter(Backdrop):
         x0, y0, x1, y1 = self.changed
         return math.floor(x0) - 1, math.floor(y0) - 1, math.ceil(x1) + 2, math.ceil(y1) + 2
 
+    def _bands(self) -> list[tuple[int, int]]:
+        """Each bar's band (px: top, bottom): from the middle of the gap above it to the
+        middle of the gap below it (the panel's block, first and last); one band for all
+        bars when a value's text would not fit in its own (so redrawing a band never touches
+        another's)."""
+        rows = self.rows
+        edges = [rows[0][1] - 3]
+        edges += [(bot + nxt) // 2 for (_, _, bot), (_, nxt, _) in itertools.pairwise(rows)]
+        edges.append(rows[-1][2] + 3)
+        ascent, descent = self.st_text.font.getmetrics()
+        fits = all(lo <= round((top + bot) / 2 + self.st_text.cap / 2) - ascent - 2
+                   and round((top + bot) / 2 + self.st_text.cap / 2) + descent + 2 <= hi
+                   for (_, top, bot), lo, hi in zip(rows, edges, edges[1:]))
+        if not fits or not self._white["values"]:
+            return [(edges[0], edges[-1])] * len(rows)
+        return list(itertools.pairwise(edges))
+
     def _bars(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
-        """Draw the bars and their values if any changed; the box touched."""
+        """Draw again the bars (with their values) that changed; the boxes touched."""
         values = {n: float(self.e[n][k]) for n in self.names}
         spans = []
         for name, top, bot in self.rows:
             v = values[name]
             if not math.isfinite(v):
-                spans.append(None)
+                spans.append((None, self.scale.text(v)))
                 continue
             a, b = sorted((round(self.bar_px(0.0)), round(self.bar_px(v))))
             h = b
             if name == "E" and self.rec.heat and values["heat"] > 0:
                 # E + heat: what E was, were no energy lost to the contacts.
                 h = max(b, round(self.bar_px(v + values["heat"])))
-            spans.append((a, b, h, self.scale.text(v)))
-        key = tuple(spans)
-        if self._shown.get("bars") == key:
+            spans.append(((a, b, h), self.scale.text(v)))
+        bands = self._band_of
+        shown = self._shown.get("bars") or [None] * len(spans)
+        redo = sorted({bands[j] for j, span in enumerate(spans) if span != shown[j]})
+        if not redo:
             return []
-        self._shown["bars"] = key
-        box = (self.bar_left - 1, self.rows[0][1] - 3, self.W, self.rows[-1][2] + 3)
-        self._restore(box)
+        self._shown["bars"] = spans
         d = ImageDraw.Draw(img)
-        for (name, top, bot), span in zip(self.rows, spans, strict=True):
-            if span is None:
-                continue
-            a, b, h, _ = span
-            if h > b:
-                d.rectangle([b, top, h - 1, bot - 1], fill=self.idx["heat"])
-            if b > a:
-                d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
         bx1 = self.bars_box[2]
-        if self._white["values"]:
-            for (name, top, bot), span in zip(self.rows, spans, strict=True):
-                self.tx_text.draw(img, (bx1, (top + bot) / 2),
-                                  span[3] if span else self.scale.text(values[name]), "rm")
-        else:
-            draw_values(self.patch(img, self._values_box(), 1), self.rows,
-                        lambda name: self.scale.text(values[name]), bx1, self.st_text)
-        return [box]
+        boxes: list[tuple[float, float, float, float]] = []
+        for band in redo:
+            box = (self.bar_left - 1, band[0], self.W, band[1])
+            self._restore(box)
+            boxes.append(box)
+            rows = [j for j, b in enumerate(bands) if b == band]
+            for j in rows:
+                name, top, bot = self.rows[j]
+                extent, text = spans[j]
+                if extent is not None:
+                    a, b, h = extent
+                    if h > b:
+                        d.rectangle([b, top, h - 1, bot - 1], fill=self.idx["heat"])
+                    if b > a:
+                        d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
+                if self._white["values"]:
+                    self.tx_text.draw(img, (bx1, (top + bot) / 2), text, "rm")
+            if not self._white["values"]:
+                draw_values(self.patch(img, self._values_box(), 1), self.rows,
+                            lambda name: self.scale.text(values[name]), bx1, self.st_text)
+        return boxes
 
     def _cursor(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
         """Move the strip's cursor if it moved; the boxes touched."""
@@ -1258,15 +1326,13 @@ class _Text:
         """Paste ``text`` on the palette image ``img`` at ``xy`` (px), anchored as
         :meth:`Stamps.draw` anchors it."""
         x, y = xy
-        if anchor[0] == "r":
-            x -= self.st.width(text)
-        elif anchor[0] == "m":
-            x -= self.st.width(text) / 2
+        glyphs = [self._glyph(ch) for ch in text]
+        if anchor[0] in "rm":
+            x -= sum(g[4] for g in glyphs) / (1 if anchor[0] == "r" else 2)
         base = round({"m": y + self.st.cap / 2, "t": y + self.st.cap, "s": y}[anchor[1]])
         img.load()
         core = img.im  # pasted through Pillow's core: no per-call checks, both are "P"
-        for ch in text:
-            sprite, mask, left, top, advance = self._glyph(ch)
+        for sprite, mask, left, top, advance in glyphs:
             X, Y = round(x) - left, base - top
             core.paste(sprite.im, (X, Y, X + sprite.width, Y + sprite.height), mask.im)
             x += advance
