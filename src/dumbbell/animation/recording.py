@@ -72,7 +72,7 @@ from .palette import (
 )
 from .render import delays_cs
 from .strip import GRID
-from .world import zigzag
+from .world import LEAD
 
 #: No public names: the painter behind :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
@@ -550,6 +550,27 @@ def _keep(key: tuple, value: tuple) -> tuple:
     return value
 
 
+def _zigzags(ends: np.ndarray, u: float) -> np.ndarray:
+    """Springs from whole-pixel ends (m x 2 x 2, at :data:`SS` times the size) as zig-zags in
+    whole pixels (m x 2(2 COILS + 4), flat x, y): straight leads of LEAD of the length at each
+    end and COILS zig-zags between, at most SPRING_WIDTH u or a tenth of the spring's length
+    wide (a web of short springs stays legible); all springs at once, as
+    :func:`~dumbbell.animation.world.zigzag` draws one."""
+    m = len(ends)
+    p0 = ends[:, 0].astype(float)
+    d = ends[:, 1] - ends[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    amp = np.minimum(SPRING_WIDTH * u * SS, 0.1 * length)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / length[:, None] * amp[:, None]
+    normal[length == 0] = 0.0  # a spring of no length: all its points at its ends
+    i = np.arange(2 * COILS)
+    f = np.r_[0.0, LEAD, LEAD + (1 - 2 * LEAD) * (i + 0.5) / (2 * COILS), 1 - LEAD, 1.0]
+    side = np.r_[0.0, 0.0, np.where(i % 2 == 0, 1.0, -1.0), 0.0, 0.0]
+    pts = p0[:, None] + d[:, None] * f[None, :, None] + side[None, :, None] * normal[:, None]
+    return np.rint(pts).astype(np.int64).reshape(m, 2 * len(f))
+
+
 def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
                  ) -> tuple[list[tuple | None], np.ndarray]:
     """Constraints' primitives seen through ``view`` in whole pixels at :data:`SS` times the
@@ -564,7 +585,10 @@ def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
     # Every primitive's first point (and second, for springs and lines) at once.
     pts = np.array([(it[3], it[4], it[5], it[6]) if it[0] in ("spring", "line") else
                     (it[3], it[4], it[3], it[4]) for it in items], dtype=float)
-    ends = _to_pixels(pts.reshape(m, 2, 2), view).reshape(m, 4).tolist()
+    whole = _to_pixels(pts.reshape(m, 2, 2), view)
+    ends = whole.reshape(m, 4).tolist()
+    springs = [j for j, it in enumerate(items) if it[0] == "spring"]
+    coils = dict(zip(springs, _zigzags(whole[springs], u).tolist(), strict=True))
     for j, (it, (ax, ay, bx, by)) in enumerate(zip(items, ends, strict=True)):
         kind = it[0]
         room = line
@@ -572,10 +596,7 @@ def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
             xy = [ax, ay, bx, by]
             px: tuple = ("line", xy)
         elif kind == "spring":
-            # Coils at most a tenth of the spring's drawn length wide: a web of short springs
-            # stays legible.
-            amp = min(SPRING_WIDTH * u * S, 0.1 * math.hypot(bx - ax, by - ay))
-            xy = [round(v) for q in zigzag((ax, ay), (bx, by), amp, COILS) for v in q]
+            xy = coils[j]
             px = ("spring", xy)
         elif kind == "dot":
             xy = [ax, ay]
