@@ -44,7 +44,20 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "src"))
-from dumbbell.animation.recording import scene_area
+
+#: The recorder's scene area on a frame without the energy panel (px: left, top, width,
+#: height), given to the baselines' processes on their command line, so that they do not
+#: import dumbbell (what a user of matplotlib_util or pygame_util does not load).
+AREA: tuple[int, int, int, int] | None = None
+
+
+def scene_area() -> tuple[int, int, int, int]:
+    """Where the recorder draws the view on a W x H frame without the energy panel (px)."""
+    if AREA is not None:
+        return AREA
+    from dumbbell.animation.recording import scene_area as area
+
+    return area(W, H, False)
 
 FPS, DT = 25, 1e-3
 W, H = 640, 360
@@ -69,7 +82,7 @@ class Matplotlib:
         self.world = world
         self.fig = plt.figure(figsize=(W / 100, H / 100), dpi=100)
         # The recorder's view of the world box: its scene area under the time label.
-        left, top, width, height = scene_area(W, H, False)
+        left, top, width, height = scene_area()
         self.ax = self.fig.add_axes((left / W, 1 - (top + height) / H, width / W, height / H))
         self.ax.set_axis_off()
         px_per_unit = width / (world[1] - world[0])
@@ -121,7 +134,7 @@ class Pygame:
         self.options.flags = (pymunk.SpaceDebugDrawOptions.DRAW_SHAPES
                               | pymunk.SpaceDebugDrawOptions.DRAW_CONSTRAINTS)
         # The recorder's view of the world box: its scene area under the time label.
-        left, top_px, width, _ = scene_area(W, H, False)
+        left, top_px, width, _ = scene_area()
         x0, x1, bottom, top = world
         s = width / (x1 - x0)
         flip = 1.0 if bottom > top else -1.0
@@ -219,8 +232,8 @@ def _run(side: str, out: str, seconds: float, world: tuple[float, ...]) -> tuple
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     subprocess.run([sys.executable, __file__, "--side", side, "--out", out, "--seconds",
-                    str(seconds), "--world=" + ",".join(repr(v) for v in world)], check=True,
-                   env=env)
+                    str(seconds), "--world=" + ",".join(repr(v) for v in world),
+                    "--area=" + ",".join(str(v) for v in scene_area())], check=True, env=env)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -370,8 +383,12 @@ def main() -> None:
     parser.add_argument("--side", choices=SIDES)
     parser.add_argument("--out")
     parser.add_argument("--world", help="x0,x1,bottom,top (for --side)")
+    parser.add_argument("--area", help="the scene area: left,top,width,height px (for --side)")
     args = parser.parse_args()
     if args.side:
+        global AREA
+        if args.area:
+            AREA = tuple(int(v) for v in args.area.split(","))  # type: ignore[assignment]
         world = tuple(float(v) for v in args.world.split(","))
         cradle_side(args.side, args.out, args.seconds, world)
     elif args.table:

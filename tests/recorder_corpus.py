@@ -201,6 +201,33 @@ def smallest(space: Any) -> int | None:
     return min(found, key=lambda i: body_size(list(space.bodies)[i])) if found else None
 
 
+def in_view(space: Any, rec: Any, i: int) -> bool:
+    """Whether body ``i`` of ``space`` has its position inside the recording's view."""
+    x0, x1, y0, y1 = rec.view
+    p = list(space.bodies)[i].position
+    return min(x0, x1) <= p.x <= max(x0, x1) and min(y0, y1) <= p.y <= max(y0, y1)
+
+
+def smallest_in_view(space: Any, rec: Any) -> int | None:
+    """Index of the dynamic body with the smallest shapes among those in the view, or
+    None."""
+    visible = [i for i in dynamic(space) if in_view(space, rec, i)]
+    return min(visible, key=lambda i: body_size(list(space.bodies)[i])) if visible else None
+
+
+def smallest_px(space: Any, rec: Any) -> float | None:
+    """How large (px, the larger side of its pixels) the smallest body in the view is drawn:
+    that body drawn alone through the recording's view, measured on its pixels; None
+    without a dynamic body in the view."""
+    i = smallest_in_view(space, rec)
+    return None if i is None else extent(picture(space, rec, bodies=[i]))
+
+
+def orientation(rec: Any) -> str:
+    """'up' or 'down': which way y points in the recording's picture."""
+    return "up" if rec.view[3] > rec.view[2] else "down"
+
+
 def ground(space: Any) -> int | None:
     """Index into ``space.shapes`` of the ground: the static segment nearest below the
     lowest dynamic body along gravity, among those that reach under the bodies (None without

@@ -434,6 +434,128 @@ def test_bars_show_changes_from_the_start_in_the_spaces_units(tmp_path):
     assert lengths[0] > 50 and abs(lengths[0] - lengths[1]) <= 2
 
 
+def test_the_energy_panel_is_spaces_energy_at_every_frame_whatever_changes(tmp_path):
+    # The panel samples the space in bulk and takes its inventory again only when something
+    # it rests on changes. Hand-checked against spaces.energy(space) at each capture while the
+    # run changes, one at a time: a spring's rest length and stiffness, a body's mass and
+    # centre of gravity, gravity, a body added, a spring's force function, a body's type.
+    space = pymunk.Space()
+    space.gravity = (0.0, -9.81)
+    a = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    b = pymunk.Body(2.0, pymunk.moment_for_circle(2.0, 0, 0.1))
+    a.position, b.position = (0.0, 1.0), (0.5, 1.2)
+    a.velocity, b.angular_velocity = (0.3, 0.0), 2.0
+    spring = pymunk.DampedSpring(a, b, (0.05, 0), (0, 0.02), 0.4, 30.0, 0.1)
+    rotary = pymunk.DampedRotarySpring(space.static_body, b, 0.1, 5.0, 0.0)
+    space.add(a, pymunk.Circle(a, 0.1), b, pymunk.Circle(b, 0.1), spring, rotary)
+    late = pymunk.Body(1.5, 1.0)
+    late.position, late.velocity = (1.0, 2.0), (0.0, 1.0)
+
+    def change(k):
+        if k == 2:
+            spring.rest_length, spring.stiffness = 0.6, 50.0
+        elif k == 4:
+            a.mass = 1.5
+        elif k == 5:
+            b.center_of_gravity = (0.01, 0.0)
+        elif k == 6:
+            space.gravity = (0.0, -5.0)
+        elif k == 7:
+            space.add(late, pymunk.Circle(late, 0.1))
+        elif k == 8:
+            rotary.rest_angle, rotary.stiffness = -0.2, 8.0
+        elif k == 9:
+            spring.force_func = lambda s, d: 0.0  # its energy unknown from here
+        elif k == 10:
+            late.body_type = pymunk.Body.KINEMATIC
+
+    want = {n: [] for n in ("K_trans", "K_rot", "U_g", "U_spring", "E")}
+
+    def keep():
+        e = spaces.energy(space)
+        for n, values in want.items():
+            values.append(getattr(e, n))
+
+    with spaces.Recorder(space, tmp_path / "a.gif", reference="space") as rec:
+        keep()
+        for k in range(12):
+            change(k)
+            spaces.step(space, 1 / 25, substeps=5)
+            rec.capture()
+            keep()
+    got = rec.recording().energy
+    for n, values in want.items():
+        assert got[n] == pytest.approx(values, rel=1e-14, abs=1e-14), n
+    assert got["U_spring"][10] != got["U_spring"][9]  # the custom spring left U_spring
+
+
+def test_a_frame_drawn_in_parts_is_the_frame_drawn_whole(tmp_path, monkeypatch):
+    # From frame to frame the painter draws again only what changed (the moving layer's
+    # boxes, the label, a bar, the cursor), on the previous picture. Drawing every frame
+    # from nothing gives the same file, byte for byte: with and without the panel, a body
+    # thrown out of the view, a static shape added at the fourth frame, springs and pins.
+    from dumbbell.animation import recording
+
+    whole = recording.Painter.frame
+
+    def from_nothing(self, k):
+        self._canvas = None
+        return whole(self, k)
+
+    for kw in ({}, {"energy": False}):
+        space = _space()
+        thrown = pymunk.Body(0.2, pymunk.moment_for_circle(0.2, 0, 0.03))
+        thrown.position, thrown.velocity = (0.0, 0.3), (6.0, 4.0)
+        space.add(thrown, pymunk.Circle(thrown, 0.03))
+        with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
+            for k in range(30):
+                if k == 3:
+                    space.add(pymunk.Segment(space.static_body, (-1, 0.5), (-0.5, 0.7), 0.02))
+                spaces.step(space, 1 / 25, substeps=10)
+                rec.capture()
+        with monkeypatch.context() as m:
+            m.setattr(recording.Painter, "frame", from_nothing)
+            recording.write(tmp_path / "b.gif", rec.recording())
+        assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+
+
+def _boxes_space(n: int) -> pymunk.Space:
+    """``n`` boxes 8 px wide falling side by side onto a floor, in pixels (y down)."""
+    space = pymunk.Space()
+    space.gravity = (0.0, 900.0)
+    space.add(pymunk.Segment(space.static_body, (0, 400), (1200, 400), 2))
+    for i in range(n):
+        body = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (8, 8)))
+        body.position = (10 + 10 * (i % 110), 380 - 12 * (i // 110))
+        body.angular_velocity = 0.3
+        space.add(body, pymunk.Poly.create_box(body, (8, 8)))
+    return space
+
+
+@pytest.mark.parametrize("n, flat", [(99, False), (100, True)])
+def test_many_small_bodies_are_drawn_flat(tmp_path, n, flat):
+    # The rule (recording.FLAT_MANY, FLAT_PX): 100 moving shapes or more, each drawn within
+    # 20 px, are drawn flat: the bodies' pixels are their fill or outline exactly, no blend
+    # of an ink with white in between (the static floor stays smooth). 99 are drawn smooth:
+    # blends at their edges.
+    from dumbbell.animation.palette import blend
+    from dumbbell.animation.recording import BODY_INKS, FLAT_MANY, FLAT_PX
+
+    assert (FLAT_MANY, FLAT_PX) == (100, 20)
+    space = _boxes_space(n)
+    with spaces.Recorder(space, tmp_path / "a.gif", energy=False, units="px") as rec:
+        for _ in range(5):
+            spaces.step(space, 1 / 25, substeps=4)
+            rec.capture()
+    edges = {blend(ink, level / 15) for ink in BODY_INKS for level in (1, 2, 3, 4)}
+    fills = {blend(ink, 0.33) for ink in BODY_INKS}
+    for k in (0, -1):
+        scene = _frames(tmp_path / "a.gif")[k][40:, :]
+        colours = {tuple(c) for c in np.unique(scene.reshape(-1, 3), axis=0).tolist()}
+        assert colours & fills  # the bodies are there
+        assert bool(colours & edges) is not flat
+
+
 def test_a_reference_you_set(tmp_path):
     space, _ = _ball(y=2.0)
     with spaces.Recorder(space, tmp_path / "a.gif", reference={"U_g": -5.0}) as rec:

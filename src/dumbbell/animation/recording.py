@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import itertools
 import math
 import os
 import signal
@@ -71,7 +72,7 @@ from .palette import (
 )
 from .render import delays_cs
 from .strip import GRID
-from .world import zigzag
+from .world import LEAD
 
 #: No public names: the painter behind :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
@@ -109,17 +110,117 @@ STOP_SIGNALS = ("SIGTERM", "SIGHUP")
 Box = tuple[float, float, float, float]  # x0, x1, y0, y1 with x0 <= x1, y0 <= y1
 
 
+@dataclass(frozen=True, eq=False)
+class Group:
+    """Shapes of one kind of a :class:`Shapes` (polygons: of one number of corners): their
+    places in its order (``at``), their points in their bodies' coordinates (``local``,
+    m x p x 2: a circle's centre, a segment's two ends, a polygon's corners) and radii
+    (``r``)."""
+
+    kind: str
+    at: np.ndarray
+    local: np.ndarray
+    r: np.ndarray
+    #: Each shape's body (its row in a frame's poses), and whether all the group's points
+    #: are their bodies' origins (circles centred on their bodies: placed without turning).
+    rows: np.ndarray
+    origin: bool
+
+
+@dataclass(frozen=True, eq=False)
+class Shapes:
+    """A set of shapes in their bodies' coordinates, in drawing order: each one's body (its
+    row in a frame's poses: x, y, angle), ink (-1 grey) and moving body's number (-1 for a
+    shape on a static body), grouped by kind. A frame is a pose per body: the shapes are
+    placed by numpy, all of a group at once, never one by one in Python."""
+
+    body: np.ndarray
+    ink: np.ndarray
+    number: np.ndarray
+    groups: tuple[Group, ...]
+
+    @classmethod
+    def of(cls, kinds: list[str], body: list[int], ink: list[int], number: list[int],
+           local: list[list[tuple[float, float]]], r: list[float]) -> Shapes:
+        """From per-shape lists: kind ("circle", "seg", "poly"), body row, ink, number, points
+        in body coordinates and radius."""
+        by: dict[tuple[str, int], list[int]] = {}
+        for j, (kind, pts) in enumerate(zip(kinds, local, strict=True)):
+            by.setdefault((kind, len(pts)), []).append(j)
+        rows = np.array(body, dtype=np.intp)
+        groups = []
+        for (kind, p), idx in by.items():
+            pts = np.array([local[j] for j in idx], dtype=float).reshape(len(idx), p, 2)
+            at = np.array(idx, dtype=np.intp)
+            groups.append(Group(kind, at, pts, np.array([r[j] for j in idx], dtype=float),
+                                rows[at], bool(p) and not pts.any()))
+        return cls(rows, np.array(ink, dtype=int), np.array(number, dtype=int), tuple(groups))
+
+    @property
+    def n(self) -> int:
+        return len(self.body)
+
+    def place(self, pose: np.ndarray, g: Group) -> tuple[np.ndarray, np.ndarray]:
+        """Group ``g``'s points in the world (..., m, p, 2) and its bodies' angles (..., m), at
+        ``pose`` (..., bodies, 3: x, y, angle; leading axes: frames)."""
+        p = pose[..., g.rows, :]
+        angle = p[..., 2]
+        if g.origin:  # x + cos 0 - sin 0 is x
+            return p[..., None, :2], angle
+        c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
+        lx, ly = g.local[..., 0], g.local[..., 1]
+        x = p[..., 0, None] + c * lx - s * ly
+        y = p[..., 1, None] + s * lx + c * ly
+        return np.stack([x, y], axis=-1), angle
+
+    def boxes(self, pose: np.ndarray) -> np.ndarray:
+        """World box (x0, x1, y0, y1) of each shape at ``pose`` (..., bodies, 3): (..., n, 4);
+        nan where a shape has none."""
+        out = np.full((*pose.shape[:-2], self.n, 4), math.nan)
+        for g in self.groups:
+            if not g.local.shape[1]:
+                continue
+            pts, _ = self.place(pose, g)
+            r = g.r
+            out[..., g.at, 0] = pts[..., 0].min(axis=-1) - r
+            out[..., g.at, 1] = pts[..., 0].max(axis=-1) + r
+            out[..., g.at, 2] = pts[..., 1].min(axis=-1) - r
+            out[..., g.at, 3] = pts[..., 1].max(axis=-1) + r
+        return out
+
+    def items(self, pose: np.ndarray) -> list[tuple]:
+        """The shapes at ``pose`` as primitives (see the module docstring), in order."""
+        out: list[tuple | None] = [None] * self.n
+        ink, number = self.ink.tolist(), self.number.tolist()
+        for g in self.groups:
+            pts, angle = self.place(pose, g)
+            for j, flat, a, r in zip(g.at.tolist(), pts.reshape(len(g.at), -1).tolist(),
+                                     angle.tolist(), g.r.tolist(), strict=True):
+                if g.kind == "circle":
+                    out[j] = ("circle", ink[j], number[j], flat[0], flat[1], r, a)
+                elif g.kind == "seg":
+                    out[j] = ("seg", ink[j], number[j], *flat, r)
+                else:
+                    out[j] = ("poly", ink[j], number[j], tuple(flat), r)
+        return out  # type: ignore[return-value]
+
+
 @dataclass(frozen=True)
 class Recording:
-    """Everything the painter needs, frozen: per frame its moving primitives, which static set
-    it shows (``static_of`` indexes ``statics``) and its time; the frame ``size`` (px) and
-    ``fps``; ``y_up``; the camera (``camera`` "auto", "all", "box" with ``box``, or
+    """Everything the painter needs, frozen: per frame its moving shapes (``shape_of`` indexes
+    ``shapes``, the sets of moving shapes) with its bodies' poses (``poses``, one row per body
+    of the set: x, y, angle), its other moving primitives (``extras``: the constraints), which
+    static set it shows (``static_of`` indexes ``statics``) and its time; the frame ``size``
+    (px) and ``fps``; ``y_up``; the camera (``camera`` "auto", "all", "box" with ``box``, or
     "follow" with a centre per frame in ``follow`` and the view's larger side ``span``); the
     energy rows (name -> values shown, in ``energy``; None without bars) with their labels
     and ``energy_title``; ``heat`` (the last row is heat, and E's row shows E + heat pale);
     ``strip``; the ``title``; the time unit."""
 
-    frames: tuple[tuple[tuple, ...], ...]
+    shapes: tuple[Shapes, ...]
+    shape_of: tuple[int, ...]
+    poses: tuple[np.ndarray, ...]
+    extras: tuple[tuple[tuple, ...], ...]
     statics: tuple[tuple[tuple, ...], ...]
     static_of: tuple[int, ...]
     t: tuple[float, ...]
@@ -137,6 +238,15 @@ class Recording:
     strip: bool = True
     title: str = ""
     time_unit: str = "s"
+
+    @property
+    def n(self) -> int:
+        """Number of frames."""
+        return len(self.t)
+
+    def items(self, k: int) -> list[tuple]:
+        """Frame ``k``'s moving primitives (its shapes, then its extras)."""
+        return [*self.shapes[self.shape_of[k]].items(self.poses[k]), *self.extras[k]]
 
 
 # --- the camera --------------------------------------------------------------------------------
@@ -170,93 +280,42 @@ def _finite(boxes: np.ndarray) -> np.ndarray:
 
 #: Kinds of primitive that are a body's shape (the others are constraints).
 SHAPES = ("circle", "seg", "poly")
+#: Frames whose shapes are placed together when the camera measures them (bounds memory).
+CHUNK = 64
 
 
-@dataclass(frozen=True)
-class Measured:
-    """One frame's primitives measured once: each one's world box (n x 4: x0, x1, y0, y1),
-    a point that turns with it (n x 2: a polygon's first corner, the end of a circle's radius
-    line, a segment's or constraint's first end; a rotary spring's twist and 0), and its
-    element: the number of the moving body whose shape it is, or ``-1 - j`` for the j-th
-    primitive (a constraint, or a shape on no moving body), alone."""
-
-    box: np.ndarray
-    turn: np.ndarray
-    key: np.ndarray
-    rotary: np.ndarray
-    #: Indices of the polygons, by their number of coordinates (twice their corners).
-    poly_groups: dict[int, list[int]]
-    polys: list[int]
-
-    @classmethod
-    def of(cls, items: tuple[tuple, ...]) -> Measured:
-        n = len(items)
-        box, turn = np.full((n, 4), math.nan), np.full((n, 2), math.nan)
-        groups: dict[Any, list[int]] = {}
-        for j, it in enumerate(items):
-            groups.setdefault(it[0] if it[0] != "poly" else len(it[3]), []).append(j)
-        for kind, idx in groups.items():
-            _measure(kind, [items[j] for j in idx], box, turn, np.array(idx))
-        keys = [it[2] if it[0] in SHAPES and it[2] >= 0 else -1 - j
-                for j, it in enumerate(items)]
-        polys = [j for kind, idx in groups.items() if not isinstance(kind, str) for j in idx]
-        return cls(box, turn, np.array(keys, dtype=int),
-                   np.array([it[0] == "rotary" for it in items], dtype=bool),
-                   {k: idx for k, idx in groups.items() if not isinstance(k, str)}, polys)
-
-    def elements(self) -> np.ndarray:
-        """World boxes of the elements (one per moving body, one per other primitive), finite
-        ones only."""
-        if not len(self.key):
-            return np.zeros((0, 4))
-        keys, inverse = np.unique(self.key, return_inverse=True)
-        out = np.empty((len(keys), 4))
-        out[:, [0, 2]], out[:, [1, 3]] = np.inf, -np.inf
-        with np.errstate(invalid="ignore"):  # a body at nan is no element
-            np.minimum.at(out[:, 0], inverse, self.box[:, 0])
-            np.maximum.at(out[:, 1], inverse, self.box[:, 1])
-            np.minimum.at(out[:, 2], inverse, self.box[:, 2])
-            np.maximum.at(out[:, 3], inverse, self.box[:, 3])
-        return _finite(out)
-
-
-def _measure(kind: Any, items: list[tuple], box: np.ndarray, turn: np.ndarray,
-             idx: np.ndarray) -> None:
-    """Fill ``box`` and ``turn`` (see :class:`Measured`) at rows ``idx`` for ``items``, all
-    of one kind (a polygon's kind: its number of coordinates)."""
-    if not isinstance(kind, str):  # polygons with kind / 2 corners
-        if not kind:
-            return
-        flat = np.array([it[3] for it in items], dtype=float)
-        r = np.array([it[4] for it in items], dtype=float)
-        xs, ys = flat[:, 0::2], flat[:, 1::2]
-        box[idx] = np.stack([xs.min(1) - r, xs.max(1) + r, ys.min(1) - r, ys.max(1) + r], 1)
-        turn[idx] = flat[:, :2]
-        return
-    a = np.array([it[3:] for it in items], dtype=float)
-    if kind == "circle":  # x, y, r, angle
-        x, y, r, ang = a.T
-        box[idx] = np.stack([x - r, x + r, y - r, y + r], 1)
-        turn[idx] = np.stack([x + r * np.cos(ang), y + r * np.sin(ang)], 1)
-    elif kind in ("seg", "spring", "line"):  # ax, ay, bx, by (, r)
-        r = a[:, 4] if kind == "seg" else 0.0
-        box[idx] = np.stack([np.minimum(a[:, 0], a[:, 2]) - r, np.maximum(a[:, 0], a[:, 2]) + r,
-                             np.minimum(a[:, 1], a[:, 3]) - r, np.maximum(a[:, 1], a[:, 3]) + r],
-                            1)
-        turn[idx] = a[:, :2]
-    else:  # dot (x, y), rotary (x, y, twist)
-        box[idx] = a[:, [0, 0, 1, 1]]
-        turn[idx] = a[:, :2] if kind == "dot" else np.stack([a[:, 2], 0 * a[:, 2]], 1)
-
-
-def element_boxes(measured: list[Measured]) -> tuple[np.ndarray, np.ndarray]:
+def element_boxes(rec: Recording) -> tuple[np.ndarray, np.ndarray]:
     """World boxes (n x 4: x0, x1, y0, y1) of the moving elements of every frame, finite
     ones only, and the frame of each: each moving body's shapes (one box per body and frame),
-    and each constraint."""
-    parts = [m.elements() for m in measured]
-    where = np.concatenate([np.full(len(p), k, dtype=int) for k, p in enumerate(parts)]
-                           + [np.zeros(0, dtype=int)])
-    return np.concatenate([*parts, np.zeros((0, 4))]), where
+    each shape on no moving body, and each extra (constraint)."""
+    parts: list[np.ndarray] = []
+    where: list[np.ndarray] = []
+    for i, shapes in enumerate(rec.shapes):
+        frames = [k for k, s in enumerate(rec.shape_of) if s == i]
+        if not shapes.n or not frames:
+            continue
+        # The elements: one per moving body number, one per shape on none.
+        key = np.where(shapes.number >= 0, shapes.number, -1 - np.arange(shapes.n))
+        order = np.argsort(key, kind="stable")
+        starts = np.flatnonzero(np.r_[True, np.diff(key[order]) != 0])
+        for c in range(0, len(frames), CHUNK):
+            chunk = frames[c:c + CHUNK]
+            box = shapes.boxes(np.stack([rec.poses[k] for k in chunk]))[:, order]
+            with np.errstate(invalid="ignore"):  # a body at nan is no element
+                out = np.stack([np.minimum.reduceat(box[..., 0], starts, axis=1),
+                                np.maximum.reduceat(box[..., 1], starts, axis=1),
+                                np.minimum.reduceat(box[..., 2], starts, axis=1),
+                                np.maximum.reduceat(box[..., 3], starts, axis=1)], axis=-1)
+            parts.append(out.reshape(-1, 4))
+            where.append(np.repeat(np.array(chunk, dtype=int), len(starts)))
+    for k, extras in enumerate(rec.extras):
+        if extras:
+            parts.append(np.array([item_box(it) for it in extras], dtype=float).reshape(-1, 4))
+            where.append(np.full(len(extras), k, dtype=int))
+    boxes = np.concatenate([*parts, np.zeros((0, 4))])
+    frame = np.concatenate([*where, np.zeros(0, dtype=int)])
+    ok = np.isfinite(boxes).all(axis=1)
+    return boxes[ok], frame[ok]
 
 
 def _union(boxes: np.ndarray) -> Box | None:
@@ -272,18 +331,20 @@ def static_boxes(statics: tuple[tuple[tuple, ...], ...]) -> np.ndarray:
     return _finite(np.array(boxes, dtype=float).reshape(-1, 4))
 
 
-def auto_box(frames: list[Measured], statics: tuple[tuple[tuple, ...], ...]) -> Box:
+def auto_box(rec: Recording) -> Box:
     """The automatic camera's world box (see the module's docstring for the rule)."""
-    moving, where = element_boxes(frames)
-    fixed = static_boxes(statics)
+    moving, where = element_boxes(rec)
+    fixed = static_boxes(rec.statics)
     if not len(moving):
         return _union(fixed) or (-1.0, 1.0, -1.0, 1.0)
     size = np.maximum(moving[:, 1] - moving[:, 0], moving[:, 3] - moving[:, 2])
     size = size[size > 0]
-    typical = float(np.median(size)) if len(size) else 0.0
+    # The median (as np.median, which would import numpy.ma).
+    size = np.sort(size)
+    typical = float(size[(len(size) - 1) // 2] + size[len(size) // 2]) / 2 if len(size) else 0.0
     keep = where == where.min()  # the first frame's elements, always
     centres = [(moving[:, 0] + moving[:, 1]) / 2, (moving[:, 2] + moving[:, 3]) / 2]
-    quartiles = [np.quantile(c, (0.25, 0.75)) for c in centres]
+    quartiles = [_quartiles(c) for c in centres]
     reach = FENCE * max(typical, *(float(q3 - q1) for q1, q3 in quartiles))
     inside = np.ones(len(moving), dtype=bool)
     for c, (q1, q3) in zip(centres, quartiles, strict=True):
@@ -310,9 +371,22 @@ def auto_box(frames: list[Measured], statics: tuple[tuple[tuple, ...], ...]) -> 
     return bx0, bx1, by0, by1
 
 
-def all_box(frames: list[Measured], statics: tuple[tuple[tuple, ...], ...]) -> Box:
+def _quartiles(values: np.ndarray) -> tuple[float, float]:
+    """The first and third quartiles of ``values``, interpolated linearly between the sorted
+    values (as np.quantile does by default; it would import numpy.ma)."""
+    v = np.sort(values)
+    out = []
+    for q in (0.25, 0.75):
+        h = (len(v) - 1) * q
+        lo = math.floor(h)
+        hi = min(lo + 1, len(v) - 1)
+        out.append(float(v[lo] + (h - lo) * (v[hi] - v[lo])))
+    return out[0], out[1]
+
+
+def all_box(rec: Recording) -> Box:
     """Everything ever captured, static shapes included."""
-    boxes = np.concatenate([element_boxes(frames)[0], static_boxes(statics)])
+    boxes = np.concatenate([element_boxes(rec)[0], static_boxes(rec.statics)])
     return _union(boxes) or (-1.0, 1.0, -1.0, 1.0)
 
 
@@ -384,179 +458,435 @@ def scene_area(width: int, height: int, energy: bool) -> tuple[int, int, int, in
 # --- the painter ---------------------------------------------------------------------------------
 
 
-def _clip(v: float) -> float:
-    return min(max(v, -CLIP), CLIP) if not math.isnan(v) else -CLIP
+def line_width(u: float) -> int:
+    """Width of outlines and lines (px at :data:`SS` times the size)."""
+    return max(1, round(1.5 * u * SS))
 
 
-class Pen:
-    """Draws primitives through ``view`` on ``d``, an image ``S`` times the size whose corner
-    is the frame's pixel ``corner`` and which is ``size`` frame pixels large (``u``: the
-    frame's length unit); what lies wholly outside it is skipped."""
+def _snap(v: np.ndarray) -> np.ndarray:
+    """Pixel coordinates (floats) as whole pixels, clipped to :data:`CLIP` (nan: -CLIP)."""
+    return np.rint(np.fmin(np.fmax(v, -CLIP), CLIP)).astype(np.int64)
 
-    def __init__(self, d: ImageDraw.ImageDraw, u: float, S: int, view: View,
-                 corner: tuple[float, float], size: tuple[float, float]) -> None:
-        self.d, self.u, self.S, self.flip = d, u, S, view.flip
-        self.width = max(1, round(1.5 * u * S))
-        self.ox, self.oy = (view.ox - corner[0]) * S, (view.oy - corner[1]) * S
-        self.sS = view.s * S
-        self.lim_x, self.lim_y = size[0] * S, size[1] * S
 
-    def draw(self, items: tuple[tuple, ...] | list[tuple],
-             polys: dict[int, list[float]] | None = None,
-             index: list[int] | None = None) -> None:
-        """Draw ``items``; ``polys``: the corners of polygons in this image's pixels by
-        ``index`` (the items' indices in their frame), where known."""
-        for j, it in enumerate(items):
-            if polys is not None and it[0] == "poly":
-                self.poly(it, polys.get(index[j] if index is not None else j))
-            else:
-                getattr(self, it[0])(it)
+def _to_pixels(pts: np.ndarray, view: View) -> np.ndarray:
+    """World points (..., 2) as whole pixels at :data:`SS` times the size (..., 2)."""
+    S = SS
+    return _snap(pts * (view.s * S, view.flip * view.s * S) + (view.ox * S, view.oy * S))
 
-    def P(self, x: float, y: float) -> tuple[float, float]:
-        """The pixel (on this image) of world point (x, y), clipped."""
-        return _clip(self.ox + x * self.sS), _clip(self.oy + y * self.flip * self.sS)
 
-    def outside(self, xs: list[float], ys: list[float], m: float) -> bool:
-        return (max(xs) < -m or min(xs) > self.lim_x + m or max(ys) < -m
-                or min(ys) > self.lim_y + m)
+def shape_pixels(kind: str, pts: np.ndarray, r: np.ndarray, angle: np.ndarray, view: View,
+                 u: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Shapes of one kind at world points ``pts`` (m x p x 2), radii ``r`` and (circles) their
+    bodies' angles, seen through ``view``: their whole-pixel coordinates at :data:`SS` times
+    the size (m x w integers: a circle's centre, the end of its radius line (the centre
+    without one) and radius; a segment's ends and width; a polygon's corners: points first,
+    x then y, then at most one length), their boxes (m x 4, frame
+    px: left, top, right, bottom, with room for outlines and smoothing), and which can be
+    drawn (m)."""
+    S, line = SS, line_width(u)
+    m, p = pts.shape[:2]
+    P = _to_pixels(pts, view)
+    ok = ~np.isnan(pts).reshape(m, -1).any(axis=1) if p else np.zeros(m, dtype=bool)
+    if kind == "circle":
+        XY = P[:, 0]
+        R, known = _radii(r, view, u)
+        ok &= known
+        turns = np.isfinite(angle)
+        every = bool(turns.all())
+        a = angle if every else np.where(turns, angle, 0.0)
+        end = _snap(XY + R[:, None] * np.stack([np.cos(a), view.flip * np.sin(a)], axis=1))
+        if not every:
+            end[~turns] = XY[~turns]  # no radius line
+        ints = np.concatenate([XY, end, R[:, None]], axis=1)
+        lo, hi = XY - (R + line)[:, None], XY + (R + line)[:, None]
+    elif kind == "seg":
+        W = _widths(r, view, u)
+        ints = np.concatenate([P.reshape(m, 4), W[:, None]], axis=1)
+        reach = (W / 2 + line)[:, None]
+        lo, hi = P.min(axis=1) - reach, P.max(axis=1) + reach
+    else:
+        ok &= p >= 2
+        ints = P.reshape(m, -1)
+        if p:
+            lo, hi = P.min(axis=1) - line, P.max(axis=1) + line
+        else:
+            lo = hi = np.zeros((m, 2))
+    boxes = np.concatenate([lo / S - 1, hi / S + 1], axis=1)
+    if not ok.all():
+        boxes[~ok] = math.nan
+    return ints, boxes, ok
 
-    @staticmethod
-    def colours(ink: int) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
-        """Outline and fill of a shape of ``ink`` (-1: static or kinematic, grey)."""
-        return SHAPE_COLOURS[ink]
 
-    def circle(self, it: tuple) -> None:
-        _, ink, _, x, y, r, angle = it
-        (X, Y), R = self.P(x, y), min(max(r * self.sS, 1.5 * self.u * self.S), CLIP)
-        if math.isnan(R) or self.outside([X], [Y], R):
-            return
-        out, fill = self.colours(ink)
-        self.d.ellipse([X - R, Y - R, X + R, Y + R], fill=fill, outline=out, width=self.width)
-        if math.isfinite(angle):
-            self.d.line([(X, Y), (X + R * math.cos(angle), Y + self.flip * R * math.sin(angle))],
-                        fill=out, width=self.width)
+def _radii(r: np.ndarray, view: View, u: float) -> tuple[np.ndarray, np.ndarray]:
+    """Circles' radii (whole pixels at :data:`SS` times the size; at least 1.5 u) and which
+    are numbers; the same for a set of shapes and a view, so kept for the last few."""
+    key = ("radii", id(r), view, u)
+    got = _KEPT.get(key)
+    if got is None or got[0] is not r:
+        radius = np.fmin(np.maximum(r * (view.s * SS), 1.5 * u * SS), CLIP)
+        known = ~np.isnan(radius)
+        got = _keep(key, (r, (np.rint(np.where(known, radius, 0.0)).astype(np.int64), known)))
+    return got[1]
 
-    def seg(self, it: tuple) -> None:
-        _, ink, _, ax, ay, bx, by, r = it
-        ends = [self.P(ax, ay), self.P(bx, by)]
+
+def _widths(r: np.ndarray, view: View, u: float) -> np.ndarray:
+    """Segments' widths (whole pixels at :data:`SS` times the size; at least a line's)."""
+    key = ("widths", id(r), view, u)
+    got = _KEPT.get(key)
+    if got is None or got[0] is not r:
+        wide = np.rint(np.fmin(2 * np.where(np.isnan(r), 0.0, r) * (view.s * SS), CLIP))
+        got = _keep(key, (r, np.maximum(line_width(u), wide).astype(np.int64)))
+    return got[1]
+
+
+#: What :func:`_radii` and :func:`_widths` keep (their arrays held, so an id is not reused).
+_KEPT: dict[tuple, tuple] = {}
+
+
+def _keep(key: tuple, value: tuple) -> tuple:
+    if len(_KEPT) >= 64:
+        _KEPT.clear()
+    _KEPT[key] = value
+    return value
+
+
+def _zigzags(ends: np.ndarray, u: float) -> np.ndarray:
+    """Springs from whole-pixel ends (m x 2 x 2, at :data:`SS` times the size) as zig-zags in
+    whole pixels (m x 2(2 COILS + 4), flat x, y): straight leads of LEAD of the length at each
+    end and COILS zig-zags between, at most SPRING_WIDTH u or a tenth of the spring's length
+    wide (a web of short springs stays legible); all springs at once, as
+    :func:`~dumbbell.animation.world.zigzag` draws one."""
+    m = len(ends)
+    p0 = ends[:, 0].astype(float)
+    d = ends[:, 1] - ends[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    amp = np.minimum(SPRING_WIDTH * u * SS, 0.1 * length)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / length[:, None] * amp[:, None]
+    normal[length == 0] = 0.0  # a spring of no length: all its points at its ends
+    i = np.arange(2 * COILS)
+    f = np.r_[0.0, LEAD, LEAD + (1 - 2 * LEAD) * (i + 0.5) / (2 * COILS), 1 - LEAD, 1.0]
+    side = np.r_[0.0, 0.0, np.where(i % 2 == 0, 1.0, -1.0), 0.0, 0.0]
+    pts = p0[:, None] + d[:, None] * f[None, :, None] + side[None, :, None] * normal[:, None]
+    return np.rint(pts).astype(np.int64).reshape(m, 2 * len(f))
+
+
+def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
+                 ) -> tuple[list[tuple | None], np.ndarray]:
+    """Constraints' primitives seen through ``view`` in whole pixels at :data:`SS` times the
+    size (a spring's zig-zag, a line, a pivot's dot, a rotary spring's coil; None where one
+    cannot be drawn), and their boxes (m x 4, frame px: left, top, right, bottom)."""
+    S, line = SS, line_width(u)
+    m = len(items)
+    boxes = np.full((m, 4), math.nan)
+    out: list[tuple | None] = [None] * m
+    if not m:
+        return out, boxes
+    # Every primitive's first point (and second, for springs and lines) at once.
+    pts = np.array([(it[3], it[4], it[5], it[6]) if it[0] in ("spring", "line") else
+                    (it[3], it[4], it[3], it[4]) for it in items], dtype=float)
+    whole = _to_pixels(pts.reshape(m, 2, 2), view)
+    ends = whole.reshape(m, 4).tolist()
+    springs = [j for j, it in enumerate(items) if it[0] == "spring"]
+    coils = dict(zip(springs, _zigzags(whole[springs], u).tolist(), strict=True))
+    for j, (it, (ax, ay, bx, by)) in enumerate(zip(items, ends, strict=True)):
+        kind = it[0]
+        room = line
+        if kind == "line":
+            xy = [ax, ay, bx, by]
+            px: tuple = ("line", xy)
+        elif kind == "spring":
+            xy = coils[j]
+            px = ("spring", xy)
+        elif kind == "dot":
+            xy = [ax, ay]
+            room = round(3 * u * S)
+            px = ("dot", ax, ay, room)
+        elif kind == "rotary" and math.isfinite(it[5]):
+            # A coil of 2.5 turns about the pivot, turned by the spring's twist.
+            xy = []
+            for i in range(61):
+                f = i / 60
+                a = f * 2.5 * 2 * math.pi + it[5]
+                rr = (4 + 8 * f) * u * S
+                xy += [round(ax + rr * math.cos(a)), round(ay + view.flip * rr * math.sin(a))]
+            px = ("rotary", xy)
+        else:
+            continue
+        out[j] = px
+        xs, ys = xy[0::2], xy[1::2]
+        boxes[j] = ((min(xs) - room) / S - 1, (min(ys) - room) / S - 1,
+                    (max(xs) + room) / S + 1, (max(ys) + room) / S + 1)
+    return out, boxes
+
+
+class Pixels:
+    """Primitives seen through a view, in whole pixels at :data:`SS` times the size and in
+    drawing order: shapes (``groups`` of one kind, each with the shapes' places, integer
+    coordinates, inks and whether each can be drawn; see :func:`shape_pixels`), then
+    ``extras`` (constraints; see :func:`extra_pixels`); ``boxes`` (n x 4, frame px) and ``ok``
+    (can be drawn) per primitive. Being whole pixels, a primitive drawn on a crop whose corner
+    is a whole pixel gives the same pixels as drawn on the whole frame; and two frames whose
+    numbers for a primitive agree draw it alike."""
+
+    def __init__(self, shapes: Shapes | None, pose: np.ndarray | None,
+                 extras: tuple[tuple, ...] | list[tuple], view: View, u: float) -> None:
+        self.shapes, self.view, self.u = shapes, view, u
+        self.n_shapes = shapes.n if shapes is not None else 0
+        self.n = self.n_shapes + len(extras)
+        self.boxes = np.full((self.n, 4), math.nan)
+        self.groups: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        if shapes is not None and pose is not None:
+            for g in shapes.groups:
+                pts, angle = shapes.place(pose, g)
+                ints, boxes, ok = shape_pixels(g.kind, pts, g.r, angle, view, u)
+                self.boxes[g.at] = boxes
+                self.groups.append((g.kind, g.at, ints, shapes.ink[g.at], ok))
+        self.extras, self.boxes[self.n_shapes:] = extra_pixels(extras, view, u)
+        self.ok = np.isfinite(self.boxes).all(axis=1)
+
+    @classmethod
+    def of_items(cls, items: tuple[tuple, ...] | list[tuple], view: View, u: float) -> Pixels:
+        """Primitives given as tuples (see the module docstring): the static shapes."""
+        shapes = [it for it in items if it[0] in SHAPES]
+        extras = [it for it in items if it[0] not in SHAPES]
+        if not shapes:
+            return cls(None, None, extras, view, u)
+        # Each shape its own body: a circle's centre is its body's position, turned by its
+        # angle; the other shapes' points are world points on a body at the origin.
+        local = [[(0.0, 0.0)] if it[0] == "circle" else
+                 [(it[3], it[4]), (it[5], it[6])] if it[0] == "seg" else
+                 list(zip(it[3][0::2], it[3][1::2], strict=True)) for it in shapes]
+        r = [it[5] if it[0] == "circle" else it[7] if it[0] == "seg" else it[4]
+             for it in shapes]
+        set_ = Shapes.of([it[0] for it in shapes], list(range(len(shapes))),
+                         [it[1] for it in shapes], [it[2] for it in shapes], local, r)
+        pose = np.array([(it[3], it[4], it[6]) if it[0] == "circle" else (0.0, 0.0, 0.0)
+                         for it in shapes], dtype=float).reshape(-1, 3)
+        return cls(set_, pose, extras, view, u)
+
+    @functools.cached_property
+    def box(self) -> tuple[float, float, float, float] | None:
+        """The box (frame px) of everything that can be drawn."""
+        b = self.boxes[self.ok]
+        if not len(b):
+            return None
+        return (float(b[:, 0].min()), float(b[:, 1].min()), float(b[:, 2].max()),
+                float(b[:, 3].max()))
+
+    def changed(self, before: Pixels) -> np.ndarray | None:
+        """Which primitives are drawn differently from ``before`` (the previous frame's), or
+        None when the two cannot be compared (other shapes, another view)."""
+        if (before.shapes is not self.shapes or before.view is not self.view
+                or len(before.extras) != len(self.extras)):
+            return None
+        out = np.zeros(self.n, dtype=bool)
+        for (_, at, ints, _, ok), (_, _, ints0, _, ok0) in zip(self.groups, before.groups,
+                                                                 strict=True):
+            out[at] = (ok != ok0) | (ok & (ints != ints0).any(axis=1))
+        for j, (a, b) in enumerate(zip(self.extras, before.extras, strict=True)):
+            out[self.n_shapes + j] = a != b
+        return out
+
+    def within(self, rect: tuple[float, float, float, float]) -> np.ndarray:
+        """Whether each primitive's box meets ``rect`` (frame px) and it can be drawn."""
+        x0, y0, x1, y1 = rect
+        b = self.boxes
+        return self.ok & ~((b[:, 2] < x0) | (b[:, 0] > x1) | (b[:, 3] < y0) | (b[:, 1] > y1))
+
+    def draw(self, d: ImageDraw.ImageDraw, corner: tuple[int, int],
+             want: np.ndarray | None = None, flat: bool = False) -> None:
+        """Draw the primitives (those ``want`` says, else all that can be drawn) in order on
+        ``d``, whose pixel (0, 0) is the frame's pixel ``corner``: an RGB image :data:`SS`
+        times the size (smooth edges once halved), or, ``flat``, a palette image of the
+        frame's size (flat edges, as pygame draws: each whole-pixel number halved)."""
+        S = SS
+        want = self.ok if want is None else want & self.ok
+        ox, oy = corner[0] * S, corner[1] * S
+        places, kinds, inks, coords = [], [], [], []
+        for kind, at, ints, ink, _ in self.groups:
+            rows = np.flatnonzero(want[at])
+            if not len(rows):
+                continue
+            w = ints.shape[1]
+            shift = np.zeros(w, dtype=np.int64)
+            points = w if kind == "poly" else 4  # then a radius or width
+            shift[0:points:2], shift[1:points:2] = ox, oy
+            places.append(at[rows])
+            kinds += [kind] * len(rows)
+            inks += ink[rows].tolist()
+            shifted = ints[rows] - shift
+            coords += (((shifted + 1) // S) if flat else shifted).tolist()
+        pen = _FlatPen(d) if flat else _Pen(d, self.u)
+        if places:
+            order = np.argsort(np.concatenate(places), kind="stable").tolist()
+            for i in order:
+                getattr(pen, kinds[i])(inks[i], coords[i])
+        for j in np.flatnonzero(want[self.n_shapes:]).tolist():
+            px = self.extras[j]
+            getattr(pen, px[0])(px, ox, oy)  # type: ignore[index]
+
+
+@functools.cache
+def _inks() -> tuple[list[tuple[int, int]], int, int, dict[int, tuple[int, int, int]]]:
+    """Pillow's inks on an RGB image: of each shape colour pair (outline, fill), of springs,
+    of pivots, and the colour of each ink."""
+    ink = ImageDraw.Draw(Image.new("RGB", (1, 1))).draw.draw_ink
+    pairs = [(ink(out), ink(fill)) for out, fill in SHAPE_COLOURS]
+    rgb = {ink(c): c for c in (*(c for pair in SHAPE_COLOURS for c in pair), SPRING, INK)}
+    return pairs, ink(SPRING), ink(INK), rgb
+
+
+class _Pen:
+    """Draws whole-pixel primitives on an RGB image :data:`SS` times the size: shapes filled
+    and outlined in their ink's colours (grey for ink -1), constraints in the spring colour,
+    pivots in ink; through Pillow's drawing core."""
+
+    def __init__(self, d: ImageDraw.ImageDraw, u: float) -> None:
+        self.d, self.core, self.u = d, d.draw, u
+        self.width = line_width(u)
+        self.inks, self.spring_ink, self.dot_ink, self.rgb = _inks()
+
+    def _lines(self, xy: list[int], ink: int, width: int, closed: bool = False) -> None:
+        if closed:
+            xy = [*xy, xy[0], xy[1]]
+        if width > 4 and len(xy) > 4:
+            # Pillow rounds the joints of wide lines itself (as ImageDraw.line(joint="curve")).
+            self.d.line(xy, fill=self.rgb[ink], width=width, joint="curve")
+        else:
+            self.core.draw_lines(xy, ink, width)
+
+    def circle(self, ink: int, c: list[int]) -> None:
+        X, Y, EX, EY, R = c
+        out, fill = self.inks[ink]
+        box = (X - R, Y - R, X + R, Y + R)
+        self.core.draw_ellipse(box, fill, 1)
+        if out != fill:
+            self.core.draw_ellipse(box, out, 0, self.width)
+        if EX != X or EY != Y:
+            self.core.draw_lines((X, Y, EX, EY), out, self.width)
+
+    def seg(self, ink: int, c: list[int]) -> None:
+        AX, AY, BX, BY, W = c
+        out, fill = self.inks[ink]
         line = self.width
-        w = max(line, round(min(2 * r * self.sS, CLIP))) if not math.isnan(r) else line
-        if self.outside([e[0] for e in ends], [e[1] for e in ends], w):
-            return
-        out, fill = self.colours(ink)
-        self.d.line(ends, fill=out, width=w)
-        if w > 2 * line:
+        self.core.draw_lines((AX, AY, BX, BY), out, W)
+        if W > 2 * line:
             # A fat segment: its outline, then its fill inside, with round ends.
-            for width, ink_rgb in ((w, out), (w - 2 * line, fill)):
-                for X, Y in ends:
-                    self.d.ellipse([X - width / 2, Y - width / 2, X + width / 2,
-                                    Y + width / 2], fill=ink_rgb)
-                if ink_rgb == fill:
-                    self.d.line(ends, fill=fill, width=width)
+            for width, colour in ((W, out), (W - 2 * line, fill)):
+                h = width // 2
+                for X, Y in ((AX, AY), (BX, BY)):
+                    self.core.draw_ellipse((X - h, Y - h, X - h + width, Y - h + width),
+                                           colour, 1)
+                if colour == fill:
+                    self.core.draw_lines((AX, AY, BX, BY), fill, width)
 
-    def poly(self, it: tuple, px: list[float] | None = None) -> None:
-        """A polygon; ``px``: its corners in this image's pixels (flat), if known."""
-        _, ink, _, flat, _ = it
-        if len(flat) < 4:
-            return
-        if px is None:
-            ox, oy, sS, fS = self.ox, self.oy, self.sS, self.flip * self.sS
-            px = [ox + v * sS if i % 2 == 0 else oy + v * fS for i, v in enumerate(flat)]
-        xs, ys = px[0::2], px[1::2]
-        if self.outside(xs, ys, self.width):
-            return
-        if not (-CLIP < min(xs) and max(xs) < CLIP and -CLIP < min(ys) and max(ys) < CLIP):
-            px = [_clip(v) for v in px]  # far off, or not a number
-        out, fill = SHAPE_COLOURS[ink]
+    def poly(self, ink: int, c: list[int]) -> None:
+        out, fill = self.inks[ink]
         # Filled, then outlined with a closed line: Pillow's wide polygon outline draws
         # through a mask image per polygon, many times slower.
-        self.d.polygon(px, fill=fill)
-        self.d.line([*px, px[0], px[1]], fill=out, width=self.width, joint="curve")
+        self.core.draw_polygon(c, fill, 1)
+        self._lines(c, out, self.width, closed=True)
 
-    def spring(self, it: tuple) -> None:
-        pa, pb = self.P(it[3], it[4]), self.P(it[5], it[6])
-        if not self.outside([pa[0], pb[0]], [pa[1], pb[1]], 6 * self.u * self.S):
-            # Coils at most a tenth of the spring's drawn length wide: a web of short springs
-            # stays legible.
-            amp = min(SPRING_WIDTH * self.u * self.S, 0.1 * math.dist(pa, pb))
-            self.d.line(zigzag(pa, pb, amp, COILS), fill=SPRING, width=self.width,
-                        joint="curve")
+    def _shifted(self, pts: list[int], ox: int, oy: int) -> list[int]:
+        return [v - (ox if i % 2 == 0 else oy) for i, v in enumerate(pts)]
 
-    def line(self, it: tuple) -> None:
-        pa, pb = self.P(it[3], it[4]), self.P(it[5], it[6])
-        if not self.outside([pa[0], pb[0]], [pa[1], pb[1]], self.width):
-            self.d.line([pa, pb], fill=SPRING, width=self.width)
+    def spring(self, px: tuple, ox: int, oy: int) -> None:
+        self._lines(self._shifted(px[1], ox, oy), self.spring_ink, self.width)
 
-    def dot(self, it: tuple) -> None:
-        X, Y = self.P(it[3], it[4])
-        R = 3 * self.u * self.S
-        if not self.outside([X], [Y], R):
-            self.d.ellipse([X - R, Y - R, X + R, Y + R], fill=INK)
+    def line(self, px: tuple, ox: int, oy: int) -> None:
+        self._lines(self._shifted(px[1], ox, oy), self.spring_ink, self.width)
 
-    def rotary(self, it: tuple) -> None:
-        """A coil of 2.5 turns about the pivot, turned by the spring's twist."""
-        _, _, _, x, y, twist = it
-        X, Y = self.P(x, y)
-        if self.outside([X], [Y], 12 * self.u * self.S) or not math.isfinite(twist):
-            return
-        pts = []
-        for i in range(61):
-            f = i / 60
-            a = f * 2.5 * 2 * math.pi + twist
-            rr = (4 + 8 * f) * self.u * self.S
-            pts.append((X + rr * math.cos(a), Y + self.flip * rr * math.sin(a)))
-        self.d.line(pts, fill=SPRING, width=self.width, joint="curve")
+    def rotary(self, px: tuple, ox: int, oy: int) -> None:
+        self._lines(self._shifted(px[1], ox, oy), self.spring_ink, self.width)
+
+    def dot(self, px: tuple, ox: int, oy: int) -> None:
+        _, X, Y, R = px
+        X, Y = X - ox, Y - oy
+        self.core.draw_ellipse((X - R, Y - R, X + R, Y + R), self.dot_ink, 1)
 
 
-#: Redrawing: an element is drawn again once a coordinate crosses a grid of this many
-#: pixels (smaller shifts change no pixel's blend level); past this share of the moving
-#: elements changed, or this many separate boxes, the whole moving layer is drawn again.
-QUANTUM, REDRAW_SHARE, MAX_RECTS = 0.1, 0.4, 24
-#: Room (u) around each kind of primitive's box for what is drawn beyond it: outlines, the
-#: smallest circle, a spring's coils, a rotary spring's coil, a pivot's dot.
-ROOM = {"circle": 2.5, "seg": 2.0, "poly": 2.0, "spring": 6.0, "line": 2.0, "rotary": 13.0,
-        "dot": 4.0}
+@functools.cache
+def _flat_inks() -> tuple[list[tuple[int, int]], int, int]:
+    """Palette indices of each shape colour pair (outline, fill), of springs and pivots."""
+    return ([(ink_index(out), ink_index(fill)) for out, fill in SHAPE_COLOURS],
+            ink_index(SPRING), ink_index(INK))
+
+
+class _FlatPen:
+    """Draws primitives flat, at the frame's size, straight in palette indices (1 px lines
+    and outlines): what :class:`_Pen` draws smooth, with each whole-pixel number halved."""
+
+    def __init__(self, d: ImageDraw.ImageDraw) -> None:
+        self.core = d.draw
+        self.inks, self.spring_ink, self.dot_ink = _flat_inks()
+
+    def circle(self, ink: int, c: list[int]) -> None:
+        X, Y, EX, EY, R = c
+        out, fill = self.inks[ink]
+        box = (X - R, Y - R, X + R, Y + R)
+        self.core.draw_ellipse(box, fill, 1)
+        self.core.draw_ellipse(box, out, 0, 1)
+        if EX != X or EY != Y:
+            self.core.draw_lines((X, Y, EX, EY), out, 1)
+
+    def seg(self, ink: int, c: list[int]) -> None:
+        AX, AY, BX, BY, W = c
+        out, fill = self.inks[ink]
+        self.core.draw_lines((AX, AY, BX, BY), out if W <= 2 else fill, W)
+
+    def poly(self, ink: int, c: list[int]) -> None:
+        out, fill = self.inks[ink]
+        self.core.draw_polygon(c, fill, 1)
+        self.core.draw_lines([*c, c[0], c[1]], out, 1)
+
+    def _halved(self, pts: list[int], ox: int, oy: int) -> list[int]:
+        return [(v - (ox if i % 2 == 0 else oy) + 1) // SS for i, v in enumerate(pts)]
+
+    def spring(self, px: tuple, ox: int, oy: int) -> None:
+        self.core.draw_lines(self._halved(px[1], ox, oy), self.spring_ink, 1)
+
+    line = rotary = spring
+
+    def dot(self, px: tuple, ox: int, oy: int) -> None:
+        _, X, Y, R = px
+        X, Y = self._halved([X, Y], ox, oy)
+        R = (R + 1) // SS
+        self.core.draw_ellipse((X - R, Y - R, X + R, Y + R), self.dot_ink, 1)
+
+
+#: Flat drawing (no smoothing) for many small bodies: a set of at least FLAT_MANY moving
+#: shapes, each drawn within FLAT_PX px (its box, outline included) when the set is first
+#: seen through a view, is drawn flat with 1 px outlines, as pygame_util draws.
+FLAT_MANY, FLAT_PX = 100, 20
+
+#: Redrawing: the whole moving layer is drawn again when more than this many primitives
+#: changed, when the boxes to draw again are more than this many, or when their area (px),
+#: each counted with this many more for its own cost, exceeds the whole layer's.
+MAX_CHANGED, MAX_RECTS, RECT_COST = 64, 24, 4000.0
 
 
 class Layer:
-    """One frame's moving primitives seen through a view: each one's pixel box (with room
-    for what is drawn around it), and per element (a moving body's shapes, or one
-    constraint) its signature: its box and turning point in pixels on a grid of
-    :data:`QUANTUM` px (a rigid shape's pose to that grid). From the previous frame's layer,
-    :meth:`damage` finds the boxes to draw again."""
+    """One frame's moving primitives (:class:`Pixels`) on the scene panel (``panel``: its
+    width and height, px). From the previous frame's layer, :meth:`damage` finds the boxes to
+    draw again: where a primitive's whole-pixel numbers changed (so every other primitive
+    there is drawn as it was)."""
 
-    def __init__(self, items: tuple[tuple, ...], measured: Measured, view: View, u: float,
-                 panel: tuple[int, int]) -> None:
-        self.items = items
+    def __init__(self, rec: Recording, k: int, view: View, u: float,
+                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None
+                 ) -> None:
+        self.px = Pixels(rec.shapes[rec.shape_of[k]], rec.poses[k], rec.extras[k], view, u)
         self.panel = panel
-        s, fs = view.s, view.flip * view.s
-        room = np.array([ROOM[it[0]] * u for it in items]).reshape(-1)
-        b = measured.box
-        xa, xb = view.ox + b[:, 0] * s, view.ox + b[:, 1] * s
-        ya, yb = view.oy + b[:, 2] * fs, view.oy + b[:, 3] * fs
-        px = np.stack([xa - room, np.minimum(ya, yb) - room, xb + room,
-                       np.maximum(ya, yb) + room], axis=1)
-        self.boxes = px.tolist()
-        inv = s / QUANTUM
-        grid = np.concatenate([b * inv, measured.turn * inv], axis=1)
-        # A rotary spring turns its coil, 12 u px out, by its twist.
-        grid[measured.rotary, 4] = measured.turn[measured.rotary, 0] * 12 * u / QUANTUM
-        with np.errstate(invalid="ignore"):
-            grid = np.floor(grid)  # a value that is not a number never equals itself
-        self.measured, self.view, self.corner = measured, view, None
-        self.keys = measured.key.tolist()
-        rows = map(tuple, grid.tolist())
-        if len(set(self.keys)) == len(self.keys):  # one primitive per element
-            self.sigs = dict(zip(self.keys, rows, strict=True))
-        else:
-            sigs: dict[int, list[tuple]] = {}
-            for key, row in zip(self.keys, rows, strict=True):
-                sigs.setdefault(key, []).append(row)
-            self.sigs = {key: tuple(v) for key, v in sigs.items()}
-        finite = px[np.isfinite(px).all(axis=1)]
-        self.box = self._clipped((float(finite[:, 0].min()), float(finite[:, 1].min()),
-                                  float(finite[:, 2].max()), float(finite[:, 3].max()))
-                                 ) if len(finite) else None
+        box = self.px.box
+        self.box = self._clipped(box) if box is not None else None
+        # Flat or smooth: decided when a set of shapes is first seen through a view.
+        key = (rec.shape_of[k], id(view))
+        known = flat if flat is not None else {}
+        if key not in known:
+            b = self.px.boxes[:self.px.n_shapes][self.px.ok[:self.px.n_shapes]]
+            size = np.maximum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1]) - 2 if len(b) else b
+            known[key] = self.px.n_shapes >= FLAT_MANY and bool((size <= FLAT_PX).all())
+        self.flat = known[key]
 
     def _clipped(self, box: tuple[float, float, float, float]
                  ) -> tuple[float, float, float, float] | None:
@@ -564,52 +894,32 @@ class Layer:
         out = (max(box[0], 0), max(box[1], 0), min(box[2], w - 1), min(box[3], h))
         return out if out[2] > out[0] and out[3] > out[1] else None
 
-    @functools.cached_property
-    def element_boxes(self) -> dict[Any, tuple[float, float, float, float]]:
-        """The pixel box of each element."""
-        out: dict[Any, tuple[float, float, float, float]] = {}
-        for key, box in zip(self.keys, self.boxes, strict=True):
-            have = out.get(key)
-            out[key] = box if have is None else _union_px([have, box])
-        return out
-
     def damage(self, before: Layer) -> list[tuple[float, float, float, float]] | None:
-        """The boxes (px) to draw again over the previous frame's picture: where an element
+        """The boxes (px) to draw again over the previous frame's picture: where a primitive
         changed, appeared or went; None when the whole layer must be drawn again."""
-        changed = [k for k in self.sigs.keys() | before.sigs.keys()
-                   if self.sigs.get(k) != before.sigs.get(k)]
-        if len(changed) > REDRAW_SHARE * max(len(self.sigs), 1):
+        changed = self.px.changed(before.px)
+        if changed is None or self.flat != before.flat:
             return None
-        now, then = self.element_boxes, before.element_boxes
-        rects = [b for k in changed for b in (now.get(k), then.get(k)) if b is not None]
-        if not all(math.isfinite(v) for b in rects for v in b):
+        idx = np.flatnonzero(changed)
+        if len(idx) > MAX_CHANGED:
             return None
-        merged = _merge(rects)
+        rects = [tuple(b) for px in (self.px, before.px)
+                 for b in px.boxes[idx[px.ok[idx]]].tolist()]
+        merged = [c for c in (self._clipped(r) for r in _merge(rects))  # type: ignore[arg-type]
+                  if c is not None]
         if len(merged) > MAX_RECTS:
             return None
-        return [c for c in (self._clipped(r) for r in merged) if c is not None]
+        whole = self.box
+        cost = sum((r[2] - r[0]) * (r[3] - r[1]) + RECT_COST for r in merged)
+        if whole is not None and cost > (whole[2] - whole[0]) * (whole[3] - whole[1]):
+            return None
+        return merged
 
-    def within(self, rect: tuple[float, float, float, float]) -> list[int]:
-        """The indices of the primitives whose boxes meet ``rect``, in drawing order."""
-        x0, y0, x1, y1 = rect
-        return [j for j, b in enumerate(self.boxes)
-                if not (b[2] < x0 or b[0] > x1 or b[3] < y0 or b[1] > y1)]
-
-    def draw(self, pen: Pen, rect: tuple[float, float, float, float]) -> None:
-        """Draw the primitives that meet ``rect`` with ``pen``: the polygons' corners placed
-        in the pen's pixels all at once."""
-        index = self.within(rect)
-        wanted = set(index)
-        polys: dict[int, list[float]] = {}
-        for count, group in self.measured.poly_groups.items():
-            idx = [j for j in group if j in wanted]
-            if not count or not idx:
-                continue
-            flat = np.array([self.items[j][3] for j in idx], dtype=float)
-            flat[:, 0::2] = pen.ox + flat[:, 0::2] * pen.sS
-            flat[:, 1::2] = pen.oy + flat[:, 1::2] * (pen.flip * pen.sS)
-            polys.update(zip(idx, flat.tolist(), strict=True))
-        pen.draw([self.items[j] for j in index], polys, index)
+    def draw(self, d: ImageDraw.ImageDraw, corner: tuple[int, int],
+             rect: tuple[float, float, float, float]) -> None:
+        """Draw the primitives that meet ``rect`` (frame px) on ``d``, whose pixel (0, 0) is
+        the frame's pixel ``corner`` (see :meth:`Pixels.draw`; flat when the layer is)."""
+        self.px.draw(d, corner, self.px.within(rect), self.flat)
 
 
 def _union_px(boxes: list[tuple[float, float, float, float]]
@@ -640,7 +950,7 @@ class Painter(Backdrop):
     def __init__(self, rec: Recording) -> None:
         self.rec = rec
         self.W, self.H = rec.size
-        self.n = len(rec.frames)
+        self.n = rec.n
         self.u = u = unit(self.W, self.H)
         self.t = np.asarray(rec.t, dtype=float)
         self.st_time = Stamps(font(max(9, round(14 * u)), bold=True))
@@ -657,16 +967,18 @@ class Painter(Backdrop):
         least = float(steps[steps > 0].min()) if (steps > 0).any() else 1.0
         self.t_decimals = max(2, min(6, math.ceil(-math.log10(least) - 1e-9)))
         self.t_end = max(float(span), 1e-300)
-        self.measured = [Measured.of(items) for items in rec.frames]
         self._layout()
         if self.energy:
             self._energy_scale()
         self.base = self._base()
         self._views()
+        self.tx_time, self.tx_text = _Text(self.st_time), _Text(self.st_text)
+        self.label_box = (4 * u, 2 * u, 150 * u, 24 * u)
         self._bg_key: tuple[int, int] | None = None
         self._layer: Layer | None = None
-        self._scene: Image.Image | None = None
-        self._touched: list[tuple[float, float, float, float]] | None = None
+        self._canvas: Image.Image | None = None
+        self._shown: dict[str, Any] = {}
+        self._flat: dict[tuple[int, int], bool] = {}
         self.changed: tuple[float, float, float, float] | None = None
 
     # --- geometry -----------------------------------------------------------------------
@@ -698,9 +1010,9 @@ class Painter(Backdrop):
         if rec.camera == "box" and rec.box is not None:
             box = fit(rec.box, aw, ah, 0.0)
         elif rec.camera == "all":
-            box = fit(all_box(self.measured, rec.statics), aw, ah)
+            box = fit(all_box(rec), aw, ah)
         else:
-            box = fit(auto_box(self.measured, rec.statics), aw, ah)
+            box = fit(auto_box(rec), aw, ah)
         self.views = [View.of(box, self.area, rec.y_up)] * self.n
 
     @property
@@ -765,8 +1077,8 @@ class Painter(Backdrop):
         u, S = self.u, SS
         img = self.base.copy()
         scene = Image.new("RGB", (self.scene_w * S, self.H * S), WHITE)
-        Pen(ImageDraw.Draw(scene), self.u, S, view, (0, 0), (self.scene_w, self.H)).draw(
-            self.rec.statics[version])
+        Pixels.of_items(self.rec.statics[version], view, self.u).draw(ImageDraw.Draw(scene),
+                                                                      (0, 0))
         img.paste(scene, (0, 0))
         if self.rec.title:
             ImageDraw.Draw(img).text(((self.scene_w - 8 * u) * S, 6 * u * S), self.rec.title,
@@ -775,6 +1087,14 @@ class Painter(Backdrop):
         self.bg_rgb = self.bg.convert("RGB")
         self.bg_ss = self.bg_rgb.resize((self.W * S, self.H * S), Image.Resampling.NEAREST)
         self._bg_key = key
+        # Text is pasted from glyphs drawn on white where the background is white.
+        white = ink_index(WHITE)
+        self._white = {name: bool((np.asarray(self.bg.crop(_whole(box, self.W, self.H)))
+                                   == white).all())
+                       for name, box in (("label", self.label_box),
+                                         ("values", self._values_box()))}
+        if self.energy:
+            self._band_of = self._bands()
         return True
 
     def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
@@ -811,54 +1131,87 @@ class Painter(Backdrop):
     # --- one frame --------------------------------------------------------------------------
 
     def frame(self, k: int) -> Image.Image:
-        """Frame ``k`` as a palette image."""
+        """Frame ``k`` as a palette image (the painter's canvas: drawn over by the next
+        frame). From one frame to the next only what changed is drawn again: the moving
+        layer's changed boxes (see :class:`Layer`), the time label, the bars and the cursor
+        when theirs changed."""
         fresh = self.background(k)
-        img = self.bg.copy()
         view = self.views[k]
-        layer = Layer(self.rec.frames[k], self.measured[k], view, self.u,
-                      (self.scene_w, self.H))
-        rects = None if fresh or self._layer is None else layer.damage(self._layer)
-        if rects is None:
+        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat)
+        touched: list[tuple[float, float, float, float]] | None = []
+        if fresh or self._canvas is None or self._layer is None:
+            self._canvas, self._shown, touched = self.bg.copy(), {}, None
             rects = [layer.box] if layer.box is not None else []
         else:
-            img.paste(self._scene, (0, 0))
-        touched = [*rects, *self._panel_boxes(k)]
-        self.changed = None if fresh or self._touched is None else _union_px(
-            touched + self._touched)
-        self._touched = touched
+            rects = layer.damage(self._layer)
+            if rects is None:
+                # The whole layer again: the previous one's pixels go first.
+                old = self._layer.box
+                if old is not None:
+                    self._restore(old)
+                    touched.append(old)  # type: ignore[union-attr]
+                rects = [layer.box] if layer.box is not None else []
+            touched += rects  # type: ignore[operator]
+        img = self._canvas
         for rect in rects:
-            crop, corner, done = self.patch(img, rect, SS)
-            layer.draw(Pen(ImageDraw.Draw(crop), self.u, SS, view, corner,
-                           (crop.width / SS, crop.height / SS)), rect)
+            if layer.flat:
+                # Straight in palette indices on a crop of the background.
+                whole = _whole(rect, self.W, self.H)
+                crop = self.bg.crop(whole)
+                layer.draw(ImageDraw.Draw(crop), whole[:2], whole)
+                img.paste(crop, whole[:2])
+                continue
+            crop, (cx, cy), done = self.patch(img, rect, SS)
+            # Everything that meets the crop (whole pixels around the rectangle) is drawn.
+            layer.draw(ImageDraw.Draw(crop), (cx, cy),
+                       (cx, cy, cx + crop.width / SS, cy + crop.height / SS))
             done()
-        self._layer, self._scene = layer, img.crop((0, 0, self.scene_w, self.H))
-        u = self.u
-        crop, (cx, cy), done = self.patch(img, (4 * u, 2 * u, 150 * u, 24 * u), 1)
-        label = f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
-        self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), label, INK, "lt")
-        done()
+        self._layer = layer
+        parts = self._label(img, k, [] if touched is None else touched)
         if self.energy:
-            self._bars(img, k)
+            parts += self._bars(img, k)
             if self.strip:
-                _, sy0, _, sy1 = self.strip_box
-                x = round(float(self.strip_x(self.t[k])))
-                ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
-                                         width=max(1, round(1.2 * u)))
+                parts += self._cursor(img, k)
+        if touched is None:
+            self.changed = None
+        else:
+            touched += parts
+            self.changed = _union_px(touched) if touched else (0.0, 0.0, 0.0, 0.0)
         return img
 
-    def _panel_boxes(self, k: int) -> list[tuple[float, float, float, float]]:
-        """The boxes (px) frame ``k`` draws outside the moving layer: the time label, and
-        the bars, their values and the strip's cursor."""
-        u = self.u
-        boxes = [(4 * u, 2 * u, 150 * u, 24 * u)]
-        if self.energy:
-            boxes.append((self.bars_box[0], self.rows[0][1] - 3, self.W,
-                          self.rows[-1][2] + 3))
-            if self.strip:
-                x = float(self.strip_x(self.t[k]))
-                boxes.append((x - 2 * u - 1, self.strip_box[1], x + 2 * u + 1,
-                              self.strip_box[3]))
-        return boxes
+    def _restore(self, box: tuple[float, float, float, float]) -> tuple[int, int, int, int]:
+        """Put the background back over the whole pixels that cover ``box`` (px); returns
+        them (left, top, right, bottom)."""
+        whole = _whole(box, self.W, self.H)
+        if whole[2] > whole[0] and whole[3] > whole[1]:
+            # Through Pillow's core (both "P", the canvas a copy of its own): no per-call
+            # checks.
+            self._canvas.im.paste(self.bg.im.crop(whole), whole)  # type: ignore[union-attr]
+        return whole
+
+    def _label(self, img: Image.Image, k: int, scene: list[tuple[float, float, float, float]]
+               ) -> list[tuple[float, float, float, float]]:
+        """Draw the time label if it changed or the scene was drawn over it; the box
+        touched."""
+        u, box = self.u, self.label_box
+        label = f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
+        if self._shown.get("label") == label and not any(_meets(r, box) for r in scene):
+            return []
+        self._shown["label"] = label
+        if self._white["label"]:
+            self._restore(box)
+            self.tx_time.draw(img, (6 * u, 6 * u), label, "lt")
+        else:
+            crop, (cx, cy), done = self.patch(img, box, 1)
+            self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), label, INK, "lt")
+            done()
+        return [box]
+
+    def _values_box(self) -> tuple[float, float, float, float]:
+        """Where the bars' values are written (px)."""
+        if not self.energy:
+            return (0.0, 0.0, 1.0, 1.0)
+        return (self.bar_right + 2, self.rows[0][1] - 3, self.bars_box[2], self.rows[-1][2] + 3)
 
     def region(self, k: int) -> tuple[int, int, int, int] | None:
         """Where frame ``k`` (just drawn) can differ from frame k - 1 (px: left, top, right,
@@ -868,25 +1221,142 @@ class Painter(Backdrop):
         x0, y0, x1, y1 = self.changed
         return math.floor(x0) - 1, math.floor(y0) - 1, math.ceil(x1) + 2, math.ceil(y1) + 2
 
-    def _bars(self, img: Image.Image, k: int) -> None:
-        d = ImageDraw.Draw(img)
+    def _bands(self) -> list[tuple[int, int]]:
+        """Each bar's band (px: top, bottom): from the middle of the gap above it to the
+        middle of the gap below it (the panel's block, first and last); one band for all
+        bars when a value's text would not fit in its own (so redrawing a band never touches
+        another's)."""
+        rows = self.rows
+        edges = [rows[0][1] - 3]
+        edges += [(bot + nxt) // 2 for (_, _, bot), (_, nxt, _) in itertools.pairwise(rows)]
+        edges.append(rows[-1][2] + 3)
+        ascent, descent = self.st_text.font.getmetrics()
+        fits = all(lo <= round((top + bot) / 2 + self.st_text.cap / 2) - ascent - 2
+                   and round((top + bot) / 2 + self.st_text.cap / 2) + descent + 2 <= hi
+                   for (_, top, bot), lo, hi in zip(rows, edges, edges[1:]))
+        if not fits or not self._white["values"]:
+            return [(edges[0], edges[-1])] * len(rows)
+        return list(itertools.pairwise(edges))
+
+    def _bars(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
+        """Draw again the bars (with their values) that changed; the boxes touched."""
         values = {n: float(self.e[n][k]) for n in self.names}
+        spans = []
         for name, top, bot in self.rows:
             v = values[name]
             if not math.isfinite(v):
+                spans.append((None, self.scale.text(v)))
                 continue
             a, b = sorted((round(self.bar_px(0.0)), round(self.bar_px(v))))
+            h = b
             if name == "E" and self.rec.heat and values["heat"] > 0:
                 # E + heat: what E was, were no energy lost to the contacts.
-                h = round(self.bar_px(v + values["heat"]))
-                if h > b:
-                    d.rectangle([b, top, h - 1, bot - 1], fill=self.idx["heat"])
-            if b > a:
-                d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
+                h = max(b, round(self.bar_px(v + values["heat"])))
+            spans.append(((a, b, h), self.scale.text(v)))
+        bands = self._band_of
+        shown = self._shown.get("bars") or [None] * len(spans)
+        redo = sorted({bands[j] for j, span in enumerate(spans) if span != shown[j]})
+        if not redo:
+            return []
+        self._shown["bars"] = spans
+        d = ImageDraw.Draw(img)
         bx1 = self.bars_box[2]
-        box = (self.bar_right + 2, self.rows[0][1] - 3, bx1, self.rows[-1][2] + 3)
-        draw_values(self.patch(img, box, 1), self.rows,
-                    lambda name: self.scale.text(values[name]), bx1, self.st_text)
+        boxes: list[tuple[float, float, float, float]] = []
+        for band in redo:
+            box = (self.bar_left - 1, band[0], self.W, band[1])
+            self._restore(box)
+            boxes.append(box)
+            rows = [j for j, b in enumerate(bands) if b == band]
+            for j in rows:
+                name, top, bot = self.rows[j]
+                extent, text = spans[j]
+                if extent is not None:
+                    a, b, h = extent
+                    if h > b:
+                        d.rectangle([b, top, h - 1, bot - 1], fill=self.idx["heat"])
+                    if b > a:
+                        d.rectangle([a, top, b - 1, bot - 1], fill=self.idx[name])
+                if self._white["values"]:
+                    self.tx_text.draw(img, (bx1, (top + bot) / 2), text, "rm")
+            if not self._white["values"]:
+                draw_values(self.patch(img, self._values_box(), 1), self.rows,
+                            lambda name: self.scale.text(values[name]), bx1, self.st_text)
+        return boxes
+
+    def _cursor(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
+        """Move the strip's cursor if it moved; the boxes touched."""
+        u = self.u
+        _, sy0, _, sy1 = self.strip_box
+        x = round(float(self.strip_x(self.t[k])))
+        before = self._shown.get("cursor")
+        if before == x:
+            return []
+        self._shown["cursor"] = x
+        half = 2 * u + 1
+        boxes = [(x - half, sy0, x + half, sy1)]
+        if before is not None:
+            boxes.append(self._restore((before - half, sy0, before + half, sy1)))
+        ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
+                                 width=max(1, round(1.2 * u)))
+        return boxes
+
+
+def _whole(box: tuple[float, float, float, float], width: int = 1 << 30,
+           height: int = 1 << 30) -> tuple[int, int, int, int]:
+    """The whole pixels that cover ``box`` (px: left, top, right, bottom), within the frame."""
+    return (max(0, math.floor(box[0])), max(0, math.floor(box[1])),
+            min(width, math.ceil(box[2])), min(height, math.ceil(box[3])))
+
+
+def _meets(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return not (a[2] < b[0] or a[0] > b[2] or a[3] < b[1] or a[1] > b[3])
+
+
+class _Text:
+    """Text pasted on a palette image from glyphs drawn once: each character drawn by
+    ``stamps`` in ink on white at a whole pixel, mapped to the palette, pasted through the
+    mask of the pixels it inks. For text on a white background: the same pixels as the
+    stamps give there, without drawing in RGB and mapping back every frame."""
+
+    #: White margin (px) around each glyph's cell.
+    MARGIN = 4
+
+    def __init__(self, stamps: Stamps) -> None:
+        self.st = stamps
+        self.glyphs: dict[str, tuple[Image.Image, Image.Image, int, int, float]] = {}
+
+    def _glyph(self, ch: str) -> tuple[Image.Image, Image.Image, int, int, float]:
+        g = self.glyphs.get(ch)
+        if g is None:
+            ascent, descent = self.st.font.getmetrics()
+            m = self.MARGIN
+            advance = self.st.width(ch)
+            x0, _, x1, _ = self.st.font.getbbox(ch, anchor="ls")
+            left = m + max(0, -x0)
+            tile = Image.new("RGB", (left + max(x1, math.ceil(advance)) + m,
+                                     ascent + descent + 2 * m), WHITE)
+            self.st.draw(tile, (left, m + ascent), ch, INK, "ls")
+            inked = (np.asarray(tile) != 255).any(axis=2)
+            sprite, mask = to_palette(tile), Image.fromarray(inked)
+            sprite.load()
+            mask.load()
+            g = self.glyphs[ch] = (sprite, mask, left, m + ascent, advance)
+        return g
+
+    def draw(self, img: Image.Image, xy: tuple[float, float], text: str, anchor: str) -> None:
+        """Paste ``text`` on the palette image ``img`` at ``xy`` (px), anchored as
+        :meth:`Stamps.draw` anchors it."""
+        x, y = xy
+        glyphs = [self._glyph(ch) for ch in text]
+        if anchor[0] in "rm":
+            x -= sum(g[4] for g in glyphs) / (1 if anchor[0] == "r" else 2)
+        base = round({"m": y + self.st.cap / 2, "t": y + self.st.cap, "s": y}[anchor[1]])
+        img.load()
+        core = img.im  # pasted through Pillow's core: no per-call checks, both are "P"
+        for sprite, mask, left, top, advance in glyphs:
+            X, Y = round(x) - left, base - top
+            core.paste(sprite.im, (X, Y, X + sprite.width, Y + sprite.height), mask.im)
+            x += advance
 
 
 # --- writing -----------------------------------------------------------------------------------

@@ -139,20 +139,25 @@ def _options_class() -> type:
             from ..model import args
 
             args.space(space)
+            self.items, self.static = self._geometry_of(space).items(space)
+            self.items += _constraint_items(space, self._number_of)
+            return self.items
+
+        def _geometry_of(self, space: Any) -> _Geometry:
+            """The geometry of the shapes of ``space`` now (made again when they change)."""
             shapes = space.shapes
             if self._geometry is None or not self._geometry.same(shapes):
                 self._geometry = _Geometry(list(shapes), self._ink_of, self._number_of)
-            self.items, self.static = self._geometry.items(space)
-            self.items += _constraint_items(space, self._number_of)
-            return self.items
+            return self._geometry
 
     return PaletteDrawOptions
 
 
 class _Geometry:
-    """A space's shapes as local geometry on their bodies, made again when the shapes
-    change: a capture then reads every body's pose at once (``pymunk.batch``) and moves each
-    kind of shape with one numpy expression, instead of a Python call per shape from
+    """A space's shapes as local geometry on their bodies (a moving and a static
+    :class:`~dumbbell.animation.recording.Shapes`), made again when the shapes change: a
+    capture then reads every body's pose at once (``pymunk.batch``), and the painter places
+    each kind of shape with one numpy expression, instead of a Python call per shape from
     ``space.debug_draw``. Always the bodies' present pose, so a body placed by hand before a
     step is drawn where it is (pymunk's own drawing waits for the next step). A shape changed
     in place (pymunk's ``unsafe_set_radius``, ``unsafe_set_vertices``, ...) is seen once the
@@ -161,39 +166,42 @@ class _Geometry:
     def __init__(self, shapes: list[Any], ink_of: Any, number_of: Any) -> None:
         import pymunk
 
+        from ..animation.recording import Shapes
+
         self.shapes = shapes
         self.bodies: list[Any] = []
         where: dict[int, int] = {}
-        kinds = {"circle": [], "seg": [], "poly": []}  # type: dict[str, list[int]]
-        for i, shape in enumerate(shapes):
+        kinds, rows, local, radii = [], [], [], []
+        for shape in shapes:
             body = shape.body
             if id(body) not in where:
                 where[id(body)] = len(self.bodies)
                 self.bodies.append(body)
-            kind = ("circle" if isinstance(shape, pymunk.Circle) else
-                    "seg" if isinstance(shape, pymunk.Segment) else "poly")
-            kinds[kind].append(i)
-        self.static_shape = [s.body.body_type == pymunk.Body.STATIC for s in shapes]
+            rows.append(where[id(body)])
+            if isinstance(shape, pymunk.Circle):
+                kinds.append("circle")
+                local.append([tuple(shape.offset)])
+            elif isinstance(shape, pymunk.Segment):
+                kinds.append("seg")
+                local.append([tuple(shape.a), tuple(shape.b)])
+            else:
+                kinds.append("poly")
+                local.append([tuple(v) for v in shape.get_vertices()])
+            radii.append(shape.radius)
+        tags = [(ink_of(b), number_of(b)) for b in self.bodies]
+        static = [b.body_type == pymunk.Body.STATIC for b in self.bodies]
+
+        def subset(want: bool) -> Any:
+            idx = [i for i, r in enumerate(rows) if static[r] == want]
+            return Shapes.of([kinds[i] for i in idx], [rows[i] for i in idx],
+                             [tags[rows[i]][0] for i in idx], [tags[rows[i]][1] for i in idx],
+                             [local[i] for i in idx], [radii[i] for i in idx])
+
+        self.moving, self.static = subset(False), subset(True)
+        self.static_rows = np.flatnonzero(static)
         self._ids = np.array([b.id for b in self.bodies], dtype=np.int64)
         self._rows: np.ndarray | None = None
         self._seen, self._found = -1, np.zeros(0, dtype=bool)
-        self.tags = [(ink_of(b), number_of(b)) for b in self.bodies]
-        self.body_of = {k: np.array([where[id(shapes[i].body)] for i in idx], dtype=int)
-                        for k, idx in kinds.items()}
-        self.index = kinds
-        c = [shapes[i] for i in kinds["circle"]]
-        self.circle = (np.array([tuple(s.offset) for s in c], dtype=float).reshape(-1, 2),
-                       [s.radius for s in c])
-        g = [shapes[i] for i in kinds["seg"]]
-        self.seg = (np.array([(*s.a, *s.b) for s in g], dtype=float).reshape(-1, 4),
-                    [s.radius for s in g])
-        p = [shapes[i] for i in kinds["poly"]]
-        verts = [s.get_vertices() for s in p]
-        self.poly_counts = [len(v) for v in verts]
-        self.poly_verts = np.array([tuple(v) for vs in verts for v in vs],
-                                   dtype=float).reshape(-1, 2)
-        self.poly_body = np.repeat(self.body_of["poly"], self.poly_counts)
-        self.poly_r = [s.radius for s in p]
 
     def same(self, shapes: Any) -> bool:
         """Whether ``shapes`` are the shapes this geometry was made of, in the same order."""
@@ -227,35 +235,7 @@ class _Geometry:
     def items(self, space: Any) -> tuple[list[tuple], list[tuple]]:
         """The moving and the static primitives of the shapes now, in the shapes' order."""
         pose = self.poses(space)
-        cos, sin = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-
-        def world(local: np.ndarray, body: np.ndarray) -> np.ndarray:
-            c, s = cos[body], sin[body]
-            return np.stack([pose[body, 0] + c * local[:, 0] - s * local[:, 1],
-                             pose[body, 1] + s * local[:, 0] + c * local[:, 1]], axis=1)
-
-        out: list[tuple | None] = [None] * len(self.shapes)
-        tags, angle = self.tags, pose[:, 2].tolist()
-        body = self.body_of["circle"]
-        for i, b, (x, y), r in zip(self.index["circle"], body.tolist(),
-                                   world(self.circle[0], body).tolist(), self.circle[1],
-                                   strict=True):
-            out[i] = ("circle", *tags[b], x, y, r, angle[b])
-        body = self.body_of["seg"]
-        ends = np.concatenate([world(self.seg[0][:, :2], body), world(self.seg[0][:, 2:], body)],
-                              axis=1)
-        for i, b, (ax, ay, bx, by), r in zip(self.index["seg"], body.tolist(), ends.tolist(),
-                                             self.seg[1], strict=True):
-            out[i] = ("seg", *tags[b], ax, ay, bx, by, r)
-        flat = world(self.poly_verts, self.poly_body).ravel().tolist()
-        start = 0
-        for i, b, n, r in zip(self.index["poly"], self.body_of["poly"].tolist(),
-                              self.poly_counts, self.poly_r, strict=True):
-            out[i] = ("poly", *tags[b], tuple(flat[start:start + 2 * n]), r)
-            start += 2 * n
-        moving = [it for it, st in zip(out, self.static_shape, strict=True) if not st]
-        static = [it for it, st in zip(out, self.static_shape, strict=True) if st]
-        return moving, static  # type: ignore[return-value]
+        return self.moving.items(pose), self.static.items(pose)
 
 
 def _constraint_items(space: Any, number_of: Any) -> list[tuple]:
@@ -479,12 +459,23 @@ class Recorder:
         self.title = args.text(title, "title", "a str (written at the top)")
         self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
-        self.items: list[list[tuple]] = []
+        # Per frame: its set of moving shapes (an index into shape_sets), its bodies' poses,
+        # its constraints' primitives, its static set (an index into statics), its time.
+        self.shape_sets: list[Any] = []
+        self.shape_of: list[int] = []
+        self.poses: list[np.ndarray] = []
+        self.extras: list[tuple[tuple, ...]] = []
         self.statics: list[tuple[tuple, ...]] = []
         self.static_of: list[int] = []
         self.t: list[float] = []
         self.follow: list[tuple[float, float]] = []
-        self.terms: dict[str, list[float]] = {n: [] for n in (*TERMS, "heat")}
+        self.heat_total: list[float] = []
+        self._geometry: Any = None
+        self._static_pose: np.ndarray | None = None
+        if self.energy:
+            from .accounting import _Sampler
+
+            self._sampler = _Sampler(self.space)
         self.timing: dict[str, float] = {}
         #: The world box shown (left, right, bottom, top, y up) once the file is written.
         self.view: tuple[float, float, float, float] | None = None
@@ -504,7 +495,7 @@ class Recorder:
     @property
     def frames(self) -> int:
         """Frames so far (frame 0, the space when the recorder was made, included)."""
-        return len(self.items)
+        return len(self.t)
 
     @property
     def times(self) -> tuple[float, ...]:
@@ -539,40 +530,46 @@ class Recorder:
         self._captured = True
 
     def _keep(self, t: float) -> None:
-        """Keep the space now as a frame at time ``t``."""
-        items = self.options.capture(self.space)
-        static = tuple(self.options.static)
-        if not self.statics or static != self.statics[-1]:
-            self.statics.append(static)
-        self.items.append(items)
+        """Keep the space now as a frame at time ``t``: its bodies' poses (the shapes are
+        placed when the file is drawn), its constraints' primitives, and its energy."""
+        space = self.space
+        geometry = self.options._geometry_of(space)
+        pose = geometry.poses(space)
+        if geometry is not self._geometry:
+            self._geometry, self._static_pose = geometry, None
+            self.shape_sets.append(geometry.moving)
+        static_pose = pose[geometry.static_rows]
+        if self._static_pose is None or not np.array_equal(static_pose, self._static_pose):
+            static = tuple(geometry.static.items(pose))
+            if not self.statics or static != self.statics[-1]:
+                self.statics.append(static)
+            self._static_pose = static_pose
+        self.shape_of.append(len(self.shape_sets) - 1)
+        self.poses.append(pose)
+        self.extras.append(tuple(_constraint_items(space, self.options._number_of)))
         self.static_of.append(len(self.statics) - 1)
         self.t.append(float(t))
         if not isinstance(self.camera, str):
             p = self.camera.local_to_world(self.camera.center_of_gravity)
             self.follow.append((float(p.x), float(p.y)))
         if self.energy:
-            from .accounting import energy
-
-            e = energy(self.space, self.about)
-            for name in TERMS:
-                self.terms[name].append(float(getattr(e, name)))
-            self.terms["heat"].append(float(self.heat.total) if self.heat is not None else 0.0)
+            self._sampler.sample()
+            self.heat_total.append(float(self.heat.total) if self.heat is not None else 0.0)
         self._stepped = False
-        self.space.add_post_step_callback(self._on_step, self._key)
+        space.add_post_step_callback(self._on_step, self._key)
 
     def _drop_last(self) -> None:
-        self.items.pop()
-        self.static_of.pop()
-        self.t.pop()
-        if self.follow:
-            self.follow.pop()
-        for values in self.terms.values():
+        for values in (self.shape_of, self.poses, self.extras, self.static_of, self.t,
+                       self.follow, self.heat_total):
             if values:
                 values.pop()
+        if self.energy:
+            self._sampler.drop()
         if self.static_of.count(len(self.statics) - 1) == 0 and len(self.statics) > 1:
             self.statics.pop()
         elif not self.static_of:
             self.statics.clear()
+        self._geometry = self._static_pose = None  # the next frame takes them again
 
     # --- writing -------------------------------------------------------------------------
 
@@ -592,7 +589,8 @@ class Recorder:
 
     def _rows(self) -> tuple[dict[str, np.ndarray], dict[str, str]]:
         """The energy rows shown (name -> values) and their labels."""
-        e = {name: np.asarray(self.terms[name], dtype=float) for name in TERMS}
+        terms = self._sampler.terms(self.about)
+        e = {name: terms[name] for name in TERMS}
         labels = {name: name for name in TERMS}
         if self.reference != "space":
             refs = ({n: float(e[n][0]) for n in POTENTIALS} if self.reference == "start"
@@ -602,7 +600,7 @@ class Recorder:
             e["E"] = e["E"] - sum(refs.values())
             labels.update(DELTA_LABELS)
         if self.heat is not None:
-            e["heat"] = np.asarray(self.terms["heat"], dtype=float)
+            e["heat"] = np.asarray(self.heat_total, dtype=float)
             labels["heat"] = "heat"
         return e, labels
 
@@ -628,17 +626,20 @@ class Recorder:
                 size = max((max(b[1] - b[0], b[3] - b[2]) for b in boxes), default=0.0)
                 span = 8 * size if size > 0 and math.isfinite(size) else 1.0
             kw.update(camera="follow", follow=tuple(self.follow), span=span)
-        return Recording(frames=tuple(tuple(f) for f in self.items), statics=tuple(self.statics),
-                         static_of=tuple(self.static_of), t=tuple(self.t),
+        return Recording(shapes=tuple(self.shape_sets), shape_of=tuple(self.shape_of),
+                         poses=tuple(self.poses), extras=tuple(self.extras),
+                         statics=tuple(self.statics), static_of=tuple(self.static_of),
+                         t=tuple(self.t),
                          size=(self.W, self.H), fps=self.fps, y_up=self._y_up(),
                          strip=self.strip, title=self.title, time_unit=self.units[2], **kw)
 
     def _shapes_of(self, body: Any) -> list[tuple]:
         """The followed body's shapes in the first frame that shows them."""
         number = self.options._number_of(body)
-        for frame in self.items:
-            shapes = [it for it in frame if it[2] == number and it[0] in ("circle", "seg",
-                                                                          "poly")]
+        for k, i in enumerate(self.shape_of):
+            if k and i == self.shape_of[k - 1]:
+                continue  # the same shapes as the frame before
+            shapes = [it for it in self.shape_sets[i].items(self.poses[k]) if it[2] == number]
             if shapes:
                 return shapes
         return []
