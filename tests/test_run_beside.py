@@ -220,7 +220,7 @@ def test_a_slow_first_use_says_it_compiles_once(monkeypatch, capsys):
     monkeypatch.setattr(_install, "_compiling_said", set())
     monkeypatch.delenv(_install._SAID, raising=False)
     watching = {"yes": True}
-    monkeypatch.setattr(progress, "progress_wanted", lambda quiet=False: watching["yes"]
+    monkeypatch.setattr(progress, "_progress_wanted", lambda quiet=False: watching["yes"]
                         and not quiet)
     with _install.compiling("the test solver's kernels", quiet=False):
         pass  # a load from the cache: quick

@@ -178,9 +178,9 @@ def compiling(what: str, quiet: bool = True) -> Iterator[None]:
     no CI: as a progress bar), one line on stderr says what is compiling and why, once per
     process; not again after the line about the cache's place (:func:`njit`), which says it.
     """
-    from .progress import progress_wanted
+    from .progress import _progress_wanted
 
-    if what in _compiling_said or not progress_wanted(quiet) or os.environ.get(_SAID):
+    if what in _compiling_said or not _progress_wanted(quiet) or os.environ.get(_SAID):
         yield
         return
     _numba_target()  # numba's own start-up, compiling or not: not timed

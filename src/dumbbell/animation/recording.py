@@ -140,10 +140,12 @@ class Shapes:
     groups: tuple[Group, ...]
 
     @classmethod
-    def of(cls, kinds: list[str], body: list[int], ink: list[int], number: list[int],
-           local: list[list[tuple[float, float]]], r: list[float]) -> Shapes:
-        """From per-shape lists: kind ("circle", "seg", "poly"), body row, ink, number, points
-        in body coordinates and radius."""
+    def of(cls, tags: list[tuple[str, int, int, int]], local: list[list[tuple[float, float]]],
+           r: list[float]) -> Shapes:
+        """From per-shape lists: ``tags`` (kind ("circle", "seg", "poly"), body row, ink,
+        number), points in body coordinates and radius."""
+        kinds = [t[0] for t in tags]
+        body, ink, number = ([t[i] for t in tags] for i in (1, 2, 3))
         by: dict[tuple[str, int], list[int]] = {}
         for j, (kind, pts) in enumerate(zip(kinds, local, strict=True)):
             by.setdefault((kind, len(pts)), []).append(j)
@@ -474,16 +476,17 @@ def _to_pixels(pts: np.ndarray, view: View) -> np.ndarray:
     return _snap(pts * (view.s * S, view.flip * view.s * S) + (view.ox * S, view.oy * S))
 
 
-def shape_pixels(kind: str, pts: np.ndarray, r: np.ndarray, angle: np.ndarray, view: View,
-                 u: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Shapes of one kind at world points ``pts`` (m x p x 2), radii ``r`` and (circles) their
-    bodies' angles, seen through ``view``: their whole-pixel coordinates at :data:`SS` times
+def shape_pixels(g: Group, pts: np.ndarray, angle: np.ndarray, view: View, u: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Group ``g``'s shapes (one kind, radii ``g.r``) at world points ``pts`` (m x p x 2) and
+    (circles) their bodies' angles, seen through ``view``: their whole-pixel coordinates at :data:`SS` times
     the size (m x w integers: a circle's centre, the end of its radius line (the centre
     without one) and radius; a segment's ends and width; a polygon's corners: points first,
     x then y, then at most one length), their boxes (m x 4, frame
     px: left, top, right, bottom, with room for outlines and smoothing), and which can be
     drawn (m)."""
     S, line = SS, line_width(u)
+    kind, r = g.kind, g.r
     m, p = pts.shape[:2]
     P = _to_pixels(pts, view)
     ok = ~np.isnan(pts).reshape(m, -1).any(axis=1) if p else np.zeros(m, dtype=bool)
@@ -639,7 +642,7 @@ class Pixels:
         if shapes is not None and pose is not None:
             for g in shapes.groups:
                 pts, angle = shapes.place(pose, g)
-                ints, boxes, ok = shape_pixels(g.kind, pts, g.r, angle, view, u)
+                ints, boxes, ok = shape_pixels(g, pts, angle, view, u)
                 self.boxes[g.at] = boxes
                 self.groups.append((g.kind, g.at, ints, shapes.ink[g.at], ok))
         self.extras, self.boxes[self.n_shapes:] = extra_pixels(extras, view, u)
@@ -659,8 +662,7 @@ class Pixels:
                  list(zip(it[3][0::2], it[3][1::2], strict=True)) for it in shapes]
         r = [it[5] if it[0] == "circle" else it[7] if it[0] == "seg" else it[4]
              for it in shapes]
-        set_ = Shapes.of([it[0] for it in shapes], list(range(len(shapes))),
-                         [it[1] for it in shapes], [it[2] for it in shapes], local, r)
+        set_ = Shapes.of([(it[0], j, it[1], it[2]) for j, it in enumerate(shapes)], local, r)
         pose = np.array([(it[3], it[4], it[6]) if it[0] == "circle" else (0.0, 0.0, 0.0)
                          for it in shapes], dtype=float).reshape(-1, 3)
         return cls(set_, pose, extras, view, u)
@@ -1241,18 +1243,7 @@ class Painter(Backdrop):
     def _bars(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
         """Draw again the bars (with their values) that changed; the boxes touched."""
         values = {n: float(self.e[n][k]) for n in self.names}
-        spans = []
-        for name, top, bot in self.rows:
-            v = values[name]
-            if not math.isfinite(v):
-                spans.append((None, self.scale.text(v)))
-                continue
-            a, b = sorted((round(self.bar_px(0.0)), round(self.bar_px(v))))
-            h = b
-            if name == "E" and self.rec.heat and values["heat"] > 0:
-                # E + heat: what E was, were no energy lost to the contacts.
-                h = max(b, round(self.bar_px(v + values["heat"])))
-            spans.append(((a, b, h), self.scale.text(v)))
+        spans = self._spans(values)
         bands = self._band_of
         shown = self._shown.get("bars") or [None] * len(spans)
         redo = sorted({bands[j] for j, span in enumerate(spans) if span != shown[j]})
@@ -1266,8 +1257,7 @@ class Painter(Backdrop):
             box = (self.bar_left - 1, band[0], self.W, band[1])
             self._restore(box)
             boxes.append(box)
-            rows = [j for j, b in enumerate(bands) if b == band]
-            for j in rows:
+            for j in (j for j, b in enumerate(bands) if b == band):
                 name, top, bot = self.rows[j]
                 extent, text = spans[j]
                 if extent is not None:
@@ -1282,6 +1272,23 @@ class Painter(Backdrop):
                 draw_values(self.patch(img, self._values_box(), 1), self.rows,
                             lambda name: self.scale.text(values[name]), bx1, self.st_text)
         return boxes
+
+    def _spans(self, values: dict[str, float]) -> list[tuple[tuple[int, int, int] | None, str]]:
+        """Each bar's pixels (its start, its end, the end of E + heat; None when its value is
+        not finite) and its value's text."""
+        spans: list[tuple[tuple[int, int, int] | None, str]] = []
+        for name, _, _ in self.rows:
+            v = values[name]
+            if not math.isfinite(v):
+                spans.append((None, self.scale.text(v)))
+                continue
+            a, b = sorted((round(self.bar_px(0.0)), round(self.bar_px(v))))
+            h = b
+            if name == "E" and self.rec.heat and values["heat"] > 0:
+                # E + heat: what E was, were no energy lost to the contacts.
+                h = max(b, round(self.bar_px(v + values["heat"])))
+            spans.append(((a, b, h), self.scale.text(v)))
+        return spans
 
     def _cursor(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
         """Move the strip's cursor if it moved; the boxes touched."""

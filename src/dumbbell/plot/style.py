@@ -87,10 +87,12 @@ def _figure(**kwargs: Any) -> Any:
     return fig
 
 
-def _subplots(nrows: int = 1, ncols: int = 1, *, sharex: bool | str = False,
-              sharey: bool | str = False, squeeze: bool = True,
-              gridspec_kw: dict[str, Any] | None = None, **fig_kw: Any) -> tuple[Any, Any]:
+#: The keywords of ``pyplot.subplots`` that go to ``Figure.subplots`` (the rest make the figure).
+_GRID_KEYWORDS = ("sharex", "sharey", "squeeze", "gridspec_kw")
+
+
+def _subplots(nrows: int = 1, ncols: int = 1, **kw: Any) -> tuple[Any, Any]:
     """``pyplot.subplots`` by way of :func:`_figure`: the figure and its grid of axes."""
-    fig = _figure(**fig_kw)
-    return fig, fig.subplots(nrows, ncols, sharex=sharex, sharey=sharey, squeeze=squeeze,
-                             gridspec_kw=gridspec_kw)
+    grid = {k: kw.pop(k) for k in _GRID_KEYWORDS if k in kw}
+    fig = _figure(**kw)
+    return fig, fig.subplots(nrows, ncols, **grid)

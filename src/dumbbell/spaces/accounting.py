@@ -412,12 +412,12 @@ def evaluate(inv: Inventory, st: State, about: tuple[float, float] = (0.0, 0.0)
 class _Sampler:
     """The energy terms of one space, sampled many times cheaply (the recorder's energy
     panel, one sample per frame). :meth:`sample` reads every tracked body's state at once and
-    keeps it; the :func:`_inventory` is taken again only when something it holds changes:
+    keeps it; the :func:`inventory` is taken again only when something it holds changes:
     the space's bodies or constraints, a body's type, mass, moment or centre of gravity,
     gravity, a spring's anchors, rest length or angle, stiffness or force function (read in
     bulk from pymunk's structs; on a pymunk build whose structs cannot be read, every sample
     takes the inventory again). :meth:`terms` evaluates all samples at once with
-    :func:`_evaluate`: at each sample the numbers :func:`energy` gives. A sample whose state
+    :func:`evaluate`: at each sample the numbers :func:`energy` gives. A sample whose state
     is not finite is refused as :func:`energy` refuses it."""
 
     #: Body fields read per sample: the fingerprint (type, mass, moment, centre of gravity),
@@ -456,7 +456,7 @@ class _Sampler:
         from . import _memory as mem
 
         space = self.space
-        inv = _inventory(space)
+        inv = inventory(space)
         self.inventories.append(inv)
         self._bodies, self._constraints = list(space.bodies), list(space.constraints)
         self._gravity = tuple(space.gravity)
@@ -533,7 +533,7 @@ class _Sampler:
         self.samples.pop()
 
     def terms(self, about: tuple[float, float] = (0.0, 0.0)) -> dict[str, np.ndarray]:
-        """K_trans, K_rot, U_g, U_spring and E (and the other sums :func:`_evaluate` gives)
+        """K_trans, K_rot, U_g, U_spring and E (and the other sums :func:`evaluate` gives)
         at every sample, in order (arrays of one value per sample)."""
         names = ("K_trans", "K_rot", "K_cm", "K_int", "U_g", "U_spring", "E")
         out = {k: np.zeros(len(self.samples)) for k in names}
@@ -542,7 +542,7 @@ class _Sampler:
             rows = np.flatnonzero(which == i)
             stacked = np.stack([self.samples[r][1] for r in rows.tolist()])
             st = State(*(np.ascontiguousarray(stacked[:, j]) for j in range(6)))
-            terms = _evaluate(self.inventories[i], st, about)
+            terms = evaluate(self.inventories[i], st, about)
             for k in names:
                 out[k][rows] = terms[k]
         return out

@@ -193,8 +193,7 @@ class _Geometry:
 
         def subset(want: bool) -> Any:
             idx = [i for i, r in enumerate(rows) if static[r] == want]
-            return Shapes.of([kinds[i] for i in idx], [rows[i] for i in idx],
-                             [tags[rows[i]][0] for i in idx], [tags[rows[i]][1] for i in idx],
+            return Shapes.of([(kinds[i], rows[i], *tags[rows[i]]) for i in idx],
                              [local[i] for i in idx], [radii[i] for i in idx])
 
         self.moving, self.static = subset(False), subset(True)
@@ -459,19 +458,7 @@ class Recorder:
         self.title = args.text(title, "title", "a str (written at the top)")
         self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
-        # Per frame: its set of moving shapes (an index into shape_sets), its bodies' poses,
-        # its constraints' primitives, its static set (an index into statics), its time.
-        self.shape_sets: list[Any] = []
-        self.shape_of: list[int] = []
-        self.poses: list[np.ndarray] = []
-        self.extras: list[tuple[tuple, ...]] = []
-        self.statics: list[tuple[tuple, ...]] = []
-        self.static_of: list[int] = []
-        self.t: list[float] = []
-        self.follow: list[tuple[float, float]] = []
-        self.heat_total: list[float] = []
-        self._geometry: Any = None
-        self._static_pose: np.ndarray | None = None
+        self._no_frames()
         if self.energy:
             from .accounting import _Sampler
 
@@ -484,6 +471,22 @@ class Recorder:
         self._captured = False
         self._clock = (self.t0, 0)  # (the last time given, frames since)
         self._keep(self.t0)
+
+    def _no_frames(self) -> None:
+        """What the frames keep, empty. Per frame: its set of moving shapes (an index into
+        shape_sets), its bodies' poses, its constraints' primitives, its static set (an index
+        into statics), its time, the followed point, the heat so far."""
+        self.shape_sets: list[Any] = []
+        self.shape_of: list[int] = []
+        self.poses: list[np.ndarray] = []
+        self.extras: list[tuple[tuple, ...]] = []
+        self.statics: list[tuple[tuple, ...]] = []
+        self.static_of: list[int] = []
+        self.t: list[float] = []
+        self.follow: list[tuple[float, float]] = []
+        self.heat_total: list[float] = []
+        self._geometry: Any = None
+        self._static_pose: np.ndarray | None = None
 
     def __enter__(self) -> Self:
         return self
