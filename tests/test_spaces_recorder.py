@@ -694,3 +694,27 @@ def test_comparing_only_where_a_frame_drew_gives_the_same_file(tmp_path, monkeyp
     monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
     recording.write(tmp_path / "b.gif", rec.recording())
     assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+
+
+def test_a_recording_imports_neither_the_figures_nor_matplotlib(tmp_path):
+    # The recorder draws with Pillow alone: a script that records a space (energy panel on)
+    # loads neither dumbbell.plot (and the analyses it draws) nor matplotlib, nor numba's
+    # solvers.
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, pymunk\n"
+        "from dumbbell import spaces\n"
+        "s = pymunk.Space(); s.gravity = (0, -9.8)\n"
+        "b = pymunk.Body(1, 1); b.position = (0, 1); s.add(b, pymunk.Circle(b, 0.1))\n"
+        f"with spaces.Recorder(s, {str(tmp_path / 'a.gif')!r}) as rec:\n"
+        "    for _ in range(3):\n"
+        "        s.step(0.04); rec.capture()\n"
+        "print(' '.join(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'\n"
+        "      or m.startswith(('dumbbell.plot', 'dumbbell.analysis', 'dumbbell.solvers')))))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert (tmp_path / "a.gif").stat().st_size > 0
+    assert out.stdout.split() == []

@@ -12,7 +12,7 @@ from functools import lru_cache
 
 from PIL import Image
 
-from ..plot.style import COLOURS
+from ..colours import COLOURS
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []

@@ -791,7 +791,12 @@ class _Pen:
         self._lines(c, out, self.width, closed=True)
 
     def _shifted(self, pts: list[int], ox: int, oy: int) -> list[int]:
-        return [v - (ox if i % 2 == 0 else oy) for i, v in enumerate(pts)]
+        if not (ox or oy):
+            return pts
+        out = pts[:]
+        out[0::2] = [v - ox for v in pts[0::2]]
+        out[1::2] = [v - oy for v in pts[1::2]]
+        return out
 
     def spring(self, px: tuple, ox: int, oy: int) -> None:
         self._lines(self._shifted(px[1], ox, oy), self.spring_ink, self.width)
@@ -843,7 +848,10 @@ class _FlatPen:
         self.core.draw_lines([*c, c[0], c[1]], out, 1)
 
     def _halved(self, pts: list[int], ox: int, oy: int) -> list[int]:
-        return [(v - (ox if i % 2 == 0 else oy) + 1) // SS for i, v in enumerate(pts)]
+        out = pts[:]
+        out[0::2] = [(v - ox + 1) // SS for v in pts[0::2]]
+        out[1::2] = [(v - oy + 1) // SS for v in pts[1::2]]
+        return out
 
     def spring(self, px: tuple, ox: int, oy: int) -> None:
         self.core.draw_lines(self._halved(px[1], ox, oy), self.spring_ink, 1)

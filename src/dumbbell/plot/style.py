@@ -1,4 +1,5 @@
-"""The one place colours, labels and line styles are defined, for figures and animations.
+"""The one place colours, labels and line styles are defined, for figures and animations
+(the particles' and energy terms' colours in :mod:`dumbbell.colours`, re-exported here).
 
 Also :func:`pyplot`, the lazy import of matplotlib's pyplot, and how the package's figures are
 made (:func:`_figure`, :func:`_subplots`): through pyplot, so that a notebook shows them and
@@ -12,13 +13,13 @@ from __future__ import annotations
 
 from typing import Any
 
+# Colour of each particle, the centre of mass and each energy term: defined apart, because the
+# animations' palette is built from them without importing this package.
+from ..colours import COLOURS  # noqa: F401  (re-exported)
+
 #: No public names: the colours every figure shares.
 __all__: list[str] = []
 
-#: Colour of each particle, the centre of mass and each energy term.
-COLOURS = {"A": "#1f77b4", "B": "#d62728", "cm": "black", "K_cm": "#1f77b4", "K_int": "#d62728",
-           "K_rot": "#2ca02c", "K_vib": "#d62728", "K_spin": "#9467bd", "U_g": "#8c564b",
-           "U_spring": "#e6a700", "E": "black", "E_lost": "#7f7f7f"}
 #: Colour of the angular momentum L_cm (kept out of COLOURS: the GIF's palette is built from
 #: those, and L_cm is text there, drawn in ink).
 MOMENTUM_COLOUR = "#17becf"

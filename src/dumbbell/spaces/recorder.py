@@ -247,7 +247,9 @@ def _constraint_items(space: Any, number_of: Any) -> list[tuple]:
     items: list[tuple] = []
     for c in space.constraints:
         a, b = c.a, c.b
-        tag = number_of(b) if number_of(b) >= 0 else number_of(a)
+        tag = number_of(b)
+        if tag < 0:
+            tag = number_of(a)
         if isinstance(c, pymunk.DampedSpring):
             pa, pb = a.local_to_world(c.anchor_a), b.local_to_world(c.anchor_b)
             items.append(("spring", -1, tag, pa.x, pa.y, pb.x, pb.y))
