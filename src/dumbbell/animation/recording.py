@@ -590,18 +590,24 @@ def extra_pixels(items: tuple[tuple, ...] | list[tuple], view: View, u: float
                     (it[3], it[4], it[3], it[4]) for it in items], dtype=float)
     whole = _to_pixels(pts.reshape(m, 2, 2), view)
     ends = whole.reshape(m, 4).tolist()
-    springs = [j for j, it in enumerate(items) if it[0] == "spring"]
-    coils = dict(zip(springs, _zigzags(whole[springs], u).tolist(), strict=True))
-    for j, (it, (ax, ay, bx, by)) in enumerate(zip(items, ends, strict=True)):
+    # Springs and lines, the many: their points and boxes all at once.
+    for kind, flat in (("spring", lambda w: _zigzags(w, u)),
+                       ("line", lambda w: w.reshape(len(w), 4))):
+        at = [j for j, it in enumerate(items) if it[0] == kind]
+        if not at:
+            continue
+        xy_all = flat(whole[at])
+        lo = np.stack([xy_all[:, 0::2].min(axis=1), xy_all[:, 1::2].min(axis=1)], axis=1)
+        hi = np.stack([xy_all[:, 0::2].max(axis=1), xy_all[:, 1::2].max(axis=1)], axis=1)
+        boxes[at] = np.concatenate([(lo - line) / S - 1, (hi + line) / S + 1], axis=1)
+        for j, xy in zip(at, xy_all.tolist(), strict=True):
+            out[j] = (kind, xy)
+    for j, (it, (ax, ay, _, _)) in enumerate(zip(items, ends, strict=True)):
         kind = it[0]
         room = line
-        if kind == "line":
-            xy = [ax, ay, bx, by]
-            px: tuple = ("line", xy)
-        elif kind == "spring":
-            xy = coils[j]
-            px = ("spring", xy)
-        elif kind == "dot":
+        if kind in ("spring", "line"):
+            continue
+        if kind == "dot":
             xy = [ax, ay]
             room = round(3 * u * S)
             px = ("dot", ax, ay, room)
