@@ -47,6 +47,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
+from .accounting import settings_problem
 from .estimates import Estimates, estimate, length_unit, state_problem
 
 __all__ = ["Driver", "Finding", "check", "energy_swing", "report", "shape_size",
@@ -373,7 +374,7 @@ class _Advice:
 def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
     """Every check at ``dt`` and the sub-steps that clear the ones a step can clear."""
     sc = scan(space)
-    problem = state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc)
     if problem is not None:
         who, what, value = problem
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
