@@ -170,3 +170,24 @@ def test_a_finite_space_still_counts():
     e = spaces.energy(s)
     # two 1 kg balls at height 1 m, at rest, the spring stretched by 0.2 m
     assert e.E == pytest.approx(2 * 9.81 * 1.0 + 0.5 * 50.0 * 0.2 ** 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("how", ["no shapes' mass", "mass 0 set"])
+def test_stepping_a_body_pymunk_cannot_step_is_a_dumbbell_error(how):
+    """spaces.step and Driver.step on a dynamic body of mass 0 let pymunk's AssertionError
+    out; they name the body instead, and step nothing."""
+    from dumbbell import DumbbellError, spaces
+
+    s = _space()
+    body = pymunk.Body()
+    shape = pymunk.Circle(body, 0.1)
+    if how == "mass 0 set":
+        shape.mass = 0
+    s.add(body, shape)
+    before = [tuple(b.position) for b in s.bodies]
+    for call in (lambda: spaces.step(s, 1 / 60, 4),
+                 lambda: spaces.Driver(s, 1 / 60, substeps=4).step(2)):
+        with pytest.raises(DumbbellError, match=r"space: .*mass") as info:
+            call()
+        assert len(str(info.value).splitlines()) == 1
+    assert [tuple(b.position) for b in s.bodies] == before

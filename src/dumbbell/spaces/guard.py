@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -505,8 +506,24 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
     args.space(space)
     substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
     h = args.real(dt, "dt", "s") / substeps
-    for _ in range(substeps):
-        space.step(h)
+    _stepped(space, h, substeps)
+
+
+def _stepped(space: Any, h: float, count: int) -> None:
+    """``count`` steps of ``h`` (s); pymunk's refusal of a body it cannot step (an
+    AssertionError raised before it steps anything: a dynamic body of mass 0) as a
+    UsageError naming the space."""
+    step_ = space.step
+    try:
+        for _ in range(count):
+            step_(h)
+    except AssertionError as exc:
+        import traceback
+
+        if not traceback.extract_tb(exc.__traceback__)[-1].filename.endswith(
+                os.path.join("pymunk", "space.py")):
+            raise  # a callback's own assertion is the user's
+        raise UsageError(f"space: {' '.join(str(exc).split())}", param="space") from None
 
 
 class Driver:
@@ -531,9 +548,6 @@ class Driver:
     def step(self, frames: int = 1) -> None:
         """Advance ``frames`` frames."""
         frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)
-        step_ = self.space.step
-        h = self.h
-        for _ in range(frames * self.substeps):
-            step_(h)
+        _stepped(self.space, self.h, frames * self.substeps)
         self.frames += frames
 
