@@ -59,6 +59,15 @@ class Parser(argparse.ArgumentParser):
                          + "\n")
         sys.exit(EXIT_USAGE)
 
+    def _get_value(self, action: argparse.Action, arg_string: str) -> Any:
+        """A flag's value; an empty one (`-o ''`, `--out ''`, `--size ''`) is refused for
+        every flag that takes a word: taken as 'not given', it wrote to standard output, into
+        the working folder or with the scene's size instead of what the user asked for."""
+        if arg_string == "" and action.option_strings and action.type is None:
+            what = action.metavar if isinstance(action.metavar, str) else "value"
+            raise argparse.ArgumentError(action, f"'': must be a {what}, not empty")
+        return super()._get_value(action, arg_string)
+
 
 def _shown(text: str) -> str:
     """A flag's value for an error message: quoted, one line, at most 40 characters."""

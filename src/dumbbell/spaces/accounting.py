@@ -222,6 +222,76 @@ def check_finite(space: Any) -> None:
                      [b.moment if d else 1.0 for b, d in zip(bodies, dyn, strict=True)])
 
 
+def settings_problem(space: Any) -> tuple[str, str, float] | None:
+    """The first setting of ``space`` that enters its energy and is not a finite number:
+    (subject, what is wrong, the value), or None. ``space.gravity``, and each spring's
+    stiffness, damping, rest length (rest angle) and anchors: with one of them NaN or
+    infinite every energy would be NaN, and the guard's frequencies and steps too."""
+    import pymunk
+
+    def bad(values: Any) -> float | None:
+        return next((float(v) for v in values if not math.isfinite(v)), None)
+
+    g = tuple(space.gravity)
+    if (value := bad(g)) is not None:
+        return "space.gravity", f"gravity = {_shown(g)}{_NO_STEP}", value
+    kinds = (pymunk.DampedSpring, pymunk.DampedRotarySpring)
+    for j, c in enumerate(x for x in space.constraints if isinstance(x, kinds)):
+        rotary = isinstance(c, pymunk.DampedRotarySpring)
+        fields = (("rest_angle",) if rotary else ("rest_length", "anchor_a", "anchor_b")) + \
+            ("stiffness", "damping")
+        for name in fields:
+            v = getattr(c, name)
+            values = tuple(v) if name.startswith("anchor") else (v,)
+            if (value := bad(values)) is not None:
+                who = f"{type(c).__name__} {j}"
+                return who, f"{name} = {_shown(values)}{_NO_STEP}", value
+    return None
+
+
+#: What a setting that is not finite means, after its name and value.
+_NO_STEP = (" is not a finite number: every energy would be NaN and no step fixes it; set it to "
+            "a finite number")
+
+
+def _shown(values: tuple[float, ...]) -> str:
+    return f"({values[0]:g}, {values[1]:g})" if len(values) == 2 else f"{values[0]:g}"
+
+
+def refuse_settings(space: Any) -> None:
+    """Raise a :class:`~dumbbell.errors.DumbbellError` naming the first setting of ``space``
+    that is not finite (:func:`settings_problem`)."""
+    from ..errors import DumbbellError
+
+    problem = settings_problem(space)
+    if problem is not None:
+        raise DumbbellError(f"space: {problem[0]}: {problem[1]}")
+
+
+def refuse_overflow(labels: list[str], terms: dict[str, np.ndarray], st: State) -> None:
+    """Raise a :class:`~dumbbell.errors.DumbbellError` naming the first body whose kinetic
+    or gravitational energy is past the floats (a body at 1e300 m/s: 1/2 m v^2 = inf), when
+    the total ``E`` of ``terms`` is not finite."""
+    from ..errors import DumbbellError
+    from ..model import args
+
+    if np.isfinite(terms["E"]).all():
+        return
+    for name, values in (("velocity", ("body_K_trans", st.vx, st.vy)),
+                         ("angular_velocity", ("body_K_rot", st.omega)),
+                         ("position", ("body_U_g", st.x, st.y))):
+        column = terms[values[0]][0]
+        for i in np.flatnonzero(~np.isfinite(column[:len(labels)])):
+            i = int(i)
+            shown = tuple(float(a[0, i]) for a in values[1:])
+            raise DumbbellError(f"{labels[i]}: {name} = "
+                                f"{args.show(shown[0] if len(shown) == 1 else shown)}: its "
+                                "energy overflows a float (is past 1.8e308 J); no number can "
+                                "report it")
+    raise DumbbellError("space: its energy overflows a float (is past 1.8e308 J): its springs "
+                        "or bodies are too far apart or too fast")
+
+
 def refuse_bad_state(labels: list[str], st: State, mass: Any, moment: Any) -> None:
     """Raise a :class:`~dumbbell.errors.DumbbellError` naming the first body (``labels``, in
     the order of the state's columns) whose state is not finite, or whose mass or moment
@@ -616,7 +686,10 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
     st = read_state(inv)
     n = inv.dynamic
     refuse_bad_state(list(inv.labels[:n]), st, inv.mass, inv.moment)
-    terms = evaluate(inv, st, (ox, oy))
+    refuse_settings(space)
+    with np.errstate(over="ignore", invalid="ignore"):
+        terms = evaluate(inv, st, (ox, oy))
+    refuse_overflow(list(inv.labels[:n]), terms, st)
 
     def f(name: str) -> float:
         return float(terms[name][0])

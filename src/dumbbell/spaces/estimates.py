@@ -63,6 +63,7 @@ from ..errors import UsageError
 from ..model import args
 from ..model.energy import rotational_ke, spring_potential, translational_ke
 from ._scan import DYNAMIC, KINEMATIC, Scan, scan, world_outline
+from .accounting import settings_problem
 
 __all__ = ["Reach", "reach"]
 
@@ -105,7 +106,7 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     dt = args.real(dt, "dt", "s")
     unit = length_unit(units)
     sc = scan(space)
-    problem = state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc)
     if problem is not None:
         raise UsageError(f"space: {problem[0]}: {problem[1]}", param="space")
     est = estimate(sc, dt, unit)

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -47,6 +48,7 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
+from .accounting import settings_problem
 from .estimates import Estimates, estimate, length_unit, state_problem
 
 __all__ = ["Driver", "Finding", "check", "energy_swing", "report", "shape_size",
@@ -373,7 +375,7 @@ class _Advice:
 def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
     """Every check at ``dt`` and the sub-steps that clear the ones a step can clear."""
     sc = scan(space)
-    problem = state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc)
     if problem is not None:
         who, what, value = problem
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
@@ -504,8 +506,24 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
     args.space(space)
     substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
     h = args.real(dt, "dt", "s") / substeps
-    for _ in range(substeps):
-        space.step(h)
+    _stepped(space, h, substeps)
+
+
+def _stepped(space: Any, h: float, count: int) -> None:
+    """``count`` steps of ``h`` (s); pymunk's refusal of a body it cannot step (an
+    AssertionError raised before it steps anything: a dynamic body of mass 0) as a
+    UsageError naming the space."""
+    step_ = space.step
+    try:
+        for _ in range(count):
+            step_(h)
+    except AssertionError as exc:
+        import traceback
+
+        if not traceback.extract_tb(exc.__traceback__)[-1].filename.endswith(
+                os.path.join("pymunk", "space.py")):
+            raise  # a callback's own assertion is the user's
+        raise UsageError(f"space: {' '.join(str(exc).split())}", param="space") from None
 
 
 class Driver:
@@ -530,9 +548,6 @@ class Driver:
     def step(self, frames: int = 1) -> None:
         """Advance ``frames`` frames."""
         frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)
-        step_ = self.space.step
-        h = self.h
-        for _ in range(frames * self.substeps):
-            step_(h)
+        _stepped(self.space, self.h, frames * self.substeps)
         self.frames += frames
 

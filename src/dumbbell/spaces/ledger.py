@@ -533,9 +533,10 @@ class Ledger:
         if getattr(space, "_locked", False):
             raise UsageError("space: attach the ledger between steps, not from a callback",
                              param="space")
-        from .accounting import check_finite
+        from .accounting import check_finite, energy
 
         check_finite(space)
+        energy(space)  # refuses settings that are not finite and energies past the floats
         if not mem.readable():
             import pymunk
 

@@ -462,8 +462,9 @@ class Recorder:
         self.options = draw_options()
         self._no_frames()
         if self.energy:
-            from .accounting import _Sampler
+            from .accounting import _Sampler, refuse_settings
 
+            refuse_settings(self.space)
             self._sampler = _Sampler(self.space)
         self.timing: dict[str, float] = {}
         #: The world box shown (left, right, bottom, top, y up) once the file is written.
