@@ -191,3 +191,48 @@ def test_stepping_a_body_pymunk_cannot_step_is_a_dumbbell_error(how):
             call()
         assert len(str(info.value).splitlines()) == 1
     assert [tuple(b.position) for b in s.bodies] == before
+
+
+def _shape_space(kind, bad):
+    import pymunk
+
+    s = pymunk.Space()
+    s.gravity = (0.0, -9.81)
+    s.add(pymunk.Segment(s.static_body, (-5, 0), (5, 0), 0.05))
+    b = pymunk.Body(2.0, 3.0)
+    b.position, b.velocity = (0.5, 1.5), (0.25, -1.0)
+    shape = {"radius": lambda: pymunk.Circle(b, bad),
+             "offset": lambda: pymunk.Circle(b, 0.1, (bad, 0.0)),
+             "end": lambda: pymunk.Segment(b, (0.0, 0.0), (0.0, bad), 0.02),
+             "seg-radius": lambda: pymunk.Segment(b, (0.0, 0.0), (0.3, 0.0), bad)}[kind]()
+    s.add(b, shape)
+    return s
+
+
+@pytest.mark.parametrize("bad", NONFINITE, ids=["nan", "inf", "-inf"])
+@pytest.mark.parametrize("kind", ["radius", "offset", "end", "seg-radius"])
+def test_a_shape_that_is_not_finite_is_named_by_the_guard(kind, bad):
+    """A Circle of radius nan gave `tunnelling at up to nan units/s` (or a Reach of now =
+    nan), one of radius inf a numpy warning: the guard names the shape and its field as a
+    state no step fixes. The energy does not depend on the shapes and still counts, to the
+    hand computation: 1/2 m v^2 + 1/2 I w^2 + m g y."""
+    import warnings
+
+    from dumbbell import DumbbellError, spaces
+
+    word = {"radius": "radius", "offset": "offset", "end": "b =", "seg-radius": "radius"}[kind]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        space = _shape_space(kind, bad)
+        found = [f for f in spaces.check(space, 1 / 60) if f.kind == "state"]
+        assert found and "shape 1" in found[0].subject and word in found[0].fix, found
+        assert "no step fixes it" in found[0].fix
+        text = spaces.report(space, 1 / 60)
+        assert "shape 1" in text and "nan units" not in text
+        for call in (lambda: spaces.suggest_dt(space, 1 / 60),
+                     lambda: spaces.Driver(space, 1 / 60),
+                     lambda: spaces.reach(space, 1 / 60)):
+            with pytest.raises(DumbbellError, match="shape 1"):
+                call()
+        e = spaces.energy(space)
+    assert e.E == pytest.approx(0.5 * 2.0 * (0.25**2 + 1.0) + 2.0 * 9.81 * 1.5, rel=1e-12)

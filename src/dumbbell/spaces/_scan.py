@@ -148,7 +148,14 @@ def _motion(space: Any, bodies: list[Any]) -> np.ndarray:
 
 
 def scan(space: Any) -> Scan:
-    """Read ``space`` (a pymunk.Space, already checked) into a :class:`Scan`."""
+    """Read ``space`` (a pymunk.Space, already checked) into a :class:`Scan`. Numbers that
+    are not finite (an angle of inf, a radius of nan) pass through quietly, as NaN or inf:
+    :func:`~dumbbell.spaces.estimates.state_problem` names them."""
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        return _scan(space)
+
+
+def _scan(space: Any) -> Scan:
     bodies = list(space.bodies)
     in_space = len(bodies)
     shapes = list(space.shapes)
@@ -224,6 +231,10 @@ def _shapes(shapes: list[Any], owner: np.ndarray, cog: np.ndarray,
         radius[j] = r
         points.append(pts)
         reach[j] = max(math.hypot(x - c[0], y - c[1]) for x, y in pts) + r
+        if not (math.isfinite(r) and all(math.isfinite(v) for p in pts for v in p)):
+            # Geometry that is not a number (max() can pass over a NaN): nan marks the
+            # shape for :func:`~dumbbell.spaces.estimates.state_problem`.
+            reach[j] = size[j] = math.nan
     for count, idx in polys.items():
         v = np.array([points[j] for j in idx], dtype=float).reshape(-1, count, 2)
         size[idx] = _poly_width(v) + 2.0 * radius[idx]

@@ -133,7 +133,8 @@ def state_problem(sc: Scan) -> tuple[str, str, float] | None:
     """The first body whose state no step can fix: (subject, what is wrong, the value), or
     None. A position, angle, velocity or spin that is not finite (pymunk carries a NaN on
     forever), or a dynamic body whose mass or moment is not a number > 0 and < inf (pymunk
-    refuses to step it)."""
+    refuses to step it); then the first shape whose geometry (radius, offset, ends,
+    vertices) is not finite."""
     motion = np.column_stack([sc.pos, sc.angle, sc.v, sc.w])
     bad = ~np.isfinite(motion).all(axis=1)
     dyn = sc.kind == DYNAMIC
@@ -160,7 +161,28 @@ def state_problem(sc: Scan) -> tuple[str, str, float] | None:
                 "< inf and a moment > 0 (give its shapes a mass or density, or set "
                 f"body.{what})")
         return who, text, value
+    for j in np.flatnonzero(np.isnan(sc.reach)):
+        shape = sc.shapes[int(j)]
+        name, vals = _bad_geometry(shape)
+        shown = f"({vals[0]:g}, {vals[1]:g})" if len(vals) == 2 else f"{vals[0]:g}"
+        who = f"shape {int(j)} ({type(shape).__name__} on {sc.label(int(sc.owner[j]))})"
+        what = (f"{name} = {shown} is not a finite number: no step fixes it (its contacts and "
+                "sizes would be NaN); give the shape finite geometry")
+        return who, what, float(next(x for x in vals if not math.isfinite(x)))
     return None
+
+
+def _bad_geometry(shape: Any) -> tuple[str, tuple[float, ...]]:
+    """The first number of ``shape``'s geometry that is not finite: (its name, its value as a
+    tuple of one or two numbers)."""
+    fields = [("radius", (float(shape.radius),))]
+    for name in ("offset", "a", "b"):
+        if hasattr(shape, name):
+            fields.append((name, tuple(getattr(shape, name))))
+    if hasattr(shape, "get_vertices"):
+        fields += [(f"vertex {k}", tuple(v)) for k, v in enumerate(shape.get_vertices())]
+    return next(((n, v) for n, v in fields if not all(math.isfinite(x) for x in v)),
+                ("geometry", (math.nan,)))
 
 
 # --- the estimate ----------------------------------------------------------------------------
