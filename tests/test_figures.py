@@ -140,3 +140,28 @@ def test_the_energy_figure_of_a_1d_scene(runs):
     from dumbbell import plot
 
     assert_fit(plot.energy(runs("textbook-1d", 2.0)).figure)
+
+
+def test_the_rotation_preview_keeps_every_curve_inside_its_panel():
+    """The panels share one energy scale; over the notebook's 1 s window the rigid panel's K_cm
+    (1.96 J just before the first impact: M g times the centre of mass's 1 m drop) peaks above
+    every run's internal energy, and the scale must still hold it (it was cut off at 1.88 J)."""
+    import numpy as np
+
+    from dumbbell import plot
+    from dumbbell.analysis.rotation import series
+
+    preview = series(load_scene(SCENES / "tilted-2d.toml"), solver="verlet", t_end=1.0)
+    fig = plot.rotation(preview).figure
+    energy_panels = [ax for ax in fig.axes if ax.get_ylabel() == "E [J]"]
+    assert len(energy_panels) == len(preview.runs)
+    for ax in energy_panels:
+        bottom, top = ax.get_ylim()
+        for line in ax.get_lines():
+            y = np.asarray(line.get_ydata(), float)
+            assert bottom <= y.min() and y.max() <= top, (ax.get_title(), line.get_label())
+    rigid = preview.runs["rigid"]
+    # M g h: 0.2 kg x 9.8 m/s² x 1 m of free fall before the first impact, to within what one
+    # sample (0.2 ms) before it misses: M g v dt_sample = 0.2 x 9.8 x 4.43 x 2e-4 = 1.7e-3 J.
+    assert abs(float(np.max(rigid["K_cm"])) - 0.2 * 9.8 * 1.0) < 2e-3
+    assert_fit(fig)

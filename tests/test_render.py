@@ -318,3 +318,27 @@ def test_contact_checks_its_fields():
         Contact(0.4, 0.1, "B")
     with pytest.raises(UsageError, match="t_start"):
         Contact(float("nan"), 0.1, "B")
+
+
+@pytest.mark.parametrize("radius", [3.5, 8.0, 22.0])
+def test_a_2d_particle_letter_stays_off_both_particles_and_above_the_floor(radius):
+    """A dumbbell standing on the floor at every tilt from upright to lying (pixel rows grow
+    downwards): each letter's box keeps off both discs and stays above the floor. Before, B's
+    letter was pushed up from under the floor straight onto B when B was larger than the gap
+    (the toppling dumbbell: r = 22 px at 640x360)."""
+    from dumbbell.animation.world import letter_at
+
+    floor_y, length, half, u = 300.0, 200.0, (4.0, 4.5), 1.0
+    for deg in range(0, 91, 3):
+        th = math.radians(deg)
+        pb = (100.0, floor_y - radius)                       # B resting on the floor
+        pa = (pb[0] + length * math.sin(th), pb[1] - length * math.cos(th))
+        pc = ((pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2)
+        e = ((pa[0] - pb[0]) / length, (pa[1] - pb[1]) / length)
+        for p, other, sign in ((pa, pb, 1), (pb, pa, -1)):
+            x, y = letter_at(p, radius, other, pc, (sign * e[0], sign * e[1]), floor_y, half, u)
+            assert y + half[1] < floor_y, (deg, sign, y)
+            for centre in (pa, pb):
+                dx = max(abs(x - centre[0]) - half[0], 0.0)
+                dy = max(abs(y - centre[1]) - half[1], 0.0)
+                assert math.hypot(dx, dy) >= radius, (deg, sign, (x, y), centre)

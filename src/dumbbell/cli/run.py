@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="make the whole showcase, every file the repository tracks in "
                         "renders/: the scenes " + ", ".join(SHOWCASE) + ", then "
                         + "; ".join(p.command for p in PIECES if p.argv[0] != "run")
-                        + " (several minutes)")
+                        + " (about two minutes on 2 cores)")
     p.add_argument("--max-samples", type=positive_int("samples", 10**12), metavar="N",
                    default=MAX_SAMPLES,
                    help=f"refuse, before anything runs, a scene whose run would keep more than "

@@ -89,6 +89,9 @@ def rotation(s: Series, ax: Any = None) -> Any:
     top = max(float(np.max(r["K_rot"])) for r in s.runs.values())
     top = max(top, max(float(np.max(r["K_vib"] + r.energy.get("U_spring", 0.0)))
                        for r in s.runs.values()))
+    # The rigid panel draws K_cm too: over a short window (1 s) it peaks above every run's
+    # internal energy, and a shared scale without it would cut the parabola's top off.
+    top = max(top, float(np.max(rigid["K_cm"])))
     for panel, label in zip(axes, labels, strict=False):
         r = s.runs[label]
         note = (_rigid_panel(panel, r, rigid_mean) if label == "rigid"
