@@ -70,6 +70,8 @@ SHOWN = 6
 
 #: The relation a good value keeps to its limit, and the one a failing value shows.
 _FAILS = {"<": ">=", "<=": ">", ">=": "<"}
+#: What a kind's value is, where its number alone would not say.
+_QUANTITY = {"spring": "w dt = ", "rotary-spring": "w dt = ", "spring-network": "w dt = "}
 
 
 @dataclass(frozen=True)
@@ -109,7 +111,7 @@ class Finding:
         rel = self.relation if self.ok else _FAILS[self.relation]
         unit = f" {self.unit}" if self.unit else ""
         a, b = _distinct(self.value, self.limit, rel)
-        return f"{a}{unit} {rel} {b}{unit}"
+        return f"{_QUANTITY.get(self.kind, '')}{a}{unit} {rel} {b}{unit}"
 
     def __str__(self) -> str:
         shown = self.comparison()
@@ -489,10 +491,10 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     elif n is None:
         t = advice.tightest
         lines.append(f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
-                     f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of dt")
+                     f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of a step")
     elif n > 1:
         t = advice.tightest
-        lines.append(f"  suggested: {n} sub-steps of dt, dt = {dt / n:.4g} s, for {t.kind} of "
+        lines.append(f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
                      f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
     elif any(not f.ok for f in advice.rows):
         lines.append(f"  the step is fine; the failures are settings{swing}")
