@@ -489,6 +489,18 @@ def test_the_energy_panel_is_spaces_energy_at_every_frame_whatever_changes(tmp_p
     assert got["U_spring"][10] != got["U_spring"][9]  # the custom spring left U_spring
 
 
+def _record_adding_a_wall(space, path, frames, **kw):
+    """A recording of ``frames`` frames of ``space`` at 1/25 s (10 sub-steps each), a static
+    segment added before the fourth."""
+    with spaces.Recorder(space, path, **kw) as rec:
+        for k in range(frames):
+            if k == 3:
+                space.add(pymunk.Segment(space.static_body, (-1, 0.5), (-0.5, 0.7), 0.02))
+            spaces.step(space, 1 / 25, substeps=10)
+            rec.capture()
+    return rec
+
+
 def test_a_frame_drawn_in_parts_is_the_frame_drawn_whole(tmp_path, monkeypatch):
     # From frame to frame the painter draws again only what changed (the moving layer's
     # boxes, the label, a bar, the cursor), on the previous picture. Drawing every frame
@@ -507,12 +519,7 @@ def test_a_frame_drawn_in_parts_is_the_frame_drawn_whole(tmp_path, monkeypatch):
         thrown = pymunk.Body(0.2, pymunk.moment_for_circle(0.2, 0, 0.03))
         thrown.position, thrown.velocity = (0.0, 0.3), (6.0, 4.0)
         space.add(thrown, pymunk.Circle(thrown, 0.03))
-        with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
-            for k in range(30):
-                if k == 3:
-                    space.add(pymunk.Segment(space.static_body, (-1, 0.5), (-0.5, 0.7), 0.02))
-                spaces.step(space, 1 / 25, substeps=10)
-                rec.capture()
+        rec = _record_adding_a_wall(space, tmp_path / "a.gif", 30, **kw)
         with monkeypatch.context() as m:
             m.setattr(recording.Painter, "frame", from_nothing)
             recording.write(tmp_path / "b.gif", rec.recording())
@@ -685,12 +692,7 @@ def test_comparing_only_where_a_frame_drew_gives_the_same_file(tmp_path, monkeyp
     space = _space()
     if kw.get("camera") == "follow":
         kw = {"camera": next(b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC)}
-    with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
-        for k in range(12):
-            if k == 3:
-                space.add(pymunk.Segment(space.static_body, (-1, 0.5), (-0.5, 0.7), 0.02))
-            spaces.step(space, 1 / 25, substeps=10)
-            rec.capture()
+    rec = _record_adding_a_wall(space, tmp_path / "a.gif", 12, **kw)
     monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
     recording.write(tmp_path / "b.gif", rec.recording())
     assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
