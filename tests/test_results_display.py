@@ -141,3 +141,36 @@ def test_to_csv_writes_what_simulate_writes(textbook, tmp_path):
     rows = np.loadtxt(tmp_path / "api.csv", delimiter=",", skiprows=1)
     # E0 = (mA + mB) g x_cm + 0 (at rest, spring at rest length) = 0.2 * 9.8 * 1.1 = 2.156 J
     assert rows.shape == (501, 10) and math.isclose(rows[0, -1], 0.2 * 9.8 * 1.1, rel_tol=1e-15)
+
+
+def test_the_spaces_objects_say_what_they_hold_in_a_line(tmp_path):
+    # A notebook shows a counter, a driver, a recorder or a ledger by its repr: one line of
+    # at most 200 characters with what it holds now, never the default '<... object at 0x>'.
+    import pymunk
+
+    from dumbbell import spaces
+
+    s = pymunk.Space()
+    s.gravity = (0.0, -9.81)
+    b = pymunk.Body(2.0, 1.0)
+    b.position, b.velocity = (0.0, 1.0), (3.0, 0.0)
+    s.add(b, pymunk.Circle(b, 0.1))
+    heat, ledger = spaces.HeatCounter(s), spaces.Ledger(s)
+    driver = spaces.Driver(s, 1 / 50, substeps=2)
+    folder = tmp_path / ("x" * 120) / ("y" * 120)
+    folder.mkdir(parents=True)
+    rec = spaces.Recorder(s, folder / "a.gif")
+    driver.step(5)
+    rec.capture()
+    shown = {o: repr(o) for o in (heat, ledger, driver, rec)}
+    for text in shown.values():
+        assert "object at 0x" not in text and "\n" not in text and len(text) <= 200, text
+    assert shown[driver] == "Driver(dt=0.02 s, substeps=2, frames=5, t=0.1 s)"
+    # E0 = 1/2 m v^2 + m g y = 9 + 19.62 J, and E after 0.1 s of free flight is the same
+    # but for the step's error (pymunk's symplectic Euler: g dt^2 terms).
+    e0 = 0.5 * 2.0 * 9.0 + 2.0 * 9.81 * 1.0
+    assert f"E0={e0:.6g}" in shown[ledger] and "steps=10" in shown[ledger]
+    assert shown[heat] == "HeatCounter(attached, total=0)"
+    assert "frames=2" in shown[rec] and "..." in shown[rec]
+    heat.detach()
+    assert repr(heat).startswith("HeatCounter(detached")

@@ -547,6 +547,10 @@ class Driver:
         """Time stepped so far (s)."""
         return self.frames * self.dt
 
+    def __repr__(self) -> str:
+        return (f"Driver(dt={self.dt:.6g} s, substeps={self.substeps}, frames={self.frames}, "
+                f"t={self.t:.6g} s)")
+
     def step(self, frames: int = 1) -> None:
         """Advance ``frames`` frames."""
         frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)

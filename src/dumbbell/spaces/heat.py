@@ -75,6 +75,10 @@ class HeatCounter:
         d = self.space.__dict__.get(_KEY)
         return self.stopped is None and d is not None and self in d.counters
 
+    def __repr__(self) -> str:
+        state = "attached" if self.attached else (self.stopped or "not attached")
+        return f"HeatCounter({state}, total={self.total:.6g})"
+
     def detach(self) -> None:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are
         the ones it had before the first counter attached."""

@@ -671,6 +671,12 @@ class Ledger:
         self._Uref[2] = after["Ud"]
         self._E = after["E"]
 
+    def __repr__(self) -> str:
+        # What the ledger holds already: no accounting is run to show it.
+        state = "attached" if self.attached else "detached"
+        return (f"Ledger({state}, steps={self.steps}, t={self.t:.6g} s, "
+                f"E0={self._E0:.6g}, E={self._E:.6g}; balance() for the terms)")
+
     def balance(self) -> Balance:
         """The account from attaching until now (what the program changed since the last
         step counts as ``program``). Raises a :class:`~dumbbell.errors.DumbbellError` naming

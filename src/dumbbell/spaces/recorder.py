@@ -491,6 +491,12 @@ class Recorder:
         self._geometry: Any = None
         self._static_pose: np.ndarray | None = None
 
+    def __repr__(self) -> str:
+        from ..model import args
+
+        return (f"Recorder({args.show(str(self.path))}, {self.fps} fps, {self.W}x{self.H}, "
+                f"frames={self.frames}, energy={self.energy})")
+
     def __enter__(self) -> Self:
         return self
 
