@@ -701,7 +701,7 @@ def test_comparing_only_where_a_frame_drew_gives_the_same_file(tmp_path, monkeyp
 def test_a_recording_imports_neither_the_figures_nor_matplotlib(tmp_path):
     # The recorder draws with Pillow alone: a script that records a space (energy panel on)
     # loads neither dumbbell.plot (and the analyses it draws) nor matplotlib, nor numba's
-    # solvers.
+    # solvers, nor the scene reader and the trajectory's renderer.
     import subprocess
     import sys
 
@@ -714,7 +714,8 @@ def test_a_recording_imports_neither_the_figures_nor_matplotlib(tmp_path):
         "    for _ in range(3):\n"
         "        s.step(0.04); rec.capture()\n"
         "print(' '.join(sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'\n"
-        "      or m.startswith(('dumbbell.plot', 'dumbbell.analysis', 'dumbbell.solvers')))))\n"
+        "      or m.startswith(('dumbbell.plot', 'dumbbell.analysis', 'dumbbell.solvers',\n"
+        "                        'dumbbell.model.scene', 'dumbbell.animation.render')))))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)

@@ -8,11 +8,14 @@ mapping keeps the aspect ratio: 1 m is as long in x as in y.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..model.scene import Scene
 from .frames import Frames
+
+if TYPE_CHECKING:  # for the annotations only: a recording does not read scenes
+    from ..model.scene import Scene
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []

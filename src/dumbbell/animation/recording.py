@@ -70,8 +70,8 @@ from .palette import (
     palette,
     to_palette,
 )
-from .render import delays_cs
 from .strip import GRID
+from .timing import delays_cs
 from .world import LEAD
 
 #: No public names: the painter behind :class:`dumbbell.spaces.Recorder`.

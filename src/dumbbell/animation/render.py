@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import itertools
 import math
 import time
 from pathlib import Path
@@ -35,14 +34,13 @@ from ..errors import UsageError
 from ..io.files import atomic_output
 from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
+from .timing import check_fps, check_size, delays_cs
 
 if TYPE_CHECKING:
     from .frames import Frames
 
 __all__ = ["Gif", "render_gif"]
 
-#: Highest frame rate a GIF can show faithfully (delays of 10 ms or less are shown as 100 ms).
-MAX_FPS = 50
 #: Most frames an animation may have unless told otherwise (``max_frames``, ``--max-frames``):
 #: 10 minutes at 25 fps, about a minute of drawing per 1,000 frames on one core.
 MAX_FRAMES = 15_000
@@ -52,31 +50,6 @@ MAX_FRAMES = 15_000
 STRIP_RATE = 500.0
 #: Most samples kept for the strip over the whole animation (memory of very long runs).
 STRIP_SAMPLES = 200_000
-
-
-def check_fps(fps: Any, where: str = "fps") -> int:
-    """``fps`` as an int in 1..50, else a UsageError naming ``where`` and why."""
-    if isinstance(fps, bool) or not isinstance(fps, int | np.integer) or not 1 <= fps <= MAX_FPS:
-        raise UsageError(
-            f"{where} = {fps}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
-            "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)",
-            param=where.lstrip("-") if isinstance(where, str) else None)
-    return int(fps)
-
-
-def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, int]:
-    """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
-    from ..model.scene import SIZE_RULE, parse_size
-
-    if isinstance(size, tuple | list) and len(size) == 2:
-        size = f"{size[0]}x{size[1]}"
-    try:
-        return parse_size(size)
-    except ValueError:
-        from ..model import args
-
-        raise UsageError(f"{where}: {args.show(size)}: {SIZE_RULE}",
-                         param=where.lstrip("-") if isinstance(where, str) else None) from None
 
 
 def frame_count(t_end: float, fps: int) -> int:
@@ -112,15 +85,7 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
                                                "raise the budget ({max_frames})"))
 
 
-def delays_cs(n: int, fps: int) -> list[int]:
-    """Delay of each of ``n`` frames in GIF units (10 ms): frame k starts at
-    round(k * 100 / fps) units, so the animation keeps real time."""
-    from ..model import args
 
-    n = args.whole(n, "n", "frames", lo=0, hi=10**7)
-    fps = check_fps(fps)
-    starts = [math.floor(k * 100 / fps + 0.5) for k in range(n + 1)]
-    return [b - a for a, b in itertools.pairwise(starts)]
 
 
 #: Longest frame interval, in steps, whose divisors :func:`sample_every` searches (dt down to

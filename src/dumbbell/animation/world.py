@@ -8,15 +8,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from PIL import ImageDraw
 
-from ..model.scene import System
 from .backdrop import SS, Patch
 from .frames import Frames
 from .glyphs import Stamps, fmt_tick, nice_step
 from .layout import Layout
 from .palette import BLACK, FLOOR, GREY, INK, LIGHT, SPRING, TERM_RGB, WHITE
+
+if TYPE_CHECKING:  # for the annotations only: a recording does not read scenes
+    from ..model.scene import System
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []

@@ -311,3 +311,4 @@ def pymunk_object(value: Any, name: str, kinds: tuple[str, ...]) -> Any:
     """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle')."""
     classes = tuple(c for c in (_pymunk(k) for k in kinds) if c != ())
     return instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))
+

@@ -28,13 +28,13 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError, UsageError
+from .sizes import SIZE_RULE, pixel_size
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
 
 #: Figure names ``[outputs] figures`` may list.
 FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topple", "contact")
 #: What a GIF size must be.
-SIZE_RULE = "must be WIDTHxHEIGHT in pixels, each between 64 and 4096"
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
 #: Largest magnitude of any number in a scene (m, kg, m/s, N/m, ...), and the smallest mass
@@ -692,7 +692,7 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
             strip=bool(cgif.boolean("strip", GifSettings.strip)),
             t_end=cgif.number("t_end", t_end, lo=0.0, lo_open=True, unit="s"),
         )
-        if _parse_size(gif.size) is None:
+        if pixel_size(gif.size) is None:
             cgif.fail("outputs.gif.size", gif.size, "must be WIDTHxHEIGHT in pixels, "
                       "each between 64 and 4096")
         cgif.done()
@@ -714,21 +714,9 @@ def _pymunk(top: _Checker) -> tuple[Any, bool]:
     return settings, discs
 
 
-def _parse_size(text: Any) -> tuple[int, int] | None:
-    """'640x360' -> (640, 360); None when not a valid size."""
-    if not isinstance(text, str):
-        return None
-    parts = text.lower().split("x")
-    # ASCII digits only, and few: int() rejects other Unicode digits and huge strings.
-    if len(parts) != 2 or not all(p.isascii() and p.isdigit() and len(p) <= 6 for p in parts):
-        return None
-    w, h = int(parts[0]), int(parts[1])
-    return (w, h) if 64 <= w <= 4096 and 64 <= h <= 4096 else None
-
-
 def parse_size(text: str) -> tuple[int, int]:
     """Parse 'WIDTHxHEIGHT' (pixels); raises UsageError (a ValueError) with the allowed form."""
-    size = _parse_size(text)
+    size = pixel_size(text)
     if size is None:
         raise UsageError(f"text = {_show(text)}: {SIZE_RULE}", param="text")
     return size

@@ -420,7 +420,7 @@ class Recorder:
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
         import pymunk
 
-        from ..animation.render import check_fps, check_size
+        from ..animation.timing import check_fps, check_size
         from ..model import args
         from .heat import HeatCounter
 
