@@ -336,7 +336,8 @@ def test_a_2d_particle_letter_stays_off_both_particles_and_above_the_floor(radiu
         pc = ((pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2)
         e = ((pa[0] - pb[0]) / length, (pa[1] - pb[1]) / length)
         for p, other, sign in ((pa, pb, 1), (pb, pa, -1)):
-            x, y = letter_at(p, radius, other, pc, (sign * e[0], sign * e[1]), floor_y, half, u)
+            x, y = letter_at(p, radius, other, (pc, (sign * e[0], sign * e[1])),
+                             (floor_y, half, u))
             assert y + half[1] < floor_y, (deg, sign, y)
             for centre in (pa, pb):
                 dx = max(abs(x - centre[0]) - half[0], 0.0)

@@ -72,27 +72,30 @@ def axis_angle(pa: tuple[float, float], pb: tuple[float, float]) -> float:
 
 
 def letter_at(p: tuple[float, float], r: float, other: tuple[float, float],
-              pc: tuple[float, float], out: tuple[float, float], floor_y: float,
-              half: tuple[float, float], u: float) -> tuple[float, float]:
+              axis: tuple[tuple[float, float], tuple[float, float]],
+              room: tuple[float, tuple[float, float], float]) -> tuple[float, float]:
     """Centre (px) of a 2D particle's letter: beyond the particle ``p`` (radius ``r``) along
-    the axis pointing ``out`` from the centre of mass ``pc``, at least :data:`LABEL_CLEAR`
-    from it, and above the floor (pixel row ``floor_y``). Pushed up from under the floor, the
+    the ``axis`` (the centre of mass, the unit vector pointing out from it), at least
+    :data:`LABEL_CLEAR` from it, and above the floor. Pushed up from under the floor, the
     letter of a particle larger than the gap would land on the particle itself (the toppling
     dumbbell's B, standing on the floor): it goes beside the particle then, away from the
-    ``other`` one. ``half``: the letter's half width and half height (px)."""
+    ``other`` one. ``room``: the floor's pixel row, the letter's half width and half height
+    (px), and ``u``."""
+    (pc, out), (floor_y, half, u) = axis, room
     reach = max(math.hypot(p[0] - pc[0], p[1] - pc[1]) + r + LETTER_GAP * u, LABEL_CLEAR * u)
     lx, ly = pc[0] + out[0] * reach, min(pc[1] + out[1] * reach, floor_y - LETTER_GAP * u)
-    if _letter_on_disc(lx, ly, half[0], half[1], p, r + u):
+    if _letter_on_disc((lx, ly), half, p, r + u):
         side = 1.0 if p[0] >= other[0] else -1.0
         lx, ly = p[0] + side * (r + LETTER_GAP * u), min(p[1], floor_y - LETTER_GAP * u)
     return lx, ly
 
 
-def _letter_on_disc(x: float, y: float, half_w: float, half_h: float,
+def _letter_on_disc(at: tuple[float, float], half: tuple[float, float],
                     centre: tuple[float, float], radius: float) -> bool:
-    """Whether a letter's box (centre ``x, y``, half sizes in px) reaches into the disc."""
-    dx = max(abs(x - centre[0]) - half_w, 0.0)
-    dy = max(abs(y - centre[1]) - half_h, 0.0)
+    """Whether a letter's box (centre ``at``, half width and height in px) reaches into the
+    disc."""
+    dx = max(abs(at[0] - centre[0]) - half[0], 0.0)
+    dy = max(abs(at[1] - centre[1]) - half[1], 0.0)
     return dx * dx + dy * dy < radius * radius
 
 
@@ -210,8 +213,8 @@ class World:
                       outline=INK, width=outline)
             if ex or ey:
                 other = pb if name == "A" else pa
-                lx, ly = letter_at(p, r, other, pc, (sign * ex, sign * ey), floor_y,
-                                   (letters.width(name) / (2 * S), letters.cap / (2 * S)), u)
+                half = (letters.width(name) / (2 * S), letters.cap / (2 * S))
+                lx, ly = letter_at(p, r, other, (pc, (sign * ex, sign * ey)), (floor_y, half, u))
                 letters.draw(crop, P((lx, ly)), name, INK, "mm")
             else:
                 letters.draw(crop, (x + (r + LETTER_GAP_1D * u) * S, y), name, INK, "lm")
