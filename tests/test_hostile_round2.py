@@ -236,3 +236,27 @@ def test_a_shape_that_is_not_finite_is_named_by_the_guard(kind, bad):
                 call()
         e = spaces.energy(space)
     assert e.E == pytest.approx(0.5 * 2.0 * (0.25**2 + 1.0) + 2.0 * 9.81 * 1.5, rel=1e-12)
+
+
+def test_a_bad_spring_is_named_by_its_place_among_the_constraints():
+    """Every part of dumbbell.spaces names a constraint by its place in space.constraints
+    ('DampedSpring 1' after a PinJoint): the refusal of a spring that is not finite too, in
+    spaces.energy (which reads the settings its inventory took), the guard and the recorder.
+    A custom force function leaves the spring out of the energy, not out of the check."""
+    from dumbbell import DumbbellError, spaces
+
+    s = _space(k=math.nan)
+    a, b = [x for x in s.bodies]
+    spring = next(iter(s.constraints))
+    s.remove(spring)
+    s.add(pymunk.PinJoint(a, b), spring)
+    assert spaces.energy(_space()).springs[0].subject == "DampedSpring 0"
+    for call in (lambda: spaces.energy(s), lambda: spaces.reach(s, 1 / 60),
+                 lambda: spaces.Recorder(s, "never-written.gif")):
+        with pytest.raises(DumbbellError, match=r"DampedSpring 1: stiffness = nan"):
+            call()
+    found = [f for f in spaces.check(s, 1 / 60) if f.kind == "state"]
+    assert found[0].subject == "DampedSpring 1", found
+    spring.force_func = lambda c, d: 0.0
+    with pytest.raises(DumbbellError, match=r"DampedSpring 1: stiffness = nan"):
+        spaces.energy(s)

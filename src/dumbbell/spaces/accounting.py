@@ -222,12 +222,20 @@ def check_finite(space: Any) -> None:
                      [b.moment if d else 1.0 for b, d in zip(bodies, dyn, strict=True)])
 
 
-def settings_problem(space: Any) -> tuple[str, str, float] | None:
+def settings_problem(space: Any, inv: Inventory | None = None
+                     ) -> tuple[str, str, float] | None:
     """The first setting of ``space`` that enters its energy and is not a finite number:
     (subject, what is wrong, the value), or None. ``space.gravity``, and each spring's
     stiffness, damping, rest length (rest angle) and anchors: with one of them NaN or
-    infinite every energy would be NaN, and the guard's frequencies and steps too."""
+    infinite every energy would be NaN, and the guard's frequencies and steps too. Springs
+    are named as everywhere else, by their place in ``space.constraints``. Given ``inv``, the
+    inventory just taken of ``space``, the settings it read are looked at first: the space
+    is read again only when one of them is not finite (or a spring it left out has a force
+    function of its own), to name the setting as the user set it."""
     import pymunk
+
+    if inv is not None and _settings_finite(inv):
+        return None
 
     def bad(values: Any) -> float | None:
         return next((float(v) for v in values if not math.isfinite(v)), None)
@@ -236,7 +244,9 @@ def settings_problem(space: Any) -> tuple[str, str, float] | None:
     if (value := bad(g)) is not None:
         return "space.gravity", f"gravity = {_shown(g)}{_NO_STEP}", value
     kinds = (pymunk.DampedSpring, pymunk.DampedRotarySpring)
-    for j, c in enumerate(x for x in space.constraints if isinstance(x, kinds)):
+    for i, c in enumerate(space.constraints):
+        if not isinstance(c, kinds):
+            continue
         rotary = isinstance(c, pymunk.DampedRotarySpring)
         fields = (("rest_angle",) if rotary else ("rest_length", "anchor_a", "anchor_b")) + \
             ("stiffness", "damping")
@@ -244,9 +254,18 @@ def settings_problem(space: Any) -> tuple[str, str, float] | None:
             v = getattr(c, name)
             values = tuple(v) if name.startswith("anchor") else (v,)
             if (value := bad(values)) is not None:
-                who = f"{type(c).__name__} {j}"
-                return who, f"{name} = {_shown(values)}{_NO_STEP}", value
+                return f"{type(c).__name__} {i}", f"{name} = {_shown(values)}{_NO_STEP}", value
     return None
+
+
+def _settings_finite(inv: Inventory) -> bool:
+    """Whether every setting ``inv`` read (gravity, each counted spring's) is finite and it
+    left out no spring (one with a force function of its own, whose settings it did not
+    read)."""
+    numbers = [*inv.gravity, *(v for sp in inv.springs for v in (
+        sp.stiffness, sp.rest, sp.damping, *sp.anchor_a, *sp.anchor_b))]
+    return (all(math.isfinite(v) for v in numbers)
+            and not any(u.subject.startswith("Damped") for u in inv.unknown))
 
 
 #: What a setting that is not finite means, after its name and value.
@@ -258,12 +277,12 @@ def _shown(values: tuple[float, ...]) -> str:
     return f"({values[0]:g}, {values[1]:g})" if len(values) == 2 else f"{values[0]:g}"
 
 
-def refuse_settings(space: Any) -> None:
+def refuse_settings(space: Any, inv: Inventory | None = None) -> None:
     """Raise a :class:`~dumbbell.errors.DumbbellError` naming the first setting of ``space``
-    that is not finite (:func:`settings_problem`)."""
+    that is not finite (:func:`settings_problem`; from the settings ``inv`` holds, when given)."""
     from ..errors import DumbbellError
 
-    problem = settings_problem(space)
+    problem = settings_problem(space, inv)
     if problem is not None:
         raise DumbbellError(f"space: {problem[0]}: {problem[1]}")
 
@@ -686,7 +705,7 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
     st = read_state(inv)
     n = inv.dynamic
     refuse_bad_state(list(inv.labels[:n]), st, inv.mass, inv.moment)
-    refuse_settings(space)
+    refuse_settings(space, inv)
     with np.errstate(over="ignore", invalid="ignore"):
         terms = evaluate(inv, st, (ox, oy))
     refuse_overflow(list(inv.labels[:n]), terms, st)
