@@ -62,7 +62,6 @@ from ..model.trajectory import Contact, Impact, Trajectory, Verdict
 from .base import ExplicitSpring, RunOptions, Solver
 from .verdicts import RawRun, Sinking, conclude, nonfinite_reason, tunnel_reason
 
-#: The public API: the solver class (its supports and solve); the rest serves it.
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
 

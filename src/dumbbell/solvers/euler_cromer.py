@@ -22,7 +22,6 @@ from .base import ExplicitSpring
 from .kernels import Kernel
 from .stepping import Stepper
 
-#: The public API: the solver class (its supports and solve); the rest serves it.
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
 

@@ -25,7 +25,6 @@ from .base import ExplicitSpring, point_particle_limits
 from .kernels import Kernel
 from .stepping import Stepper
 
-#: The public API: the solver class (its supports and solve); the rest serves it.
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
 

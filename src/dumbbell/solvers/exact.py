@@ -38,7 +38,6 @@ from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_fail
 from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
 from .verdicts import RawRun, conclude
 
-#: The public API: the solver class (its supports and solve); the rest serves it.
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
 

@@ -59,7 +59,6 @@ from .base import RunOptions, Solver
 from .kernels import REST_SPEED
 from .verdicts import RawRun, head, judge
 
-#: The public API: the solver class (its supports and solve); the rest serves it.
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
 
