@@ -221,7 +221,7 @@ def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     from dumbbell.animation.render import frames_of
 
     frames = frames_of(short, 25, 1.0)
-    painter = Painter(short.scene, frames, (320, 180), True)
+    painter = Painter.of(short.scene, frames, (320, 180), True)
     clear = palette()[1]
     assert all(clear not in np.asarray(painter.frame(k)) for k in range(len(frames.t)))
 
@@ -235,7 +235,7 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
     frames = frames_of(traj, 25, 2.0)
-    painter = Painter(textbook, frames, (640, 360), True)
+    painter = Painter.of(textbook, frames, (640, 360), True)
     strip = painter.strip
     assert strip.window == WINDOW < 2.0
     sx0, sy0, sx1, sy1 = strip.box
@@ -289,7 +289,7 @@ def test_strip_marks_a_lasting_contact_along_its_foot_and_impacts_across_it(shor
 
     traj = dataclasses.replace(short, contacts=(Contact(0.2, 0.6, "B"), Contact(0.7, 1.0, "A")))
     frames = frames_of(traj, 25, 1.0)
-    painter = Painter(traj.scene, frames, (640, 360), True)
+    painter = Painter.of(traj.scene, frames, (640, 360), True)
     strip = painter.strip
     rgb = np.asarray(painter.frame(0).convert("RGB"))     # the cursor at t = 0
     sx0, _, sx1, sy1 = strip.box

@@ -32,6 +32,9 @@ __all__: list[str] = []
 WINDOW = 1.0
 #: Fraction of the strip's window after the cursor (what comes next).
 AHEAD = 0.25
+#: Opacity of what lies after the cursor (over white): it has not happened yet at the
+#: frame's time, so it is drawn faded.
+FUTURE = 0.25
 #: Width (px) of the pieces the strip's tape is drawn in.
 TAPE_CHUNK = 1024
 #: Time ticks per window (about).
@@ -43,6 +46,8 @@ BAND_PX = 3
 BAND_ALPHA = 0.45
 GRID = (238, 238, 238)     # the energy grid lines
 IMPACT = (216, 216, 216)   # the impacts' faint lines
+#: The names of the strip's axes: energy (left) and time (under it).
+ENERGY_AXIS, TIME_AXIS = "J", "t (s)"
 #: The strip, in units of u (px on the 640 x 360 reference frame).
 PAD = 4          # between the strip's frame and the highest and lowest energy
 TICK = 3         # length of a time tick under the strip (at least 2 px)
@@ -118,10 +123,34 @@ class Strip:
             y = self.y(v)
             d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(v), font=fs, fill=GREY,
                    anchor="rm")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), "J", font=fs, fill=GREY,
-               anchor="rs")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), "t (s)", font=fs,
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS, font=fs,
+               fill=GREY, anchor="rs")
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), TIME_AXIS, font=fs,
                fill=GREY, anchor="rt")
+
+    def curves(self, frames: Frames, names: Sequence[str]
+               ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], dict[str, bool]]:
+        """The series ``names`` of ``frames`` as the strip draws them, E last (on top): for
+        each term with at least two finite samples, its sample times (s), tape columns and
+        rows (px from the tape's top), and whether it is drawn as a pale band (its range
+        within one pixel column mostly wider than :data:`BAND_PX`: it changes faster than a
+        column shows) or as a line."""
+        order = [n for n in names if n != "E"] + ["E"]
+        t = frames.series_t
+        cols_all = np.floor(t * self.px_per_s).astype(np.int64)
+        series: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        band: dict[str, bool] = {}
+        for name in order:
+            ys = self.y(frames.series[name]) - self.tape_y
+            ok = np.isfinite(ys)
+            if ok.sum() < 2:
+                continue
+            c, y = cols_all[ok], ys[ok]
+            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+            series[name] = (t[ok], c, y)
+            band[name] = bool(np.median(np.maximum.reduceat(y, starts)
+                                        - np.minimum.reduceat(y, starts)) > BAND_PX)
+        return series, band
 
     def tape(self, frames: Frames, names: Sequence[str]) -> Tape:
         """The energy time series ``names`` of the whole animation as a :class:`Tape` at the
@@ -169,7 +198,6 @@ class Tape:
     def __init__(self, strip: Strip, frames: Frames, names: Sequence[str]):
         fr, S = frames, 1
         self.strip, self.width, self.height = strip, strip.tape_w, strip.tape_h
-        p = strip.px_per_s
         self.grid_y = [(strip.y(v) - strip.tape_y) * S for v in strip.scale.ticks()]
         self.edge = (strip.box[3] - strip.tape_y) * S
         self.ticks = [k * strip.t_step
@@ -179,21 +207,7 @@ class Tape:
         self.contacts = [(self.edge - (1 if body == "B" else 2) * self.bar, TERM_RGB[body], t0,
                           min(t1, fr.t_end)) for body, t0, t1 in fr.contacts if t0 <= fr.t_end]
         # Fast terms as pale bands, the others as lines; E on top.
-        order = [n for n in names if n != "E"] + ["E"]
-        t = fr.series_t
-        cols_all = np.floor(t * p * S).astype(np.int64)
-        self.series: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self.band: dict[str, bool] = {}
-        for name in order:
-            ys = (strip.y(fr.series[name]) - strip.tape_y) * S
-            ok = np.isfinite(ys)
-            if ok.sum() < 2:
-                continue
-            c, y = cols_all[ok], ys[ok]
-            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-            self.series[name] = (t[ok], c, y)
-            self.band[name] = bool(np.median(np.maximum.reduceat(y, starts)
-                                             - np.minimum.reduceat(y, starts)) > BAND_PX * S)
+        self.series, self.band = strip.curves(fr, names)
         self.pieces: dict[int, Image.Image] = {}
 
     def piece(self, c0: int) -> Image.Image:
