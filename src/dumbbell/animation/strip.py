@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from PIL import Image, ImageDraw
@@ -21,7 +22,7 @@ from .backdrop import Patch
 from .bars import EnergyScale
 from .frames import Frames
 from .glyphs import Stamps, fmt_tick, nice_step
-from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, term_inks, to_palette
+from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, palette, term_inks, to_palette
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []
@@ -162,8 +163,12 @@ class Strip:
         """The window of ``tape`` a frame at ``t`` (s) shows, its time labels (on a crop from
         ``patch``, reaching to the frame's right edge) and the cursor."""
         left, x = self.offset(t)
-        img.paste(tape.crop((left, 0, left + self.inner_w, self.tape_h)),
-                  (self.inner_x, self.tape_y))
+        window = tape.crop((left, 0, left + self.inner_w, self.tape_h))
+        # What lies after the cursor has not happened yet: faded, down to the strip's foot.
+        future = (x - left + 1, 0, self.inner_w, tape.edge)
+        if future[2] > future[0]:
+            window.paste(window.crop(future).point(fade_table()), future[:2])
+        img.paste(window, (self.inner_x, self.tape_y))
         sx0, _, _, sy1 = self.box
         u, W = self.u, img.width
         y = sy1 + self.tick_len + 1
@@ -182,6 +187,19 @@ class Strip:
         xc = self.inner_x + x - left
         ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=term_inks()["ink"],
                                  width=max(1, round(CURSOR * u)))
+
+
+@lru_cache(maxsize=1)
+def fade_table() -> list[int]:
+    """For each palette index, the index of its colour at opacity :data:`FUTURE` over white
+    (the nearest in the palette); the index kept for 'unchanged' stays itself."""
+    pal, clear = palette()
+    rgb = np.frombuffer(pal, dtype=np.uint8).reshape(256, 3).astype(float)
+    faded = 255.0 + (rgb - 255.0) * FUTURE
+    nearest = ((faded[:, None, :] - rgb[None, :clear, :]) ** 2).sum(axis=2).argmin(axis=1)
+    table = nearest.tolist()
+    table[clear] = clear
+    return table
 
 
 class Tape:

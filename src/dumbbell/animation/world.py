@@ -158,7 +158,7 @@ class World:
         # Where the particle centres meet the floor is height 0; a disc of the drawn radius
         # resting there reaches that far below it (the larger disc, when the two differ:
         # no particle is ever drawn inside the floor).
-        floor_y = L.px(0.0, 0.0)[1] if system.floor is not None else None
+        floor_y = L.px(0.0, 0.0)[1] + max(ra, rb) if system.floor is not None else None
         _, _, y0, y1 = L.world
         step = nice_step((y1 - y0) / 5)
         lo, hi = math.ceil(y0 / step - 1e-9), math.floor(y1 / step + 1e-9)
@@ -173,7 +173,7 @@ class World:
             # The surface is the line's top edge: a particle resting on the floor touches it.
             fy, line = self.floor_y, round(FLOOR_LINE * u * S)
             d.rectangle([0, fy * S, L.scene_w * S, H * S], fill=FLOOR)
-            d.line([(0, fy * S), (L.scene_w * S, fy * S)], fill=GREY,
+            d.line([(0, fy * S + line / 2), (L.scene_w * S, fy * S + line / 2)], fill=GREY,
                    width=line)
         rx = L.ruler_x * S
         d.line([(rx, self.ruler[0][0] * S), (rx, self.ruler[-1][0] * S)], fill=GREY, width=S)
