@@ -42,6 +42,9 @@ NOTES = ("fixed scale; pale: largest value since the last frame",
          "pale: largest since last frame", "pale: since last frame")
 #: The panel's title.
 TITLE = "Energy (J)"
+#: L_cm's line under the bars: before its value, after it, and the note that follows when
+#: it fits.
+MOMENTUM_TEXT = ("L_cm = ", " kg m²/s", " (about the centre of mass)")
 
 
 @dataclass(frozen=True)
@@ -244,9 +247,10 @@ class Bars:
         y = (below + limit) / 2
         box = (self.box[0], round(y - MOMENTUM_HALF * u), self.box[2],
                round(y + MOMENTUM_HALF * u))
-        text = f"L_cm = {fixed(value, 4, '+')} kg m²/s (about the centre of mass)"
+        before, after, note = MOMENTUM_TEXT
+        text = f"{before}{fixed(value, 4, '+')}{after}{note}"
         if stamps.width(text) > box[2] - box[0]:
-            text = f"L_cm = {fixed(value, 4, '+')} kg m²/s"
+            text = f"{before}{fixed(value, 4, '+')}{after}"
         crop, (cx, cy), done = patch(box)
         stamps.draw(crop, (box[2] - cx, y - cy), text, INK, "rm")
         done()

@@ -18,6 +18,8 @@ number or a label of its own: a change here shows in both.
 
 from __future__ import annotations
 
+import math
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any
@@ -57,15 +59,20 @@ FACTORS = {
               "TIME_DECIMALS", "RULER_NAME", "IMPACT_WORD_TEXT", "ANGLE_TEXT"),
     "bars": ("LABEL_ROOM", "VALUE_PAD", "HEAD", "SWATCH", "SWATCH_GAP", "NOTE_X",
              "ZERO_OVERHANG", "LOST_INSET", "MARKER", "MOMENTUM_GAP", "MOMENTUM_EDGE",
-             "MOMENTUM_ROOM", "TITLE"),
+             "MOMENTUM_ROOM", "TITLE", "MOMENTUM_TEXT"),
     "strip": ("WINDOW", "AHEAD", "FUTURE", "TIME_TICKS", "BAND_ALPHA", "PAD", "TICK",
               "LABEL_GAP", "CONTACT_BAR", "IMPACT_TICK", "LINE", "CURSOR", "LABEL_OVERHANG",
               "LABEL_EDGE", "ENERGY_AXIS", "TIME_AXIS"),
     "glyphs": ("TEXT_PX", "TIME_PX", "NOTE_PX", "TITLE_PX", "SMALL_PX"),
     "palette": ("TINT",),
+    "layout": ("EDGE",),
+    "backdrop": ("SS",),
+    "picture": ("GHOST", "STACK_BELOW"),
 }
-_MODULES = {"world": world_module, "bars": bars_module, "strip": strip_module,
-            "glyphs": glyphs, "palette": palette_module}
+#: Opacity of the runs drawn beside the chosen one (ghosts), when runs are shown together.
+GHOST = 0.35
+#: A page narrower than this (px) shows the scene above the energy panel, each wider.
+STACK_BELOW = 560
 
 
 @dataclass(frozen=True)
@@ -101,13 +108,27 @@ class Picture:
             "bands": [dict(b) for b in self.bands],
             "title": self.title,
             "colours": colours(),
-            "factors": {group: {name: _value(getattr(_MODULES[group], name))
+            "factors": {group: {name: _value(getattr(_module(group), name))
                                 for name in names}
                         for group, names in FACTORS.items()},
         }
         if self.strip is not None:
-            doc["strip"]["ticks"] = [[v, glyphs.fmt_tick(v)] for v in self.strip.scale.ticks()]
+            S = self.strip
+            doc["strip"]["ticks"] = [[v, glyphs.fmt_tick(v)] for v in S.scale.ticks()]
+            # The time ticks of the whole tape, one beyond its end, and their labels.
+            last = math.floor(S.tape_w / S.px_per_s / S.t_step + 1e-9) + 1
+            doc["strip"]["time_ticks"] = [[k * S.t_step, glyphs.fmt_tick(k * S.t_step)]
+                                          for k in range(last + 1)]
         return doc
+
+
+def _module(group: str) -> Any:
+    """The module whose constants :data:`FACTORS` names under ``group``."""
+    from . import backdrop, layout as layout_module
+
+    return {"world": world_module, "bars": bars_module, "strip": strip_module,
+            "glyphs": glyphs, "palette": palette_module, "layout": layout_module,
+            "backdrop": backdrop, "picture": sys.modules[__name__]}[group]
 
 
 def colours() -> dict[str, Any]:
