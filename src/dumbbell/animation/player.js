@@ -452,7 +452,10 @@
     const o = document.createElement("option"); o.value = String(k); o.textContent = run.label || ("run " + (k + 1));
     runSelect.appendChild(o);
   });
-  if (runs.length > 1) $("run-label").hidden = false;
+  if (runs.length > 1) {
+    $("run-label").hidden = false;
+    $("stage").appendChild($("readout"));  // a column per run: under the picture, wider
+  }
   const cells = [];
   (function table() {
     const head = $("readout-head"), body = $("readout-body");

@@ -61,8 +61,10 @@ class Player:
 
             raise UsageError(f"html_text = {args.show(html_text)}: must be the page (str)",
                              param="html_text")
+        from .timing import check_size
+
         self.html = html_text
-        self.size = size
+        self.size = check_size(size)
 
     def __repr__(self) -> str:
         return f"<Player: {len(self.html.encode()):,} bytes of HTML>"
