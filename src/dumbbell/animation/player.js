@@ -592,7 +592,11 @@
       });
     },
   };
-  if (window.ResizeObserver) new ResizeObserver(function () { resize(); }).observe(document.getElementById("stage"));
+  let stageWidth = null;
+  if (window.ResizeObserver) new ResizeObserver(function () {
+    const w = document.getElementById("stage").clientWidth;
+    if (w !== stageWidth) { stageWidth = w; resize(); }
+  }).observe(document.getElementById("stage"));
   window.addEventListener("resize", resize);
   const hash = /[#&]t=([0-9.eE+-]+)/.exec(window.location.hash);
   if (hash && isFinite(parseFloat(hash[1]))) state.t = Math.min(Math.max(0, parseFloat(hash[1])), T_END);
