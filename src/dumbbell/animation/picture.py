@@ -56,13 +56,15 @@ FACTORS = {
               "RULER_LABEL", "RULER_TITLE", "ZIGZAG_LINE", "ROD_LINE", "OUTLINE",
               "IMPACT_MARK", "IMPACT_LINE", "IMPACT_GAP", "LETTER_GAP", "LETTER_GAP_1D",
               "AXIS_REACH", "AXIS_MIN", "ARC", "ARC_LINE", "TIME_AT", "ANGLE_AT",
-              "TIME_DECIMALS", "RULER_NAME", "IMPACT_WORD_TEXT", "ANGLE_TEXT"),
+              "TIME_DECIMALS", "RULER_NAME", "IMPACT_WORD_TEXT", "ANGLE_TEXT", "CROP_1D",
+              "CROP_2D", "LABELS_2D", "LABELS_RIGHT", "IMPACT_CROP", "IMPACT_WORD", "TIME_BOX",
+              "TIME_BOTTOM_1D", "TIME_BOTTOM_2D"),
     "bars": ("LABEL_ROOM", "VALUE_PAD", "HEAD", "SWATCH", "SWATCH_GAP", "NOTE_X",
              "ZERO_OVERHANG", "LOST_INSET", "MARKER", "MOMENTUM_GAP", "MOMENTUM_EDGE",
-             "MOMENTUM_ROOM", "TITLE", "MOMENTUM_TEXT"),
+             "MOMENTUM_ROOM", "MOMENTUM_HALF", "TITLE", "MOMENTUM_TEXT"),
     "strip": ("WINDOW", "AHEAD", "FUTURE", "TIME_TICKS", "BAND_ALPHA", "PAD", "TICK",
               "LABEL_GAP", "CONTACT_BAR", "IMPACT_TICK", "LINE", "CURSOR", "LABEL_OVERHANG",
-              "LABEL_EDGE", "ENERGY_AXIS", "TIME_AXIS"),
+              "LABEL_EDGE", "ENERGY_AXIS", "TIME_AXIS", "TAPE_CHUNK"),
     "glyphs": ("TEXT_PX", "TIME_PX", "NOTE_PX", "TITLE_PX", "SMALL_PX"),
     "palette": ("TINT",),
     "layout": ("EDGE",),
@@ -124,7 +126,8 @@ class Picture:
 
 def _module(group: str) -> Any:
     """The module whose constants :data:`FACTORS` names under ``group``."""
-    from . import backdrop, layout as layout_module
+    from . import backdrop
+    from . import layout as layout_module
 
     return {"world": world_module, "bars": bars_module, "strip": strip_module,
             "glyphs": glyphs, "palette": palette_module, "layout": layout_module,

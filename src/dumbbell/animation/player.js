@@ -65,7 +65,7 @@
 
   // --- the canvas --------------------------------------------------------------------------
   const canvas = document.getElementById("view");
-  const ctx = canvas.getContext("2d");
+  const ctx = canvas.getContext("2d", { alpha: false });
   canvas.width = W; canvas.height = H;
   let scale = 1, stacked = false, background = null;
   // The panels: the whole frame, or (a narrow window) the scene above the energy panel.
@@ -309,45 +309,46 @@
     }
     return out;
   }
-  runs.forEach(function (run, k) { run.bands = P.strip ? bandsOf(run, k) : {}; });
-  function drawStrip(c, run, j) {
-    const S = P.strip, [sx0, , , sy1] = S.box, pps = S.px_per_s, t = run.t[j];
-    const x = Math.round(t * pps), left = Math.min(Math.max(0, x - S.cursor_px), S.tape_w - S.inner_w);
-    const X = function (tt) { return S.inner_x + tt * pps - left; };
-    const t0 = (left - 2) / pps, t1 = (left + S.inner_w + 2) / pps;
-    c.save();
-    c.beginPath(); c.rect(S.inner_x, S.tape_y, S.inner_w, S.tape_h); c.clip();
-    for (const [v] of S.ticks) rect(c, S.inner_x, Math.round(stripY(v) - 0.5), S.inner_x + S.inner_w, Math.round(stripY(v) - 0.5) + 1, C.grid);
-    rect(c, S.inner_x, sy1, S.inner_x + S.inner_w, sy1 + 1, C.light);
+  runs.forEach(function (run, k) { run.bands = P.strip ? bandsOf(run, k) : {}; run.pieces = new Map(); });
+  // The tape: a run's whole strip (grid, ticks, impacts, curves, contacts) at the strip's
+  // time scale, drawn in pieces of TAPE_CHUNK columns when first needed, as the GIF does;
+  // a frame copies the window it shows. Tape x: column (t * px_per_s); y: from tape_y.
+  function drawTape(c, run, c0, c1) {
+    const S = P.strip, pps = S.px_per_s, edge = S.box[3] - S.tape_y;
+    const X = function (tt) { return tt * pps - c0; };
+    const t0 = (c0 - 2) / pps, t1 = (c1 + 2) / pps;
+    rect(c, 0, 0, c1 - c0, S.tape_h, C.white);
+    for (const [v] of S.ticks) { const y = Math.round(stripY(v) - S.tape_y - 0.5); rect(c, 0, y, c1 - c0, y + 1, C.grid); }
+    rect(c, 0, edge, c1 - c0, edge + 1, C.light);
     for (const [tk] of S.time_ticks) {
       if (tk < t0 || tk > t1) continue;
-      rect(c, Math.round(X(tk) - 0.5), sy1, Math.round(X(tk) - 0.5) + 1, sy1 + S.tick_len + 2, C.grey);
+      const x = Math.round(X(tk) - 0.5);
+      rect(c, x, edge, x + 1, edge + S.tick_len + 2, C.grey);
     }
     for (const ti of run.impacts) {
       if (ti < t0 || ti > t1 || ti > T_END) continue;
-      const xi = Math.round(X(ti) - 0.5);
-      rect(c, xi, S.tape_y, xi + 1, sy1, C.impact);
-      rect(c, xi, sy1 - FS.IMPACT_TICK * u, xi + 1, sy1, C.grey);
+      const x = Math.round(X(ti) - 0.5);
+      rect(c, x, 0, x + 1, edge, C.impact);
+      rect(c, x, edge - FS.IMPACT_TICK * u, x + 1, edge, C.grey);
     }
     const order = P.names.filter(function (n) { return n !== "E"; }).concat(["E"]);
-    const i0 = Math.max(0, atOrAfter(run, t0) - 1), i1 = Math.min(run.n, atOrAfter(run, t1) + 2);
     for (const name of order) {
       const band = run.bands[name];
       if (!band) continue;
       c.fillStyle = C.bands[name] || C.grey;
-      const c0 = Math.max(0, left - 1), c1 = Math.min(S.tape_w, left + S.inner_w + 1);
-      for (let col = c0; col < c1; col++) {
+      for (let col = Math.max(0, c0 - 1); col < Math.min(S.tape_w, c1 + 1); col++) {
         const a = band[0][col], b = band[1][col];
-        if (a === a) c.fillRect(S.inner_x + col - left, Math.round(a), 1, Math.max(1, Math.round(b) - Math.round(a) + 1));
+        if (a === a) c.fillRect(col - c0, Math.round(a - S.tape_y), 1, Math.max(1, Math.round(b) - Math.round(a) + 1));
       }
     }
+    const i0 = Math.max(0, atOrAfter(run, t0) - 1), i1 = Math.min(run.n, atOrAfter(run, t1) + 2);
     c.lineWidth = Math.max(1, Math.round(FS.LINE * u)); c.lineJoin = "round";
     for (const name of order) {
       if (run.bands[name]) continue;
       const v = run.E[name];
       c.beginPath(); let open = false;
       for (let i = i0; i < i1; i++) {
-        const y = stripY(v[i]);
+        const y = stripY(v[i]) - S.tape_y;
         if (!isFinite(y)) { open = false; continue; }
         if (open) c.lineTo(X(run.t[i]), y); else { c.moveTo(X(run.t[i]), y); open = true; }
       }
@@ -355,61 +356,132 @@
     }
     const bar = Math.max(1, Math.round(FS.CONTACT_BAR * u));
     for (const [body, a, b] of run.contacts) {
-      const y = sy1 - (body === "B" ? 1 : 2) * bar;
+      const y = edge - (body === "B" ? 1 : 2) * bar;
       rect(c, X(a), y, X(Math.min(b, T_END)) + 1, y + bar, C.terms[body]);
     }
-    // What has not happened yet: faded.
+  }
+  function piece(run, c0) {
+    let p = run.pieces.get(c0);
+    if (!p) {
+      const S = P.strip, c1 = Math.min(S.tape_w, c0 + FS.TAPE_CHUNK);
+      p = document.createElement("canvas");
+      p.width = Math.max(1, Math.round(c1 * scale) - Math.round(c0 * scale));
+      p.height = Math.max(1, Math.ceil(S.tape_h * scale));
+      const c = p.getContext("2d");
+      c.setTransform(scale, 0, 0, scale, 0, 0);
+      drawTape(c, run, c0, c1);
+      if (run.pieces.size > 6) run.pieces.clear();
+      run.pieces.set(c0, p);
+    }
+    return p;
+  }
+  // The strip at run's sample j: its window of the tape (copied in device pixels), what lies
+  // after the cursor faded, the cursor, and the time labels under it.
+  function drawStrip(c, run, j, panel) {
+    const S = P.strip, [sx0, , , sy1] = S.box, pps = S.px_per_s, t = run.t[j];
+    const x = Math.round(t * pps), left = Math.min(Math.max(0, x - S.cursor_px), S.tape_w - S.inner_w);
+    const right = left + S.inner_w, chunk = FS.TAPE_CHUNK;
+    const ox = panel.at[0] - panel.src[0], oy = panel.at[1] - panel.src[1];
+    c.save(); c.setTransform(1, 0, 0, 1, 0, 0);
+    for (let c0 = Math.floor(left / chunk) * chunk; c0 < right; c0 += chunk) {
+      const p = piece(run, c0), a = Math.max(left, c0), b = Math.min(right, c0 + chunk);
+      const sx = Math.round(a * scale) - Math.round(c0 * scale), sw = Math.round(b * scale) - Math.round(a * scale);
+      const dx = Math.round((S.inner_x + a - left + ox) * scale);
+      if (sw > 0) c.drawImage(p, sx, 0, sw, p.height, dx, Math.round((S.tape_y + oy) * scale), sw, p.height);
+    }
+    c.restore();
     const xc = S.inner_x + x - left;
     c.globalAlpha = 1 - FS.FUTURE;
     rect(c, xc + 1, S.tape_y, S.inner_x + S.inner_w, sy1, C.white);
     c.globalAlpha = 1;
     const cw = Math.max(1, Math.round(FS.CURSOR * u));
     rect(c, xc - cw / 2 + 0.5, S.tape_y, xc + cw / 2 + 0.5, sy1, C.ink);
-    c.restore();
-    const xMin = sx0 - Math.round(FS.LABEL_OVERHANG * u);
+    const xMin = sx0 - Math.round(FS.LABEL_OVERHANG * u), t0 = left / pps, t1 = (right - 1) / pps;
     c.font = fSmallNote;
     for (const [tk, label] of S.time_ticks) {
-      if (tk < t0 || tk > t1) continue;
-      const xt = X(tk), half = c.measureText(label).width / 2;
+      if (tk < t0 - 1e-9 || tk > t1 + 1e-9) continue;
+      const xt = S.inner_x + tk * pps - left, half = c.measureText(label).width / 2;
       if (xt - half >= xMin && xt + half <= W - FS.LABEL_EDGE * u) text(c, label, xt + 0.5, sy1 + FS.LABEL_GAP * u, "mt", fSmallNote, C.grey);
     }
   }
 
   // --- a frame -------------------------------------------------------------------------------
   const state = { t: 0, playing: false, speed: 1, loop: true, run: 0, last: null };
-  const stats = { frames: 0, drawMs: [], started: null, playedFrames: 0 };
+  const stats = { frames: 0, drawMs: [], playedFrames: 0 };
   function impactSince(run, j) {
     const t = run.t[j];
     for (const ti of run.impacts) if (ti > t - 1 / FPS && ti <= t) return true;
     return false;
   }
-  function drawFrame(c) {
-    const sel = runs[state.run], j = nearest(sel, state.t);
-    for (let k = 0; k < runs.length; k++) {
-      if (k === state.run) continue;
-      drawDumbbell(c, runs[k], nearest(runs[k], state.t), true, false);
+  // Where a run's dumbbell at sample j may draw (the GIF's crop around it), frame px.
+  function dumbbellBox(run, j, impact) {
+    const ax = run.A[2 * j], ay = run.A[2 * j + 1], bx = run.B[2 * j], by = run.B[2 * j + 1];
+    if (!(isFinite(ax) && isFinite(ay) && isFinite(bx) && isFinite(by))) return null;
+    const wd = P.world, pa = px(ax, ay), pb = px(bx, by), twoD = wd.dimensions === 2;
+    const m = Math.max(wd.radius_px[0], wd.radius_px[1], wd.amp) + (twoD ? FW.CROP_2D : FW.CROP_1D) * u;
+    const mx = m + (twoD ? FW.LABELS_2D * u : 0);
+    let x0 = Math.min(pa[0], pb[0]) - mx, x1 = Math.max(pa[0], pb[0]) + mx + FW.LABELS_RIGHT * u;
+    const y0 = Math.min(pa[1], pb[1]) - mx;
+    let y1 = Math.max(pa[1], pb[1]) + (twoD ? mx : m);
+    if (impact && wd.floor_y !== null) {
+      const low = pa[1] > pb[1] ? pa : pb;
+      x0 = Math.min(x0, low[0] - FW.IMPACT_CROP * u); x1 = Math.max(x1, low[0] + FW.IMPACT_CROP * u);
+      y1 = Math.max(y1, wd.floor_y + FW.IMPACT_WORD * u);
     }
-    drawDumbbell(c, sel, j, false, j > 0 && impactSince(sel, j));
-    drawTime(c, sel, j);
-    drawBars(c, sel, j);
-    if (P.strip) drawStrip(c, sel, j);
+    return [Math.max(0, x0), Math.max(0, y0), Math.min(L.scene_w, x1), Math.min(H, y1)];
   }
-  function render() {
+  // What changes from frame to frame besides the dumbbells: put back from the background.
+  const FIXED = (function () {
+    const B = P.bars, S = P.strip, out = [];
+    const twoD = P.world.dimensions === 2;
+    out.push([FW.TIME_BOX[0] * u, FW.TIME_BOX[1] * u, L.scene_w - FW.TIME_BOX[0] * u, (twoD ? FW.TIME_BOTTOM_2D : FW.TIME_BOTTOM_1D) * u]);
+    const top = B.rows[0][1] - 4 - Math.max(3, Math.round(FB.MARKER * u)), bottom = B.rows[B.rows.length - 1][2] + 4;
+    out.push([B.left - 2, top, W, bottom]);
+    const below = B.rows[B.rows.length - 1][2];
+    const limit = S ? S.box[1] - Math.round(FB.MOMENTUM_GAP * u) : H - Math.round(FB.MOMENTUM_EDGE * u);
+    out.push([B.box[0], (below + limit) / 2 - FB.MOMENTUM_HALF * u - 1, W, (below + limit) / 2 + FB.MOMENTUM_HALF * u + 1]);
+    if (S) out.push([S.box[0] - Math.round(FS.LABEL_OVERHANG * u) - 1, S.box[3] + S.tick_len + 1, W, H]);
+    return out;
+  })();
+  let drawn = null;  // the dumbbells' boxes of the frame on the canvas
+  function restore(box) {
+    for (const p of panels()) {
+      const x0 = Math.max(box[0], p.src[0]), y0 = Math.max(box[1], p.src[1]);
+      const x1 = Math.min(box[2], p.src[2]), y1 = Math.min(box[3], p.src[3]);
+      if (!(x1 > x0 && y1 > y0)) continue;
+      const dx0 = Math.floor((x0 - p.src[0] + p.at[0]) * scale), dy0 = Math.floor((y0 - p.src[1] + p.at[1]) * scale);
+      const dx1 = Math.ceil((x1 - p.src[0] + p.at[0]) * scale), dy1 = Math.ceil((y1 - p.src[1] + p.at[1]) * scale);
+      ctx.drawImage(background, dx0, dy0, dx1 - dx0, dy1 - dy0, dx0, dy0, dx1 - dx0, dy1 - dy0);
+    }
+  }
+  function render(force) {
     const t0 = performance.now();
+    const sel = runs[state.run], j = nearest(sel, state.t), impact = j > 0 && impactSince(sel, j);
+    const boxes = runs.map(function (run, k) {
+      return k === state.run ? dumbbellBox(sel, j, impact) : dumbbellBox(run, nearest(run, state.t), false);
+    });
     ctx.setTransform(1, 0, 0, 1, 0, 0);
-    if (background) ctx.drawImage(background, 0, 0);
+    if (drawn === null || force) ctx.drawImage(background, 0, 0);
+    else for (const box of drawn.concat(boxes, FIXED)) if (box) restore(box);
+    drawn = boxes;
     for (const p of panels()) {
       ctx.setTransform(scale, 0, 0, scale, 0, 0);
       ctx.save();
       ctx.beginPath(); ctx.rect(p.at[0], p.at[1], p.src[2] - p.src[0], p.src[3] - p.src[1]); ctx.clip();
       ctx.translate(p.at[0] - p.src[0], p.at[1] - p.src[1]);
-      drawFrame(ctx);
+      for (let k = 0; k < runs.length; k++) {
+        if (k !== state.run) drawDumbbell(ctx, runs[k], nearest(runs[k], state.t), true, false);
+      }
+      drawDumbbell(ctx, sel, j, false, impact);
+      drawTime(ctx, sel, j);
+      drawBars(ctx, sel, j);
+      if (P.strip) drawStrip(ctx, sel, j, p);
       ctx.restore();
     }
     const ms = performance.now() - t0;
     stats.frames += 1; stats.drawMs.push(ms);
     if (stats.drawMs.length > 2000) stats.drawMs.shift();
-    showValues();
+    showValues(!state.playing);
   }
   function resize() {
     const stage = document.getElementById("stage");
@@ -435,7 +507,9 @@
       drawStatic(b);
       b.restore();
     }
-    render();
+    for (const run of runs) run.pieces = new Map();
+    drawn = null;
+    render(true);
   }
 
   // --- the controls and the table of values ----------------------------------------------------
@@ -478,10 +552,15 @@
       body.appendChild(tr);
     }
   })();
-  function showValues() {
+  let valuesAt = -Infinity;
+  // The time and the table: at once when paused, about ten times a second while playing.
+  function showValues(now) {
+    const clock = performance.now();
+    if (!now && clock - valuesAt < 100) return;
+    valuesAt = clock;
     const sel = runs[state.run], j = nearest(sel, state.t);
     timeText.textContent = "t = " + sel.t[j].toFixed(T_DECIMALS) + " " + DOC.units.time;
-    if (document.activeElement !== slider || !state.playing) slider.value = String(state.t);
+    slider.value = String(state.t);
     for (const [td, k, key] of cells) {
       const run = runs[k], i = nearest(run, state.t);
       const text = key === "t" ? run.t[i].toFixed(T_DECIMALS) : key === "L_cm" ? (run.L ? fixed(run.L[i], 4, "+") : "") : energyText(run.E[key][i]);
@@ -516,7 +595,9 @@
     requestAnimationFrame(tick);
   }
   function pause() {
+    const was = state.playing;
     state.playing = false; playButton.textContent = "Play"; playButton.setAttribute("aria-pressed", "false");
+    if (was) showValues(true);
   }
   function toggle() { if (state.playing) pause(); else play(); }
   function tick(now) {
@@ -538,7 +619,7 @@
   slider.addEventListener("input", function () { seek(parseFloat(slider.value)); });
   $("speed").addEventListener("change", function (e) { state.speed = parseFloat(e.target.value); });
   $("loop").addEventListener("change", function (e) { state.loop = e.target.checked; });
-  runSelect.addEventListener("change", function (e) { state.run = parseInt(e.target.value, 10); render(); });
+  runSelect.addEventListener("change", function (e) { state.run = parseInt(e.target.value, 10); render(true); });
   document.addEventListener("keydown", function (e) {
     if (e.altKey || e.ctrlKey || e.metaKey) return;
     const tag = e.target && e.target.tagName;
@@ -582,7 +663,7 @@
           if (state.last !== null) state.t = (state.t + (now - state.last) / 1000 * state.speed) % Math.max(T_END, 1e-9);
           state.last = now; render(); n += 1;
           if (now - first < seconds * 1000) { requestAnimationFrame(step); return; }
-          state.playing = false;
+          state.playing = false; showValues(true);
           const d = stats.drawMs.slice().sort(function (a, b) { return a - b; });
           resolve({ frames: n, seconds: (now - first) / 1000, fps: (n - 1) / ((now - first) / 1000),
             meanDrawMs: d.reduce(function (a, b) { return a + b; }, 0) / d.length,
