@@ -304,8 +304,9 @@ def _check_path(path: Any) -> Path:
         raise UsageError(f"path = {shown}: a path cannot hold a NUL character", param="path")
     path = args.path(path, "path")
     suffix = path.suffix.lower()
-    if suffix not in (".gif", ".mp4"):
-        raise UsageError(f"path {args.show(str(path))}: must end in .gif or .mp4", param="path")
+    if suffix not in (".gif", ".mp4", ".html", ".htm"):
+        raise UsageError(f"path {args.show(str(path))}: must end in .gif, .mp4 or .html (the "
+                         "interactive player)", param="path")
     check_writable(path, "path")
     if suffix == ".mp4" and (problem := mp4_problem()) is not None:
         raise UsageError(f"path {args.show(str(path))}: {problem}", param="path")
