@@ -291,3 +291,81 @@ def test_a_notebook_shows_the_player_in_a_frame_of_its_own(textbook_run):
     shown = p._repr_html_()
     assert shown.startswith("<iframe srcdoc=\"") and "<script" not in shown
     assert re.search(r"Player: [\d,]+ bytes", repr(p))
+
+
+# --- a recorded pymunk space --------------------------------------------------------------------
+
+
+def _space_recording(path, title="", units=("m", "kg", "s"), frames=30):
+    """A ball falling onto a floor, a box on a spring: a circle, a polygon, a segment and a
+    spring, recorded through ``path`` (its suffix chooses the file)."""
+    import pymunk
+
+    from dumbbell import spaces
+
+    space = pymunk.Space()
+    space.gravity = (0, -9.8)
+    ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    ball.position = (0.8, 0.5)
+    box = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (0.2, 0.2)))
+    box.position = (-0.6, 0.3)
+    space.add(ball, pymunk.Circle(ball, 0.1), box, pymunk.Poly.create_box(box, (0.2, 0.2)),
+              pymunk.Segment(space.static_body, (-1, -0.5), (1.5, -0.5), 0.02),
+              pymunk.DampedSpring(space.static_body, box, (-0.6, 0.8), (0, 0), 0.3, 50.0, 0.0))
+    with spaces.Recorder(space, path, title=title, units=units) as rec:
+        for _ in range(frames):
+            spaces.step(space, 1 / 25, substeps=20)
+            rec.capture()
+    return rec
+
+
+def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium, tmp_path):
+    """Recorder(space, 'x.html'): the page loads offline and clean; at frame k's time the
+    table shows the recording's values with the bars' decimals, and the ball is drawn within
+    2 px of where the recording's GIF painter draws it in frame k."""
+    from dumbbell.animation import recording as R
+    from dumbbell.animation.palette import blend
+
+    path = tmp_path / "space.html"
+    rec = _space_recording(path)
+    r = rec.recording()
+    painter = R.Painter(r)
+    o = B.open_player(chromium, path)
+    try:
+        assert o.console == [] and o.refused == [] and o.requests == [o.url]
+        fill = np.array(blend(R.BODY_INKS[0], 0.33))
+        gif_frames = [np.asarray(painter.frame(k).convert("RGB")) for k in range(r.n)]
+        for k in (0, 9, 21):
+            before = o.shown()
+            o.page.evaluate(f"window.dumbbellPlayer.seek({r.t[k]})")
+            if k:
+                o.wait_shown(before)
+            table = o.table()
+            for name in r.energy:
+                assert table[(0, name)] == painter.scale.text(float(r.energy[name][k])), (k, name)
+            shot = tmp_path / f"space-{k}.png"
+            o.page.locator("#view").screenshot(path=str(shot))
+            page_rgb = np.asarray(Image.open(shot).convert("RGB"))
+            factor = page_rgb.shape[1] / r.size[0]
+            want = _centre(gif_frames[k][:, :painter.scene_w], fill)
+            got = _centre(page_rgb[:, :round(painter.scene_w * factor)], fill) / factor
+            assert np.hypot(*(got - want)) <= 2.0, (k, got, want)
+        assert o.console == []
+    finally:
+        o.page.close()
+
+
+def test_a_hostile_title_or_unit_of_a_recording_is_text(chromium, tmp_path):
+    evil = '</script><img src=x onerror="window.__pwned=1">"\'&\u2028' + "very long " * 300
+    path = tmp_path / "evil-space.html"
+    _space_recording(path, title=evil, units=("<i>m</i>", "kg", "s"), frames=5)
+    o = B.open_player(chromium, path)
+    try:
+        assert o.page.evaluate("window.__pwned") is None
+        assert o.page.evaluate("document.getElementById('title').textContent") == evil
+        heads = o.page.eval_on_selector_all("#readout tbody th", "t => t.map(x => x.textContent)")
+        assert any("<i>m</i>" in h for h in heads)
+        assert o.page.evaluate("document.querySelectorAll('#player img, #player i').length") == 0
+        assert o.console == [] and o.refused == [] and o.requests == [o.url]
+    finally:
+        o.page.close()
