@@ -9,9 +9,12 @@
    5 MB for 300 bodies.
 2. **Drawing**: each page opened in headless Chromium (Debian's, through Playwright), played
    for ``--seconds`` from the start; the page itself counts the frames it drew per second
-   (requestAnimationFrame) and times each drawing (performance.now() around the draw). The
-   frame rate is capped by the display's refresh (60 Hz in headless Chromium): at least 60
-   for the scenes, at least 30 for 1,000 bodies.
+   (requestAnimationFrame), how many of them showed a new picture (a recording's frames are
+   1/25 s apart: a frame of the display that shows the same samples is not drawn again) and
+   times each drawing (performance.now() around the draw). The frame rate is capped by the
+   display's refresh (60 Hz in headless Chromium): at least 60 for the scenes, at least 30
+   for 1,000 bodies. A first row measures the browser's own pace on the machine at that
+   moment: a page that only fills a canvas of the same size each frame.
 3. **Writing**: the player and the GIF of the same run, written in this one process,
    alternately, ``--rounds`` times; the minimum of each, and their ratio.
 
@@ -46,9 +49,9 @@ def scene_run(name: str):
     return gif_trajectory(scene, gif.fps, gif.t_end), gif.t_end
 
 
-def recording(bodies: int, path: Path, seconds: float = 10.0) -> float:
+def recording(bodies: int, path: Path, seconds: float = 10.0):
     """Record ``bodies`` circles falling into a box for ``seconds`` at 25 fps to ``path``
-    (the page, or a GIF by its suffix); returns the seconds the file took to write."""
+    (the page, or a GIF by its suffix); returns the recorder."""
     import pymunk
 
     from dumbbell import spaces
@@ -73,8 +76,24 @@ def recording(bodies: int, path: Path, seconds: float = 10.0) -> float:
             for _ in range(4):
                 space.step(1 / FPS / 4)
             rec.capture()
-        t0 = time.perf_counter()
-    return time.perf_counter() - t0
+    return rec
+
+
+BASELINE = """<!DOCTYPE html><canvas id=c width=906 height=510></canvas><script>
+const c = document.getElementById("c").getContext("2d", {alpha: false});
+function measure(seconds) { return new Promise(function (resolve) {
+  let n = 0, first = null; const ms = [];
+  function step(now) {
+    const t0 = performance.now(); c.fillStyle = n % 2 ? "#fff" : "#eee"; c.fillRect(0, 0, 906, 510);
+    ms.push(performance.now() - t0); if (first === null) first = now; n += 1;
+    if (now - first < seconds * 1000) { requestAnimationFrame(step); return; }
+    ms.sort(function (a, b) { return a - b; });
+    resolve({frames: n, fps: (n - 1) / ((now - first) / 1000),
+             meanDrawMs: ms.reduce(function (a, b) { return a + b; }, 0) / ms.length,
+             p95DrawMs: ms[Math.floor(0.95 * (ms.length - 1))]});
+  }
+  requestAnimationFrame(step); }); }
+</script>"""
 
 
 def measure_pages(paths: dict[str, Path], seconds: float) -> dict[str, dict]:
@@ -86,6 +105,12 @@ def measure_pages(paths: dict[str, Path], seconds: float) -> dict[str, dict]:
         return {}
     out = {}
     with browser.launched() as b:
+        # The browser's own pace on this machine now: a page that fills a canvas of the
+        # same size each frame and draws nothing else.
+        blank = b.new_page(viewport={"width": 1280, "height": 720})
+        blank.set_content(BASELINE)
+        out["baseline: a canvas filled each frame"] = blank.evaluate(f"measure({seconds})")
+        blank.close()
         for name, path in paths.items():
             opened = browser.open_player(b, path)
             out[name] = opened.page.evaluate(f"window.dumbbellPlayer.measure({seconds})")
@@ -114,27 +139,26 @@ def main() -> None:
         pages[name] = player(traj).save(tmp / f"{name}.html")
         budget = 1.0 if name == "textbook-1d" else 1.5
         print(f"| {name} | {t_end:g} | {pages[name].stat().st_size / 1e6:.3f} | {budget} |")
+    recorders = {}
     for n in a.bodies:
         path = tmp / f"bodies-{n}.html"
-        try:
-            recording(n, path)
-        except Exception as exc:  # noqa: BLE001 - report what could not be measured
-            print(f"| {n} bodies | 10 | not written: {exc} | |")
-            continue
+        recorders[n] = recording(n, path)
         pages[f"{n} bodies"] = path
         print(f"| {n} bodies (recording) | 10 | {path.stat().st_size / 1e6:.3f} | "
               f"{'5' if n <= 300 else '-'} |")
 
     print(f"\nDrawing in headless Chromium, {a.seconds:g} s of play each (measured in the page)")
-    print("| page | frames drawn per second | mean draw (ms) | 95th percentile (ms) |")
-    print("|---|---|---|---|")
+    print("| page | frames per second (requestAnimationFrame) | new pictures drawn per "
+          "second | mean draw (ms) | 95th percentile (ms) |")
+    print("|---|---|---|---|---|")
     for name, m in measure_pages(pages, a.seconds).items():
-        print(f"| {name} | {m['fps']:.1f} | {m['meanDrawMs']:.2f} | {m['p95DrawMs']:.2f} |"
-              + (f" console: {m['console']}" if "console" in m else ""))
+        drawn = f"{m['drawnPerSecond']:.1f}" if "drawnPerSecond" in m else "-"
+        print(f"| {name} | {m['fps']:.1f} | {drawn} | {m['meanDrawMs']:.2f} | "
+              f"{m['p95DrawMs']:.2f} |" + (f" console: {m['console']}" if "console" in m else ""))
 
     print(f"\nWriting the player against the GIF of the same run, {a.rounds} rounds "
           "alternately, in this process (minimum of each)")
-    print("| scene | player (s) | GIF (s) | player / GIF |\n|---|---|---|---|")
+    print("| run | player (s) | GIF (s) | player / GIF |\n|---|---|---|---|")
     for name in ("textbook-1d", "tilted-2d"):
         traj, t_end = runs[name]
         tp, tg = [], []
@@ -146,6 +170,20 @@ def main() -> None:
             render_gif(traj, tmp / "w.gif", quiet=True, t_end=t_end)
             tg.append(time.perf_counter() - t0)
         print(f"| {name} | {min(tp):.3f} | {min(tg):.3f} | {min(tp) / min(tg):.3f} |")
+    from dumbbell.animation import recording as R
+
+    for n, rec in recorders.items():
+        r = rec.recording()
+        tp, tg = [], []
+        for _ in range(a.rounds):
+            t0 = time.perf_counter()
+            R.write(tmp / "w.html", r)
+            tp.append(time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            R.write(tmp / "w.gif", r)
+            tg.append(time.perf_counter() - t0)
+        print(f"| {n} bodies (recording) | {min(tp):.3f} | {min(tg):.3f} | "
+              f"{min(tp) / min(tg):.3f} |")
     print(f"\nload average at end: {os.getloadavg()[0]:.2f}")
 
 

@@ -548,9 +548,35 @@
       }
     }
     function statics(c, k) { for (const it of P.statics[P.static_of[k]] || []) item(c, view(k), it); }
+    // Many circles (as many as the GIF draws flat): one path per colour, not one per circle.
+    function manyCircles(c, g, v, base) {
+      const fills = {}, lines = {};
+      for (let j = 0; j < g.kind.length; j++) {
+        if (g.kind[j] !== "circle") continue;
+        const o = base + 3 * g.body[j], a = poses[o + 2], s0 = g.start[j];
+        const lx = g.local[s0], ly = g.local[s0 + 1], cos = Math.cos(a), sin = Math.sin(a);
+        const p = toPx(v, poses[o] + cos * lx - sin * ly, poses[o + 1] + sin * lx + cos * ly);
+        const R = Math.max(g.r[j] * v[0], 1.5 * u);
+        if (!(isFinite(p[0]) && isFinite(p[1]) && isFinite(R))) continue;
+        const key = g.ink[j];
+        const f = fills[key] || (fills[key] = new Path2D()), l = lines[key] || (lines[key] = new Path2D());
+        const r = Math.max(0.1, R - LW / 2);
+        f.moveTo(p[0] + r, p[1]); f.arc(p[0], p[1], r, 0, 2 * Math.PI);
+        l.moveTo(p[0] + r, p[1]); l.arc(p[0], p[1], r, 0, 2 * Math.PI);
+        if (isFinite(a)) { l.moveTo(p[0], p[1]); l.lineTo(p[0] + R * Math.cos(a), p[1] + v[3] * R * Math.sin(a)); }
+      }
+      c.lineWidth = LW;
+      for (const key in fills) {
+        const colours = colourOf(Number(key));
+        c.fillStyle = colours[1]; c.fill(fills[key]); c.strokeStyle = colours[0]; c.stroke(lines[key]);
+      }
+    }
     function moving(c, k) {
       const g = sets[P.shape_of[k]], v = view(k), base = offsets[k], pts = [];
+      const many = g.kind.length >= P.factors.FLAT_MANY;
+      if (many) manyCircles(c, g, v, base);
       for (let j = 0; j < g.kind.length; j++) {
+        if (many && g.kind[j] === "circle") continue;
         const o = base + 3 * g.body[j], x = poses[o], y = poses[o + 1], a = poses[o + 2];
         const cos = Math.cos(a), sin = Math.sin(a), s0 = g.start[j], m = g.npts[j];
         const colours = colourOf(g.ink[j]);
@@ -671,7 +697,11 @@
       ctx.drawImage(background, dx0, dy0, dx1 - dx0, dy1 - dy0, dx0, dy0, dx1 - dx0, dy1 - dy0);
     }
   }
+  let shownKey = null;  // the samples the canvas shows: a frame that shows the same is not drawn again
   function render(force) {
+    const key = state.run + ":" + runs.map(function (r) { return nearest(r, state.t); }).join(",");
+    if (!force && key === shownKey && drawn !== null) { showValues(!state.playing); return; }
+    shownKey = key;
     const t0 = performance.now();
     const boxes = drawer.boxes();
     ctx.setTransform(1, 0, 0, 1, 0, 0);
@@ -863,7 +893,7 @@
     measure: function (seconds) {
       return new Promise(function (resolve) {
         pause(); seek(0); stats.drawMs = [];
-        let n = 0, first = null;
+        let n = 0, first = null, drawnBefore = stats.frames;
         state.playing = true; state.last = null; state.loop = true;
         function step(now) {
           if (first === null) first = now;
@@ -873,6 +903,7 @@
           state.playing = false; showValues(true);
           const d = stats.drawMs.slice().sort(function (a, b) { return a - b; });
           resolve({ frames: n, seconds: (now - first) / 1000, fps: (n - 1) / ((now - first) / 1000),
+            drawn: stats.frames - drawnBefore, drawnPerSecond: (stats.frames - drawnBefore) / ((now - first) / 1000),
             meanDrawMs: d.reduce(function (a, b) { return a + b; }, 0) / d.length,
             p95DrawMs: d[Math.min(d.length - 1, Math.floor(0.95 * d.length))] });
         }

@@ -376,7 +376,8 @@ def space_document(painter: Any) -> dict[str, Any]:
         "light": _hexrgb(R.LIGHT), "grey": _hexrgb(R.GREY), "grid": _hexrgb(R.GRID),
         "white": _hexrgb(R.WHITE),
         "factors": {"COILS": R.COILS, "SPRING_WIDTH": R.SPRING_WIDTH, "LEAD": R.LEAD,
-                    "SS": R.SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below()},
+                    "SS": R.SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
+                    "FLAT_MANY": R.FLAT_MANY},
         "label_box": list(painter.label_box), "colours": colours(),
     }
     if painter.energy:
