@@ -369,3 +369,43 @@ def test_a_hostile_title_or_unit_of_a_recording_is_text(chromium, tmp_path):
         assert o.console == [] and o.refused == [] and o.requests == [o.url]
     finally:
         o.page.close()
+
+
+# --- the command and the data, without a browser ------------------------------------------------
+
+
+def test_play_writes_one_page_and_refuses_bad_input_in_one_line(tmp_path, capsys):
+    from dumbbell.cli import main
+
+    scene = str(SCENES / "textbook-1d.toml")
+    out = tmp_path / "tb.html"
+    assert main(["play", scene, "--t-end", "0.5", "-o", str(out), "-q"]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("<!DOCTYPE html>") and 'name="generator" content="dumbbell player"' in text
+    assert "http://" not in text.split("<script>")[1] and "https://" not in text
+    two = tmp_path / "two.html"
+    assert main(["play", scene, "--t-end", "0.3", "--solvers", "euler-cromer", "exact",
+                 "-o", str(two), "-q"]) == 0
+    assert two.read_text(encoding="utf-8").count('"label":') == 2
+    capsys.readouterr()
+    for argv in (["-o", str(tmp_path / "x.gif")], ["--solvers", "nope", "-o", str(out)],
+                 ["--solvers", "exact", "exact", "-o", str(out)], ["--fps", "0"]):
+        try:
+            status = main(["play", scene, "--t-end", "0.2", "-q", *argv])
+        except SystemExit as exc:  # argparse's own refusals
+            status = exc.code
+        assert status == 2, argv
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1, (argv, err)
+    assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_long_run_is_thinned_keeping_the_frames_times(textbook_run):
+    from dumbbell.animation.player import run_of
+
+    run = run_of(textbook_run, ["E"], 2.0, "x", max_samples=300, fps=25)
+    assert len(run.t) <= 300
+    frame_times = np.arange(50) / 25
+    assert np.all(np.min(np.abs(run.t[:, None] - frame_times[None, :]), axis=0) < 1e-9)
+    kept = np.searchsorted(textbook_run.t, run.t)
+    assert np.array_equal(run.energy["E"], textbook_run["E"][kept])   # the run's own values
