@@ -450,11 +450,13 @@
     })();
     function frame(c, p) {
       const sel = runs[state.run], j = nearest(sel, state.t), impact = j > 0 && impactSince(sel, j);
+      c.save(); c.beginPath(); c.rect(0, 0, L.scene_w, H); c.clip();  // the scene panel's
       for (let k = 0; k < runs.length; k++) {
         if (k !== state.run) drawDumbbell(c, runs[k], nearest(runs[k], state.t), true, false);
       }
       drawDumbbell(c, sel, j, false, impact);
       drawTime(c, sel, j);
+      c.restore();
       drawBars(c, sel, j);
       if (P.strip) drawStrip(c, sel, j, p);
     }
