@@ -550,28 +550,45 @@
       }
     }
     function statics(c, k) { for (const it of P.statics[P.static_of[k]] || []) item(c, view(k), it); }
-    // Many circles (as many as the GIF draws flat): one path per colour, not one per circle.
+    // Many circles (as many as the GIF draws flat): each disc pasted from a picture of it
+    // drawn once per colour and size (in device pixels), the radius lines one path per colour.
+    const sprites = new Map();
+    function sprite(ink, R) {
+      const key = ink * 1e7 + Math.round(2 * R);
+      let sp = sprites.get(key);
+      if (!sp) {
+        const colours = colourOf(ink), half = Math.ceil((R + LW) * scale) + 1;
+        sp = document.createElement("canvas"); sp.width = sp.height = 2 * half;
+        const g = sp.getContext("2d");
+        g.setTransform(scale, 0, 0, scale, half, half);
+        g.beginPath(); g.arc(0, 0, Math.max(0.1, R - LW / 2), 0, 2 * Math.PI);
+        g.fillStyle = colours[1]; g.fill(); g.strokeStyle = colours[0]; g.lineWidth = LW; g.stroke();
+        sp.half = half;
+        if (sprites.size > 256) sprites.clear();
+        sprites.set(key, sp);
+      }
+      return sp;
+    }
     function manyCircles(c, g, v, base) {
-      const fills = {}, lines = {};
+      const lines = {}, m = c.getTransform();
+      c.save(); c.setTransform(1, 0, 0, 1, 0, 0);
       for (let j = 0; j < g.kind.length; j++) {
         if (g.kind[j] !== "circle") continue;
         const o = base + 3 * g.body[j], a = poses[o + 2], s0 = g.start[j];
         const lx = g.local[s0], ly = g.local[s0 + 1], cos = Math.cos(a), sin = Math.sin(a);
         const p = toPx(v, poses[o] + cos * lx - sin * ly, poses[o + 1] + sin * lx + cos * ly);
-        const R = Math.max(g.r[j] * v[0], 1.5 * u);
+        const R = Math.round(2 * Math.max(g.r[j] * v[0], 1.5 * u)) / 2;
         if (!(isFinite(p[0]) && isFinite(p[1]) && isFinite(R))) continue;
-        const key = g.ink[j];
-        const f = fills[key] || (fills[key] = new Path2D()), l = lines[key] || (lines[key] = new Path2D());
-        const r = Math.max(0.1, R - LW / 2);
-        f.moveTo(p[0] + r, p[1]); f.arc(p[0], p[1], r, 0, 2 * Math.PI);
-        l.moveTo(p[0] + r, p[1]); l.arc(p[0], p[1], r, 0, 2 * Math.PI);
-        if (isFinite(a)) { l.moveTo(p[0], p[1]); l.lineTo(p[0] + R * Math.cos(a), p[1] + v[3] * R * Math.sin(a)); }
+        const sp = sprite(g.ink[j], R);
+        c.drawImage(sp, Math.round(m.a * p[0] + m.e) - sp.half, Math.round(m.d * p[1] + m.f) - sp.half);
+        if (isFinite(a)) {
+          const l = lines[g.ink[j]] || (lines[g.ink[j]] = new Path2D());
+          l.moveTo(p[0], p[1]); l.lineTo(p[0] + R * Math.cos(a), p[1] + v[3] * R * Math.sin(a));
+        }
       }
+      c.restore();
       c.lineWidth = LW;
-      for (const key in fills) {
-        const colours = colourOf(Number(key));
-        c.fillStyle = colours[1]; c.fill(fills[key]); c.strokeStyle = colours[0]; c.stroke(lines[key]);
-      }
+      for (const key in lines) { c.strokeStyle = colourOf(Number(key))[0]; c.stroke(lines[key]); }
     }
     function moving(c, k) {
       const g = sets[P.shape_of[k]], v = view(k), base = offsets[k], pts = [];
@@ -683,7 +700,7 @@
     function rows() {
       return B ? B.rows.map(function (r) { return [r[0], B.labels[r[0]] + " (" + DOC.units.energy + ")", B.inks[r[0]]]; }) : [];
     }
-    return { drawStatic: drawStatic, frame: frame, boxes: boxes, rows: rows, reset: function () {} };
+    return { drawStatic: drawStatic, frame: frame, boxes: boxes, rows: rows, reset: function () { sprites.clear(); } };
   }
 
   const drawer = SPACE ? spaceDrawer() : sceneDrawer();
