@@ -142,15 +142,15 @@ def colours() -> dict[str, Any]:
     roles = {"white": P.WHITE, "black": P.BLACK, "ink": P.INK, "grey": P.GREY,
              "light": P.LIGHT, "floor": P.FLOOR, "spring": P.SPRING,
              "grid": strip_module.GRID, "impact": strip_module.IMPACT}
-    out: dict[str, Any] = {name: _hex(rgb) for name, rgb in roles.items()}
-    out["terms"] = {name: _hex(rgb) for name, rgb in P.TERM_RGB.items()}
-    out["tints"] = {name: _hex(P.blend(rgb, P.TINT)) for name, rgb in P.TERM_RGB.items()}
-    out["bands"] = {name: _hex(P.blend(rgb, strip_module.BAND_ALPHA))
+    out: dict[str, Any] = {name: hex_colour(rgb) for name, rgb in roles.items()}
+    out["terms"] = {name: hex_colour(rgb) for name, rgb in P.TERM_RGB.items()}
+    out["tints"] = {name: hex_colour(P.blend(rgb, P.TINT)) for name, rgb in P.TERM_RGB.items()}
+    out["bands"] = {name: hex_colour(P.blend(rgb, strip_module.BAND_ALPHA))
                     for name, rgb in P.TERM_RGB.items()}
     return out
 
 
-def _hex(rgb: tuple[int, int, int]) -> str:
+def hex_colour(rgb: tuple[int, int, int]) -> str:
     r, g, b = rgb
     return f"#{r:02x}{g:02x}{b:02x}"
 

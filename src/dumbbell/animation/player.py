@@ -91,7 +91,7 @@ class Player:
 # --- the data --------------------------------------------------------------------------------
 
 
-def _b64(values: np.ndarray, dtype: str) -> dict[str, Any]:
+def b64_array(values: np.ndarray, dtype: str) -> dict[str, Any]:
     """An array as base64 of its little-endian ``dtype`` ('f4' or 'f8') bytes."""
     data = np.ascontiguousarray(values, dtype=np.dtype(dtype).newbyteorder("<"))
     return {"dtype": dtype, "n": int(data.size), "data": base64.b64encode(data.tobytes()).decode()}
@@ -135,10 +135,10 @@ def exact_float32(values: np.ndarray, decimals: int) -> tuple[np.ndarray, bool]:
     return v32, False
 
 
-def _energy(values: np.ndarray, decimals: int) -> dict[str, Any]:
+def energy_array(values: np.ndarray, decimals: int) -> dict[str, Any]:
     """An energy column: float32 that prints as the float64 does, else float64."""
     v32, same = exact_float32(values, decimals)
-    return _b64(v32, "f4") if same else _b64(values, "f8")
+    return b64_array(v32, "f4") if same else b64_array(values, "f8")
 
 
 @dataclass(frozen=True)
@@ -160,10 +160,10 @@ class Run:
     def document(self, decimals: int) -> dict[str, Any]:
         """The run as plain data, its arrays base64 (energies printed with ``decimals``)."""
         return {
-            "label": self.label, "note": self.note, "t": _b64(self.t, "f8"),
-            "A": _b64(self.A, "f4"), "B": _b64(self.B, "f4"),
-            "energy": {name: _energy(v, decimals) for name, v in self.energy.items()},
-            "L_cm": None if self.L_cm is None else _energy(self.L_cm, 4),
+            "label": self.label, "note": self.note, "t": b64_array(self.t, "f8"),
+            "A": b64_array(self.A, "f4"), "B": b64_array(self.B, "f4"),
+            "energy": {name: energy_array(v, decimals) for name, v in self.energy.items()},
+            "L_cm": None if self.L_cm is None else energy_array(self.L_cm, 4),
             "impacts": [float(t) for t in self.impacts],
             "contacts": [[b, float(t0), float(t1)] for b, t0, t1 in self.contacts],
         }
@@ -322,120 +322,3 @@ def player(source: Any, *, fps: int | None = None, size: str | tuple[int, int] |
            "units": {"energy": "J", "time": "s", "L_cm": "kg m²/s"}}
     return Player(page(doc, scene.title or scene.name), (width, height))
 
-
-# --- a recorded pymunk space -------------------------------------------------------------------
-
-
-def space_document(painter: Any) -> dict[str, Any]:
-    """The page's data for a recorded space, from the painter of its GIF
-    (:class:`~.recording.Painter`): the frame's layout, the camera's views, the static and
-    moving shapes (each moving set in its bodies' coordinates, a pose per body and frame),
-    the constraints per frame, the energy rows with their labels, scale and values, and the
-    strip of the whole run. The page draws what the painter draws, from the painter's own
-    numbers."""
-    from . import recording as R
-    from .picture import colours
-
-    rec, u = painter.rec, painter.u
-    views: list[Any] = []
-    view_of = []
-    for v in painter.views:
-        if not views or views[-1] is not v:
-            views.append(v)
-        view_of.append(len(views) - 1)
-    shape_sets = []
-    for shapes in rec.shapes:
-        kinds = [""] * shapes.n
-        npts = [0] * shapes.n
-        local: list[list[float]] = [[] for _ in range(shapes.n)]
-        radius = [0.0] * shapes.n
-        for g in shapes.groups:
-            for i, j in enumerate(g.at.tolist()):
-                kinds[j], npts[j] = g.kind, int(g.local.shape[1])
-                local[j] = g.local[i].reshape(-1).tolist()
-                radius[j] = float(g.r[i])
-        shape_sets.append({"kind": kinds, "body": shapes.body.tolist(),
-                           "ink": shapes.ink.tolist(), "npts": npts,
-                           "local": _b64(np.array([c for pts in local for c in pts]), "f8"),
-                           "r": radius})
-    counts = [len(p) for p in rec.poses]
-    poses = np.concatenate([np.asarray(p, dtype=float).reshape(-1, 3) for p in rec.poses]
-                           + [np.zeros((0, 3))])
-    shape_colours = [[_hexrgb(out), _hexrgb(fill)] for out, fill in R.SHAPE_COLOURS]
-    doc: dict[str, Any] = {
-        "size": [painter.W, painter.H], "u": u, "title": rec.title,
-        "time_unit": rec.time_unit, "t_decimals": painter.t_decimals,
-        "scene_w": painter.scene_w, "area": list(painter.area),
-        "views": [[v.s, v.ox, v.oy, v.flip] for v in views], "view_of": view_of,
-        "statics": [[list(it) for it in items] for items in rec.statics],
-        "static_of": list(rec.static_of),
-        "shapes": shape_sets, "shape_of": list(rec.shape_of),
-        "counts": counts, "poses": _b64(poses, "f4"),
-        "extras": [[list(it) for it in items] for items in rec.extras],
-        "shape_colours": shape_colours, "spring": _hexrgb(R.SPRING), "ink": _hexrgb(R.INK),
-        "light": _hexrgb(R.LIGHT), "grey": _hexrgb(R.GREY), "grid": _hexrgb(R.GRID),
-        "white": _hexrgb(R.WHITE),
-        "factors": {"COILS": R.COILS, "SPRING_WIDTH": R.SPRING_WIDTH, "LEAD": R.LEAD,
-                    "SS": R.SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
-                    "FLAT_MANY": R.FLAT_MANY},
-        "label_box": list(painter.label_box), "colours": colours(),
-    }
-    if painter.energy:
-        labels = rec.labels or {}
-        doc["bars"] = {
-            "box": list(painter.bars_box), "rows": [list(r) for r in painter.rows],
-            "labels": {n: labels.get(n, n) for n in painter.names},
-            "title": rec.energy_title, "scale": {"lo": painter.scale.lo,
-                                                "hi": painter.scale.hi,
-                                                "decimals": painter.scale.decimals},
-            "left": painter.bar_left, "right": painter.bar_right, "zero": painter.bar_zero,
-            "px_per_j": painter.bar_scale, "heat": rec.heat,
-            "inks": {n: _hexrgb(R.TERM_INKS[n]) for n in painter.names},
-            "heat_ink": _hexrgb(R.blend(R.TERM_INKS["heat"], 0.6)),
-        }
-        if painter.strip:
-            from .glyphs import fmt_tick, nice_step
-
-            t0, end = float(painter.t[0]), float(painter.t[-1])
-            tstep = nice_step((end - t0) / 4) if end > t0 else 1.0
-            ticks = range(math.ceil(t0 / tstep - 1e-9), math.floor(end / tstep + 1e-9) + 1)
-            doc["strip"] = {"box": list(painter.strip_box), "pad": 3 * u, "t0": t0,
-                            "span": painter.t_end,
-                            "ticks": [[v, fmt_tick(v)] for v in painter.scale.ticks()],
-                            "time_ticks": [[k * tstep, fmt_tick(k * tstep)] for k in ticks]}
-    return doc
-
-
-def _hexrgb(rgb: tuple[int, int, int]) -> str:
-    r, g, b = rgb
-    return f"#{r:02x}{g:02x}{b:02x}"
-
-
-def _strip_future() -> float:
-    from .strip import FUTURE
-
-    return FUTURE
-
-
-def _stack_below() -> int:
-    from .picture import STACK_BELOW
-
-    return STACK_BELOW
-
-
-def space_page(painter: Any) -> str:
-    """The player page of a recorded space (see :func:`space_document`)."""
-    rec = painter.rec
-    decimals = painter.scale.decimals if painter.energy else 2
-    run = {"label": rec.title or "", "note": "", "t": _b64(np.asarray(painter.t), "f8"),
-           "energy": {name: _energy(painter.e[name], decimals) for name in painter.names}}
-    doc = {"kind": "space", "fps": rec.fps, "t_end": float(painter.t[-1]),
-           "picture": space_document(painter), "runs": [run],
-           "units": {"energy": _energy_unit(rec), "time": rec.time_unit, "L_cm": ""}}
-    return page(doc, rec.title or "pymunk space")
-
-
-def _energy_unit(rec: Any) -> str:
-    """The energy's unit, as the bars' title gives it in parentheses ('Energy (J)')."""
-    title = rec.energy_title or ""
-    return title[title.find("(") + 1:title.rfind(")")] if "(" in title and ")" in title else ""

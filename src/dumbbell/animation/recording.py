@@ -1430,20 +1430,15 @@ def _signals_end_cleanly() -> Iterator[None]:
 
 
 def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) -> Painter:
-    """Paint ``rec`` and write it to ``path`` (.gif, .mp4 through imageio's ffmpeg plugin,
-    or .html: the interactive player, :func:`~.player.space_page`), atomically; ``timing`` receives the seconds spent. Returns the painter (its ``view``)."""
+    """Paint ``rec`` and write it to ``path`` (.gif, or .mp4 through imageio's ffmpeg plugin),
+    atomically; ``timing`` receives the seconds spent. Returns the painter (its ``view``)."""
     t0 = time.perf_counter()
     painter = Painter(rec)
     stats = {"setup": time.perf_counter() - t0}
     with _signals_end_cleanly():
         if path.suffix.lower() == ".mp4":
             _write_mp4(path, painter, rec.fps)
-        elif path.suffix.lower() in (".html", ".htm"):
-            from .player import space_page
 
-            text = space_page(painter)
-            with atomic_output(path) as tmp:
-                Path(tmp).write_text(text, encoding="utf-8")
         else:
             with atomic_output(path) as tmp, open(tmp, "wb") as fh:
                 stats["draw"], stats["encode"] = write_frames(

@@ -664,7 +664,12 @@ class Recorder:
         if not self._captured:
             raise DumbbellError(f"{self.path}: no frames captured (call capture() after each "
                                 "frame's steps)")
-        painter = recording.write(self.path, self.recording(), self.timing)
+        if self.path.suffix.lower() in (".html", ".htm"):  # the interactive player
+            from ..animation import space_player
+
+            painter = space_player.write(self.path, self.recording(), self.timing)
+        else:
+            painter = recording.write(self.path, self.recording(), self.timing)
         x0, x1, y0, y1 = painter.view
         self.view = (x0, x1, y0, y1) if painter.rec.y_up else (x0, x1, y1, y0)
         return self.path
