@@ -171,13 +171,14 @@ def main() -> None:
             tg.append(time.perf_counter() - t0)
         print(f"| {name} | {min(tp):.3f} | {min(tg):.3f} | {min(tp) / min(tg):.3f} |")
     from dumbbell.animation import recording as R
+    from dumbbell.animation import space_player
 
     for n, rec in recorders.items():
         r = rec.recording()
         tp, tg = [], []
         for _ in range(a.rounds):
             t0 = time.perf_counter()
-            R.write(tmp / "w.html", r)
+            space_player.write(tmp / "w.html", r)
             tp.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             R.write(tmp / "w.gif", r)

@@ -18,6 +18,9 @@ energies as float32 chosen so that each prints with the bars' decimals exactly a
 float64 value does (:func:`exact_float32`): the bars read the same numbers as the CSV. The
 page needs no network: everything is in the one file, the script included.
 
+A recorded pymunk space gets the same page (``spaces.Recorder(space, "run.html")``), drawn
+from the recording painter's own numbers: :mod:`.space_player`.
+
 The JSON is embedded in a ``<script type="application/json">`` with ``<``, ``>``, ``&`` and
 every non-ASCII character escaped (so no text of a title or a name can end the script or
 be read as markup), and the page puts every text into the document as text (``textContent``)
