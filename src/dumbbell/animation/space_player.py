@@ -56,7 +56,13 @@ def space_document(painter: Any) -> dict[str, Any]:
             views.append(v)
         view_of.append(len(views) - 1)
     shape_sets = []
-    for shapes in rec.shapes:
+    for i, shapes in enumerate(rec.shapes):
+        # As the painter draws them: a painter that grows small bodies to a least size
+        # gives the shapes it draws through a view (Painter._shapes).
+        first = next((k for k, s in enumerate(rec.shape_of) if s == i), None)
+        drawn = getattr(painter, "_shapes", None)
+        if drawn is not None and first is not None:
+            shapes = drawn(i, painter.views[first])
         kinds = [""] * shapes.n
         npts = [0] * shapes.n
         local: list[list[float]] = [[] for _ in range(shapes.n)]
