@@ -65,7 +65,7 @@ def supported(version: str) -> bool:
 def check(version: str) -> None:
     """Nothing when pymunk ``version`` is supported, else :class:`PymunkVersionError`."""
     if not supported(version):
-        shown = version if release(version) is not None and len(version) <= 40 else (
+        shown = version.strip() if release(version) is not None and len(version) <= 40 else (
             repr(version) if len(repr(version)) <= 40 else repr(version)[:37] + "...")
         raise PymunkVersionError(f"pymunk {shown} is installed; dumbbell needs {RANGE}: "
                                  f"pip install '{RANGE}'", version=version, supported=RANGE)
