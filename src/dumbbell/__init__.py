@@ -23,7 +23,7 @@ _NAMES = {
     "sweep": "analysis.api",
     "Gif": "animation.render", "render_gif": "animation.render",
     "ColumnError": "errors", "DumbbellError": "errors", "MissingExtraError": "errors",
-    "SceneError": "errors", "UsageError": "errors",
+    "PymunkVersionError": "errors", "SceneError": "errors", "UsageError": "errors",
     "Scene": "model.scene", "load_scene": "model.scene",
     "Impact": "model.trajectory", "Trajectory": "model.trajectory", "Verdict": "model.trajectory",
     "simulate": "solvers",
@@ -35,9 +35,9 @@ SUBMODULES = ("analysis", "animation", "cli", "errors", "examples", "io", "model
 _getattr, _, _ = _attach(__name__, SUBMODULES, _NAMES)
 
 __all__ = [
-    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError",
-    "Trajectory", "UsageError", "Verdict", "available_solvers", "bench", "compare", "load_scene",
-    "render_gif", "simulate", "stability", "sweep",
+    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "PymunkVersionError",
+    "Scene", "SceneError", "Trajectory", "UsageError", "Verdict", "available_solvers", "bench",
+    "compare", "load_scene", "render_gif", "simulate", "stability", "sweep",
 ]
 
 
