@@ -100,6 +100,88 @@ def test_bad_arguments_are_one_clear_error(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("kw, param", [
+    ({"fps": 10**5000}, "fps"),
+    ({"fps": "9" * 100_000}, "fps"),
+    ({"fps": 51}, "fps"),
+    ({"size": (10**5000, 360)}, "size"),
+    ({"size": (640, -10**5000)}, "size"),
+    ({"size": ("9" * 100_000, 360)}, "size"),
+    ({"size": "9" * 100_000}, "size"),
+    ({"size": (640.0, 360.0)}, "size"),
+    ({"t0": 1e308}, "t0"),
+    ({"t0": -2e9}, "t0"),
+    ({"t0": 10**5000}, "t0"),
+    ({"t0": "9" * 100_000}, "t0"),
+])
+def test_huge_arguments_are_one_short_line_before_any_work(tmp_path, kw, param):
+    # Issue 30: fps=10**5000 and size=(10**5000, 360) raised ValueError from int -> str,
+    # fps='9' * 100000 gave a 100,000-character message.
+    with pytest.raises(UsageError) as info:
+        spaces.Recorder(_space(), tmp_path / "a.gif", **kw)
+    message = str(info.value)
+    assert message.startswith(param) and info.value.param == param
+    assert "\n" not in message and len(message) <= 250
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("t", [1e308, -1e308, 2e9, 10**5000, float("nan"), "1"],
+                         ids=["1e308", "-1e308", "2e9", "10**5000", "nan", "str"])
+def test_a_frame_time_beyond_what_a_label_shows_is_refused_and_the_recording_goes_on(
+        tmp_path, t):
+    # Issue 30: capture(t=1e308) raised OverflowError when the file was written.
+    space, _ = _ball()
+    with spaces.Recorder(space, tmp_path / "a.gif", energy=True) as rec:
+        space.step(0.04)
+        with pytest.raises(UsageError, match=r"^t = .{1,60}: must be a finite number from "
+                                             r"-1e\+09 to 1e\+09 \(s\)$"):
+            rec.capture(t=t)
+        rec.capture(t=1e9)  # the largest: its label fits
+        space.step(0.04)
+        rec.capture()
+    assert rec.times == (0.0, 1e9, 1e9 + 0.04)
+
+
+def test_a_long_time_label_is_drawn_whole_over_the_one_before(tmp_path, monkeypatch):
+    # Labels wider than the usual box (t near 1e9 with 5 decimals, a 12-character unit):
+    # the file is the one made of every frame drawn whole and compared whole.
+    from dumbbell.animation import recording
+
+    space, _ = _ball()
+    kw = {"energy": False, "units": ("m", "kg", "fortnights__"), "t0": 999_999_999.8}
+    with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
+        for k in range(1, 4):
+            space.step(0.04)
+            rec.capture(t=999_999_999.8 + k * 1e-5)  # "t = 999999999.80003 fortnights__"
+    whole = recording.Painter.frame
+
+    def from_nothing(self, k):
+        self._canvas = None
+        return whole(self, k)
+
+    monkeypatch.setattr(recording.Painter, "frame", from_nothing)
+    monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
+    recording.write(tmp_path / "b.gif", rec.recording())
+    assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+
+
+@pytest.mark.parametrize("name", ["a.gif/", "a.gif/.", "sub/a.gif/"])
+def test_a_path_naming_a_folder_is_refused(tmp_path, name):
+    # Issue 30: Recorder(s, "a.gif/") wrote a file named without the slash.
+    message = _refused(f"{tmp_path}/{name}", "names a folder")
+    assert name.rstrip("/.") in message
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", ["a" * 100_000 + ".gif", "a b " * 25_000 + ".gif",
+                                  "d/" * 30_000 + "a.gif"])
+def test_a_huge_path_is_echoed_clipped(tmp_path, name):
+    # Issue 30: a 100,000-character path gave a 100,000-character message.
+    message = _refused(f"{tmp_path}/{name}", ".")
+    assert len(message) <= 1000
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.skipif(importlib.util.find_spec("imageio_ffmpeg") is None,
                     reason="the [mp4] extra (imageio-ffmpeg) is not installed")
 def test_mp4_frame_count(tmp_path):

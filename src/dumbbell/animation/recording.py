@@ -989,7 +989,11 @@ class Painter(Backdrop):
         self.base = self._base()
         self._views()
         self.tx_time, self.tx_text = _Text(self.st_time), _Text(self.st_text)
-        self.label_box = (4 * u, 2 * u, 150 * u, 24 * u)
+        # The time label's box: wider when the longest label needs it (a large t0, a long
+        # time unit), so that each label is drawn over the whole of the one before.
+        longest = max((self._time_label(k) for k in range(self.n)), key=len, default="")
+        self.label_box = (4 * u, 2 * u, max(150 * u, self.st_time.width(longest) + 12 * u),
+                          24 * u)
         self._bg_key: tuple[int, int] | None = None
         self._layer: Layer | None = None
         self._canvas: Image.Image | None = None
@@ -1210,7 +1214,7 @@ class Painter(Backdrop):
         """Draw the time label if it changed or the scene was drawn over it; the box
         touched."""
         u, box = self.u, self.label_box
-        label = f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
+        label = self._time_label(k)
         if self._shown.get("label") == label and not any(_meets(r, box) for r in scene):
             return []
         self._shown["label"] = label
@@ -1222,6 +1226,9 @@ class Painter(Backdrop):
             self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), label, INK, "lt")
             done()
         return [box]
+
+    def _time_label(self, k: int) -> str:
+        return f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
 
     def _values_box(self) -> tuple[float, float, float, float]:
         """Where the bars' values are written (px)."""

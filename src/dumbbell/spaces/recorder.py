@@ -51,6 +51,9 @@ DELTA_LABELS = {"U_g": "ΔU_g", "U_spring": "ΔU_spring", "E": "K + ΔU"}
 SI = ("m", "kg", "s")
 #: Longest unit name.
 UNIT_CHARS = 12
+#: Largest magnitude of a frame's time (``t0``, ``capture(t=...)``; the space's time unit):
+#: its label, with two decimals or more, fits the frame.
+TIME_MAX = 1e9
 
 __all__ = ["PaletteDrawOptions", "Recorder", "draw_options"]  # noqa: F822 - see __getattr__
 
@@ -302,11 +305,18 @@ def _check_path(path: Any) -> Path:
     shown = args.show(path) if isinstance(path, str | os.PathLike) else None
     if shown is not None and "\0" in str(path):
         raise UsageError(f"path = {shown}: a path cannot hold a NUL character", param="path")
+    text = path
     path = args.path(path, "path")
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise UsageError(f"path {args.show(str(path))}: must end in .gif or .mp4", param="path")
-    check_writable(path, "path")
+    try:
+        # As spelt (a Path drops a final '/': 'a.gif/' names a folder, not a file).
+        check_writable(text, "path")
+    except UsageError as exc:
+        from ..cli.app import clip  # its echo of the path, bounded
+
+        raise UsageError(clip(exc.reason), param="path") from None
     if suffix == ".mp4" and (problem := mp4_problem()) is not None:
         raise UsageError(f"path {args.show(str(path))}: {problem}", param="path")
     if not is_special(path):
@@ -456,7 +466,7 @@ class Recorder:
                              "of them", param="y_up")
         self.units = _check_units(units)
         self.reference = _check_reference(reference)
-        self.t0 = args.real(t0, "t0", self.units[2], positive=False)
+        self.t0 = args.real(t0, "t0", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         self.title = args.text(title, "title", "a str (written at the top)")
         self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
@@ -525,7 +535,7 @@ class Recorder:
 
         previous = self.t[-1]
         if t is not None:
-            t = args.real(t, "t", self.units[2], positive=False)
+            t = args.real(t, "t", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         first = not self._captured and not self._stepped
         if t is not None and not first and not t >= previous:
             raise UsageError(f"t = {t:g}: must be at least the previous frame's time "
