@@ -97,6 +97,12 @@ NEAR = 0.25
 MIN_SIZE = 4.0
 #: ... with this margin (a share of its span) on each side.
 PAD = 0.05
+#: Every moving body is drawn at least this many px across (its larger side, whichever
+#: way it turns; times the frame's size unit when larger than 640x360), larger than to scale
+#: if need be (the recorder's note names those), ...
+BODY_PX = 4.0
+#: ... measured on its box turned this many times in a quarter turn.
+TURNS = 16
 #: A spring's zig-zag: its coils, and its half-width at most (px at 640x360).
 COILS, SPRING_WIDTH = 9, 5.0
 #: Pixel coordinates are clipped to this far outside the frame (px) before drawing.
@@ -189,6 +195,65 @@ class Shapes:
             out[..., g.at, 2] = pts[..., 1].min(axis=-1) - r
             out[..., g.at, 3] = pts[..., 1].max(axis=-1) + r
         return out
+
+    @functools.cached_property
+    def least(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per body row: how small the body can look, the least over its turns of the larger
+        side of its shapes' box (world units; nan for a row without shapes), and the middle
+        of that box in the body's coordinates (rows x 2)."""
+        rows = int(self.body.max()) + 1 if self.n else 0
+        a = np.arange(TURNS) * (math.pi / 2 / TURNS)  # the box repeats every quarter turn
+        c, s = np.cos(a), np.sin(a)
+        # Each shape's extent along x and y turned by each angle (n x 2 x turns) ...
+        lo = np.full((self.n, 2, TURNS), math.inf)
+        hi = np.full((self.n, 2, TURNS), -math.inf)
+        for g in self.groups:
+            if not g.local.shape[1]:
+                continue
+            x, y = g.local[..., 0, None], g.local[..., 1, None]  # m x p x 1
+            r = g.r[:, None, None]
+            along = np.stack([x * c + y * s, y * c - x * s], axis=2)  # m x p x 2 x turns
+            lo[g.at], hi[g.at] = along.min(axis=1) - r, along.max(axis=1) + r
+        # ... then each body's (its shapes together).
+        order = np.argsort(self.body, kind="stable")
+        starts = np.flatnonzero(np.r_[True, np.diff(self.body[order]) != 0]) if self.n else order
+        body_lo, body_hi = np.full((rows, 2, TURNS), math.inf), np.full((rows, 2, TURNS), -math.inf)
+        if self.n:
+            at = self.body[order][starts]
+            body_lo[at] = np.minimum.reduceat(lo[order], starts, axis=0)
+            body_hi[at] = np.maximum.reduceat(hi[order], starts, axis=0)
+        with np.errstate(invalid="ignore"):
+            # (Between two of the turns measured the side can be at most this much smaller.)
+            side = (body_hi - body_lo).max(axis=1).min(axis=1) * math.cos(math.pi / 4 / TURNS)
+            middle = (body_lo[:, :, 0] + body_hi[:, :, 0]) / 2
+        side[~(side >= 0)] = math.nan
+        return side, middle
+
+    def at_least(self, s: float, px: float) -> tuple[Shapes, np.ndarray]:
+        """The shapes drawn at ``s`` px per unit with every body at least ``px`` px across
+        whichever way it turns (its larger side): a body that would be drawn smaller is
+        drawn larger than to scale, its shapes grown about the middle of their box. Returns
+        the shapes to draw (these, when none is grown) and the numbers of the moving bodies
+        grown."""
+        side, middle = self.least
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            # (A body exactly px across, as a view made for it draws it, is not grown.)
+            grow = np.where(side * s < px * (1 - 1e-9), px / (side * s), 1.0)
+        grow[~np.isfinite(grow) | (side <= 0)] = 1.0  # nothing to grow (no size, no shapes)
+        if not (grow > 1).any():
+            return self, np.zeros(0, dtype=int)
+        groups = []
+        for g in self.groups:
+            f = grow[g.rows]
+            if not (f > 1).any():
+                groups.append(g)
+                continue
+            m = middle[g.rows][:, None, :]
+            local = m + f[:, None, None] * (g.local - m)
+            groups.append(Group(g.kind, g.at, local, g.r * f, g.rows,
+                                bool(local.shape[1]) and not local.any()))
+        grown = np.unique(self.number[(grow[self.body] > 1) & (self.number >= 0)])
+        return Shapes(self.body, self.ink, self.number, tuple(groups)), grown
 
     def items(self, pose: np.ndarray) -> list[tuple]:
         """The shapes at ``pose`` as primitives (see the module docstring), in order."""
@@ -889,9 +954,10 @@ class Layer:
     there is drawn as it was)."""
 
     def __init__(self, rec: Recording, k: int, view: View, u: float,
-                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None
-                 ) -> None:
-        self.px = Pixels(rec.shapes[rec.shape_of[k]], rec.poses[k], rec.extras[k], view, u)
+                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None,
+                 shapes: Shapes | None = None) -> None:
+        shapes = rec.shapes[rec.shape_of[k]] if shapes is None else shapes
+        self.px = Pixels(shapes, rec.poses[k], rec.extras[k], view, u)
         self.panel = panel
         box = self.px.box
         self.box = self._clipped(box) if box is not None else None
@@ -987,6 +1053,7 @@ class Painter(Backdrop):
         if self.energy:
             self._energy_scale()
         self.base = self._base()
+        self.body_px = BODY_PX * max(1.0, u)
         self._views()
         self.tx_time, self.tx_text = _Text(self.st_time), _Text(self.st_text)
         # The time label's box: wider when the longest label needs it (a large t0, a long
@@ -1000,6 +1067,14 @@ class Painter(Backdrop):
         self._shown: dict[str, Any] = {}
         self._flat: dict[tuple[int, int], bool] = {}
         self.changed: tuple[float, float, float, float] | None = None
+        # The shapes drawn, each body at least BODY_PX across, per set of shapes and scale.
+        self._drawn: dict[tuple[int, float], Shapes] = {}
+        #: Numbers of the moving bodies drawn larger than to scale (to be body_px across).
+        self.grown: set[int] = set()
+        # Per moving body's number: in how many frames it is, and is in the picture.
+        bodies = max((int(sh.number.max()) + 1 for sh in rec.shapes if sh.n), default=0)
+        self.frames_in = np.zeros(bodies, dtype=np.int64)
+        self.frames_shown = np.zeros(bodies, dtype=np.int64)
 
     # --- geometry -----------------------------------------------------------------------
 
@@ -1157,7 +1232,9 @@ class Painter(Backdrop):
         when theirs changed."""
         fresh = self.background(k)
         view = self.views[k]
-        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat)
+        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat,
+                      self._shapes(self.rec.shape_of[k], view))
+        self._count(layer)
         touched: list[tuple[float, float, float, float]] | None = []
         if fresh or self._canvas is None or self._layer is None:
             self._canvas, self._shown, touched = self.bg.copy(), {}, None
@@ -1198,6 +1275,30 @@ class Painter(Backdrop):
             touched += parts
             self.changed = _union_px(touched) if touched else (0.0, 0.0, 0.0, 0.0)
         return img
+
+    def _shapes(self, i: int, view: View) -> Shapes:
+        """Set ``i`` of moving shapes as drawn through ``view``: each body at least
+        :attr:`body_px` across (:meth:`Shapes.at_least`); the same object for the same set
+        and scale, so that frames compare their pixels."""
+        key = (i, view.s)
+        got = self._drawn.get(key)
+        if got is None:
+            got, grown = self.rec.shapes[i].at_least(view.s, self.body_px)
+            self._drawn[key] = got
+            self.grown.update(grown.tolist())
+        return got
+
+    def _count(self, layer: Layer) -> None:
+        """Count the moving bodies of a frame, and those it shows (a shape of theirs drawn
+        on the scene panel)."""
+        px, n = layer.px, layer.px.n_shapes
+        if not n or not len(self.frames_in):
+            return
+        number = px.shapes.number  # type: ignore[union-attr]
+        mine = number >= 0
+        shown = px.within((0.0, 0.0, float(self.scene_w), float(self.H)))[:n] & mine
+        self.frames_in += np.bincount(number[mine], minlength=len(self.frames_in)) > 0
+        self.frames_shown += np.bincount(number[shown], minlength=len(self.frames_in)) > 0
 
     def _restore(self, box: tuple[float, float, float, float]) -> tuple[int, int, int, int]:
         """Put the background back over the whole pixels that cover ``box`` (px); returns
