@@ -23,14 +23,22 @@ the positions of every moving element (each moving body's shapes, and each const
 holds one, static anchors included) at every frame, and keeps those whose centre lies within
 :data:`FENCE` interquartile ranges of the middle half of all centres along x and along y
 (Tukey's far-out fences; the range is the larger of x's and y's, and at least the median
-element's size), and every element of the first frame. The view holds the kept elements: a body that flies away (or strays for a small
-share of the time) leaves the picture instead of shrinking everything else. Static shapes
-within :data:`NEAR` of that box (a share of its size along each axis) are added, a floor under
-the bodies say; one that runs past the near zone on both sides along an axis (a long floor, a
-tall wall) does not widen the view along it. The box is at least :data:`MIN_SIZE` times the
-median element's size, padded by :data:`PAD` and fitted to the scene panel. ``"all"`` shows
-everything ever captured, static shapes included; a fixed box is the user's; ``"follow"``
-keeps one body at the centre of a view of fixed size.
+element's size), and every element of the first frame. The box of the kept elements, at
+least :data:`MIN_SIZE` times the median element's size, is where the bodies move: a body
+that flies away (or strays for a small share of the time) leaves the picture instead of
+shrinking everything else. Static shapes within :data:`NEAR` of that box (a share of its
+size along each axis) are shown too, a floor under the bodies say (one that runs past the
+near zone on both sides along an axis, a long floor or a tall wall, does not widen the view
+along it), as long as that leaves every moving body at least :data:`BODY_PX` across to
+scale; else the view widens only that far (not at all if the bodies' box alone is too
+large), placed to hold as much of them as it can: static shapes never shrink a body below
+:data:`BODY_PX`, and those farther away never count. The box is padded by :data:`PAD` and
+fitted to the scene panel. ``"all"`` shows everything ever captured, static shapes included;
+a fixed box is the user's; ``"follow"`` keeps one body at the centre of a view of fixed size.
+
+**Sizes.** Whatever the view, every moving body is drawn at least :data:`BODY_PX` across
+whichever way it turns (:meth:`Shapes.at_least`): a smaller one is drawn larger than to
+scale, and the painter says which (``Painter.grown``, named in the recorder's note).
 """
 
 from __future__ import annotations
@@ -91,7 +99,8 @@ ROW_MAX = 26
 #: The camera: a moving body's position counts unless it lies more than this many
 #: interquartile ranges beyond the middle half of all positions (Tukey's far-out fences) ...
 FENCE = 3.0
-#: ... static shapes this near the bodies' box (a share of its size along each axis) count ...
+#: ... static shapes this near the bodies' box (a share of its size along each axis) are
+#: shown where the view has room for them, never by widening it ...
 NEAR = 0.25
 #: ... the view is at least this many times the median body's size ...
 MIN_SIZE = 4.0
@@ -398,12 +407,16 @@ def static_boxes(statics: tuple[tuple[tuple, ...], ...]) -> np.ndarray:
     return _finite(np.array(boxes, dtype=float).reshape(-1, 4))
 
 
-def auto_box(rec: Recording) -> Box:
-    """The automatic camera's world box (see the module's docstring for the rule)."""
+def auto_boxes(rec: Recording) -> tuple[Box, Box]:
+    """The automatic camera's boxes (see the module's docstring for the rule): where the
+    bodies move (dynamic and kinematic, with their constraints), which the view holds at
+    its scale; and that box with the static shapes near it, which the view holds where it
+    has room."""
     moving, where = element_boxes(rec)
     fixed = static_boxes(rec.statics)
     if not len(moving):
-        return _union(fixed) or (-1.0, 1.0, -1.0, 1.0)
+        box = _union(fixed) or (-1.0, 1.0, -1.0, 1.0)
+        return box, box
     size = np.maximum(moving[:, 1] - moving[:, 0], moving[:, 3] - moving[:, 2])
     size = size[size > 0]
     # The median (as np.median, which would import numpy.ma).
@@ -422,7 +435,8 @@ def auto_box(rec: Recording) -> Box:
     if not max(x1 - x0, y1 - y0) > 0:
         # Only points move (pivots of bodies without shapes): show the static shapes, or
         # one unit around them.
-        return _union(fixed) or (x0 - 0.5, x1 + 0.5, y0 - 0.5, y1 + 0.5)
+        box = _union(fixed) or (x0 - 0.5, x1 + 0.5, y0 - 0.5, y1 + 0.5)
+        return box, box
     nx, ny = NEAR * (x1 - x0), NEAR * (y1 - y0)
     ex0, ex1, ey0, ey1 = x0 - nx, x1 + nx, y0 - ny, y1 + ny
     bx0, bx1, by0, by1 = x0, x1, y0, y1
@@ -430,12 +444,44 @@ def auto_box(rec: Recording) -> Box:
         if sx1 < ex0 or sx0 > ex1 or sy1 < ey0 or sy0 > ey1:
             continue
         # Along an axis where the shape runs past the near zone on both sides, it does not
-        # widen the view (a long floor, a tall wall); else the part of it near the bodies does.
+        # move the view (a long floor, a tall wall); else the part of it near the bodies does.
         if not (sx0 <= ex0 and sx1 >= ex1):
             bx0, bx1 = min(bx0, max(sx0, ex0)), max(bx1, min(sx1, ex1))
         if not (sy0 <= ey0 and sy1 >= ey1):
             by0, by1 = min(by0, max(sy0, ey0)), max(by1, min(sy1, ey1))
-    return bx0, bx1, by0, by1
+    return (x0, x1, y0, y1), (bx0, bx1, by0, by1)
+
+
+def auto_view(rec: Recording, width: float, height: float, body_px: float = 0.0) -> Box:
+    """The automatic camera's view, of the aspect ratio ``width`` : ``height`` (px): the box
+    where the bodies move with the static shapes near them (:func:`auto_boxes`), fitted
+    (:func:`fit`), as long as that leaves every moving body at least ``body_px`` across; else
+    the view is only as large as keeps them so (the box where the bodies move, if even that
+    is too large), placed to hold as much of the static shapes near them as it can: static
+    shapes never make a body smaller than ``body_px``."""
+    core, near = auto_boxes(rec)
+    wide = fit(near, width, height)
+    if near == core:
+        return wide
+    tight = fit(core, width, height)
+    least = [float(np.nanmin(sh.least[0])) for sh in rec.shapes
+             if sh.n and np.isfinite(sh.least[0]).any()]
+    # The largest view (world units across) that draws the smallest body body_px across.
+    most = min(least, default=math.inf) * width / body_px if body_px > 0 else math.inf
+    if wide[1] - wide[0] <= most:
+        return wide
+    span = max(tight[1] - tight[0], most)
+    spans = (span, span * height / width)
+    out: list[float] = []
+    for size, (c0, c1), (n0, n1) in zip(spans, (core[:2], core[2:]), (near[:2], near[2:]),
+                                        strict=True):
+        # The view holds the bodies' box, padded as fit pads it, and is centred on the
+        # shapes near them as far as that allows.
+        half, mid = (c1 / 2 - c0 / 2) * (1 + 2 * PAD), c0 / 2 + c1 / 2
+        lo = min(max(n0 / 2 + n1 / 2 - size / 2, mid + half - size), mid - half)
+        out += [lo, lo + size]
+    box = (out[0], out[1], out[2], out[3])
+    return box if all(math.isfinite(v) for v in box) else tight
 
 
 def _quartiles(values: np.ndarray) -> tuple[float, float]:
@@ -1107,7 +1153,7 @@ class Painter(Backdrop):
         elif rec.camera == "all":
             box = fit(all_box(rec), aw, ah)
         else:
-            box = fit(auto_box(rec), aw, ah)
+            box = auto_view(rec, aw, ah, self.body_px)
         self.views = [View.of(box, self.area, rec.y_up)] * self.n
 
     @property
