@@ -651,6 +651,21 @@ def test_bad_worlds_are_refused_when_the_recorder_is_made(tmp_path, world):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_refusals_name_the_spaces_units(tmp_path):
+    # Issue 29: a value of a space carries the space's unit wherever it is printed.
+    space = _space()
+    body = next(b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC)
+    for kw, unit in [({"world": (0, "a", 0, 1)}, "(px)"), ({"world": (0, 1e40, 0, 1)}, " px,"),
+                     ({"camera": body, "span": -1.0}, "(px)"),
+                     ({"reference": {"U_g": math.nan}}, "(kg px²/s²)"),
+                     ({"t0": math.inf}, "(s)")]:
+        with pytest.raises(UsageError) as info:
+            spaces.Recorder(space, tmp_path / "a.gif", units="px", **kw)
+        assert unit in str(info.value)
+    with pytest.raises(UsageError, match=r"\(J\)$"):
+        spaces.Recorder(space, tmp_path / "a.gif", reference={"U_g": math.nan})
+
+
 # --- energy bars --------------------------------------------------------------------------------
 
 

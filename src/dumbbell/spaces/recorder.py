@@ -376,8 +376,9 @@ def _check_path(path: Any) -> Path:
     return path
 
 
-def _check_world(world: Any) -> tuple[float, float, float, float]:
-    """``world`` = (left, right, bottom, top) as floats that can be drawn, else a UsageError."""
+def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, float, float]:
+    """``world`` = (left, right, bottom, top) as floats that can be drawn (in the length
+    ``unit``), else a UsageError."""
     from ..animation.recording import SPAN_MAX, SPAN_MIN
     from ..model import args
 
@@ -387,14 +388,14 @@ def _check_world(world: Any) -> tuple[float, float, float, float]:
         world = tuple(world.tolist()) if world.ndim == 1 else None
     if not isinstance(world, tuple | list) or len(world) != 4:
         raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-    x0, x1, y0, y1 = (args.real(v, "world", "space units", positive=False) for v in world)
+    x0, x1, y0, y1 = (args.real(v, "world", unit, positive=False) for v in world)
     if not (x1 > x0 and y1 != y0):
         raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
     for lo, hi in ((x0, x1), (min(y0, y1), max(y0, y1))):
         span = hi - lo
         if not (SPAN_MIN <= span <= SPAN_MAX and span >= 1e-9 * max(abs(lo), abs(hi))):
             raise UsageError(f"world = {args.show(world)}: each side must span between "
-                             f"{SPAN_MIN:g} and {SPAN_MAX:g} units, and at least 1e-9 of its "
+                             f"{SPAN_MIN:g} and {SPAN_MAX:g} {unit}, and at least 1e-9 of its "
                              "coordinates (else no pixel can be told from the next)",
                              param="world")
     return x0, x1, y0, y1
@@ -425,7 +426,7 @@ def _energy_unit(units: tuple[str, str, str]) -> str:
     return "J" if tuple(units) == SI else f"{mass} {length}²/{t}²"
 
 
-def _check_reference(reference: Any) -> str | dict[str, float]:
+def _check_reference(reference: Any, unit: str = "energy units") -> str | dict[str, float]:
     from ..model import args
 
     allowed = ("must be 'start' (potential energies from their values at t0), 'space' (as "
@@ -438,7 +439,7 @@ def _check_reference(reference: Any) -> str | dict[str, float]:
     if not isinstance(reference, Mapping) or not reference or not set(reference) <= set(
             POTENTIALS):
         raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
-    return {k: args.real(v, "reference", "energy units", positive=False)
+    return {k: args.real(v, "reference", unit, positive=False)
             for k, v in reference.items()}
 
 
@@ -490,11 +491,12 @@ class Recorder:
         self.path = _check_path(path)
         self.fps = check_fps(fps)
         self.W, self.H = check_size(size)
+        self.units = _check_units(units)
         self.energy = args.flag(energy, "energy")
         self.strip = args.flag(strip, "strip") and self.energy
         self.heat = None if heat is None else args.instance(
             heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
-        self.world = None if world is None else _check_world(world)
+        self.world = None if world is None else _check_world(world, self.units[0])
         if isinstance(camera, pymunk.Body):
             if camera.body_type == pymunk.Body.STATIC:
                 raise UsageError("camera: a static body cannot be followed; give a moving "
@@ -506,7 +508,7 @@ class Recorder:
         if self.world is not None and self.camera != "auto":
             raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
                              "camera, not both", param="camera")
-        self.span = None if span is None else args.real(span, "span", "space units")
+        self.span = None if span is None else args.real(span, "span", self.units[0])
         if self.span is not None and not isinstance(self.camera, pymunk.Body):
             raise UsageError(f"span = {args.show(span)}: only for a followed body "
                              "(camera=<a pymunk.Body>)", param="span")
@@ -525,8 +527,7 @@ class Recorder:
         self._up = up
         #: Which way y points in the picture, and why (see the module docstring).
         self.orientation = f"y {'up' if up else 'down'}: {why}"
-        self.units = _check_units(units)
-        self.reference = _check_reference(reference)
+        self.reference = _check_reference(reference, _energy_unit(self.units))
         self.t0 = args.real(t0, "t0", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         self.title = args.text(title, "title", "a str (written at the top)")
         self.about = args.pair(about, "about", self.units[0])
