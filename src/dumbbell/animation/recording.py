@@ -1121,6 +1121,7 @@ class Painter(Backdrop):
         bodies = max((int(sh.number.max()) + 1 for sh in rec.shapes if sh.n), default=0)
         self.frames_in = np.zeros(bodies, dtype=np.int64)
         self.frames_shown = np.zeros(bodies, dtype=np.int64)
+        self._present: dict[int, tuple] = {}
 
     # --- geometry -----------------------------------------------------------------------
 
@@ -1340,10 +1341,21 @@ class Painter(Backdrop):
         px, n = layer.px, layer.px.n_shapes
         if not n or not len(self.frames_in):
             return
-        number = px.shapes.number  # type: ignore[union-attr]
-        mine = number >= 0
+        shapes = px.shapes
+        got = self._present.get(id(shapes))
+        if got is None or got[0] is not shapes:
+            number = shapes.number  # type: ignore[union-attr]
+            mine = number >= 0
+            present = np.bincount(number[mine], minlength=len(self.frames_in)) > 0
+            got = self._present[id(shapes)] = (shapes, number, mine, present)
+        _, number, mine, present = got
+        self.frames_in += present
+        box = px.box
+        if box is not None and px.ok[:n].all() and box[0] >= 0 and box[1] >= 0 and (
+                box[2] <= self.scene_w and box[3] <= self.H):
+            self.frames_shown += present  # everything drawn is on the panel
+            return
         shown = px.within((0.0, 0.0, float(self.scene_w), float(self.H)))[:n] & mine
-        self.frames_in += np.bincount(number[mine], minlength=len(self.frames_in)) > 0
         self.frames_shown += np.bincount(number[shown], minlength=len(self.frames_in)) > 0
 
     def _restore(self, box: tuple[float, float, float, float]) -> tuple[int, int, int, int]:
