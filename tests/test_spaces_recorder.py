@@ -337,7 +337,8 @@ def _window(monkeypatch, imported: tuple[str, ...], flag: bool | None = None) ->
     for name in ("pygame", "pymunk.pygame_util", "pyglet", "arcade", "kivy"):
         monkeypatch.delitem(sys.modules, name, raising=False)
     for name in imported:
-        monkeypatch.setitem(sys.modules, name, types.ModuleType(name))
+        name, _, blocked = name.partition("=")
+        monkeypatch.setitem(sys.modules, name, None if blocked else types.ModuleType(name))
     if flag is not None:
         util = types.ModuleType("pymunk.pygame_util")
         util.positive_y_is_up = flag
@@ -374,6 +375,7 @@ WINDOWS = [
     ((), None, -900.0, True),
     (("pygame", "pyglet"), None, 0.0, True),     # both kinds: as with none
     (("pygame", "pyglet"), None, 900.0, False),
+    (("pyglet", "pygame=None"), None, 0.0, True),  # an import blocked is no import
 ]
 
 

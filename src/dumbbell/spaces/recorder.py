@@ -301,10 +301,11 @@ def _window_y_up(space: Any) -> tuple[bool, str]:
     gy = float(space.gravity.y)
     gy = gy if math.isfinite(gy) else 0.0
     util = modules.get("pymunk.pygame_util")
-    if util is not None and getattr(util, "positive_y_is_up", False) is True:
+    if util is not None and bool(getattr(util, "positive_y_is_up", False)):
         return True, "pymunk.pygame_util.positive_y_is_up is True"
-    pygame = "pygame" in modules
-    up = [name for name in Y_UP_WINDOWS if name in modules]
+    # (A name set to None in sys.modules is an import blocked, not a library imported.)
+    pygame = modules.get("pygame") is not None
+    up = [name for name in Y_UP_WINDOWS if modules.get(name) is not None]
     if pygame and not up:
         if gy < 0:
             return True, ("pygame is imported (its window has y down) and gravity points to "
