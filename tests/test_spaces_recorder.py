@@ -389,7 +389,7 @@ def test_y_points_the_way_the_programs_window_shows_it(tmp_path, monkeypatch, im
     assert _ball_above_floor(tmp_path / "a.gif") is not up
     assert rec.orientation.startswith(f"y {'up' if up else 'down'}: ")
     assert rec.note.splitlines()[0] == rec.orientation
-    x0, x1, bottom, top = rec.view
+    _, _, bottom, top = rec.view
     assert (top > bottom) is up
 
 
@@ -620,7 +620,7 @@ def test_static_shapes_near_the_bodies_never_make_one_smaller_than_4_px(tmp_path
 
 
 def test_a_body_that_leaves_the_picture_is_named(tmp_path):
-    space, balls = _row_of_balls(runaway=40.0)
+    space, _ = _row_of_balls(runaway=40.0)
     with spaces.Recorder(space, tmp_path / "a.gif", energy=False) as rec:
         for _ in range(50):
             spaces.step(space, 1 / 25, substeps=2)
