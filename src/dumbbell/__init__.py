@@ -24,7 +24,7 @@ _NAMES = {
     "Gif": "animation.render", "render_gif": "animation.render",
     "Player": "animation.player", "player": "animation.player",
     "ColumnError": "errors", "DumbbellError": "errors", "MissingExtraError": "errors",
-    "SceneError": "errors", "UsageError": "errors",
+    "PymunkVersionError": "errors", "SceneError": "errors", "UsageError": "errors",
     "Scene": "model.scene", "load_scene": "model.scene",
     "Impact": "model.trajectory", "Trajectory": "model.trajectory", "Verdict": "model.trajectory",
     "simulate": "solvers",
@@ -36,9 +36,10 @@ SUBMODULES = ("analysis", "animation", "cli", "errors", "examples", "io", "model
 _getattr, _, _ = _attach(__name__, SUBMODULES, _NAMES)
 
 __all__ = [
-    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Player", "Scene",
-    "SceneError", "Trajectory", "UsageError", "Verdict", "available_solvers", "bench", "compare",
-    "load_scene", "player", "render_gif", "simulate", "stability", "sweep",
+    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Player",
+    "PymunkVersionError", "Scene", "SceneError", "Trajectory", "UsageError", "Verdict",
+    "available_solvers", "bench", "compare", "load_scene", "player", "render_gif", "simulate",
+    "stability", "sweep",
 ]
 
 

@@ -33,6 +33,13 @@ def write(path: Path, rec: R.Recording, timing: dict[str, float] | None = None) 
     painter = R.Painter(rec)
     with R._signals_end_cleanly():
         text = space_page(painter)
+        # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
+        # for the recorder's note), counted without drawing.
+        panel = (painter.scene_w, painter.H)
+        for k in range(painter.n):
+            view = painter.views[k]
+            painter._count(R.Layer(rec, k, view, painter.u, panel, painter._flat,
+                                   painter._shapes(rec.shape_of[k], view)))
         with atomic_output(path) as tmp:
             Path(tmp).write_text(text, encoding="utf-8")
     if timing is not None:
@@ -57,12 +64,10 @@ def space_document(painter: Any) -> dict[str, Any]:
         view_of.append(len(views) - 1)
     shape_sets = []
     for i, shapes in enumerate(rec.shapes):
-        # As the painter draws them: a painter that grows small bodies to a least size
-        # gives the shapes it draws through a view (Painter._shapes).
+        # As the painter draws them: each body at least its least size across.
         first = next((k for k, s in enumerate(rec.shape_of) if s == i), None)
-        drawn = getattr(painter, "_shapes", None)
-        if drawn is not None and first is not None:
-            shapes = drawn(i, painter.views[first])
+        if first is not None:
+            shapes = painter._shapes(i, painter.views[first])
         kinds = [""] * shapes.n
         npts = [0] * shapes.n
         local: list[list[float]] = [[] for _ in range(shapes.n)]

@@ -16,6 +16,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._pymunk import require as require_pymunk
 from ..errors import UsageError
 
 #: None: these are the checks the public functions call, not functions a user calls.
@@ -303,12 +304,18 @@ def _pymunk(name: str) -> Any:
 
 
 def space(value: Any, name: str = "space") -> Any:
-    """``value`` as a ``pymunk.Space`` (pymunk is not imported here)."""
-    return instance(value, name, _pymunk("Space"), "a pymunk.Space")
+    """``value`` as a ``pymunk.Space`` (pymunk is not imported here), on a pymunk release
+    dumbbell runs on (else a PymunkVersionError: this is the spaces API's first use of it)."""
+    instance(value, name, _pymunk("Space"), "a pymunk.Space")
+    require_pymunk()
+    return value
 
 
 def pymunk_object(value: Any, name: str, kinds: tuple[str, ...]) -> Any:
-    """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle')."""
+    """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle'), on a
+    pymunk release dumbbell runs on."""
     classes = tuple(c for c in (_pymunk(k) for k in kinds) if c != ())
-    return instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))
+    instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))
+    require_pymunk()
+    return value
 

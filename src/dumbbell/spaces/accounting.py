@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from .._pymunk import spring_function
 from ..model.energy import (
     angular_momentum,
     gravity_potential,
@@ -369,9 +370,7 @@ def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped
     import pymunk
 
     rotary = isinstance(c, pymunk.DampedRotarySpring)
-    custom = c._torque_func if rotary else c._force_func
-    if custom is not None and custom not in (pymunk.DampedSpring.spring_force,
-                                             pymunk.DampedRotarySpring.spring_torque):
+    if spring_function(c) is not None:
         return Skipped(label, "custom force function: its energy is unknown")
     a, b = c.a, c.b
     ia, ib = index(a), index(b)
@@ -561,8 +560,7 @@ class _Sampler:
         self._rows = np.array([rows[id(b)] for b in inv.bodies], dtype=np.intp)
         springs = [c for c in self._constraints
                    if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
-        self._funcs = [c._torque_func if isinstance(c, pymunk.DampedRotarySpring)
-                       else c._force_func for c in springs]
+        self._funcs = [spring_function(c) for c in springs]
         self._springs = []
         for kind, fields in self._SPRING:
             objs = [c for c in springs if mem.struct_of(c) == kind]
@@ -585,8 +583,7 @@ class _Sampler:
         n = len(self._PRINT)
         parts = [values[:n].ravel(), np.isinf(values[2])]
         parts += [span.f(at, fields).ravel() for span, at, fields in self._springs]
-        funcs = [c._torque_func if isinstance(c, pymunk.DampedRotarySpring) else c._force_func
-                 for c in self._constraints
+        funcs = [spring_function(c) for c in self._constraints
                  if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
         same = len(funcs) == len(self._funcs) and all(
             f is g for f, g in zip(funcs, self._funcs, strict=True))

@@ -59,6 +59,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._pymunk import spring_function
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import rotational_ke, spring_potential, translational_ke
@@ -522,9 +523,7 @@ def _body_reach(sc: Scan, idx: np.ndarray) -> np.ndarray:
 def _spring_energy(c: Any, pymunk: Any) -> tuple[float, bool]:
     """A spring's energy now and whether a custom force function makes it unknown."""
     rotary = isinstance(c, pymunk.DampedRotarySpring)
-    custom = c._torque_func if rotary else c._force_func
-    unknown = custom is not None and custom not in (pymunk.DampedSpring.spring_force,
-                                                    pymunk.DampedRotarySpring.spring_torque)
+    unknown = spring_function(c) is not None
     if rotary:
         extent, rest = c.a.angle - c.b.angle, c.rest_angle
     else:

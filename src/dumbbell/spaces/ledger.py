@@ -66,6 +66,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._pymunk import spring_function
 from . import _memory as mem
 
 __all__ = ["Balance", "Ledger", "Term"]
@@ -843,7 +844,7 @@ class Ledger:
             mem.check_constraint(c)
             default = True
             if kind in ("spring", "rotary_spring"):
-                default = (c._torque_func if kind == "rotary_spring" else c._force_func) is None
+                default = spring_function(c) is None
                 if not default:
                     self._current[clabel] = ("custom force function: its potential is not "
                                                  "in E (its work is counted)")
