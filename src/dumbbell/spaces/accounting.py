@@ -104,7 +104,9 @@ def inventory(space: Any) -> Inventory:
     where = {id(b): i for i, b in enumerate(tracked)}
 
     def name(body: Any) -> str:
-        if body is space.static_body:
+        # The space's own static body, without making it (pymunk makes it on first use).
+        if body.body_type == pymunk.Body.STATIC and body.space is space and \
+                body not in space.bodies:
             return "static body"
         i = place.get(id(body))
         return "body (not in the space)" if i is None else f"body {i}"
