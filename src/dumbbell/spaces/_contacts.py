@@ -10,6 +10,11 @@ apply: pymunk applies the carried impulse scaled by dt / previous dt (``coef``),
 a first contact (it keeps one cached from an earlier touch there without applying it). The
 work of every contact impulse on the bodies' relative motion, J . (u0 + u1) / 2 at each
 contact point, is summed per pair of bodies.
+
+Each read is one numpy gather of several fields of every arbiter (or contact) at once; what
+depends only on which bodies an arbiter joins (their rows, their pair's slot, where the
+impulses go) is kept from one step to the next while the arbiters and their bodies are the
+same.
 """
 
 from __future__ import annotations
@@ -17,13 +22,37 @@ from __future__ import annotations
 import numpy as np
 
 from . import _memory as mem
-from ._inventory import PAIR, Pairs, Table
+from ._inventory import Pairs, Table
 from ._records import Step
 
 
 class UnknownBody(Exception):
     """A contact touches a body that is not in the ledger's table (one pymunk made since:
     the space's static body, say): the table must be built again."""
+
+
+class _Layout:
+    """Where each field is, in 8-byte words from a contact's (or arbiter's) start."""
+
+    def __init__(self) -> None:
+        p = mem._pymunk_ffi()
+        ps = mem.pointer_size()
+        arb = {name: p.offsetof("cpArbiter", name) for name in
+               ("contacts", "body_a", "body_b", "count", "state", "n")}
+        self.asize, self.csize = p.sizeof("cpArbiter"), p.sizeof("cpContact")
+        # Pointers (body_a, body_b, contacts) in pointer-sized words, the normal in 8-byte
+        # words, count and state in 4-byte words.
+        self.ptr = np.array([arb["body_a"], arb["body_b"], arb["contacts"]]) // ps
+        self.pshift = 3 if ps == 8 else 2
+        self.normal = np.array([arb["n"], arb["n"] + 8]) // 8
+        self.ints = np.array([arb["count"], arb["state"]]) // 4
+        con = {name: p.offsetof("cpContact", name) for name in
+               ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
+        # jn, jt, jBias, r1.x, r1.y, r2.x, r2.y
+        self.words8 = np.concatenate([self.ptr, self.normal]) if ps == 8 else None
+        self.contact = np.array([con["jnAcc"], con["jtAcc"], con["jBias"], con["r1"],
+                                 con["r1"] + 8, con["r2"], con["r2"] + 8]) // 8
+        self.carried = self.contact[:2]
 
 
 class Contacts:
@@ -33,23 +62,22 @@ class Contacts:
         p = mem._pymunk_ffi()
         self.arr = p.cast("cpArray *", arbiters_at)
         self.buffer = p.buffer
-        self.o = {name: p.offsetof("cpArbiter", name) for name in
-                  ("contacts", "body_a", "body_b", "count", "state", "n")}
-        self.c = {name: p.offsetof("cpContact", name) for name in
-                  ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
-        self.asize = p.sizeof("cpArbiter")
-        self.csize = p.sizeof("cpContact")
         self.psize = mem.pointer_size()
+        self.dtype = mem.pointer_dtype()
+        self.L = _Layout()
+        self.span: mem.Span | None = None
         self.cspan: mem.Span | None = None
+        self._prev: tuple[Table, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                          np.ndarray] | None = None
 
-    def _contact_span(self, low: int, high: int) -> mem.Span:
-        """A span over the contact buffers, grown to cover [low, high)."""
-        span = self.cspan
-        if span is None or low < span.lo or high > span.lo + len(span.u8):
-            lo = low if span is None else min(low, span.lo)
-            hi = high if span is None else max(high, span.lo + len(span.u8))
-            span = self.cspan = mem.Span(lo, hi)
-        return span
+    @staticmethod
+    def _grown(span: mem.Span | None, low: int, high: int) -> mem.Span:
+        """``span``, or a new one covering it and [low, high)."""
+        if span is not None and low >= span.lo and high <= span.lo + len(span.u8):
+            return span
+        if span is not None:
+            low, high = min(low, span.lo), max(high, span.lo + len(span.u8))
+        return mem.Span(low, high)
 
     def before(self, table: Table, pairs: Pairs, coef: float) -> bool:
         """Read the step's contacts and the impulses they carry in; False if none. Raises
@@ -57,93 +85,119 @@ class Contacts:
         num = int(self.arr.num)
         if num == 0 or not 0 < num <= int(self.arr.max):
             return False
-        arb = np.frombuffer(self.buffer(self.arr.arr, self.psize * num),
-                            dtype=mem.pointer_dtype()).astype(np.int64)
-        span = mem.Span(int(arb.min()), int(arb.max()) + self.asize)
+        L = self.L
+        # In address order: the solver's order changes from step to step, the set little.
+        arb = np.sort(np.frombuffer(self.buffer(self.arr.arr, self.psize * num),
+                                    dtype=self.dtype)).astype(np.int64)
+        span = self.span = self._grown(self.span, int(arb[0]), int(arb[-1]) + L.asize)
         rel = arb - span.lo
-        o, ps = self.o, span.pshift
-        count = span.u32[(rel + o["count"]) >> 2].astype(np.int64)
-        keep = count > 0
-        if not keep.all():
-            rel, count = rel[keep], count[keep]
-            if not len(rel):
+        ints = span.u32[(rel >> 2)[:, None] + L.ints]
+        words = (rel >> 3)[:, None]
+        if L.pshift == 3:  # the pointers and the normal in one gather of 8-byte words
+            g = span.u64[words + L.words8]
+            ptr, n = g[:, :3].view(np.int64), g[:, 3:].view(np.float64)
+        else:
+            ptr = span.ptr[(rel >> L.pshift)[:, None] + L.ptr].astype(np.int64)
+            n = span.f64[words + L.normal]
+        count = ints[:, 0]
+        if not count.all():  # arbiters without contacts: left out
+            keep = count > 0
+            if not keep.any():
                 return False
-        ends = np.stack([span.ptr[(rel + o["body_a"]) >> ps],
-                         span.ptr[(rel + o["body_b"]) >> ps]]).astype(np.int64)
-        nb = len(table.sorted_i64)
-        pos = np.minimum(np.searchsorted(table.sorted_i64, ends), max(nb - 1, 0))
-        if nb == 0 or not np.all(table.sorted_i64[pos] == ends):
-            raise UnknownBody
-        ra, rb = table.order[pos]
-        self.n = np.stack([span.f64[(rel + o["n"]) >> 3], span.f64[(rel + o["n"] + 8) >> 3]])
-        self.first = span.u32[(rel + o["state"]) >> 2] == 0
-        first_c = span.ptr[(rel + o["contacts"]) >> ps].astype(np.int64)
-        self.at = np.stack([first_c, first_c + np.where(count > 1, self.csize, 0)])
-        self.weight = np.stack([np.ones(len(rel)), (count > 1).astype(float)])
-        ua, ub = table.uid[ra], table.uid[rb]
-        slots = pairs.lookup(np.minimum(ua, ub) * PAIR + np.maximum(ua, ub))
-        if slots.min() < 0:
-            slots = table.pair_slots(ra, rb, pairs)
-        self.ra, self.rb, self.slots = ra, rb, slots
-        self.sign = table.lin_free[rb].astype(float) - table.lin_free[ra].astype(float)
-        cspan = self._contact_span(int(first_c.min()), int(self.at[1].max()) + self.csize)
+            arb, count, ints, ptr, n = arb[keep], count[keep], ints[keep], ptr[keep], n[keep]
+        self._rows(table, pairs, arb, np.ascontiguousarray(ptr[:, :2]))
+        self.n = n.T
+        self.weight = np.stack([np.ones(len(arb)), (count > 1).astype(float)])
+        self.first = ints[:, 1] == 0
+        first_c = ptr[:, 2]
+        second = first_c + np.where(count > 1, L.csize, 0)
+        cspan = self.cspan = self._grown(self.cspan, int(first_c.min()),
+                                         int(second.max()) + L.csize)
+        self.words = (np.stack([first_c, second]) - cspan.lo) >> 3
         self.has_j0 = coef != 1.0 or bool(self.first.any())
         if self.has_j0:
-            idx = self.at - cspan.lo
-            c = self.c
-            self.j0 = np.stack([cspan.f64[(idx + c["jnAcc"]) >> 3],
-                                cspan.f64[(idx + c["jtAcc"]) >> 3]])
+            self.j0 = cspan.f64[self.words[..., None] + L.carried]  # (2, m, 2)
             self.kept = 1.0 - np.where(self.first, 0.0, coef)
         return True
 
+    def _rows(self, table: Table, pairs: Pairs, arb: np.ndarray, ends: np.ndarray) -> None:
+        """The rows of each arbiter's bodies, its pair's slot, and where its impulses go;
+        an arbiter at the same address joining the same bodies as in the last step keeps
+        what it had."""
+        prev = self._prev
+        m = len(arb)
+        if prev is not None and prev[0] is table:
+            _, p_arb, p_ends, p_ra, p_rb, p_slots = prev
+            i = np.minimum(np.searchsorted(p_arb, arb), len(p_arb) - 1)
+            hit = (p_arb[i] == arb) & (p_ends[i] == ends).all(axis=1)
+        else:
+            i, hit = np.zeros(m, dtype=np.int64), np.zeros(m, dtype=bool)
+        if hit.all():
+            ra, rb, slots = p_ra[i], p_rb[i], p_slots[i]
+        else:
+            miss = np.nonzero(~hit)[0]
+            nb = len(table.sorted_i64)
+            if nb == 0:
+                raise UnknownBody
+            pos = np.minimum(np.searchsorted(table.sorted_i64, ends[miss]), nb - 1)
+            if not np.array_equal(table.sorted_i64[pos], ends[miss]):
+                raise UnknownBody
+            new = table.order[pos]
+            if hit.any():
+                ra, rb, slots = p_ra[i], p_rb[i], p_slots[i]
+            else:
+                ra, rb, slots = (np.zeros(m, dtype=np.int64) for _ in range(3))
+            ra[miss], rb[miss] = new[:, 0], new[:, 1]
+            slots[miss] = table.pair_slots(ra[miss], rb[miss], pairs)
+        self._prev = (table, arb, ends, ra, rb, slots)
+        self.ra, self.rb, self.slots = ra, rb, slots
+        self.sign = table.lin_free[rb].astype(float) - table.lin_free[ra].astype(float)
+        # One scatter of the impulses (x, y, angle) onto both ends.
+        self.scatter = np.concatenate([3 * rb, 3 * rb + 1, 3 * rb + 2, 3 * ra, 3 * ra + 1,
+                                       3 * ra + 2])
+        self.driven = np.nonzero(table.drives[ra] | table.drives[rb])[0]
+
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
-        """Work (energy units) of the step's contact impulses, summed per pair into
-        ``pairs.work``; their impulses added to ``step.imp``, the work of driven ends to
-        ``drive`` (rows); and the bias impulse along the normal on the dynamic ends of each
-        arbiter (its position correction's push)."""
-        span, c = self.cspan, self.c
-        idx = self.at - span.lo
-        f64 = span.f64
-        jn = f64[(idx + c["jnAcc"]) >> 3]
-        jt = f64[(idx + c["jtAcc"]) >> 3]
+        """Work of the step's contact impulses, summed per pair into ``pairs.work``; their
+        impulses added to ``step.imp``, the work of driven ends to ``drive`` (rows); and the
+        bias impulse along the normal on the dynamic ends of each arbiter (its position
+        correction's push)."""
+        f = self.cspan.f64[self.words[..., None] + self.L.contact]  # (2, m, 7)
+        jn, jt = f[..., 0], f[..., 1]
         if self.has_j0:
-            jn = jn - self.kept * self.j0[0]
-            jt = jt - self.kept * self.j0[1]
+            jn = jn - self.kept * self.j0[..., 0]
+            jt = jt - self.kept * self.j0[..., 1]
         w = self.weight
         nx, ny = self.n
         qx = (nx * jn - ny * jt) * w
         qy = (ny * jn + nx * jt) * w
-        r1x, r1y = f64[(idx + c["r1"]) >> 3], f64[(idx + c["r1"] + 8) >> 3]
-        r2x, r2y = f64[(idx + c["r2"]) >> 3], f64[(idx + c["r2"] + 8) >> 3]
-        px, py = qx.sum(axis=0), qy.sum(axis=0)
-        ta = (r1x * qy - r1y * qx).sum(axis=0)
-        tb = (r2x * qy - r2y * qx).sum(axis=0)
-        jbias = (f64[(idx + c["jBias"]) >> 3] * w).sum(axis=0)
+        px, py = qx[0] + qx[1], qy[0] + qy[1]
+        ta = f[0, :, 3] * qy[0] - f[0, :, 4] * qx[0] + f[1, :, 3] * qy[1] - f[1, :, 4] * qx[1]
+        tb = f[0, :, 5] * qy[0] - f[0, :, 6] * qx[0] + f[1, :, 5] * qy[1] - f[1, :, 6] * qx[1]
+        jbias = f[0, :, 2] * w[0] + f[1, :, 2] * w[1]
         a, b, u = self.ra, self.rb, step.u
-        rel = px * (u[0, b] - u[0, a]) + py * (u[1, b] - u[1, a]) + tb * u[2, b] - ta * u[2, a]
+        ub, ua = u[:, b], u[:, a]
+        rel = px * (ub[0] - ua[0]) + py * (ub[1] - ua[1]) + tb * ub[2] - ta * ua[2]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
-        rows = table.rows
-        imp = step.imp
-        imp[0] += _scatter(b, px, rows) - _scatter(a, px, rows)
-        imp[1] += _scatter(b, py, rows) - _scatter(a, py, rows)
-        imp[2] += _scatter(b, tb, rows) - _scatter(a, ta, rows)
+        step.imp[...] += np.bincount(self.scatter, weights=np.concatenate([px, py, tb, -px, -py,
+                                                                      -ta]),
+                                minlength=3 * table.rows).reshape(table.rows, 3).T
         total = float(rel.sum())
-        # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
-        # bodies of infinite moment): what the relative work leaves out of theirs.
-        lin, ang = table.lin_free, table.ang_free
-        da = (np.where(lin[a], 0.0, px * u[0, a] + py * u[1, a])
-              + np.where(ang[a], 0.0, ta * u[2, a]))
-        db = -(np.where(lin[b], 0.0, px * u[0, b] + py * u[1, b])
-               + np.where(ang[b], 0.0, tb * u[2, b]))
-        if da.any() or db.any():
-            drive += _scatter(a, da, rows) + _scatter(b, db, rows)
+        d = self.driven
+        if len(d):
+            # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
+            # bodies of infinite moment): what the relative work leaves out of theirs.
+            lin, ang = table.lin_free, table.ang_free
+            da_, db_ = a[d], b[d]
+            da = (np.where(lin[da_], 0.0, px[d] * u[0, da_] + py[d] * u[1, da_])
+                  + np.where(ang[da_], 0.0, ta[d] * u[2, da_]))
+            db = -(np.where(lin[db_], 0.0, px[d] * u[0, db_] + py[d] * u[1, db_])
+                   + np.where(ang[db_], 0.0, tb[d] * u[2, db_]))
+            drive += (np.bincount(da_, weights=da, minlength=table.rows)
+                      + np.bincount(db_, weights=db, minlength=table.rows))
             total += float(da.sum() + db.sum())
         return total, jbias * self.sign
-
-
-def _scatter(rows: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
-    return np.bincount(rows, weights=values, minlength=size)
 
 
 def arbiters_address(space_at: int) -> int:

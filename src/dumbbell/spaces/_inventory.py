@@ -360,10 +360,9 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
-    if not (np.array_equal(F[9:13], t.settings) and np.array_equal(np.isinf(F[13]),
-                                                                   t.static)):
+    if not ((F[9:13] == t.settings).all() and (np.isinf(F[13]) == t.static).all()):
         return "a mass, moment, centre of gravity or body type"
-    if not (np.array_equal(P[1, : t.n], b.vf) and np.array_equal(P[2, : t.n], b.pf)):
+    if not ((P[1, : t.n] == b.vf).all() and (P[2, : t.n] == b.pf).all()):
         return "a velocity_func or position_func"
     if tuple(space.gravity) != b.gravity:
         return "space.gravity"

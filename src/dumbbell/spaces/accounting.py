@@ -104,12 +104,14 @@ def inventory(space: Any) -> Inventory:
     where = {id(b): i for i, b in enumerate(tracked)}
 
     def name(body: Any) -> str:
-        # The space's own static body, without making it (pymunk makes it on first use).
-        if body.body_type == pymunk.Body.STATIC and body.space is space and \
-                body not in space.bodies:
-            return "static body"
         i = place.get(id(body))
-        return "body (not in the space)" if i is None else f"body {i}"
+        if i is not None:
+            return f"body {i}"
+        # The space's own static body (not among its bodies), without making it: pymunk
+        # makes it on first use.
+        if body.body_type == pymunk.Body.STATIC and body.space is space:
+            return "static body"
+        return "body (not in the space)"
 
     labels = [name(b) for b in dyn]
     moments = [i for i, kind in zip(moments_all, types, strict=True)

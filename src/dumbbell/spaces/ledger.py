@@ -540,16 +540,17 @@ class Ledger:
             self._restructure(reason, dt, "program")
         coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
         for attempt in (0, 1):
-            t = self._b.table
             try:
-                contacts = self._contacts.before(t, self._pairs, coef)
+                contacts = self._contacts.before(self._b.table, self._pairs, coef)
                 break
             except UnknownBody:
                 if attempt:
                     raise RuntimeError("a contact touches a body the ledger does not "
                                        "know") from None
                 self._restructure("a body touched for the first time", dt, "program")
-        F, P = t.pre.floats(), t.pre.pointers()
+        if self._b.table is not t:
+            t = self._b.table
+            F, P = t.pre.floats(), t.pre.pointers()
         b, s, n = self._b, self._snap, t.n
         move = phys.move_of(b, s, F[0:3], F[3:6], dt)
         total = 0.0
