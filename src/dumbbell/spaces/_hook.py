@@ -127,7 +127,7 @@ class Hook:
         if lib.cpSpaceIsLocked(self._cspace):
             space = self._space()
             if space is not None:
-                space.add_post_step_callback(_release_after_step, self)
+                space.add_post_step_callback(_release_after_step, (self, "release"))
             else:  # a space collected inside its own step: cannot happen; never free it
                 _KEPT.append(self)
             return
@@ -155,8 +155,8 @@ def _end_of_step(space: Any, hook: Hook) -> None:
     hook.end()
 
 
-def _release_after_step(space: Any, hook: Hook) -> None:
-    hook.release()
+def _release_after_step(space: Any, key: tuple[Hook, str]) -> None:
+    key[0].release()
 
 
 def _rotate(cspace: Any, at: int, first: bool) -> None:

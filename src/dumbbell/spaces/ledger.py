@@ -400,8 +400,10 @@ class Ledger:
                 i = int(np.argmax(bad))
                 value = tuple(float(block[r, i]) for r in rows)
                 shown = value[0] if len(value) == 1 else value
+                why = self._b.current.get(t.labels[i], "")
+                why = f" ({why})" if why.startswith("a dynamic body of mass") else ""
                 self._stop(f"{t.labels[i]}: {name} = {args.show(shown)} after step "
-                           f"{self.steps + 1}: the ledger stopped counting there")
+                           f"{self.steps + 1}{why}: the ledger stopped counting there")
                 return
         self._stop(f"the energy stopped being finite after step {self.steps + 1}")
 
