@@ -341,6 +341,7 @@ class Reader:
                  ptrs: tuple[str, ...] = ()) -> None:
         self.span = Span.over(at, size(kind))
         self.fi = self.pi = None
+        self.shape = (len(floats), len(ptrs))
         if self.span is None:
             return
         if np.any(at % np.uint64(8)):
@@ -356,12 +357,12 @@ class Reader:
 
     def floats(self) -> np.ndarray:
         if self.span is None:
-            return np.zeros((0 if self.fi is None else len(self.fi), 0))
+            return np.zeros((self.shape[0], 0))
         return self.span.f64[self.fi]
 
     def pointers(self) -> np.ndarray:
         if self.span is None:
-            return np.zeros((0, 0), dtype=np.uint64)
+            return np.zeros((self.shape[1], 0), dtype=np.uint64)
         out = self.span.ptr[self.pi]
         return out if out.dtype == np.uint64 else out.astype(np.uint64)
 
@@ -572,11 +573,30 @@ def _probe_space() -> tuple[Any, list[Any], list[Any]]:
     return space, [a, b, rest], kinds
 
 
-@cache
 def problem() -> str | None:
     """Why this pymunk build's structs cannot be read as declared (None when they can):
     checked once per process (:func:`platform_problem`, then every check on
-    :func:`_probe_space`)."""
+    :func:`_probe_space`). While the check runs (a program that attaches a ledger to every
+    space it makes attaches one to the probe too), it answers None: each space's own checks
+    still come first, and nothing read from the probe's ledger is used."""
+    if _PROBLEM:
+        return _PROBLEM[0]
+    if _PROBING:
+        return None
+    _PROBING.append(True)
+    try:
+        found = _problem()
+    finally:
+        _PROBING.clear()
+    _PROBLEM.append(found)
+    return found
+
+
+_PROBLEM: list[str | None] = []
+_PROBING: list[bool] = []
+
+
+def _problem() -> str | None:
     import pymunk
 
     try:

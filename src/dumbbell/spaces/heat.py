@@ -94,9 +94,14 @@ class HeatCounter:
         self._look()
         return self._stopped
 
+    def _dispatch(self) -> _Dispatch | None:
+        """The space's dispatcher (None for a copy, which has no space)."""
+        space = self.__dict__.get("space")
+        return None if space is None else _DISPATCH.get(space)
+
     def _look(self) -> None:
         """Notice callbacks the program set over the counters' since they last ran."""
-        d = _DISPATCH.get(self.__dict__.get("space"))
+        d = self._dispatch()
         if d is not None and self._stopped is None:
             d.check()
 
@@ -104,7 +109,7 @@ class HeatCounter:
     def attached(self) -> bool:
         """True while the counter counts (False after ``detach()`` or once its callbacks
         were replaced)."""
-        d = _DISPATCH.get(self.space)
+        d = self._dispatch()
         return self.stopped is None and d is not None and self in d.counters
 
     def __repr__(self) -> str:
@@ -115,7 +120,7 @@ class HeatCounter:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are
         the ones it had before the first counter attached."""
         self._look()
-        d = _DISPATCH.get(self.space)
+        d = self._dispatch()
         if d is not None:
             d.remove(self)
         if self._stopped is None:
@@ -130,12 +135,22 @@ class HeatCounter:
             pass
 
     def __getstate__(self) -> dict[str, Any]:
-        # A copy of a counter keeps its counts and does not count (no callbacks point to it).
+        # A copy of a counter keeps its counts and does not count (no callbacks point to
+        # it), and holds no space: a pickled space or state brings its own bodies, which a
+        # second space would claim.
         state = dict(self.__dict__)
         state["_before"] = {}
+        state["space"] = None
         if state["_stopped"] is None:
             state["_stopped"] = "a copy: it does not count"
         return state
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> HeatCounter:
+        # In a copy of its space (space.copy()), the copy's counter names the copied space.
+        other = object.__new__(HeatCounter)
+        other.__dict__.update(self.__getstate__())
+        other.space = memo.get(id(self.space))
+        return other
 
     def _relative(self, arbiter: Any) -> tuple[Any, Any, Any]:
         raw = arbiter._arbiter
@@ -255,14 +270,16 @@ class _Dispatch:
     def __init__(self, space: Any) -> None:
         self._space = weakref.ref(space)
         self._counters: list[weakref.ref[HeatCounter]] = []
-        self.handler = _wildcard(space)
-        self.phases = {phase: _Phase(self, phase, getattr(self.handler, phase))
+        handler = _wildcard(space)
+        # Weakly: the map of dispatchers holds them, and the handler holds its space.
+        self._handler = weakref.ref(handler)
+        self.phases = {phase: _Phase(self, phase, getattr(handler, phase))
                        for phase in _PHASES}
         # pymunk passes the handler's data for the phase: the user's, or None if none.
-        self.no_data = [phase for phase in _PHASES if phase not in self.handler.data]
+        self.no_data = [phase for phase in _PHASES if phase not in handler.data]
         for phase, callback in self.phases.items():
-            self.handler.data.setdefault(phase, None)
-            setattr(self.handler, phase, callback)  # the property: data stays the user's
+            handler.data.setdefault(phase, None)
+            setattr(handler, phase, callback)  # the property: data stays the user's
 
     @classmethod
     def of(cls, space: Any) -> _Dispatch:
@@ -288,10 +305,9 @@ class _Dispatch:
         """Put back the handler's callbacks and data as they were (phases the user
         replaced since stay theirs). Nothing is touched once the space is going: its
         handler lives in the C space, which pymunk may have freed already."""
-        space = self._space()
-        if space is None:
+        space, h = self._space(), self._handler()
+        if space is None or h is None:
             return
-        h = self.handler
         for phase, callback in self.phases.items():
             if getattr(h, phase) is callback:
                 setattr(h, phase, callback.user)
@@ -303,8 +319,11 @@ class _Dispatch:
     def check(self) -> None:
         """Stop the counters (each warning once) when the program set a wildcard
         ``pre_solve`` or ``post_solve`` over theirs."""
+        handler = self._handler()
+        if handler is None:
+            return
         for phase, mine in self.phases.items():
-            new = getattr(self.handler, phase)
+            new = getattr(handler, phase)
             if new is mine:
                 continue
             for counter in self.counters:

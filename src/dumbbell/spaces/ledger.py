@@ -358,12 +358,14 @@ class Ledger:
         return self._copy(self.space)
 
     def __deepcopy__(self, memo: dict[int, Any]) -> Ledger:
-        import copy
-
-        return self._copy(copy.deepcopy(self.space, memo))
+        # In a copy of its space (space.copy()), the copy's ledger names the copied space;
+        # copied alone, the original (the copy does not count: it only names it).
+        return self._copy(memo.get(id(self.space), self.space))
 
     def __reduce__(self) -> tuple[Any, ...]:
-        state = self._copy(self.space).__dict__
+        # Pickled, it holds its account and no space: a pickled space or state brings its
+        # own bodies, which a second space would claim.
+        state = dict(self._copy(None).__dict__)
         return (_restored, (state,))
 
     # -- the hook ----------------------------------------------------------------------
