@@ -18,9 +18,9 @@ wall time of each run (its tests only, interpreter start apart); the spaces made
 ledgers still counting or stopped.
 
 Then the costs, each measured in a fresh subprocess that builds 50 spaces of 20 bouncing
-balls and steps each 50 times (bare, or with a ledger kept on each): the median of 20
-``gc.collect()`` calls afterwards, and the process's resident memory (VmRSS) and its peak
-(VmHWM), beside the bare process's.
+balls and steps each 50 times (bare; with the ledger's modules imported but none attached;
+with a ledger kept on each space): the median of 20 ``gc.collect()`` calls afterwards, and
+the process's resident memory (VmRSS) and its peak (VmHWM).
 """
 
 from __future__ import annotations
@@ -105,6 +105,8 @@ import gc, json, statistics, time
 import pymunk
 from dumbbell import spaces
 
+if MODE == "imported":
+    import dumbbell.spaces.ledger  # what a ledger loads (numpy), none attached
 keep = []
 for k in range(50):
     space = pymunk.Space()
@@ -118,7 +120,7 @@ for k in range(50):
         c = pymunk.Circle(b, 10)
         c.elasticity = 0.9
         space.add(b, c)
-    if LEDGER:
+    if MODE == "ledger":
         space.ledger = spaces.Ledger(space)
     for _ in range(50):
         space.step(1 / 60)
@@ -130,17 +132,18 @@ for _ in range(20):
     gc.collect()
     times.append(time.perf_counter() - t0)
 status = dict(line.split(":", 1) for line in open("/proc/self/status") if ":" in line)
-print(json.dumps({"gc_ms": statistics.median(times) * 1e3,
+print(json.dumps({"gc_ms": statistics.median(times) * 1e3, "objects": len(gc.get_objects()),
                   "rss_mb": int(status["VmRSS"].split()[0]) / 1024,
                   "peak_mb": int(status["VmHWM"].split()[0]) / 1024}))
 """
 
 
 def costs() -> dict[str, dict[str, float]]:
-    """gc.collect() and memory, bare and with a ledger on each of 50 spaces."""
+    """gc.collect() and memory: bare, with the ledger's modules imported, and with a ledger
+    on each of 50 spaces."""
     out = {}
-    for label, flag in (("bare", "False"), ("ledger", "True")):
-        done = subprocess.run([sys.executable, "-c", _COST.replace("LEDGER", flag)],
+    for label in ("bare", "imported", "ledger"):
+        done = subprocess.run([sys.executable, "-c", _COST.replace("MODE", repr(label))],
                               capture_output=True, text=True, timeout=600, check=False)
         if done.returncode != 0:
             raise SystemExit(f"cost run {label} failed: {done.stderr[-2000:]}")
@@ -172,10 +175,12 @@ def main() -> None:
     print(f"time: {led['seconds']:.2f} s against {bare['seconds']:.2f} s bare "
           f"({led['seconds'] / bare['seconds']:.1f}x)")
     c = costs()
-    print(f"50 spaces of 20 balls, 50 steps each: gc.collect() {c['ledger']['gc_ms']:.2f} ms "
-          f"with a ledger on each against {c['bare']['gc_ms']:.2f} ms bare (median of 20); "
-          f"memory {c['ledger']['rss_mb']:.0f} MB against {c['bare']['rss_mb']:.0f} MB "
-          f"(peak {c['ledger']['peak_mb']:.0f} against {c['bare']['peak_mb']:.0f} MB)")
+    print("50 spaces of 20 balls, 50 steps each: gc.collect() (median of 20) and memory")
+    for label, what in (("bare", "bare"), ("imported", "the ledger's modules imported"),
+                        ("ledger", "a ledger kept on each space")):
+        print(f"  {what:30s} gc.collect() {c[label]['gc_ms']:7.2f} ms "
+              f"({c[label]['objects']:,} objects tracked)   memory "
+              f"{c[label]['rss_mb']:5.0f} MB (peak {c[label]['peak_mb']:.0f} MB)")
     print(f"(load: {Path('/proc/loadavg').read_text().split()[:3]})")
 
 

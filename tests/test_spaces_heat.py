@@ -203,9 +203,9 @@ def test_replacing_its_callback_warns_once_and_says_so():
     heat = spaces.HeatCounter(space)
     spaces.step(space, 0.2, substeps=200)
     assert "_dumbbell_heat" not in space.__dict__  # nothing stored on the space
+    space.on_collision(None, None, post_solve=_note, data=[])
     with pytest.warns(RuntimeWarning, match="wildcard post_solve callback was replaced "
                                             r"\(by _note\) after \d+ contact-steps"):
-        space.on_collision(None, None, post_solve=_note, data=[])
         spaces.step(space, 0.01, substeps=10)  # noticed at the next contact it would count
     import warnings
 

@@ -429,22 +429,22 @@ def test_a_pymunk_build_it_cannot_read_falls_back_to_the_public_api(monkeypatch)
     import warnings
 
     from dumbbell import spaces as sp
-    from dumbbell.spaces import _memory as mem
+    from dumbbell.spaces import _layout as layout
     from dumbbell.spaces import ledger as ledger_module
 
-    monkeypatch.setattr(mem, "problem", lambda: "a layout forced for this test")
+    monkeypatch.setattr(layout, "problem", lambda: "a layout forced for this test")
     monkeypatch.setattr(ledger_module, "_FALLBACK_SAID", [])
     spaces_made = []
     with warnings.catch_warnings(record=True) as said:
         warnings.simplefilter("always")
         for _ in range(2):
             space, _ = _slope()
-            space.add(pymunk.PinJoint(space.static_body, list(space.bodies)[0], (0.0, 3.0)))
+            space.add(pymunk.PinJoint(space.static_body, next(iter(space.bodies)), (0.0, 3.0)))
             spaces_made.append((space, sp.Ledger(space)))
     assert [str(w.message) for w in said] == [
-        f"dumbbell.spaces.Ledger: pymunk {pymunk.version}'s structs are not laid out as the "
+        (f"dumbbell.spaces.Ledger: pymunk {pymunk.version}'s structs are not laid out as the "
         "ledger reads them (a layout forced for this test); it counts with pymunk's public "
-        "API only: the joints' and contacts' work as one lumped term"]
+        "API only: the joints' and contacts' work as one lumped term")]
     space, ledger = spaces_made[0]
     assert type(ledger).__name__ == "PublicLedger" and isinstance(ledger, sp.Ledger)
     for _ in range(1000):

@@ -44,9 +44,8 @@ import weakref
 from collections.abc import Callable
 from typing import Any
 
-#: Spaces -> the addresses of the hooks in them (for the layout check of the constraints
-#: array, and for tests).
-_IN: weakref.WeakKeyDictionary[Any, set[int]] = weakref.WeakKeyDictionary()
+from . import _memory as mem
+
 #: Hooks that could not be taken out (a space freed while locked: never seen); kept so that
 #: their memory outlives any space that may still list them.
 _KEPT: list[Any] = []
@@ -54,7 +53,7 @@ _KEPT: list[Any] = []
 
 def addresses(space: Any) -> set[int]:
     """Addresses of the hooks now in ``space``."""
-    return set(_IN.get(space, ()))
+    return mem.hooks(space)
 
 
 class Hook:
@@ -83,7 +82,7 @@ class Hook:
         self.at = int(ffi.cast("uintptr_t", self._c))
         lib.cpSpaceAddConstraint(self._cspace, self._c)
         self.inside = True
-        _IN.setdefault(space, set()).add(self.at)
+        mem._hooks().setdefault(space, set()).add(self.at)
         if first:
             _rotate(self._cspace, self.at, first=True)
         self._on_space = weakref.finalize(space, self.release, True)
@@ -136,8 +135,8 @@ class Hook:
         lib.cpSpaceRemoveConstraint(self._cspace, self._c)
         self.inside = False
         space = self._space()
-        if space is not None and space in _IN:
-            _IN[space].discard(self.at)
+        if space is not None:
+            mem._hooks().get(space, set()).discard(self.at)
         self._on_space.detach()
         self._cspace = None
 
@@ -167,8 +166,6 @@ def _rotate(cspace: Any, at: int, first: bool) -> None:
     docstring). The array is the space's ``constraints`` field, past ``dt``, which
     :func:`._memory.check_space` validated before the ledger attached; its items are
     written through pymunk's compiled declaration of ``cpArray``."""
-    from . import _memory as mem
-
     pffi = mem._pymunk_ffi()
     arr = pffi.cast("cpArray *", mem.view("space", mem.address(cspace)).constraints)
     items = mem.array_items(mem.address(arr)).tolist()

@@ -9,12 +9,13 @@ Bodies are named as :func:`dumbbell.spaces.energy` names them when the ledger at
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
 
+from . import _layout as layout
 from . import _memory as mem
 
 #: Body fields read before the solver: position (x, y, angle), velocity (vx, vy, w),
@@ -40,6 +41,8 @@ AFTER = {"pin": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
          "gear": ("j", "ratio_inv"), "motor": ("j",)}
 #: Pair keys: min(uid) * PAIR + max(uid).
 PAIR = 1 << 31
+#: Longest name of a declared potential (characters).
+NAME_CHARS = 60
 
 
 class Names:
@@ -289,7 +292,7 @@ def build(space: Any, names: Names, potentials: list[tuple[Any, Callable[..., An
     labels = t.labels
     groups, springs = _groups(t, current)
     ptrs = t.pre.pointers()
-    vel_default, pos_default = mem.default_funcs()
+    vel_default, pos_default = layout.default_funcs()
     vf, pf = ptrs[1, :n].copy(), ptrs[2, :n].copy()
     custom = ~np.isin(vf, np.array(sorted(vel_default), dtype=np.uint64))
     custom_pos = ~np.isin(pf, np.array(sorted(pos_default), dtype=np.uint64))
@@ -323,7 +326,7 @@ def _groups(t: Table, current: dict[str, str]) -> tuple[dict[str, Group], list[G
     """The constraints by struct kind, the springs among them; the constraints the ledger
     cannot read or whose energy is not in E are named in ``current``."""
     rows = {int(a): r for r, a in enumerate(t.at.tolist())}
-    spring_default, rotary_default = mem.default_spring_funcs()
+    spring_default, rotary_default = layout.default_spring_funcs()
     by_kind: dict[str, tuple[list[Any], ...]] = {}
     for i, c in enumerate(t.constraint_key):
         name = type(c).__name__
@@ -332,7 +335,7 @@ def _groups(t: Table, current: dict[str, str]) -> tuple[dict[str, Group], list[G
         if kind is None:
             current[clabel] = f"{name}: a constraint class the ledger cannot read"
             continue
-        mem.check_constraint(c)
+        layout.check_constraint(c)
         default = True
         if kind in ("spring", "rotary_spring"):
             r = mem.view(kind, mem.address(c._constraint))
@@ -375,3 +378,55 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
             if bodies[i].velocity_func is not b.vel_funcs[i]:
                 return "a velocity_func"
     return ""
+
+
+def declared(target: Any, potential: Callable[..., Any], name: str | None, steps: int,
+             names: Names) -> tuple[Any, str]:
+    """The key and label of a potential to declare (``Ledger.declare_potential``), checked:
+    ``target`` a body, bodies or a velocity function, ``name`` at most :data:`NAME_CHARS`
+    printable characters, ``potential`` callable on numpy arrays with finite energies, and
+    no step counted yet (``steps``); the bodies are kept in ``names``."""
+    import pymunk
+
+    from ..errors import UsageError
+    from ..model import args
+
+    args.function(potential, "potential", "a function potential(x, y, m) -> energy")
+    if isinstance(target, pymunk.Body):
+        target = [target]
+    if callable(target):
+        key: Any = ("func", target)
+        label = name or f"field of {getattr(target, '__name__', 'a velocity_func')}"
+    else:
+        bodies = list(target) if isinstance(target, Iterable) and not isinstance(
+            target, str | bytes) else []
+        if not bodies or not all(isinstance(b, pymunk.Body) for b in bodies):
+            raise UsageError(f"target = {args.show(target)}: must be a body, a list of "
+                             "bodies or a velocity function", param="target")
+        key = ("bodies", frozenset(id(b) for b in bodies))
+        names.kept.extend(bodies)
+        label = name or "declared field"
+    label = args.text(label, "name")
+    if not (0 < len(label) <= NAME_CHARS and label.isprintable()):
+        raise UsageError(f"name = {args.show(label)}: must be 1 to {NAME_CHARS} printable "
+                         "characters (no newline or other control character)",
+                         param="name")
+    if steps:
+        raise UsageError(f"potential: declare it before the first step ({steps} "
+                         "counted already; attach a new Ledger to declare it)",
+                         param="potential")
+    probe = np.array([1.0, 2.0])
+    try:
+        raw = potential(probe, probe + 1.0, probe)
+        value = np.asarray(raw, dtype=float)
+    except Exception as e:  # noqa: BLE001 - the user's function: any failure is theirs
+        raise UsageError(f"potential: calling it with numpy arrays x, y, m failed "
+                         f"({type(e).__name__}: {args.show(str(e))})",
+                         param="potential") from None
+    if value.shape not in ((2,), ()):
+        raise UsageError(f"potential: returned shape {value.shape} for 2 bodies: must "
+                         "return one energy per body", param="potential")
+    if not np.all(np.isfinite(value)):
+        raise UsageError(f"potential: returned {args.show(raw)} for bodies at x = [1, 2], "
+                         "y = [2, 3]: must return finite energies", param="potential")
+    return key, label

@@ -30,7 +30,6 @@ import numpy as np
 from . import _physics as phys
 from ._inventory import Build, Names
 from ._records import Before, Move, Potentials
-from .ledger import Ledger
 
 #: What the fallback says about what it lumps.
 LUMPED = "pymunk's structs are not readable on this build: lumped"
@@ -196,140 +195,130 @@ def _spring_kicks(b: Build, pos: np.ndarray, dt: float) -> np.ndarray:
     return out
 
 
-class PublicLedger(Ledger):
-    """:class:`Ledger` through pymunk's public API only (see the module docstring)."""
+def attach(self: Any, calls: Any) -> None:
+    """Attach the fallback ledger ``self`` (a :class:`.ledger.PublicLedger`): its hook
+    is added last and never rotated."""
+    import weakref
 
-    def _attach(self) -> None:
-        from . import _hook
+    from . import _hook
 
-        self._touching = np.zeros(0, dtype=bool)
-        self._rebuild()
-        self._snap = phys.read_snapshot(self._b)
-        self._snap_uid = self._b.table.uid.copy()
-        e = phys.energy(self._b, self._snap)
-        self._E0 = self._E = e.E
-        self._Uref = np.array([e.Ug, e.Us, e.Ud])
-        self._scale = e.K
-        self._hook = _hook.Hook(self.space, *_calls(self), first=False)
-        import weakref
+    self._touching = np.zeros(0, dtype=bool)
+    self._rebuild()
+    self._snap = phys.read_snapshot(self._b)
+    self._snap_uid = self._b.table.uid.copy()
+    e = phys.energy(self._b, self._snap)
+    self._E0 = self._E = e.E
+    self._Uref = np.array([e.Ug, e.Us, e.Ud])
+    self._scale = e.K
+    self._hook = _hook.Hook(self.space, *calls, first=False)
+    self._finalizer = weakref.finalize(self, self._hook.release)
 
-        self._finalizer = weakref.finalize(self, self._hook.release)
 
-    def _rebuild(self) -> None:
-        old = self.__dict__.get("_b")
-        if old is not None and self.steps > self._built_at:
-            self._unaccounted.update(old.current)
-        self._built_at = self.steps
-        self._b = public_build(self.space, self._names)
-        t = self._b.table
-        self._sums.reset(t.n, t.rows, 0)
-        self._touching = np.zeros(t.rows, dtype=bool)
+def rebuild(self: Any) -> None:
+    """Read again what the space holds (pymunk's getters)."""
+    old = self.__dict__.get("_b")
+    if old is not None and self.steps > self._built_at:
+        self._unaccounted.update(old.current)
+    self._built_at = self.steps
+    self._b = public_build(self.space, self._names)
+    t = self._b.table
+    self._sums.reset(t.n, t.rows, 0)
+    self._touching = np.zeros(t.rows, dtype=bool)
 
-    def declare_potential(self, target: Any, potential: Any, name: str | None = None) -> None:
-        from ..errors import UsageError
 
-        raise UsageError("potential: declared potentials need the ledger's reads of pymunk's "
-                         "structs, which this pymunk build does not allow (see the warning "
-                         "given when the ledger attached)", param="potential")
+def pre(self: Any) -> None:
+    """Before the solver (after every spring's kick: the hook is last): the program's
+    changes, the move, and the springs' kicks taken back out of the velocities."""
+    from ._inventory import changed
 
-    def _pre(self) -> None:
-        """Before the solver (after every spring's kick: the hook is last): the program's
-        changes, the move, and the springs' kicks taken back out of the velocities."""
-        from ._inventory import changed
-
-        self._awaiting_end = False
-        dt = float(self.space.current_time_step)
+    self._awaiting_end = False
+    dt = float(self.space.current_time_step)
+    t = self._b.table
+    F, P = t.pre.floats(), t.pre.pointers()
+    if changed(self._b, self.space, F, P):
+        gone = self._gone()
+        if gone.any():
+            self._catch_up(F, "program", gone)
+        self._restructure("the space's bodies, constraints or settings", dt, "program")
         t = self._b.table
         F, P = t.pre.floats(), t.pre.pointers()
-        if changed(self._b, self.space, F, P):
-            gone = self._gone()
-            if gone.any():
-                self._catch_up(F, "program", gone)
-            self._restructure("the space's bodies, constraints or settings", dt, "program")
-            t = self._b.table
-            F, P = t.pre.floats(), t.pre.pointers()
-        b, s, n = self._b, self._snap, t.n
-        coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
-        kicks = _spring_kicks(b, F[0:3], dt)
-        vel_r = F[3:6].copy()
-        vel0 = vel_r - kicks * t.inv3 if t.rows else vel_r
-        # Bodies no spring kicked keep their velocity bit for bit; a kick taken back out
-        # leaves a few roundings, which are not the program's.
-        vel0 = np.where(phys.same(vel0, s.vel), s.vel, vel0)
-        moving = t.moves & ~np.concatenate([P[0, :n].astype(bool), np.zeros(t.k, bool)])
-        expected = np.where(moving, s.pos + vel0 * dt, s.pos)
-        beyond = ~np.all(phys.same(F[0:3], expected), axis=0)
-        corrected = beyond & self._touching & moving
-        start = np.where(beyond & ~corrected, F[0:3] - np.where(moving, vel0 * dt, 0.0), s.pos)
-        total = 0.0
-        per_body, springs = phys.changes(b, s, start, vel0)
-        if np.any(per_body) or springs:
-            self._sums.program += per_body
-            if springs:
-                self._sums.add("program: springs stretched by moved bodies", "program",
-                               springs)
-            total += float(np.sum(per_body)) + springs
-        # Gravity and the springs over the move: the velocities' part, and the rest (the
-        # contacts' position correction on the bodies that touched).
-        gx, gy = b.gravity
-        mid = np.where(moving, start + vel0 * dt, start)
-        g_int = -float(gx * (t.m @ (mid[0, :n] - start[0, :n]))
-                       + gy * (t.m @ (mid[1, :n] - start[1, :n])))
-        corr = -float(gx * (t.m @ (F[0, :n] - mid[0, :n])) + gy * (t.m @ (F[1, :n] - mid[1, :n])))
-        u_start, u_mid = phys.spring_energy(b, start), phys.spring_energy(b, mid)
-        u_end = phys.spring_energy(b, F[0:3])
-        spring_int = sum(float(np.sum(m2 - a2)) for a2, m2 in zip(u_start, u_mid, strict=True))
-        corr += sum(float(np.sum(e2 - m2)) for m2, e2 in zip(u_mid, u_end, strict=True))
-        if corr:
-            self._sums.add("position correction", "correction", corr,
-                           "the contacts' position correction, with any position the program "
-                           f"set on a body that touched something ({LUMPED})")
-        elastic = 0.5 * float(np.sum(t.mass3 * (vel_r[:, :n] ** 2 - vel0[:, :n] ** 2)))
-        self._sums.add(f"springs ({LUMPED})", "step error", elastic + spring_int,
-                       "the springs' kicks and their potential's change over the moves")
-        total += corr + elastic + spring_int
-        force = F[6:9, :n]
-        awake = P[0, :n] == 0
-        move = Move(F[0:3].copy(), vel_r, start, dt)
-        self._before = Before(dt, coef, move, force if force.any() else None,
-                              None if awake.all() else awake, g_int, None,
-                              Potentials([], u_end, None, s.ud), [], False, total)
-
-    def _post(self) -> None:
-        """After the solver: gravity, forces and damping as the full ledger counts them;
-        everything else the solver did, one lumped term."""
-        from ._records import Step
-
-        p = self._before
-        if p is None:
-            return
-        self._before = None
-        b = self._b
-        t = b.table
-        n = t.n
-        Q = t.post.floats()
-        vel_r, vel1 = p.move.vel, Q[0:3]
-        damping = float(self.space.damping)
-        step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
-                    np.zeros((3, t.rows)), None, [])
-        kicked = ~b.vf.astype(bool) if p.awake is None else p.awake & ~b.vf.astype(bool)
-        ext, w_g, external = phys.external(b, step, kicked, damping, p.force, self._sums)
-        solver = t.mass3 * (vel1[:, :n] - vel_r[:, :n]) - ext
-        w_s = float(np.sum(solver * step.u[:, :n]))
-        self._sums.add(f"contacts and joints ({LUMPED})", "contacts and joints", w_s,
-                       "the work of the solver's impulses: contacts, joints, spring damping")
-        self._sums.add("gravity", "step error", w_g + p.g_int)
-        total = p.total + external + w_s + w_g + p.g_int
-        self._close_step(Q, p, total)
-        self._touching = np.zeros(t.rows, dtype=bool)
-        for r, body in enumerate(t.bodies):
-            def touched(arbiter: Any, r: int = r) -> None:
-                self._touching[r] = True
-
-            body.each_arbiter(touched)
+    b, s, n = self._b, self._snap, t.n
+    coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
+    kicks = _spring_kicks(b, F[0:3], dt)
+    vel_r = F[3:6].copy()
+    vel0 = vel_r - kicks * t.inv3 if t.rows else vel_r
+    # Bodies no spring kicked keep their velocity bit for bit; a kick taken back out
+    # leaves a few roundings, which are not the program's.
+    vel0 = np.where(phys.same(vel0, s.vel), s.vel, vel0)
+    moving = t.moves & ~np.concatenate([P[0, :n].astype(bool), np.zeros(t.k, bool)])
+    expected = np.where(moving, s.pos + vel0 * dt, s.pos)
+    beyond = ~np.all(phys.same(F[0:3], expected), axis=0)
+    corrected = beyond & self._touching & moving
+    start = np.where(beyond & ~corrected, F[0:3] - np.where(moving, vel0 * dt, 0.0), s.pos)
+    total = 0.0
+    per_body, springs = phys.changes(b, s, start, vel0)
+    if np.any(per_body) or springs:
+        self._sums.program += per_body
+        if springs:
+            self._sums.add("program: springs stretched by moved bodies", "program",
+                           springs)
+        total += float(np.sum(per_body)) + springs
+    # Gravity and the springs over the move: the velocities' part, and the rest (the
+    # contacts' position correction on the bodies that touched).
+    gx, gy = b.gravity
+    mid = np.where(moving, start + vel0 * dt, start)
+    g_int = -float(gx * (t.m @ (mid[0, :n] - start[0, :n]))
+                   + gy * (t.m @ (mid[1, :n] - start[1, :n])))
+    corr = -float(gx * (t.m @ (F[0, :n] - mid[0, :n])) + gy * (t.m @ (F[1, :n] - mid[1, :n])))
+    u_start, u_mid = phys.spring_energy(b, start), phys.spring_energy(b, mid)
+    u_end = phys.spring_energy(b, F[0:3])
+    spring_int = sum(float(np.sum(m2 - a2)) for a2, m2 in zip(u_start, u_mid, strict=True))
+    corr += sum(float(np.sum(e2 - m2)) for m2, e2 in zip(u_mid, u_end, strict=True))
+    if corr:
+        self._sums.add("position correction", "correction", corr,
+                       "the contacts' position correction, with any position the program "
+                       f"set on a body that touched something ({LUMPED})")
+    elastic = 0.5 * float(np.sum(t.mass3 * (vel_r[:, :n] ** 2 - vel0[:, :n] ** 2)))
+    self._sums.add(f"springs ({LUMPED})", "step error", elastic + spring_int,
+                   "the springs' kicks and their potential's change over the moves")
+    total += corr + elastic + spring_int
+    force = F[6:9, :n]
+    awake = P[0, :n] == 0
+    move = Move(F[0:3].copy(), vel_r, start, dt)
+    self._before = Before(dt, coef, move, force if force.any() else None,
+                          None if awake.all() else awake, g_int, None,
+                          Potentials([], u_end, None, s.ud), [], False, total)
 
 
-def _calls(ledger: Ledger) -> Any:
-    from .ledger import _calls as calls
+def post(self: Any) -> None:
+    """After the solver: gravity, forces and damping as the full ledger counts them;
+    everything else the solver did, one lumped term."""
+    from ._records import Step
 
-    return calls(ledger)
+    p = self._before
+    if p is None:
+        return
+    self._before = None
+    b = self._b
+    t = b.table
+    n = t.n
+    Q = t.post.floats()
+    vel_r, vel1 = p.move.vel, Q[0:3]
+    damping = float(self.space.damping)
+    step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
+                np.zeros((3, t.rows)), None, [])
+    kicked = ~b.vf.astype(bool) if p.awake is None else p.awake & ~b.vf.astype(bool)
+    ext, w_g, external = phys.external(b, step, kicked, damping, p.force, self._sums)
+    solver = t.mass3 * (vel1[:, :n] - vel_r[:, :n]) - ext
+    w_s = float(np.sum(solver * step.u[:, :n]))
+    self._sums.add(f"contacts and joints ({LUMPED})", "contacts and joints", w_s,
+                   "the work of the solver's impulses: contacts, joints, spring damping")
+    self._sums.add("gravity", "step error", w_g + p.g_int)
+    total = p.total + external + w_s + w_g + p.g_int
+    self._close_step(Q, p, total)
+    self._touching = np.zeros(t.rows, dtype=bool)
+    for r, body in enumerate(t.bodies):
+        def touched(arbiter: Any, r: int = r) -> None:
+            self._touching[r] = True
+
+        body.each_arbiter(touched)

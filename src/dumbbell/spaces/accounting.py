@@ -193,9 +193,10 @@ def _kinds(bodies: list[Any]) -> tuple[list[int], list[float], list[float]]:
     when its mass is), or through pymunk's getters when the structs cannot be read."""
     import pymunk
 
+    from . import _layout as layout
     from . import _memory as mem
 
-    if not bodies or not mem.readable():
+    if not bodies or not layout.readable():
         return ([b.body_type for b in bodies], [b.mass for b in bodies],
                 [b.moment for b in bodies])
     at = mem.addresses(bodies, "_body")
@@ -409,9 +410,10 @@ def read_state(inv: Inventory) -> State:
     """The present state of the tracked bodies, as one sample: read from pymunk's body
     structs in one pass (the centre of gravity as pymunk holds it), or through pymunk's
     getters on a pymunk build whose structs :mod:`._memory` cannot read."""
+    from . import _layout as layout
     from . import _memory as mem
 
-    if inv.bodies and mem.readable():
+    if inv.bodies and layout.readable():
         at = mem.addresses(inv.bodies, "_body")
         a = mem.Span.over(at, mem.size("body")).f(
             at, np.array([mem.offset("body", *f.split(".")) for f in
@@ -522,10 +524,10 @@ class _Sampler:
                ("rotary_spring", ("rest", "stiffness")))
 
     def __init__(self, space: Any) -> None:
-        from . import _memory as mem
+        from . import _layout as layout
 
         self.space = space
-        self.fast = mem.readable()
+        self.fast = layout.readable()
         self.inventories: list[Inventory] = []
         self.samples: list[tuple[int, np.ndarray]] = []
         self._bodies: list[Any] | None = None
@@ -641,10 +643,15 @@ class _Sampler:
         return out
 
 
-@dataclass(frozen=True)
+def _shown(value: float) -> str:
+    return f"{value:.9g}"
+
+
+@dataclass(frozen=True, repr=False)
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
-    momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s)."""
+    momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
+    space's ``units`` (length, mass, time), SI unless :func:`energy` was told."""
 
     subject: str
     mass: float
@@ -654,20 +661,38 @@ class BodyEnergy:
     U_g: float
     momentum: tuple[float, float]
     L_about: float
+    units: tuple[str, str, str] = ("m", "kg", "s")
+
+    def __repr__(self) -> str:
+        from .units import energy_unit, momentum_unit
+
+        e = energy_unit(self.units)
+        return (f"BodyEnergy({self.subject!r}: K_trans = {_shown(self.K_trans)} {e}, K_rot = "
+                f"{_shown(self.K_rot)} {e}, U_g = {_shown(self.U_g)} {e}, momentum = "
+                f"({_shown(self.momentum[0])}, {_shown(self.momentum[1])}) "
+                f"{momentum_unit(self.units)})")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpringEnergy:
-    """One spring: its label, kind and potential energy U (J)."""
+    """One spring: its label, kind and potential energy U (J; in the space's ``units``)."""
 
     subject: str
     kind: str
     U: float
+    units: tuple[str, str, str] = ("m", "kg", "s")
+
+    def __repr__(self) -> str:
+        from .units import energy_unit
+
+        return (f"SpringEnergy({self.subject!r}, {self.kind}: U = {_shown(self.U)} "
+                f"{energy_unit(self.units)})")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpaceEnergy:
-    """Energy and momentum of a space's dynamic bodies (SI units).
+    """Energy and momentum of a space's dynamic bodies (SI units, or the ``units``
+    :func:`energy` was given: (length, mass, time)).
 
     K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
     K_rot + U_g + U_spring in J; ``momentum`` (px, py) in kg m/s; ``L_cm`` and ``L_about`` in
@@ -691,20 +716,39 @@ class SpaceEnergy:
     skipped: tuple[Skipped, ...]
     unknown: tuple[Skipped, ...]
     notes: tuple[str, ...]
+    units: tuple[str, str, str] = ("m", "kg", "s")
 
     @property
     def complete(self) -> bool:
         """True when nothing holding energy was left out (no unknown constraints)."""
         return not self.unknown
 
+    def __repr__(self) -> str:
+        from .._display import one_line
+        from .units import angular_unit, energy_unit, momentum_unit
 
-def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
+        e = energy_unit(self.units)
+        return one_line(
+            f"SpaceEnergy(E = {_shown(self.E)} {e}: K_trans = {_shown(self.K_trans)}, K_rot = "
+            f"{_shown(self.K_rot)}, U_g = {_shown(self.U_g)}, U_spring = "
+            f"{_shown(self.U_spring)} {e}; momentum = ({_shown(self.momentum[0])}, "
+            f"{_shown(self.momentum[1])}) {momentum_unit(self.units)}, L_cm = "
+            f"{_shown(self.L_cm)} {angular_unit(self.units)}; {len(self.bodies)} bodies, "
+            f"{len(self.springs)} springs, complete = {self.complete})")
+
+
+def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
+           units: Any = ("m", "kg", "s")) -> SpaceEnergy:
     """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
-    See the module docstring for what is counted."""
+    ``units`` names the space's units as the recorder takes them (the length unit alone,
+    'px', or (length, mass, time)): the values are the same, their reprs carry them. See
+    the module docstring for what is counted."""
     from ..model import args
+    from .units import check_units
 
     args.space(space)
-    ox, oy = args.pair(about, "about", "m")
+    units = check_units(units)
+    ox, oy = args.pair(about, "about", units[0])
     inv = inventory(space)
     st = read_state(inv)
     n = inv.dynamic
@@ -721,13 +765,14 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
                terms["body_K_trans"][0].tolist(), terms["body_K_rot"][0].tolist(),
                terms["body_U_g"][0].tolist(), (inv.mass[:n] * st.vx[0, :n]).tolist(),
                (inv.mass[:n] * st.vy[0, :n]).tolist(), terms["body_L_about"][0].tolist())
-    bodies = tuple(BodyEnergy(label, m, i, kt, kr, ug, (px, py), lo)
+    bodies = tuple(BodyEnergy(label, m, i, kt, kr, ug, (px, py), lo, units)
                    for label, m, i, kt, kr, ug, px, py, lo in zip(*columns, strict=True))
-    springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]))
+    springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]), units)
                     for j, s in enumerate(inv.springs))
     return SpaceEnergy(
         K_trans=f("K_trans"), K_rot=f("K_rot"), K_cm=f("K_cm"), K_int=f("K_int"), U_g=f("U_g"),
         U_spring=f("U_spring"), E=f("E"), momentum=(f("px"), f("py")), L_cm=f("L_cm"),
         L_about=f("L_about"), about=(ox, oy), cm=(f("X"), f("Y")), bodies=bodies,
         springs=springs, skipped=inv.skipped, unknown=inv.unknown, notes=inv.notes,
+        units=units,
     )

@@ -66,6 +66,7 @@ class Balance:
     t: float
     notes: tuple[str, ...] = ()
     unit: str = "J"
+    time_unit: str = "s"
 
     def __post_init__(self) -> None:
         # Plain numbers only: numpy scalars neither print nor serialise as numbers.
@@ -122,7 +123,8 @@ class Balance:
     def __repr__(self) -> str:
         u = self.unit
         return one_line(
-            f"Balance({self.steps} steps, t = {self.t:.6g}, E0 = {self.E0:.9g} {u}, "
+            f"Balance({self.steps} steps, t = {self.t:.6g} {self.time_unit}, E0 = "
+            f"{self.E0:.9g} {u}, "
             f"E = {self.E:.9g} {u}, closure = {self.closure:+.3g} {u}, complete = "
             f"{self.complete}; {len(self.terms)} terms: .table())")
 
@@ -133,7 +135,8 @@ class Balance:
 
         top = args.whole(top, "top", "sources", lo=0)
         u = self.unit
-        lines = [f"energy ledger over {self.steps} steps, t = {self.t:.6g}, energies in {u}",
+        lines = [(f"energy ledger over {self.steps} steps, t = {self.t:.6g} {self.time_unit}, "
+                 f"energies in {u}"),
                  f"  E(0) = {self.E0:.9g}   E(t) = {self.E:.9g}   scale = {self.scale:.4g}"]
         for kind, total in sorted(self.by_kind().items(), key=lambda kv: -abs(kv[1])):
             terms = self.sources(kind)

@@ -53,12 +53,16 @@ _PHASES = ("pre_solve", "post_solve")
 class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
     the contact-steps counted. ``detach()`` stops counting; ``stopped`` says why counting
-    stopped (None while it counts)."""
+    stopped (None while it counts). ``units`` names the space's units as the recorder takes
+    them (its repr prints the total in them)."""
 
-    def __init__(self, space: Any) -> None:
+    def __init__(self, space: Any, units: Any = ("m", "kg", "s")) -> None:
         from ..model import args
+        from .units import check_units
 
-        self._start(args.space(space))
+        args.space(space)
+        self.units = check_units(units)
+        self._start(space)
 
     @classmethod
     def _on(cls, space: Any) -> HeatCounter:
@@ -113,8 +117,12 @@ class HeatCounter:
         return self.stopped is None and d is not None and self in d.counters
 
     def __repr__(self) -> str:
+        from .._display import one_line
+        from .units import energy_unit
+
         state = "attached" if self.attached else (self.stopped or "not attached")
-        return f"HeatCounter({state}, total={self.total:.6g})"
+        unit = energy_unit(self.__dict__.get("units", ("m", "kg", "s")))
+        return one_line(f"HeatCounter({state}, total={self.total:.6g} {unit})")
 
     def detach(self) -> None:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are

@@ -60,24 +60,23 @@ from __future__ import annotations
 import math
 import warnings
 import weakref
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from . import _layout as layout
 from . import _memory as mem
 from . import _physics as phys
-from ._inventory import Names, Pairs, build, changed
+from . import _public
+from ._changes import Changes
+from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
 from .units import SI, check_units, energy_unit
 
 __all__ = ["Balance", "Ledger", "Term"]
-
-#: Longest name of a declared potential (characters).
-NAME_CHARS = 60
-
 
 def _warn_fallback(why: str) -> None:
     """Say once per process that the ledger counts with pymunk's public API only."""
@@ -97,22 +96,22 @@ _FALLBACK_SAID: list[str] = []
 
 def _layout_problem(space: Any) -> str | None:
     """Why the ledger cannot read this space's structs (None when it can)."""
-    why = mem.problem()
+    why = layout.problem()
     if why is not None:
         return why
     try:
-        mem.check_space(space)
+        layout.check_space(space)
         for b in space.bodies:
-            mem.check_body(b)
+            layout.check_body(b)
         for c in space.constraints:
             if mem.struct_of(c) is not None:
-                mem.check_constraint(c)
+                layout.check_constraint(c)
     except mem.LayoutError as e:
         return str(e)
     return None
 
 
-class Ledger:
+class Ledger(Changes):
     """Attach an energy ledger to ``space``: every later ``space.step`` (whoever calls it)
     is counted while the ledger is referenced (dropping it detaches it), and
     :meth:`balance` gives the account so far.
@@ -130,8 +129,6 @@ class Ledger:
 
             why = _layout_problem(check.space(space))
             if why is not None:
-                from ._public import PublicLedger
-
                 _warn_fallback(why)
                 return super().__new__(PublicLedger)
         return super().__new__(cls)
@@ -178,7 +175,7 @@ class Ledger:
         from . import _hook
         from ._contacts import Contacts, arbiters_address
 
-        self._space_at = mem.check_space(self.space)
+        self._space_at = layout.check_space(self.space)
         self._contacts = Contacts(arbiters_address(self._space_at))
         self._rebuild()
         self._snap = phys.read_snapshot(self._b)
@@ -221,7 +218,12 @@ class Ledger:
         counts: the field's energy joins E from E(0) on, and each step's kicks count as the
         field's step error instead of unaccounted work. ``name`` labels its term (at most
         60 printable characters)."""
-        key, label = self._declared(target, potential, name)
+        from ..errors import UsageError
+
+        if self._frozen is not None:
+            raise UsageError("a copy of a Ledger does not count: attach a new Ledger",
+                             param="potential")
+        key, label = declared(target, potential, name, self.steps, self._names)
         self._sync()
         self._sums.fold(self._b, self._scale)
         self._potentials.append((key, potential, label))
@@ -240,64 +242,13 @@ class Ledger:
         self._Uref[2] = after.Ud
         self._E = after.E
 
-    def _declared(self, target: Any, potential: Callable[..., Any], name: str | None
-                  ) -> tuple[Any, str]:
-        """The key and label of a potential to declare, checked."""
-        import pymunk
-
-        from ..errors import UsageError
-        from ..model import args
-
-        if self._frozen is not None:
-            raise UsageError("a copy of a Ledger does not count: attach a new Ledger",
-                             param="potential")
-        args.function(potential, "potential", "a function potential(x, y, m) -> energy")
-        if isinstance(target, pymunk.Body):
-            target = [target]
-        if callable(target):
-            key: Any = ("func", target)
-            label = name or f"field of {getattr(target, '__name__', 'a velocity_func')}"
-        else:
-            bodies = list(target) if isinstance(target, Iterable) and not isinstance(
-                target, str | bytes) else []
-            if not bodies or not all(isinstance(b, pymunk.Body) for b in bodies):
-                raise UsageError(f"target = {args.show(target)}: must be a body, a list of "
-                                 "bodies or a velocity function", param="target")
-            key = ("bodies", frozenset(id(b) for b in bodies))
-            self._names.kept.extend(bodies)
-            label = name or "declared field"
-        label = args.text(label, "name")
-        if not (0 < len(label) <= NAME_CHARS and label.isprintable()):
-            raise UsageError(f"name = {args.show(label)}: must be 1 to {NAME_CHARS} printable "
-                             "characters (no newline or other control character)",
-                             param="name")
-        if self.steps:
-            raise UsageError(f"potential: declare it before the first step ({self.steps} "
-                             "counted already; attach a new Ledger to declare it)",
-                             param="potential")
-        probe = np.array([1.0, 2.0])
-        try:
-            raw = potential(probe, probe + 1.0, probe)
-            value = np.asarray(raw, dtype=float)
-        except Exception as e:  # noqa: BLE001 - the user's function: any failure is theirs
-            raise UsageError(f"potential: calling it with numpy arrays x, y, m failed "
-                             f"({type(e).__name__}: {args.show(str(e))})",
-                             param="potential") from None
-        if value.shape not in ((2,), ()):
-            raise UsageError(f"potential: returned shape {value.shape} for 2 bodies: must "
-                             "return one energy per body", param="potential")
-        if not np.all(np.isfinite(value)):
-            raise UsageError(f"potential: returned {args.show(raw)} for bodies at x = [1, 2], "
-                             "y = [2, 3]: must return finite energies", param="potential")
-        return key, label
-
     def __repr__(self) -> str:
         # What the ledger holds already: no accounting is run to show it.
         from .._display import one_line
 
         state = "attached" if self.attached else (
             "a copy, not counting" if self._frozen is not None else "detached")
-        return one_line(f"Ledger({state}, steps={self.steps}, t={self.t:.6g}, "
+        return one_line(f"Ledger({state}, steps={self.steps}, t={self.t:.6g} {self.units[2]}, "
                         f"E0={self._E0:.6g} {self.unit}, E={self._E:.6g} {self.unit}; "
                         "balance() for the terms)")
 
@@ -335,7 +286,7 @@ class Ledger:
                        closure=self._E - self._E0 - total, worst_step=self._worst,
                        scale=self._scale, tolerance=self.tolerance,
                        unaccounted=tuple(sorted(unacc.items())), steps=self.steps, t=self.t,
-                       notes=notes(terms, self._scale, u), unit=u)
+                       notes=notes(terms, self._scale, u), unit=u, time_unit=self.units[2])
 
     # -- copies ------------------------------------------------------------------------
 
@@ -408,121 +359,6 @@ class Ledger:
                            f"{self.steps + 1}{why}: the ledger stopped counting there")
                 return
         self._stop(f"the energy stopped being finite after step {self.steps + 1}")
-
-    # -- what is in the space ----------------------------------------------------------
-
-    def _rebuild(self) -> None:
-        """(Re)read what the space holds. What could not be accounted for while steps were
-        taken stays named."""
-        old = self.__dict__.get("_b")
-        if old is not None and self.steps > self._built_at:
-            self._unaccounted.update(old.current)
-        self._built_at = self.steps
-        self._b = build(self.space, self._names, self._potentials)
-        t = self._b.table
-        self._sums.reset(t.n, t.rows, len(self._b.fields))
-
-    def _remap(self, snap: Snapshot) -> Snapshot:
-        """``snap`` (taken on the previous table) on the present one: bodies in both keep
-        their values, new ones get their present state."""
-        t = self._b.table
-        now = phys.read_snapshot(self._b)
-        old = {int(u): r for r, u in enumerate(self._snap_uid.tolist())}
-        src = np.array([old.get(int(u), -1) for u in t.uid.tolist()], dtype=np.int64)
-        have = src >= 0
-        for mine, theirs in ((now.pos, snap.pos), (now.vel, snap.vel), (now.bias, snap.bias)):
-            mine[:, have] = theirs[:, src[have]]
-        keep = have[: t.n] & (src[: t.n] < len(snap.sleeping))
-        now.sleeping[keep] = snap.sleeping[src[: t.n][keep]]
-        self._snap_uid = t.uid.copy()
-        return phys.snapshot(self._b, now.pos, now.vel, now.bias, now.sleeping)
-
-    def _restructure(self, reason: str, dt: float | None, kind: str) -> None:
-        """The space changed (bodies, constraints, settings): fold the running sums,
-        rebuild, and count the energy that entered or left with bodies, and what the change
-        itself did (``kind``: 'program' or 'unattributed'). ``dt`` is the step under way
-        (None between steps): bodies new in it start where they were before its move."""
-        b0 = self._b
-        old = phys.energy(b0, self._snap)
-        old_dyn = b0.table.uid[: b0.table.n].copy()
-        old_rows = self._snap_uid.copy()
-        self._sums.fold(b0, self._scale)
-        self._rebuild()
-        snap = self._remap(self._snap)
-        t = self._b.table
-        if dt is not None:
-            new = ~np.isin(t.uid, old_rows) & t.moves
-            new[: t.n] &= ~snap.sleeping
-            if np.any(new):
-                pos = snap.pos.copy()
-                pos[:, new] -= snap.vel[:, new] * dt
-                snap = phys.snapshot(self._b, pos, snap.vel, snap.bias, snap.sleeping)
-        self._snap = snap
-        e = phys.energy(self._b, snap)
-        entered = left = 0.0
-        labels = self._names.labels
-        for i in np.nonzero(~np.isin(t.uid[: t.n], old_dyn))[0]:
-            self._sums.add(t.labels[i], "entered", e.body[i],
-                           "energy of a body added to the space")
-            entered += float(e.body[i])
-            self._Uref += (e.Ugb[i], 0.0, e.Udb[i])
-        for j in np.nonzero(~np.isin(old_dyn, t.uid[: t.n]))[0]:
-            self._sums.add(labels[int(old_dyn[j])], "left", -old.body[j],
-                           "energy of a body removed from the space")
-            left -= float(old.body[j])
-            self._Uref -= (old.Ugb[j], 0.0, old.Udb[j])
-        rest = e.E - old.E - entered - left
-        if abs(rest) > 1e-12 * max(abs(old.E), abs(e.E), self._scale):
-            source = f"program: {reason}" if kind == "program" else f"{reason} (a callback)"
-            self._sums.add(source, kind, rest,
-                           "energy changed by what was changed in the space")
-        self._Uref[1] += e.Us - old.Us
-        self._E = e.E
-
-    def _catch_up(self, F: np.ndarray, kind: str, rows: np.ndarray | None = None) -> None:
-        """Count, per body, what changed from the snapshot to the state read now (``F``,
-        between two parts of the solver's work or between steps, on the present table) as
-        ``kind`` ('program' or 'unattributed'); ``rows``: only those (dynamic) rows."""
-        s = self._snap
-        pos, vel = F[0:3].copy(), F[3:6].copy()
-        if rows is not None:
-            pos = np.where(rows, pos, s.pos)
-            vel = np.where(rows, vel, s.vel)
-        if np.array_equal(pos, s.pos) and np.array_equal(vel[:, : self._b.table.n],
-                                                        s.vel[:, : self._b.table.n]):
-            return
-        per_body, springs = phys.changes(self._b, s, pos, vel)
-        getattr(self._sums, kind)[:] += per_body
-        if springs:
-            source = ("program: springs stretched by moved bodies" if kind == "program"
-                      else "springs stretched by moved bodies (a callback)")
-            self._sums.add(source, kind, springs)
-        self._snap = phys.snapshot(self._b, pos, vel, s.bias, s.sleeping)
-        self._E = phys.energy(self._b, self._snap).E
-
-    def _gone(self) -> np.ndarray:
-        """The dynamic rows whose bodies are no longer in the space (pymunk does not move
-        them: what they hold now is what they leave with)."""
-        t = self._b.table
-        space = self.space
-        out = np.zeros(t.rows, dtype=bool)
-        out[: t.n] = [b.space is not space for b in t.bodies[: t.n]]
-        return out
-
-    def _sync(self) -> None:
-        """Between steps: count what the program changed since the last look."""
-        if self._hook is None or self._error is not None:
-            return
-        if self._hook.locked():
-            return  # inside a step: the account stands at the last step's end
-        if self._awaiting_end:
-            self._end()  # a post-step callback before the ledger's: still the step's
-        t = self._b.table
-        F, P = t.pre.floats(), t.pre.pointers()
-        self._catch_up(F, "program")
-        reason = changed(self._b, self.space, F, P)
-        if reason:
-            self._restructure(reason, None, "program")
 
     # -- the step ----------------------------------------------------------------------
 
@@ -691,3 +527,28 @@ def _restored(state: dict[str, Any]) -> Ledger:
     other = object.__new__(Ledger)
     other.__dict__.update(state)
     return other
+
+
+class PublicLedger(Ledger):
+    """:class:`Ledger` through pymunk's public API only, on a build whose structs it cannot
+    read (see :mod:`._public`)."""
+
+    def _attach(self) -> None:
+        _public.attach(self, _calls(self))
+
+    def _rebuild(self) -> None:
+        _public.rebuild(self)
+
+    def declare_potential(self, target: Any, potential: Callable[..., Any],
+                          name: str | None = None) -> None:
+        from ..errors import UsageError
+
+        raise UsageError("potential: declared potentials need the ledger's reads of pymunk's "
+                         "structs, which this pymunk build does not allow (see the warning "
+                         "given when the ledger attached)", param="potential")
+
+    def _pre(self) -> None:
+        _public.pre(self)
+
+    def _post(self) -> None:
+        _public.post(self)
