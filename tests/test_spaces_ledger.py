@@ -427,6 +427,7 @@ def test_a_pymunk_build_it_cannot_read_falls_back_to_the_public_api(monkeypatch)
     # ledger that reads pymunk's getters only: it closes, E is spaces.energy's, and what
     # it cannot split is one lumped term, named.
     import warnings
+    from importlib import metadata
 
     from dumbbell import spaces as sp
     from dumbbell.spaces import _layout as layout
@@ -442,9 +443,9 @@ def test_a_pymunk_build_it_cannot_read_falls_back_to_the_public_api(monkeypatch)
             space.add(pymunk.PinJoint(space.static_body, next(iter(space.bodies)), (0.0, 3.0)))
             spaces_made.append((space, sp.Ledger(space)))
     assert [str(w.message) for w in said] == [
-        (f"dumbbell.spaces.Ledger: pymunk {pymunk.version}'s structs are not laid out as the "
-        "ledger reads them (a layout forced for this test); it counts with pymunk's public "
-        "API only: the joints' and contacts' work as one lumped term")]
+        (f"dumbbell.spaces.Ledger: pymunk {metadata.version('pymunk')}'s structs are not laid "
+        "out as the ledger reads them (a layout forced for this test); it counts with "
+        "pymunk's public API only: the joints' and contacts' work as one lumped term")]
     space, ledger = spaces_made[0]
     assert type(ledger).__name__ == "PublicLedger" and isinstance(ledger, sp.Ledger)
     for _ in range(1000):

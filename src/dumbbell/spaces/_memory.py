@@ -153,6 +153,18 @@ def _lib() -> Any:
     return lib
 
 
+def pymunk_version() -> str:
+    """The installed pymunk's version (``pymunk.version`` says Munk2D's on pymunk 7.0.x)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("pymunk")
+    except metadata.PackageNotFoundError:  # pragma: no cover - pymunk not from a package
+        import pymunk
+
+        return str(pymunk.version)
+
+
 def _unsigned(size: int) -> str:
     return {1: "unsigned char", 2: "unsigned short", 4: "unsigned int",
             8: "unsigned long long"}[size]

@@ -263,9 +263,9 @@ def _wildcard(space: Any) -> Any:
     handler = getattr(space, "_handlers", {}).get((None, None))
     if not isinstance(handler, CollisionHandler) or not isinstance(
             getattr(handler, "data", None), dict):
-        import pymunk
+        from ._memory import pymunk_version
 
-        raise DumbbellError(f"dumbbell.spaces.HeatCounter: pymunk {pymunk.version} does not "
+        raise DumbbellError(f"dumbbell.spaces.HeatCounter: pymunk {pymunk_version()} does not "
                             "keep its wildcard collision handler where pymunk 7 does")
     return handler
 

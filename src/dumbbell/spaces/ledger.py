@@ -82,12 +82,10 @@ def _warn_fallback(why: str) -> None:
     """Say once per process that the ledger counts with pymunk's public API only."""
     if _FALLBACK_SAID:
         return
-    import pymunk
-
     _FALLBACK_SAID.append(why)
-    warnings.warn(f"dumbbell.spaces.Ledger: pymunk {pymunk.version}'s structs are not laid out "
-                  f"as the ledger reads them ({why}); it counts with pymunk's public API "
-                  "only: the joints' and contacts' work as one lumped term", RuntimeWarning,
+    warnings.warn(f"dumbbell.spaces.Ledger: pymunk {mem.pymunk_version()}'s structs are not "
+                  f"laid out as the ledger reads them ({why}); it counts with pymunk's public "
+                  "API only: the joints' and contacts' work as one lumped term", RuntimeWarning,
                   stacklevel=3)
 
 
