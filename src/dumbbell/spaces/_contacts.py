@@ -67,8 +67,7 @@ class Contacts:
         self.L = _Layout()
         self.span: mem.Span | None = None
         self.cspan: mem.Span | None = None
-        self._prev: tuple[Table, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                          np.ndarray] | None = None
+        self._cache: _Cache | None = None
 
     @staticmethod
     def _grown(span: mem.Span | None, low: int, high: int) -> mem.Span:
@@ -86,31 +85,36 @@ class Contacts:
         if num == 0 or not 0 < num <= int(self.arr.max):
             return False
         L = self.L
-        # In address order: the solver's order changes from step to step, the set little.
-        arb = np.sort(np.frombuffer(self.buffer(self.arr.arr, self.psize * num),
-                                    dtype=self.dtype)).astype(np.int64)
-        span = self.span = self._grown(self.span, int(arb[0]), int(arb[-1]) + L.asize)
+        arb = np.frombuffer(self.buffer(self.arr.arr, self.psize * num),
+                            dtype=self.dtype).astype(np.int64)
+        span = self.span
+        lo, hi = int(arb.min()), int(arb.max()) + L.asize
+        if span is None or lo < span.lo or hi > span.lo + len(span.u8):
+            span = self.span = self._grown(span, lo, hi)
+            self._cache = None  # its positions are the span's
         rel = arb - span.lo
         ints = span.u32[(rel >> 2)[:, None] + L.ints]
-        words = (rel >> 3)[:, None]
+        words = rel >> 3
         if L.pshift == 3:  # the pointers and the normal in one gather of 8-byte words
-            g = span.u64[words + L.words8]
+            g = span.u64[words[:, None] + L.words8]
             ptr, n = g[:, :3].view(np.int64), g[:, 3:].view(np.float64)
         else:
             ptr = span.ptr[(rel >> L.pshift)[:, None] + L.ptr].astype(np.int64)
-            n = span.f64[words + L.normal]
+            n = span.f64[words[:, None] + L.normal]
         count = ints[:, 0]
         if not count.all():  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
-            arb, count, ints, ptr, n = arb[keep], count[keep], ints[keep], ptr[keep], n[keep]
-        self._rows(table, pairs, arb, np.ascontiguousarray(ptr[:, :2]))
+            words, count, ints, ptr, n = words[keep], count[keep], ints[keep], ptr[keep], \
+                n[keep]
+        self._rows(table, pairs, words, ptr[:, 0], ptr[:, 1])
         self.n = n.T
-        self.weight = np.stack([np.ones(len(arb)), (count > 1).astype(float)])
+        two = count > 1
+        self.weight = np.stack([np.ones(len(two)), two])
         self.first = ints[:, 1] == 0
         first_c = ptr[:, 2]
-        second = first_c + np.where(count > 1, L.csize, 0)
+        second = first_c + L.csize * two
         cspan = self.cspan = self._grown(self.cspan, int(first_c.min()),
                                          int(second.max()) + L.csize)
         self.words = (np.stack([first_c, second]) - cspan.lo) >> 3
@@ -120,42 +124,21 @@ class Contacts:
             self.kept = 1.0 - np.where(self.first, 0.0, coef)
         return True
 
-    def _rows(self, table: Table, pairs: Pairs, arb: np.ndarray, ends: np.ndarray) -> None:
-        """The rows of each arbiter's bodies, its pair's slot, and where its impulses go;
-        an arbiter at the same address joining the same bodies as in the last step keeps
-        what it had."""
-        prev = self._prev
-        m = len(arb)
-        if prev is not None and prev[0] is table:
-            _, p_arb, p_ends, p_ra, p_rb, p_slots = prev
-            i = np.minimum(np.searchsorted(p_arb, arb), len(p_arb) - 1)
-            hit = (p_arb[i] == arb) & (p_ends[i] == ends).all(axis=1)
-        else:
-            i, hit = np.zeros(m, dtype=np.int64), np.zeros(m, dtype=bool)
-        if hit.all():
-            ra, rb, slots = p_ra[i], p_rb[i], p_slots[i]
-        else:
-            miss = np.nonzero(~hit)[0]
-            nb = len(table.sorted_i64)
-            if nb == 0:
-                raise UnknownBody
-            pos = np.minimum(np.searchsorted(table.sorted_i64, ends[miss]), nb - 1)
-            if not np.array_equal(table.sorted_i64[pos], ends[miss]):
-                raise UnknownBody
-            new = table.order[pos]
-            if hit.any():
-                ra, rb, slots = p_ra[i], p_rb[i], p_slots[i]
-            else:
-                ra, rb, slots = (np.zeros(m, dtype=np.int64) for _ in range(3))
-            ra[miss], rb[miss] = new[:, 0], new[:, 1]
-            slots[miss] = table.pair_slots(ra[miss], rb[miss], pairs)
-        self._prev = (table, arb, ends, ra, rb, slots)
-        self.ra, self.rb, self.slots = ra, rb, slots
-        self.sign = table.lin_free[rb].astype(float) - table.lin_free[ra].astype(float)
-        # One scatter of the impulses (x, y, angle) onto both ends.
-        self.scatter = np.concatenate([3 * rb, 3 * rb + 1, 3 * rb + 2, 3 * ra, 3 * ra + 1,
-                                       3 * ra + 2])
-        self.driven = np.nonzero(table.drives[ra] | table.drives[rb])[0]
+    def _rows(self, table: Table, pairs: Pairs, words: np.ndarray, end_a: np.ndarray,
+              end_b: np.ndarray) -> None:
+        """The rows of each arbiter's bodies, its pair's slot, the sign of its push, and
+        where its impulses go; kept, at the arbiter's place in the span, while the same
+        arbiter joins the same bodies (a few arbiters come and go each step)."""
+        c = self._cache
+        if c is None or c.table is not table:
+            c = self._cache = _Cache(len(self.span.u8) >> 3, table)
+        hit = (c.end_a[words] == end_a) & (c.end_b[words] == end_b)
+        if not hit.all():
+            c.fill(words[~hit], end_a[~hit], end_b[~hit], pairs)
+        self.ra, self.rb, self.slots = c.ra[words], c.rb[words], c.slot[words]
+        self.sign = c.sign[words]
+        self.scatter = c.scatter[words].T.ravel()
+        self.driven = np.nonzero(c.driven[words])[0]
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
@@ -198,6 +181,45 @@ class Contacts:
                       + np.bincount(db_, weights=db, minlength=table.rows))
             total += float(da.sum() + db.sum())
         return total, jbias * self.sign
+
+
+class _Cache:
+    """What :meth:`Contacts._rows` keeps for each place (8-byte word) of the arbiters' span:
+    the bodies the arbiter there joins (0: none yet), their rows in ``table``, their pair's
+    slot, the sign of the push on them, the scatter of its impulses (x, y, angle on b, then
+    on a, as indices into rows x 3) and whether an end is driven."""
+
+    def __init__(self, words: int, table: Table) -> None:
+        self.table = table
+        self.end_a = np.zeros(words, dtype=np.int64)
+        self.end_b = np.zeros(words, dtype=np.int64)
+        self.ra = np.zeros(words, dtype=np.int64)
+        self.rb = np.zeros(words, dtype=np.int64)
+        self.slot = np.zeros(words, dtype=np.int64)
+        self.sign = np.zeros(words)
+        self.scatter = np.zeros((words, 6), dtype=np.int64)
+        self.driven = np.zeros(words, dtype=bool)
+
+    def fill(self, words: np.ndarray, end_a: np.ndarray, end_b: np.ndarray,
+             pairs: Pairs) -> None:
+        """What the arbiters at ``words`` joining ``end_a`` and ``end_b`` need."""
+        t = self.table
+        nb = len(t.sorted_i64)
+        ends = np.concatenate([end_a, end_b])
+        if nb == 0:
+            raise UnknownBody
+        pos = np.minimum(np.searchsorted(t.sorted_i64, ends), nb - 1)
+        if not np.array_equal(t.sorted_i64[pos], ends):
+            raise UnknownBody
+        rows = t.order[pos]
+        ra, rb = rows[: len(end_a)], rows[len(end_a):]
+        self.end_a[words], self.end_b[words] = end_a, end_b
+        self.ra[words], self.rb[words] = ra, rb
+        self.slot[words] = t.pair_slots(ra, rb, pairs)
+        self.sign[words] = t.lin_free[rb].astype(float) - t.lin_free[ra].astype(float)
+        self.scatter[words] = np.stack([3 * rb, 3 * rb + 1, 3 * rb + 2, 3 * ra, 3 * ra + 1,
+                                        3 * ra + 2], axis=1)
+        self.driven[words] = t.drives[ra] | t.drives[rb]
 
 
 def arbiters_address(space_at: int) -> int:
