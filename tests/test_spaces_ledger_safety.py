@@ -236,3 +236,21 @@ def test_a_dynamic_body_of_mass_or_moment_0_is_named_never_complete(ghost):
     assert ("complete False a dynamic body of mass" in done.stdout
             or "refused DumbbellError body 1: " in done.stdout and
             "(a dynamic body of mass" in done.stdout), done.stdout
+
+
+def test_pymunks_own_suite_passes_with_a_ledger_and_a_heat_counter_on_every_space():
+    # benchmarks/pymunk_suite.py runs pymunk's tests twice, each in a subprocess of its
+    # own: bare, and with a Ledger and a HeatCounter kept on every Space pymunk makes.
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+    try:
+        import pymunk_suite
+    finally:
+        sys.path.pop(0)
+    bare, led = pymunk_suite.suite_run("bare"), pymunk_suite.suite_run("ledgers")
+    assert "exit" not in bare and "exit" not in led, (bare, led)
+    assert led["run"] == bare["run"] > 250
+    newly = set(led["failed"] + led["errors"]) - set(bare["failed"] + bare["errors"])
+    assert newly == set()
+    assert led["spaces"] > 500 and led["stopped"] == []
