@@ -367,6 +367,13 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "a mass, moment, centre of gravity or body type"
     if not ((P[1, : t.n] == b.vf).all() and (P[2, : t.n] == b.pf).all()):
         return "a velocity_func or position_func"
+    return _changed_settings(b, space)
+
+
+def _changed_settings(b: Build, space: Any) -> str:
+    """What changed since the build in gravity, the springs' settings and the custom
+    velocity functions ('' when nothing)."""
+    t = b.table
     if tuple(space.gravity) != b.gravity:
         return "space.gravity"
     for g in b.springs:

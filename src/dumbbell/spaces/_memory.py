@@ -225,38 +225,43 @@ _POINTER_FIELDS = {"body": ("velocity_func", "position_func", "root"),
 def platform_problem() -> str | None:
     """Why the declared structs cannot be read on this platform, or None: pymunk's scalar
     types, the pointer width, and the alignment the 8-byte gathers need."""
+    return _sizes_problem() or _alignment_problem()
+
+
+def _sizes_problem() -> str | None:
     p = _pymunk_ffi()
     ptr = p.sizeof("void *")
     if ptr not in (4, 8):
         return f"pointers are {ptr} bytes"
-    for name, want in (("cpFloat", 8), ("cpVect", 16), ("uintptr_t", ptr),
-                       ("cpHashValue", ptr)):
-        if p.sizeof(name) != want:
-            return f"{name} is {p.sizeof(name)} bytes, not {want}"
-    if p.sizeof("cpBool") not in (1, 2, 4, 8) or p.sizeof("cpTimestamp") not in (1, 2, 4, 8):
-        return "cpBool or cpTimestamp has an unusual size"
-    f = ffi()
-    if f.sizeof("void *") != ptr:
-        return "cffi and pymunk disagree on the pointer width"
+    wrong = [f"{name} is {p.sizeof(name)} bytes, not {want}" for name, want in
+             (("cpFloat", 8), ("cpVect", 16), ("uintptr_t", ptr), ("cpHashValue", ptr),
+              ("int", 4)) if p.sizeof(name) != want]
+    wrong += [f"{name} is {p.sizeof(name)} bytes" for name in ("cpBool", "cpTimestamp")
+              if p.sizeof(name) not in (1, 2, 4, 8)]
+    if ffi().sizeof("void *") != ptr:
+        wrong.append("cffi and pymunk disagree on the pointer width")
     if p.sizeof("cpCollisionHandler") % ptr:
-        return "cpCollisionHandler is not a whole number of pointers"
+        wrong.append("cpCollisionHandler is not a whole number of pointers")
+    if p.sizeof("cpArbiter") % 8 or p.sizeof("cpContact") % 8:
+        wrong.append("cpArbiter or cpContact is not a whole number of 8-byte words")
+    return wrong[0] if wrong else None
+
+
+def _alignment_problem() -> str | None:
+    p = _pymunk_ffi()
+    ptr = p.sizeof("void *")
+    fields = [(kind, path, 8) for kind, paths in _FLOAT_FIELDS.items() for path in paths]
+    fields += [(kind, path, ptr) for kind, paths in _POINTER_FIELDS.items() for path in paths]
+    for kind, path, step in fields:
+        if offset(kind, *path.split(".")) % step:
+            return f"{kind}.{path} is not {step}-byte aligned on this platform"
     # pymunk's own declarations of the arbiters and contacts the gathers read.
-    for struct, fields, step in (("cpArbiter", ("n",), 8), ("cpArbiter", ("count", "state"), 4),
-                                 ("cpArbiter", ("body_a", "body_b", "contacts"), ptr),
-                                 ("cpContact", ("r1", "r2", "jnAcc", "jtAcc", "jBias"), 8)):
-        for name in fields:
+    for struct, names, step in (("cpArbiter", ("n",), 8), ("cpArbiter", ("count", "state"), 4),
+                                ("cpArbiter", ("body_a", "body_b", "contacts"), ptr),
+                                ("cpContact", ("r1", "r2", "jnAcc", "jtAcc", "jBias"), 8)):
+        for name in names:
             if p.offsetof(struct, name) % step:
                 return f"{struct}.{name} is not aligned for the gathers on this platform"
-    if p.sizeof("cpArbiter") % 8 or p.sizeof("cpContact") % 8:
-        return "cpArbiter or cpContact is not a whole number of 8-byte words"
-    for kind, fields in _FLOAT_FIELDS.items():
-        for path in fields:
-            if offset(kind, *path.split(".")) % 8:
-                return f"{kind}.{path} is not 8-byte aligned on this platform"
-    for kind, fields in _POINTER_FIELDS.items():
-        for path in fields:
-            if offset(kind, path) % ptr:
-                return f"{kind}.{path} is not pointer-aligned on this platform"
     return None
 
 

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ._inventory import Build, Group, Table
-from ._records import Energy, Move, Potentials, Snapshot, Step
+from ._records import Before, Energy, Move, Potentials, Snapshot, Step
 from ._terms import Sums
 
 
@@ -87,11 +87,9 @@ def field_energy(b: Build, pos: np.ndarray) -> np.ndarray:
 
 
 def snapshot(b: Build, pos: np.ndarray, vel: np.ndarray, bias: np.ndarray,
-             sleeping: np.ndarray, us: list[np.ndarray] | None = None,
-             ud: np.ndarray | None = None) -> Snapshot:
-    """A snapshot at (pos, vel), the potentials computed unless given."""
-    return Snapshot(pos, vel, bias, sleeping, spring_energy(b, pos) if us is None else us,
-                    field_energy(b, pos) if ud is None else ud)
+             sleeping: np.ndarray) -> Snapshot:
+    """A snapshot at (pos, vel), with the potentials there."""
+    return Snapshot(pos, vel, bias, sleeping, spring_energy(b, pos), field_energy(b, pos))
 
 
 def read_snapshot(b: Build) -> Snapshot:
@@ -157,16 +155,18 @@ def move_of(b: Build, s: Snapshot, pos: np.ndarray, vel: np.ndarray, dt: float) 
         moving[:n] &= ~s.sleeping
     start = s.pos
     if not np.array_equal(pos, np.where(moving, start + (vel + s.bias) * dt, start)):
-        moving, start = _moved_how(b, s, pos, vel, dt, moving)
+        moving, start = _moved_how(b, s, Move(pos, vel, start, dt), moving)
     step = np.where(moving, dt, 0.0) if start is not s.pos or s.asleep else dt
     return Move(pos, vel, start, step)
 
 
-def _moved_how(b: Build, s: Snapshot, pos: np.ndarray, vel: np.ndarray, dt: float,
-               moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Which bodies pymunk moved (the program may have woken some or put them to sleep),
-    and where each started: where it was, or where the program put it."""
+def _moved_how(b: Build, s: Snapshot, move: Move, moving: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Which bodies pymunk moved over ``move`` (positions after it and velocities; its
+    ``step`` the dt) (the program may have woken some or put them to sleep), and where each
+    started: where it was, or where the program put it."""
     t = b.table
+    pos, vel, dt = move.pos, move.vel, float(move.step)
     shift = (vel + s.bias) * dt
     ok = np.all(same(pos, np.where(moving, s.pos + shift, s.pos)), axis=0)
     flipped = ~moving & t.moves
@@ -331,13 +331,16 @@ def spring_elastic(t: Table, g: Group, after: np.ndarray, step: Step) -> np.ndar
     return Jel * unit
 
 
-def external(b: Build, step: Step, kicked: np.ndarray | None, damping: float,
-             force: np.ndarray | None, sums: Sums) -> tuple[np.ndarray, float, float]:
+def external(b: Build, step: Step, p: Before, damping: float, sums: Sums
+             ) -> tuple[np.ndarray, float, float]:
     """The impulses from outside the constraints and contacts (3, dynamic rows): gravity,
-    m g dt on every awake body the default velocity_func moves (``kicked``: which, None for
-    all), applied forces and torques (``force``, read before pymunk cleared them), and
-    ``space.damping``; returns them, gravity's work, and the others' (added to ``sums``)."""
+    m g dt on every awake body (``p.awake``) the default velocity_func moves, applied forces
+    and torques (``p.force``, read before pymunk cleared them), and ``space.damping``;
+    returns them, gravity's work, and the others' (added to ``sums``)."""
     t = b.table
+    kicked, force = p.awake, p.force
+    if b.any_custom:
+        kicked = ~b.custom if kicked is None else kicked & ~b.custom
     n, m, dt = t.n, t.m, step.dt
     gx, gy = b.gravity
     un = step.u[:, :n]
@@ -370,12 +373,15 @@ def external(b: Build, step: Step, kicked: np.ndarray | None, damping: float,
     return ext, w_g, total
 
 
-def unexplained(b: Build, step: Step, ext: np.ndarray, w_g: float, g_int: float,
-                g_rows: np.ndarray | None, d_int: np.ndarray | None, sums: Sums) -> float:
+def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, float],
+                sums: Sums) -> float:
     """What no source explains (a custom velocity_func's kicks, an impulse from a callback)
-    and gravity's step error (``w_g`` its work, ``g_int`` its potential's change over the
-    move): counted into ``sums``; returns their sum."""
+    and gravity's step error (``outside``: the impulses :func:`external` gave and gravity's
+    work; ``p.g_int`` its potential's change over the move): counted into ``sums``; returns
+    their sum."""
     t = b.table
+    ext, w_g = outside
+    g_int, g_rows, d_int = p.g_int, p.g_rows, p.potentials.d_int
     n = t.n
     un = step.u[:, :n]
     R = t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) - step.imp[:, :n] - ext

@@ -161,8 +161,9 @@ def public_build(space: Any, names: Names) -> Build:
     for i in np.nonzero(t.unsteppable)[0]:
         current[labels[i]] = "a dynamic body of mass or moment 0: pymunk cannot step it"
     gravity = tuple(float(g) for g in space.gravity)
-    return Build(t, {}, springs, [], gravity, vf, pf, np.zeros(n, dtype=bool),
-                 np.zeros(n, dtype=bool), [None] * n, current)
+    funcs = [t.bodies[i].velocity_func if custom[i] else None for i in range(n)]
+    return Build(t, {}, springs, [], gravity, vf, pf, custom, np.zeros(n, dtype=bool), funcs,
+                 current)
 
 
 def _spring_kicks(b: Build, pos: np.ndarray, dt: float) -> np.ndarray:
@@ -307,8 +308,7 @@ def post(self: Any) -> None:
     damping = float(self.space.damping)
     step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
                 np.zeros((3, t.rows)), None, [])
-    kicked = ~b.vf.astype(bool) if p.awake is None else p.awake & ~b.vf.astype(bool)
-    ext, w_g, external = phys.external(b, step, kicked, damping, p.force, self._sums)
+    ext, w_g, external = phys.external(b, step, p, damping, self._sums)
     solver = t.mass3 * (vel1[:, :n] - vel_r[:, :n]) - ext
     w_s = float(np.sum(solver * step.u[:, :n]))
     self._sums.add(f"contacts and joints ({LUMPED})", "contacts and joints", w_s,

@@ -105,13 +105,7 @@ def inventory(space: Any) -> Inventory:
 
     def name(body: Any) -> str:
         i = place.get(id(body))
-        if i is not None:
-            return f"body {i}"
-        # The space's own static body (not among its bodies), without making it: pymunk
-        # makes it on first use.
-        if body.body_type == pymunk.Body.STATIC and body.space is space:
-            return "static body"
-        return "body (not in the space)"
+        return f"body {i}" if i is not None else _outside(space, body)
 
     labels = [name(b) for b in dyn]
     moments = [i for i, kind in zip(moments_all, types, strict=True)
@@ -149,6 +143,16 @@ def inventory(space: Any) -> Inventory:
         springs=tuple(springs), skipped=tuple(skipped), unknown=tuple(unknown),
         notes=tuple(notes),
     )
+
+
+def _outside(space: Any, body: Any) -> str:
+    """The label of a body not among the space's bodies: the space's own static body
+    (found without making it: pymunk makes it on first use), or one not in the space."""
+    import pymunk
+
+    if body.body_type == pymunk.Body.STATIC and body.space is space:
+        return "static body"
+    return "body (not in the space)"
 
 
 def _constraints(space: Any, index: Callable[[Any], int]

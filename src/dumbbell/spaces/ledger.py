@@ -454,13 +454,9 @@ class Ledger(Changes):
             if push.any():
                 c = self._contacts
                 self._push = (c.slots, c.n[0] * push, c.n[1] * push)
-        kicked = p.awake
-        if b.any_custom:
-            kicked = ~b.custom if kicked is None else kicked & ~b.custom
-        ext, w_g, external = phys.external(b, step, kicked, damping, p.force, self._sums)
+        ext, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
-        total += phys.unexplained(b, step, ext, w_g, p.g_int, p.g_rows, p.potentials.d_int,
-                                  self._sums)
+        total += phys.unexplained(b, step, p, (ext, w_g), self._sums)
         self._close_step(Q, p, total)
 
     def _close_step(self, Q: np.ndarray, p: Before, total: float) -> None:
