@@ -76,7 +76,7 @@ from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
 from .units import SI, check_units, energy_unit
 
-__all__ = ["Balance", "Ledger", "Term"]
+__all__ = ["Ledger"]  # Balance and Term: balance.py
 
 def _warn_fallback(why: str) -> None:
     """Say once per process that the ledger counts with pymunk's public API only."""
