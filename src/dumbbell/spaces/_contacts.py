@@ -48,10 +48,11 @@ class _Layout:
         self.ints = np.array([arb["count"], arb["state"]]) // 4
         con = {name: p.offsetof("cpContact", name) for name in
                ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
-        # jn, jt, jBias, r1.x, r1.y, r2.x, r2.y
         self.words8 = np.concatenate([self.ptr, self.normal]) if ps == 8 else None
-        self.contact = np.array([con["jnAcc"], con["jtAcc"], con["jBias"], con["r1"],
-                                 con["r1"] + 8, con["r2"], con["r2"] + 8]) // 8
+        # As complex numbers (x + i y): the impulse jn + i jt (along the normal and the
+        # tangent), r1, r2, and jBias (its real part).
+        self.contact = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r1"] + 8,
+                                 con["r2"], con["r2"] + 8, con["jBias"], con["jBias"]]) // 8
         self.carried = self.contact[:2]
 
 
@@ -109,9 +110,9 @@ class Contacts:
             words, count, ints, ptr, n = words[keep], count[keep], ints[keep], ptr[keep], \
                 n[keep]
         self._rows(table, pairs, words, ptr[:, 0], ptr[:, 1])
-        self.n = n.T
+        self.n = n[:, 0] + 1j * n[:, 1]
         two = count > 1
-        self.weight = np.stack([np.ones(len(two)), two])
+        self.single = None if two.all() else ~two
         self.first = ints[:, 1] == 0
         first_c = ptr[:, 2]
         second = first_c + L.csize * two
@@ -120,8 +121,8 @@ class Contacts:
         self.words = (np.stack([first_c, second]) - cspan.lo) >> 3
         self.has_j0 = coef != 1.0 or bool(self.first.any())
         if self.has_j0:
-            self.j0 = cspan.f64[self.words[..., None] + L.carried]  # (2, m, 2)
-            self.kept = 1.0 - np.where(self.first, 0.0, coef)
+            j0 = cspan.f64[self.words[..., None] + L.carried]  # (2, m, 2): jn, jt
+            self.j0 = j0.view(np.complex128)[..., 0] * (1.0 - np.where(self.first, 0.0, coef))
         return True
 
     def _rows(self, table: Table, pairs: Pairs, words: np.ndarray, end_a: np.ndarray,
@@ -137,57 +138,56 @@ class Contacts:
             c.fill(words[~hit], end_a[~hit], end_b[~hit], pairs)
         self.ra, self.rb, self.slots = c.ra[words], c.rb[words], c.slot[words]
         self.sign = c.sign[words]
-        self.scatter = c.scatter[words].T.ravel()
-        self.driven = np.nonzero(c.driven[words])[0]
+        self.both = np.concatenate([self.ra, self.rb])
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
-        """Work of the step's contact impulses, summed per pair into ``pairs.work``; their
-        impulses added to ``step.imp``, the work of driven ends to ``drive`` (rows); and the
-        bias impulse along the normal on the dynamic ends of each arbiter (its position
-        correction's push)."""
-        f = self.cspan.f64[self.words[..., None] + self.L.contact]  # (2, m, 7)
-        jn, jt = f[..., 0], f[..., 1]
+        """Work of the step's contact impulses, summed per pair into ``pairs.work`` and per
+        row (its linear and angular parts) into ``step.work``; the work of driven ends into
+        ``drive`` (rows); and the bias impulse along the normal on the dynamic ends of each
+        arbiter (its position correction's push). Vectors are complex numbers x + i y: a
+        product with a conjugate gives the dot product (real part) and the cross product
+        (imaginary part)."""
+        f = self.cspan.f64[self.words[..., None] + self.L.contact].view(np.complex128)
+        if self.single is not None:  # arbiters of one contact: no second one
+            f[1, self.single] = 0.0
+        J, r1, r2 = f[..., 0], f[..., 1], f[..., 2]  # (2, m) each
         if self.has_j0:
-            jn = jn - self.kept * self.j0[..., 0]
-            jt = jt - self.kept * self.j0[..., 1]
-        w = self.weight
-        nx, ny = self.n
-        qx = (nx * jn - ny * jt) * w
-        qy = (ny * jn + nx * jt) * w
-        px, py = qx[0] + qx[1], qy[0] + qy[1]
-        ta = f[0, :, 3] * qy[0] - f[0, :, 4] * qx[0] + f[1, :, 3] * qy[1] - f[1, :, 4] * qx[1]
-        tb = f[0, :, 5] * qy[0] - f[0, :, 6] * qx[0] + f[1, :, 5] * qy[1] - f[1, :, 6] * qx[1]
-        jbias = f[0, :, 2] * w[0] + f[1, :, 2] * w[1]
+            J = J - self.j0
+        q = self.n * J  # each contact's impulse on b, in world axes
+        P = q[0] + q[1]
+        ta = (r1.conj() * q).imag.sum(axis=0)
+        tb = (r2.conj() * q).imag.sum(axis=0)
+        jbias = f[0, :, 3].real + f[1, :, 3].real
         a, b, u = self.ra, self.rb, step.u
-        ub, ua = u[:, b], u[:, a]
-        rel = px * (ub[0] - ua[0]) + py * (ub[1] - ua[1]) + tb * ub[2] - ta * ua[2]
+        uc = np.empty(u.shape[1], dtype=np.complex128)
+        uc.real, uc.imag = u[0], u[1]
+        cP = P.conj()
+        lin_b = (cP * uc[b]).real
+        lin_a = -(cP * uc[a]).real
+        ang_b = tb * u[2, b]
+        ang_a = -ta * u[2, a]
+        rel = lin_a + lin_b + ang_a + ang_b
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
-        step.imp[...] += np.bincount(self.scatter, weights=np.concatenate([px, py, tb, -px, -py,
-                                                                      -ta]),
-                                minlength=3 * table.rows).reshape(table.rows, 3).T
+        rows = table.rows
+        lin = np.bincount(self.both, weights=np.concatenate([lin_a, lin_b]), minlength=rows)
+        ang = np.bincount(self.both, weights=np.concatenate([ang_a, ang_b]), minlength=rows)
+        step.work[0] += lin
+        step.work[1] += ang
         total = float(rel.sum())
-        d = self.driven
-        if len(d):
+        if table.any_driven:
             # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
             # bodies of infinite moment): what the relative work leaves out of theirs.
-            lin, ang = table.lin_free, table.ang_free
-            da_, db_ = a[d], b[d]
-            da = (np.where(lin[da_], 0.0, px[d] * u[0, da_] + py[d] * u[1, da_])
-                  + np.where(ang[da_], 0.0, ta[d] * u[2, da_]))
-            db = -(np.where(lin[db_], 0.0, px[d] * u[0, db_] + py[d] * u[1, db_])
-                   + np.where(ang[db_], 0.0, tb[d] * u[2, db_]))
-            drive += (np.bincount(da_, weights=da, minlength=table.rows)
-                      + np.bincount(db_, weights=db, minlength=table.rows))
-            total += float(da.sum() + db.sum())
+            driven = -(np.where(table.lin_free, 0.0, lin) + np.where(table.ang_free, 0.0, ang))
+            drive += driven
+            total += float(driven.sum())
         return total, jbias * self.sign
 
 
 class _Cache:
     """What :meth:`Contacts._rows` keeps for each place (8-byte word) of the arbiters' span:
     the bodies the arbiter there joins (0: none yet), their rows in ``table``, their pair's
-    slot, the sign of the push on them, the scatter of its impulses (x, y, angle on b, then
-    on a, as indices into rows x 3) and whether an end is driven."""
+    slot and the sign of the push on them."""
 
     def __init__(self, words: int, table: Table) -> None:
         self.table = table
@@ -197,8 +197,6 @@ class _Cache:
         self.rb = np.zeros(words, dtype=np.int64)
         self.slot = np.zeros(words, dtype=np.int64)
         self.sign = np.zeros(words)
-        self.scatter = np.zeros((words, 6), dtype=np.int64)
-        self.driven = np.zeros(words, dtype=bool)
 
     def fill(self, words: np.ndarray, end_a: np.ndarray, end_b: np.ndarray,
              pairs: Pairs) -> None:
@@ -217,9 +215,6 @@ class _Cache:
         self.ra[words], self.rb[words] = ra, rb
         self.slot[words] = t.pair_slots(ra, rb, pairs)
         self.sign[words] = t.lin_free[rb].astype(float) - t.lin_free[ra].astype(float)
-        self.scatter[words] = np.stack([3 * rb, 3 * rb + 1, 3 * rb + 2, 3 * ra, 3 * ra + 1,
-                                        3 * ra + 2], axis=1)
-        self.driven[words] = t.drives[ra] | t.drives[rb]
 
 
 def arbiters_address(space_at: int) -> int:

@@ -124,6 +124,7 @@ class Table:
         Table._derive(self, first)
         for r in range(n + k, self.rows):
             self.drives[r] = self.bodies[r].body_type != pymunk.Body.STATIC
+        self.any_driven = bool(self.drives.any())
         order = np.argsort(self.at)
         self.order, self.sorted_at = order, self.at[order]
         self.sorted_i64 = self.sorted_at.view(np.int64)
@@ -158,6 +159,7 @@ class Table:
         t.drives = np.zeros(t.rows, dtype=bool)
         t.drives[n: n + k] = True
         t.drives[:n] = ~t.finite
+        t.any_driven = bool(t.drives.any())
 
     def pair_slots(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
         """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added."""

@@ -238,23 +238,21 @@ def constraint_work(t: Table, g: Group, after: np.ndarray, initial: np.ndarray,
     the accumulator's end value less what it carried in and did not apply (pymunk applies
     the carried impulse scaled by dt / previous dt, and none when a stop resets it). A
     spring's impulse splits into its elastic part (its force at the step's positions,
-    applied when the step prepares it) and its damping. Adds the impulses to ``step.imp``
-    and the springs' elastic kicks to ``step.kick`` (what ``space.damping`` then scales)."""
+    applied when the step prepares it) and its damping. Adds the work on each row to
+    ``step.work`` and the springs' elastic kicks to ``step.kick`` (what ``space.damping``
+    then scales)."""
     rows = t.rows
     ra, rb = g.a, g.b
-    u, imp = step.u, step.imp
+    u = step.u
     La, Lb, Aa, Ab = impulses(g.kind, after, initial, step.coef)
-    work_a = La[0] * u[0, ra] + La[1] * u[1, ra] + Aa * u[2, ra]
-    work_b = Lb[0] * u[0, rb] + Lb[1] * u[1, rb] + Ab * u[2, rb]
-    rel = work_a + work_b
+    lin_a, ang_a = La[0] * u[0, ra] + La[1] * u[1, ra], Aa * u[2, ra]
+    lin_b, ang_b = Lb[0] * u[0, rb] + Lb[1] * u[1, rb], Ab * u[2, rb]
+    rel = lin_a + ang_a + lin_b + ang_b
     both = np.concatenate([ra, rb])
-    imp[0] += _scatter(both, np.concatenate([La[0], Lb[0]]), rows)
-    imp[1] += _scatter(both, np.concatenate([La[1], Lb[1]]), rows)
-    imp[2] += _scatter(both, np.concatenate([Aa, Ab]), rows)
-    drv_a = -np.where(t.lin_free[ra], 0.0, La[0] * u[0, ra] + La[1] * u[1, ra]) - np.where(
-        t.ang_free[ra], 0.0, Aa * u[2, ra])
-    drv_b = -np.where(t.lin_free[rb], 0.0, Lb[0] * u[0, rb] + Lb[1] * u[1, rb]) - np.where(
-        t.ang_free[rb], 0.0, Ab * u[2, rb])
+    step.work[0] += _scatter(both, np.concatenate([lin_a, lin_b]), rows)
+    step.work[1] += _scatter(both, np.concatenate([ang_a, ang_b]), rows)
+    drv_a = -np.where(t.lin_free[ra], 0.0, lin_a) - np.where(t.ang_free[ra], 0.0, ang_a)
+    drv_b = -np.where(t.lin_free[rb], 0.0, lin_b) - np.where(t.ang_free[rb], 0.0, ang_b)
     g.kin_a += drv_a
     g.kin_b += drv_b
     total = float(np.sum(rel) + np.sum(drv_a) + np.sum(drv_b))
@@ -384,10 +382,11 @@ def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, floa
     g_int, g_rows, d_int = p.g_int, p.g_rows, p.potentials.d_int
     n = t.n
     un = step.u[:, :n]
-    R = t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) - step.imp[:, :n] - ext
-    if not t.all_finite:
-        R[2] = np.where(t.finite, R[2], 0.0)  # an infinite moment's spin is imposed
-    w_r = np.sum(R * un, axis=0)
+    # The work of what no source explains: of the impulse m (v1 - v0) less the sources'.
+    D = (t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) - ext) * un
+    w_r = D[0] + D[1] - step.work[0, :n]
+    spin = D[2] - step.work[1, :n]
+    w_r += spin if t.all_finite else np.where(t.finite, spin, 0.0)  # infinite: imposed
     total = 0.0
     if b.any_custom:
         custom = b.custom

@@ -307,7 +307,7 @@ def post(self: Any) -> None:
     vel_r, vel1 = p.move.vel, Q[0:3]
     damping = float(self.space.damping)
     step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
-                np.zeros((3, t.rows)), None, [])
+                np.zeros((2, t.rows)), None, [])
     ext, w_g, external = phys.external(b, step, p, damping, self._sums)
     solver = t.mass3 * (vel1[:, :n] - vel_r[:, :n]) - ext
     w_s = float(np.sum(solver * step.u[:, :n]))

@@ -105,6 +105,6 @@ class Step(NamedTuple):
     vel0: np.ndarray
     vel1: np.ndarray
     u: np.ndarray
-    imp: np.ndarray
+    work: np.ndarray
     kick: np.ndarray | None
     spring_int: list[np.ndarray]

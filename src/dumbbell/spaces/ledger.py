@@ -442,7 +442,7 @@ class Ledger(Changes):
         # Velocities the sources act on: the mean of before and after (kinematic bodies
         # keep theirs; static ones have none).
         step = Step(p.dt, p.coef, p.move.pos, vel0, vel1, (vel0 + vel1) * 0.5,
-                    np.zeros((3, t.rows)),
+                    np.zeros((2, t.rows)),
                     np.zeros((3, t.rows)) if damping != 1.0 and b.springs else None,
                     p.potentials.spring_int)
         total = p.total
@@ -453,7 +453,7 @@ class Ledger(Changes):
             total += work
             if push.any():
                 c = self._contacts
-                self._push = (c.slots, c.n[0] * push, c.n[1] * push)
+                self._push = (c.slots, c.n.real * push, c.n.imag * push)
         ext, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
         total += phys.unexplained(b, step, p, (ext, w_g), self._sums)
