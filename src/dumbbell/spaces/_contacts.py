@@ -4,17 +4,20 @@ impulses carried in; after it, each contact's impulse and its work.
 
 The arbiters and contacts are read through pymunk's compiled declarations of ``cpArbiter``
 and ``cpContact`` (their offsets are the compiler's); the list of the step's arbiters is the
-space's ``arbiters`` array, whose place :func:`._memory.check_space` validated. Each
+space's ``arbiters`` array, whose place :func:`._layout.check_space` validated. Each
 contact applies, over the step, its accumulated impulse less what it carried in and did not
 apply: pymunk applies the carried impulse scaled by dt / previous dt (``coef``), and none on
 a first contact (it keeps one cached from an earlier touch there without applying it). The
 work of every contact impulse on the bodies' relative motion, J . (u0 + u1) / 2 at each
-contact point, is summed per pair of bodies.
+contact point, is summed per pair of bodies, and per body.
 
-Each read is one numpy gather of several fields of every arbiter (or contact) at once; what
-depends only on which bodies an arbiter joins (their rows, their pair's slot, where the
-impulses go) is kept from one step to the next while the arbiters and their bodies are the
-same.
+A pyramid's step has hundreds of arbiters, and each numpy call costs microseconds when the
+solver has just run: the reads are few, wide gathers (every field an arbiter needs in one,
+every field of both its contacts in another, laid out (field, contact, arbiter) so that
+each is a contiguous row), the arithmetic runs on both contacts at once, and the rows of
+an arbiter's bodies and its pair's slot are found with a few binary searches. Pointers are
+read as 8 bytes (:func:`._memory.platform_problem` sends other platforms to the
+public-API ledger).
 """
 
 from __future__ import annotations
@@ -22,8 +25,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import _memory as mem
-from ._inventory import Pairs, Table
+from ._inventory import PAIR, Pairs, Table
 from ._records import Step
+
+#: Work on end a and on end b of an impulse applied to b (and its opposite to a).
+_ENDS = np.array([[-1.0], [1.0]])
 
 
 class UnknownBody(Exception):
@@ -32,28 +38,26 @@ class UnknownBody(Exception):
 
 
 class _Layout:
-    """Where each field is, in 8-byte words from a contact's (or arbiter's) start."""
+    """Where the fields are, in 8-byte (or 4-byte) words from an arbiter's (or a
+    contact's) start."""
 
     def __init__(self) -> None:
         p = mem._pymunk_ffi()
-        ps = mem.pointer_size()
         arb = {name: p.offsetof("cpArbiter", name) for name in
-               ("contacts", "body_a", "body_b", "count", "state", "n")}
+               ("body_a", "body_b", "contacts", "n", "count", "state")}
         self.asize, self.csize = p.sizeof("cpArbiter"), p.sizeof("cpContact")
-        # Pointers (body_a, body_b, contacts) in pointer-sized words, the normal in 8-byte
-        # words, count and state in 4-byte words.
-        self.ptr = np.array([arb["body_a"], arb["body_b"], arb["contacts"]]) // ps
-        self.pshift = 3 if ps == 8 else 2
-        self.normal = np.array([arb["n"], arb["n"] + 8]) // 8
-        self.ints = np.array([arb["count"], arb["state"]]) // 4
+        # One gather of 8-byte words: body_a, body_b, contacts, n.x, n.y; one of 4-byte
+        # words: count, state.
+        self.arbiter = (np.array([arb["body_a"], arb["body_b"], arb["contacts"], arb["n"],
+                                  arb["n"] + 8]) // 8)[:, None]
+        self.ints = (np.array([arb["count"], arb["state"]]) // 4)[:, None]
         con = {name: p.offsetof("cpContact", name) for name in
                ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
-        self.words8 = np.concatenate([self.ptr, self.normal]) if ps == 8 else None
-        # As complex numbers (x + i y): the impulse jn + i jt (along the normal and the
-        # tangent), r1, r2, and jBias (its real part).
-        self.contact = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r1"] + 8,
-                                 con["r2"], con["r2"] + 8, con["jBias"], con["jBias"]]) // 8
-        self.carried = self.contact[:2]
+        # Per contact (jn, jt, r1.x, r1.y, r2.x, r2.y, jBias), for each of an arbiter's two
+        # contacts: (7, 2, 1) word offsets from its first contact.
+        one = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r1"] + 8, con["r2"],
+                        con["r2"] + 8, con["jBias"]]) // 8
+        self.contacts = np.stack([one, one + self.csize // 8], axis=1)[:, :, None]
 
 
 class Contacts:
@@ -63,12 +67,9 @@ class Contacts:
         p = mem._pymunk_ffi()
         self.arr = p.cast("cpArray *", arbiters_at)
         self.buffer = p.buffer
-        self.psize = mem.pointer_size()
-        self.dtype = mem.pointer_dtype()
         self.L = _Layout()
         self.span: mem.Span | None = None
         self.cspan: mem.Span | None = None
-        self._cache: _Cache | None = None
 
     @staticmethod
     def _grown(span: mem.Span | None, low: int, high: int) -> mem.Span:
@@ -86,137 +87,103 @@ class Contacts:
         if num == 0 or not 0 < num <= int(self.arr.max):
             return False
         L = self.L
-        arb = np.frombuffer(self.buffer(self.arr.arr, self.psize * num),
-                            dtype=self.dtype).astype(np.int64)
-        span = self.span
+        arb = np.frombuffer(self.buffer(self.arr.arr, 8 * num), dtype=np.int64)
         lo, hi = int(arb.min()), int(arb.max()) + L.asize
+        span = self.span
         if span is None or lo < span.lo or hi > span.lo + len(span.u8):
             span = self.span = self._grown(span, lo, hi)
-            self._cache = None  # its positions are the span's
-        rel = arb - span.lo
-        ints = span.u32[(rel >> 2)[:, None] + L.ints]
-        words = rel >> 3
-        if L.pshift == 3:  # the pointers and the normal in one gather of 8-byte words
-            g = span.u64[words[:, None] + L.words8]
-            ptr, n = g[:, :3].view(np.int64), g[:, 3:].view(np.float64)
-        else:
-            ptr = span.ptr[(rel >> L.pshift)[:, None] + L.ptr].astype(np.int64)
-            n = span.f64[words[:, None] + L.normal]
-        count = ints[:, 0]
+        words = (arb - span.lo) >> 3
+        g = span.i64[L.arbiter + words]  # (5, m): body_a, body_b, contacts, n.x, n.y
+        count, state = span.u32[L.ints + 2 * words]
         if not count.all():  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
-            words, count, ints, ptr, n = words[keep], count[keep], ints[keep], ptr[keep], \
-                n[keep]
-        self._rows(table, pairs, words, ptr[:, 0], ptr[:, 1])
-        self.n = n[:, 0] + 1j * n[:, 1]
-        two = count > 1
-        self.single = None if two.all() else ~two
-        self.first = ints[:, 1] == 0
-        first_c = ptr[:, 2]
-        second = first_c + L.csize * two
+            arb, g, count, state = arb[keep], g[:, keep], count[keep], state[keep]
+        self._rows(table, g[0:2], pairs)
+        self.n = g[3:5].view(np.float64)
+        self.first = state == 0
+        first_c = g[2]
+        self.single = None if (count > 1).all() else count < 2
         cspan = self.cspan = self._grown(self.cspan, int(first_c.min()),
-                                         int(second.max()) + L.csize)
-        self.words = (np.stack([first_c, second]) - cspan.lo) >> 3
-        self.has_j0 = coef != 1.0 or bool(self.first.any())
-        if self.has_j0:
-            j0 = cspan.f64[self.words[..., None] + L.carried]  # (2, m, 2): jn, jt
-            self.j0 = j0.view(np.complex128)[..., 0] * (1.0 - np.where(self.first, 0.0, coef))
+                                         int(first_c.max()) + 2 * L.csize)
+        idx = L.contacts + ((first_c - cspan.lo) >> 3)  # (7, 2, m)
+        if self.single is not None:  # no second contact: read the first twice, zeroed later
+            idx[:, 1, self.single] = idx[:, 0, self.single]
+        self.idx = idx
+        # The impulses carried in that the step does not apply: all of a first contact's,
+        # (1 - coef) of the others' (none when dt did not change).
+        self.carried = np.arange(len(first_c)) if coef != 1.0 else np.nonzero(self.first)[0]
+        if len(self.carried):  # (2, 2, k): jn, jt of each contact
+            kept = 1.0 - np.where(self.first[self.carried], 0.0, coef)
+            self.j0 = cspan.f64[idx[0:2, :, self.carried]] * kept
         return True
 
-    def _rows(self, table: Table, pairs: Pairs, words: np.ndarray, end_a: np.ndarray,
-              end_b: np.ndarray) -> None:
-        """The rows of each arbiter's bodies, its pair's slot, the sign of its push, and
-        where its impulses go; kept, at the arbiter's place in the span, while the same
-        arbiter joins the same bodies (a few arbiters come and go each step)."""
-        c = self._cache
-        if c is None or c.table is not table:
-            c = self._cache = _Cache(len(self.span.u8) >> 3, table)
-        hit = (c.end_a[words] == end_a) & (c.end_b[words] == end_b)
-        if not hit.all():
-            c.fill(words[~hit], end_a[~hit], end_b[~hit], pairs)
-        self.ra, self.rb, self.slots = c.ra[words], c.rb[words], c.slot[words]
-        self.sign = c.sign[words]
-        self.both = np.concatenate([self.ra, self.rb])
+    def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
+        """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), its
+        pair's slot and the sign of the push on its ends. (Found afresh each step: keeping
+        them from step to step costs more, a few arbiters coming and going each step.)"""
+        t = table
+        nb = len(t.sorted_i64)
+        if nb == 0:
+            raise UnknownBody
+        pos = np.minimum(np.searchsorted(t.sorted_i64, ends), nb - 1)
+        if not (t.sorted_i64[pos] == ends).all():
+            raise UnknownBody
+        rows = t.order[pos]
+        uid = t.uid[rows]
+        slots = pairs.lookup(np.minimum(uid[0], uid[1]) * PAIR + np.maximum(uid[0], uid[1]))
+        if slots.min() < 0:
+            slots = t.pair_slots(rows[0], rows[1], pairs)
+        self.rows, self.slots = rows, slots
+        free = t.lin_free[rows]
+        self.sign = free[1].astype(float) - free[0]
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
         """Work of the step's contact impulses, summed per pair into ``pairs.work`` and per
         row (its linear and angular parts) into ``step.work``; the work of driven ends into
         ``drive`` (rows); and the bias impulse along the normal on the dynamic ends of each
-        arbiter (its position correction's push). Vectors are complex numbers x + i y: a
-        product with a conjugate gives the dot product (real part) and the cross product
-        (imaginary part)."""
-        f = self.cspan.f64[self.words[..., None] + self.L.contact].view(np.complex128)
-        if self.single is not None:  # arbiters of one contact: no second one
-            f[1, self.single] = 0.0
-        J, r1, r2 = f[..., 0], f[..., 1], f[..., 2]  # (2, m) each
-        if self.has_j0:
-            J = J - self.j0
-        q = self.n * J  # each contact's impulse on b, in world axes
-        P = q[0] + q[1]
-        ta = (r1.conj() * q).imag.sum(axis=0)
-        tb = (r2.conj() * q).imag.sum(axis=0)
-        jbias = f[0, :, 3].real + f[1, :, 3].real
-        a, b, u = self.ra, self.rb, step.u
-        uc = np.empty(u.shape[1], dtype=np.complex128)
-        uc.real, uc.imag = u[0], u[1]
-        cP = P.conj()
-        lin_b = (cP * uc[b]).real
-        lin_a = -(cP * uc[a]).real
-        ang_b = tb * u[2, b]
-        ang_a = -ta * u[2, a]
-        rel = lin_a + lin_b + ang_a + ang_b
+        arbiter (its position correction's push)."""
+        f = self.cspan.f64[self.idx]  # (7, 2, m): each field of both contacts
+        jn, jt = f[0], f[1]
+        if len(self.carried):
+            jn[:, self.carried] -= self.j0[0]
+            jt[:, self.carried] -= self.j0[1]
+        if self.single is not None:  # the first contact read twice: not a second one
+            f[:, 1, self.single] = 0.0
+        nx, ny = self.n
+        qx = nx * jn - ny * jt  # each contact's impulse on b, in world axes (2, m)
+        qy = ny * jn + nx * jt
+        px, py = qx[0] + qx[1], qy[0] + qy[1]
+        ta = f[2] * qy - f[3] * qx
+        tb = f[4] * qy - f[5] * qx
+        U = step.u[:, self.rows]  # (3, 2, m): the velocities of ends a and b
+        lin = (px * U[0] + py * U[1]) * _ENDS
+        ang = np.stack([ta[0] + ta[1], tb[0] + tb[1]]) * U[2] * _ENDS
+        rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
-        rows = table.rows
-        lin = np.bincount(self.both, weights=np.concatenate([lin_a, lin_b]), minlength=rows)
-        ang = np.bincount(self.both, weights=np.concatenate([ang_a, ang_b]), minlength=rows)
-        step.work[0] += lin
-        step.work[1] += ang
+        rows, n = self.rows.ravel(), table.rows
+        lin_rows = np.bincount(rows, weights=lin.ravel(), minlength=n)
+        ang_rows = np.bincount(rows, weights=ang.ravel(), minlength=n)
+        step.work[0] += lin_rows
+        step.work[1] += ang_rows
         total = float(rel.sum())
         if table.any_driven:
             # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
             # bodies of infinite moment): what the relative work leaves out of theirs.
-            driven = -(np.where(table.lin_free, 0.0, lin) + np.where(table.ang_free, 0.0, ang))
+            driven = -(np.where(table.lin_free, 0.0, lin_rows)
+                       + np.where(table.ang_free, 0.0, ang_rows))
             drive += driven
             total += float(driven.sum())
-        return total, jbias * self.sign
+        return total, (f[6, 0] + f[6, 1]) * self.sign
 
-
-class _Cache:
-    """What :meth:`Contacts._rows` keeps for each place (8-byte word) of the arbiters' span:
-    the bodies the arbiter there joins (0: none yet), their rows in ``table``, their pair's
-    slot and the sign of the push on them."""
-
-    def __init__(self, words: int, table: Table) -> None:
-        self.table = table
-        self.end_a = np.zeros(words, dtype=np.int64)
-        self.end_b = np.zeros(words, dtype=np.int64)
-        self.ra = np.zeros(words, dtype=np.int64)
-        self.rb = np.zeros(words, dtype=np.int64)
-        self.slot = np.zeros(words, dtype=np.int64)
-        self.sign = np.zeros(words)
-
-    def fill(self, words: np.ndarray, end_a: np.ndarray, end_b: np.ndarray,
-             pairs: Pairs) -> None:
-        """What the arbiters at ``words`` joining ``end_a`` and ``end_b`` need."""
-        t = self.table
-        nb = len(t.sorted_i64)
-        ends = np.concatenate([end_a, end_b])
-        if nb == 0:
-            raise UnknownBody
-        pos = np.minimum(np.searchsorted(t.sorted_i64, ends), nb - 1)
-        if not np.array_equal(t.sorted_i64[pos], ends):
-            raise UnknownBody
-        rows = t.order[pos]
-        ra, rb = rows[: len(end_a)], rows[len(end_a):]
-        self.end_a[words], self.end_b[words] = end_a, end_b
-        self.ra[words], self.rb[words] = ra, rb
-        self.slot[words] = t.pair_slots(ra, rb, pairs)
-        self.sign[words] = t.lin_free[rb].astype(float) - t.lin_free[ra].astype(float)
+    @property
+    def normals(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each arbiter's normal: (x, y)."""
+        return self.n[0], self.n[1]
 
 
 def arbiters_address(space_at: int) -> int:
-    """Address of the space's arbiters array (validated by :func:`._memory.check_space`)."""
+    """Address of the space's arbiters array (validated by :func:`._layout.check_space`)."""
     return mem.address(mem.view("space", space_at).arbiters)

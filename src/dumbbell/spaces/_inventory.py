@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -121,6 +122,7 @@ class Table:
         first = self.pre.floats()
         self.settings = first[9:13].copy()
         self.static = np.isinf(first[13])
+        self.idle = first[13, n:].copy()  # 0 kinematic, infinite static: a type changed
         Table._derive(self, first)
         for r in range(n + k, self.rows):
             self.drives[r] = self.bodies[r].body_type != pymunk.Body.STATIC
@@ -279,9 +281,14 @@ class Build:
     vel_funcs: list[Any]
     current: dict[str, str]
 
-    @property
+    @cached_property
     def any_custom(self) -> bool:
         return bool(self.custom.any())
+
+    @cached_property
+    def funcs(self) -> np.ndarray:
+        """The velocity and position function pointers (2, dynamic rows)."""
+        return np.stack([self.vf, self.pf])
 
 
 def build(space: Any, names: Names, potentials: list[tuple[Any, Callable[..., Any], str]]
@@ -365,9 +372,9 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
-    if not ((F[9:13] == t.settings).all() and (np.isinf(F[13]) == t.static).all()):
+    if not ((F[9:13] == t.settings).all() and (t.n == t.rows or (F[13, t.n:] == t.idle).all())):
         return "a mass, moment, centre of gravity or body type"
-    if not ((P[1, : t.n] == b.vf).all() and (P[2, : t.n] == b.pf).all()):
+    if not (P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
     return _changed_settings(b, space)
 

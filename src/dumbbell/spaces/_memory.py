@@ -231,8 +231,8 @@ def platform_problem() -> str | None:
 def _sizes_problem() -> str | None:
     p = _pymunk_ffi()
     ptr = p.sizeof("void *")
-    if ptr not in (4, 8):
-        return f"pointers are {ptr} bytes"
+    if ptr != 8:
+        return f"pointers are {ptr} bytes (the contact reads are written for 8)"
     wrong = [f"{name} is {p.sizeof(name)} bytes, not {want}" for name, want in
              (("cpFloat", 8), ("cpVect", 16), ("uintptr_t", ptr), ("cpHashValue", ptr),
               ("int", 4)) if p.sizeof(name) != want]
@@ -372,7 +372,7 @@ class Reader:
     def __init__(self, kind: str, at: np.ndarray, floats: tuple[str, ...],
                  ptrs: tuple[str, ...] = ()) -> None:
         self.span = Span.over(at, size(kind))
-        self.fi = self.pi = None
+        self.fi = self.pi = self._all = None
         self.shape = (len(floats), len(ptrs))
         if self.span is None:
             return
@@ -391,6 +391,16 @@ class Reader:
         if self.span is None:
             return np.zeros((self.shape[0], 0))
         return self.span.f64[self.fi]
+
+    def both(self) -> tuple[np.ndarray, np.ndarray]:
+        """``floats()`` and ``pointers()``, in one gather where pointers are 8 bytes."""
+        if self.span is None or self.span.pshift != 3 or self.fi is None or self.pi is None:
+            return self.floats(), self.pointers()
+        if self._all is None:
+            self._all = np.concatenate([self.fi, self.pi])
+        out = self.span.u64[self._all]
+        nf = len(self.fi)
+        return out[:nf].view(np.float64), out[nf:]
 
     def pointers(self) -> np.ndarray:
         if self.span is None:

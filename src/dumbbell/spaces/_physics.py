@@ -117,6 +117,20 @@ def energy(b: Build, s: Snapshot) -> Energy:
     return Energy(k + ug + ud + Us, k, ug, Us, ud, K + Ug + Ud, Ug, Ud)
 
 
+def totals(b: Build, s: Snapshot) -> tuple[float, float, float, float, float]:
+    """E and its parts at ``s`` (E, K, U_g, U_springs, U_fields), in totals only: what the
+    ledger needs at each step's end (:func:`energy` gives each body's too)."""
+    t = b.table
+    n = t.n
+    v = s.vel[:, :n]
+    K = 0.5 * float(np.vdot(t.mass3, v * v))
+    mp = s.pos[:2, :n] @ t.m
+    Ug = -(b.gravity[0] * float(mp[0]) + b.gravity[1] * float(mp[1]))
+    Us = sum(float(np.sum(u)) for u in s.us) if b.springs else 0.0
+    Ud = float(np.sum(s.ud)) if b.fields else 0.0
+    return K + Ug + Ud + Us, K, Ug, Us, Ud
+
+
 def changes(b: Build, s: Snapshot, pos: np.ndarray, vel: np.ndarray
             ) -> tuple[np.ndarray, float]:
     """The energy of what changed from the snapshot to the state (pos, vel) at the same
@@ -330,11 +344,12 @@ def spring_elastic(t: Table, g: Group, after: np.ndarray, step: Step) -> np.ndar
 
 
 def external(b: Build, step: Step, p: Before, damping: float, sums: Sums
-             ) -> tuple[np.ndarray, float, float]:
-    """The impulses from outside the constraints and contacts (3, dynamic rows): gravity,
-    m g dt on every awake body (``p.awake``) the default velocity_func moves, applied forces
-    and torques (``p.force``, read before pymunk cleared them), and ``space.damping``;
-    returns them, gravity's work, and the others' (added to ``sums``)."""
+             ) -> tuple[np.ndarray, Any, float, float]:
+    """The work on each dynamic row of the impulses from outside the constraints and
+    contacts: gravity, m g dt on every awake body (``p.awake``) the default velocity_func
+    moves, applied forces and torques (``p.force``, read before pymunk cleared them), and
+    ``space.damping``. Returns their linear and angular work per row, gravity's work in all,
+    and the others' (added to ``sums``)."""
     t = b.table
     kicked, force = p.awake, p.force
     if b.any_custom:
@@ -343,20 +358,20 @@ def external(b: Build, step: Step, p: Before, damping: float, sums: Sums
     gx, gy = b.gravity
     un = step.u[:, :n]
     mk = m * dt if kicked is None else np.where(kicked, m * dt, 0.0)
-    ext = np.zeros((3, n))
-    ext[0] = mk * gx
-    ext[1] = mk * gy
-    w_g = float(gx * (mk @ un[0]) + gy * (mk @ un[1]))
+    lin = mk * (gx * un[0] + gy * un[1])
+    w_g = float(lin.sum())
+    ang: Any = 0.0
     total = 0.0
     if force is not None:
         f = force * dt
         if kicked is not None:
             f = np.where(kicked, f, 0.0)
         f[2] = np.where(t.finite, f[2], 0.0)
-        w_f = np.sum(f * un, axis=0)
+        fw = f * un
+        w_f = fw.sum(axis=0)
         sums.force += w_f
         total += float(np.sum(w_f))
-        ext += f
+        lin, ang = lin + fw[0] + fw[1], ang + fw[2]
     if damping != 1.0:
         d = damping ** dt
         kick = step.kick
@@ -364,28 +379,28 @@ def external(b: Build, step: Step, p: Before, damping: float, sums: Sums
         D = (d - 1.0) * t.mass3 * before
         if kicked is not None:
             D = np.where(kicked, D, 0.0)
-        w_d = float(np.sum(D * un))
-        ext += D
+        Dw = D * un
+        w_d = float(Dw.sum())
+        lin, ang = lin + Dw[0] + Dw[1], ang + Dw[2]
         sums.add("space.damping", "damping", w_d, f"space.damping = {damping:g}")
         total += w_d
-    return ext, w_g, total
+    return lin, ang, w_g, total
 
 
-def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, float],
+def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, Any, float],
                 sums: Sums) -> float:
     """What no source explains (a custom velocity_func's kicks, an impulse from a callback)
-    and gravity's step error (``outside``: the impulses :func:`external` gave and gravity's
-    work; ``p.g_int`` its potential's change over the move): counted into ``sums``; returns
-    their sum."""
+    and gravity's step error (``outside``: the work per row :func:`external` gave, linear
+    and angular, and gravity's in all; ``p.g_int`` gravity's potential change over the
+    move): counted into ``sums``; returns their sum."""
     t = b.table
-    ext, w_g = outside
+    lin, ang, w_g = outside
     g_int, g_rows, d_int = p.g_int, p.g_rows, p.potentials.d_int
     n = t.n
-    un = step.u[:, :n]
-    # The work of what no source explains: of the impulse m (v1 - v0) less the sources'.
-    D = (t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) - ext) * un
-    w_r = D[0] + D[1] - step.work[0, :n]
-    spin = D[2] - step.work[1, :n]
+    # The work of what no source explains: of the impulse m (v1 - v0), less the sources'.
+    K = t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) * step.u[:, :n]
+    w_r = K[0] + K[1] - lin - step.work[0, :n]
+    spin = K[2] - ang - step.work[1, :n]
     w_r += spin if t.all_finite else np.where(t.finite, spin, 0.0)  # infinite: imposed
     total = 0.0
     if b.any_custom:

@@ -61,6 +61,9 @@ class _Getters:
                          np.inf if b.body_type == pymunk.Body.STATIC else 0.0)
         return out
 
+    def both(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.floats(), self.pointers()
+
     def pointers(self) -> np.ndarray:
         import pymunk
 
@@ -96,6 +99,7 @@ class _Table:
         first = self.pre.floats()
         self.settings = first[9:13].copy()
         self.static = np.isinf(first[13])
+        self.idle = first[13, n:].copy()
         Table._derive(self, first)  # the arrays the struct-read table derives
 
 
@@ -308,14 +312,15 @@ def post(self: Any) -> None:
     damping = float(self.space.damping)
     step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
                 np.zeros((2, t.rows)), None, [])
-    ext, w_g, external = phys.external(b, step, p, damping, self._sums)
-    solver = t.mass3 * (vel1[:, :n] - vel_r[:, :n]) - ext
-    w_s = float(np.sum(solver * step.u[:, :n]))
+    lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
+    # The solver's work: of the impulse m (v1 - v0), less the outside impulses'.
+    w_s = float(np.sum(t.mass3 * (vel1[:, :n] - vel_r[:, :n]) * step.u[:, :n])
+                - np.sum(lin) - np.sum(ang))
     self._sums.add(f"contacts and joints ({LUMPED})", "contacts and joints", w_s,
                    "the work of the solver's impulses: contacts, joints, spring damping")
     self._sums.add("gravity", "step error", w_g + p.g_int)
     total = p.total + external + w_s + w_g + p.g_int
-    self._close_step(Q, p, total)
+    self._close_step(Q, t.post.pointers(), p, total)
     self._touching = np.zeros(t.rows, dtype=bool)
     for r, body in enumerate(t.bodies):
         def touched(arbiter: Any, r: int = r) -> None:

@@ -50,7 +50,8 @@ class Balance:
     check, every energy in ``unit`` (J in SI). ``E + heat + work_out - work_in = E0 +
     closure`` holds exactly; ``heat`` is what contacts, spring damping and ``space.damping``
     dissipated, ``work_in`` and ``work_out`` the other terms' inputs and outputs. ``scale``
-    is the largest kinetic energy and change of a potential seen; ``complete`` is True when
+    is the largest kinetic energy and change of a potential seen, ``worst_step`` the largest
+    closure of one step relative to it; ``complete`` is True when
     the closure and anything unattributed stay within ``tolerance`` of it and every source
     is accounted for (``unaccounted`` names the others, with why)."""
 

@@ -281,7 +281,8 @@ class Ledger(Changes):
                                  "position, impulse or setting; or a collision begin or "
                                  "pre_solve callback)")
         return Balance(E0=self._E0, E=self._E, terms=tuple(sorted(terms, key=order)),
-                       closure=self._E - self._E0 - total, worst_step=self._worst,
+                       closure=self._E - self._E0 - total,
+                       worst_step=self._worst / self._scale if self._scale > 0 else 0.0,
                        scale=self._scale, tolerance=self.tolerance,
                        unaccounted=tuple(sorted(unacc.items())), steps=self.steps, t=self.t,
                        notes=notes(terms, self._scale, u), unit=u, time_unit=self.units[2])
@@ -369,7 +370,7 @@ class Ledger(Changes):
         self._awaiting_end = False
         dt = float(self.space.current_time_step)
         t = self._b.table
-        F, P = t.pre.floats(), t.pre.pointers()
+        F, P = t.pre.both()
         reason = changed(self._b, self.space, F, P)
         if reason:
             gone = self._gone()
@@ -388,7 +389,7 @@ class Ledger(Changes):
                 self._restructure("a body touched for the first time", dt, "program")
         if self._b.table is not t:
             t = self._b.table
-            F, P = t.pre.floats(), t.pre.pointers()
+            F, P = t.pre.both()
         b, s, n = self._b, self._snap, t.n
         move = phys.move_of(b, s, F[0:3], F[3:6], dt)
         total = 0.0
@@ -436,7 +437,7 @@ class Ledger(Changes):
         self._before = None
         b = self._b
         t = b.table
-        Q = t.post.floats()
+        Q, root = t.post.both()
         vel0, vel1 = p.move.vel, Q[0:3]
         damping = float(self.space.damping)
         # Velocities the sources act on: the mean of before and after (kinematic bodies
@@ -453,35 +454,36 @@ class Ledger(Changes):
             total += work
             if push.any():
                 c = self._contacts
-                self._push = (c.slots, c.n.real * push, c.n.imag * push)
-        ext, w_g, external = phys.external(b, step, p, damping, self._sums)
+                nx, ny = c.normals
+                self._push = (c.slots, nx * push, ny * push)
+        lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
-        total += phys.unexplained(b, step, p, (ext, w_g), self._sums)
-        self._close_step(Q, p, total)
+        total += phys.unexplained(b, step, p, (lin, ang, w_g), self._sums)
+        self._close_step(Q, root, p, total)
 
-    def _close_step(self, Q: np.ndarray, p: Before, total: float) -> None:
-        """Snapshot the end of the step, check it against the terms, track the scale."""
+    def _close_step(self, Q: np.ndarray, root: np.ndarray, p: Before, total: float) -> None:
+        """Snapshot the end of the step (``Q``: the post reader's floats, ``root`` its
+        pointers), check it against the terms, track the scale."""
         t = self._b.table
         bias = Q[3:6].copy()
         bias[:, t.n:] = 0.0
-        sleeping = t.post.pointers()[0, : t.n] != 0
+        sleeping = root[0, : t.n] != 0
         snap = Snapshot(p.move.pos, Q[0:3].copy(), bias, sleeping, p.potentials.u_end,
                         p.potentials.d_end)
-        e = phys.energy(self._b, snap)
-        if not (math.isfinite(e.E) and math.isfinite(total)):
+        E, K, Ug, Us, Ud = phys.totals(self._b, snap)
+        if not (math.isfinite(E) and math.isfinite(total)):
             self._blown(snap)
             return
         self._snap = snap
-        step = e.E - self._E - total
-        self._E = e.E
+        step = E - self._E - total
+        self._E = E
         self.steps += 1
         self.t += p.dt
         self._dt_prev = p.dt
         self._awaiting_end = True
-        self._scale = max(self._scale, e.K, abs(e.Ug - self._Uref[0]),
-                          abs(e.Us - self._Uref[1]), abs(e.Ud - self._Uref[2]))
-        if self._scale > 0:
-            self._worst = max(self._worst, abs(step) / self._scale)
+        ref = self._Uref
+        self._scale = max(self._scale, K, abs(Ug - ref[0]), abs(Us - ref[1]), abs(Ud - ref[2]))
+        self._worst = max(self._worst, abs(step))  # relative to the scale when shown
 
     def _end(self) -> None:
         """At the end of the step (pymunk's post-step callbacks): what changed since the
