@@ -647,10 +647,6 @@ class _Sampler:
         return out
 
 
-def _shown(value: float) -> str:
-    return f"{value:.9g}"
-
-
 @dataclass(frozen=True, repr=False)
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
@@ -668,13 +664,9 @@ class BodyEnergy:
     units: tuple[str, str, str] = ("m", "kg", "s")
 
     def __repr__(self) -> str:
-        from .units import energy_unit, momentum_unit
+        from .units import shown
 
-        e = energy_unit(self.units)
-        return (f"BodyEnergy({self.subject!r}: K_trans = {_shown(self.K_trans)} {e}, K_rot = "
-                f"{_shown(self.K_rot)} {e}, U_g = {_shown(self.U_g)} {e}, momentum = "
-                f"({_shown(self.momentum[0])}, {_shown(self.momentum[1])}) "
-                f"{momentum_unit(self.units)})")
+        return shown(self)
 
 
 @dataclass(frozen=True, repr=False)
@@ -687,10 +679,9 @@ class SpringEnergy:
     units: tuple[str, str, str] = ("m", "kg", "s")
 
     def __repr__(self) -> str:
-        from .units import energy_unit
+        from .units import shown
 
-        return (f"SpringEnergy({self.subject!r}, {self.kind}: U = {_shown(self.U)} "
-                f"{energy_unit(self.units)})")
+        return shown(self)
 
 
 @dataclass(frozen=True, repr=False)
@@ -728,17 +719,9 @@ class SpaceEnergy:
         return not self.unknown
 
     def __repr__(self) -> str:
-        from .._display import one_line
-        from .units import angular_unit, energy_unit, momentum_unit
+        from .units import shown
 
-        e = energy_unit(self.units)
-        return one_line(
-            f"SpaceEnergy(E = {_shown(self.E)} {e}: K_trans = {_shown(self.K_trans)}, K_rot = "
-            f"{_shown(self.K_rot)}, U_g = {_shown(self.U_g)}, U_spring = "
-            f"{_shown(self.U_spring)} {e}; momentum = ({_shown(self.momentum[0])}, "
-            f"{_shown(self.momentum[1])}) {momentum_unit(self.units)}, L_cm = "
-            f"{_shown(self.L_cm)} {angular_unit(self.units)}; {len(self.bodies)} bodies, "
-            f"{len(self.springs)} springs, complete = {self.complete})")
+        return shown(self)
 
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),

@@ -44,3 +44,29 @@ def angular_unit(units: tuple[str, str, str]) -> str:
     """The unit of angular momentum (mass length² / time)."""
     length, mass, t = units
     return f"{mass} {length}²/{t}"
+
+
+def _g(value: float) -> str:
+    return f"{value:.9g}"
+
+
+def shown(record: Any) -> str:
+    """The one-line repr of a record of :func:`dumbbell.spaces.energy` (``SpaceEnergy``,
+    ``BodyEnergy``, ``SpringEnergy``), every value with its unit."""
+    from .._display import one_line
+
+    u = record.units
+    e = energy_unit(u)
+    kind = type(record).__name__
+    if kind == "SpringEnergy":
+        return f"SpringEnergy({record.subject!r}, {record.kind}: U = {_g(record.U)} {e})"
+    p = f"({_g(record.momentum[0])}, {_g(record.momentum[1])}) {momentum_unit(u)}"
+    if kind == "BodyEnergy":
+        return (f"BodyEnergy({record.subject!r}: K_trans = {_g(record.K_trans)} {e}, K_rot = "
+                f"{_g(record.K_rot)} {e}, U_g = {_g(record.U_g)} {e}, momentum = {p})")
+    return one_line(
+        f"SpaceEnergy(E = {_g(record.E)} {e}: K_trans = {_g(record.K_trans)}, K_rot = "
+        f"{_g(record.K_rot)}, U_g = {_g(record.U_g)}, U_spring = {_g(record.U_spring)} {e}; "
+        f"momentum = {p}, L_cm = {_g(record.L_cm)} {angular_unit(u)}; "
+        f"{len(record.bodies)} bodies, {len(record.springs)} springs, complete = "
+        f"{record.complete})")
