@@ -70,10 +70,15 @@ class Balance:
     time_unit: str = "s"
 
     def __post_init__(self) -> None:
-        # Plain numbers only: numpy scalars neither print nor serialise as numbers.
+        # Plain numbers only (numpy scalars neither print nor serialise as numbers).
+        from ..model import args
+
         for name in ("E0", "E", "closure", "worst_step", "scale", "tolerance", "t"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-        object.__setattr__(self, "steps", int(self.steps))
+            unit = self.time_unit if name == "t" else "-" if name in (
+                "worst_step", "tolerance") else self.unit
+            value = args.real(getattr(self, name), name, unit, positive=False)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "steps", args.whole(self.steps, "steps", "steps", lo=0))
 
     @property
     def heat(self) -> float:

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
+__all__: list[str] = []  # the toolkit's own; users pass ``units`` to its tools
+
 #: Units of a space (length, mass, time) in SI, whose energy is the joule.
 SI = ("m", "kg", "s")
 #: Longest unit name.
