@@ -112,13 +112,13 @@ class Changes:
         between two parts of the solver's work or between steps, on the present table) as
         ``kind`` ('program' or 'unattributed'); ``rows``: only those (dynamic) rows."""
         s = self._snap
+        n = self._b.table.n
+        if rows is None and (F[0:3] == s.pos).all() and (F[3:6, :n] == s.vel[:, :n]).all():
+            return
         pos, vel = F[0:3].copy(), F[3:6].copy()
         if rows is not None:
             pos = np.where(rows, pos, s.pos)
             vel = np.where(rows, vel, s.vel)
-        if np.array_equal(pos, s.pos) and np.array_equal(vel[:, : self._b.table.n],
-                                                        s.vel[:, : self._b.table.n]):
-            return
         per_body, springs = phys.changes(self._b, s, pos, vel)
         getattr(self._sums, kind)[:] += per_body
         if springs:

@@ -15,7 +15,7 @@ A pyramid's step has hundreds of arbiters, and each numpy call costs microsecond
 solver has just run: the reads are few, wide gathers (every field an arbiter needs in one,
 every field of both its contacts in another, laid out (field, contact, arbiter) so that
 each is a contiguous row), the arithmetic runs on both contacts at once, and the rows of
-an arbiter's bodies and its pair's slot are found with a few binary searches. Pointers are
+an arbiter's bodies and its pair's slot are found in dense maps. Pointers are
 read as 8 bytes (:func:`._memory.platform_problem` sends other platforms to the
 public-API ledger).
 """
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _memory as mem
-from ._inventory import PAIR, Pairs, Table
+from ._inventory import Pairs, Table
 from ._records import Step
 
 #: Work on end a and on end b of an impulse applied to b (and its opposite to a).
@@ -53,9 +53,9 @@ class _Layout:
         self.ints = (np.array([arb["count"], arb["state"]]) // 4)[:, None]
         con = {name: p.offsetof("cpContact", name) for name in
                ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
-        # Per contact (jn, jt, r1.x, r1.y, r2.x, r2.y, jBias), for each of an arbiter's two
+        # Per contact (jn, jt, r1.x, r2.x, r1.y, r2.y, jBias), for each of an arbiter's two
         # contacts: (7, 2, 1) word offsets from its first contact.
-        one = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r1"] + 8, con["r2"],
+        one = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r2"], con["r1"] + 8,
                         con["r2"] + 8, con["jBias"]]) // 8
         self.contacts = np.stack([one, one + self.csize // 8], axis=1)[:, :, None]
 
@@ -121,22 +121,13 @@ class Contacts:
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
         """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), its
-        pair's slot and the sign of the push on its ends. (Found afresh each step: keeping
-        them from step to step costs more, a few arbiters coming and going each step.)"""
-        t = table
-        nb = len(t.sorted_i64)
-        if nb == 0:
+        pair's slot and the sign of the push on its ends, through the table's maps."""
+        rows = table.rows_of(ends)
+        if rows.min() < 0:
             raise UnknownBody
-        pos = np.minimum(np.searchsorted(t.sorted_i64, ends), nb - 1)
-        if not (t.sorted_i64[pos] == ends).all():
-            raise UnknownBody
-        rows = t.order[pos]
-        uid = t.uid[rows]
-        slots = pairs.lookup(np.minimum(uid[0], uid[1]) * PAIR + np.maximum(uid[0], uid[1]))
-        if slots.min() < 0:
-            slots = t.pair_slots(rows[0], rows[1], pairs)
+        slots = table.slots_of(rows[0], rows[1], pairs)
         self.rows, self.slots = rows, slots
-        free = t.lin_free[rows]
+        free = table.lin_free[rows]
         self.sign = free[1].astype(float) - free[0]
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
@@ -152,15 +143,15 @@ class Contacts:
             jt[:, self.carried] -= self.j0[1]
         if self.single is not None:  # the first contact read twice: not a second one
             f[:, 1, self.single] = 0.0
-        nx, ny = self.n
+        n = self.n
+        nx, ny = n[0], n[1]
         qx = nx * jn - ny * jt  # each contact's impulse on b, in world axes (2, m)
         qy = ny * jn + nx * jt
         px, py = qx[0] + qx[1], qy[0] + qy[1]
-        ta = f[2] * qy - f[3] * qx
-        tb = f[4] * qy - f[5] * qx
+        moment = f[2:4] * qy - f[4:6] * qx  # (2, 2, m): r1 x q and r2 x q of each contact
         U = step.u[:, self.rows]  # (3, 2, m): the velocities of ends a and b
         lin = (px * U[0] + py * U[1]) * _ENDS
-        ang = np.stack([ta[0] + ta[1], tb[0] + tb[1]]) * U[2] * _ENDS
+        ang = (moment[:, 0] + moment[:, 1]) * U[2] * _ENDS
         rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
         rows, n = self.rows.ravel(), table.rows

@@ -119,6 +119,7 @@ class Table:
         self.at = mem.addresses(self.bodies, "_body")
         self.pre = mem.Reader("body", self.at, PRE, PTRS)
         self.post = mem.Reader("body", self.at, POST, ("root",))
+        self.state = mem.Reader("body", self.at, PRE[:6])
         first = self.pre.floats()
         self.settings = first[9:13].copy()
         self.static = np.isinf(first[13])
@@ -142,6 +143,11 @@ class Table:
         t.all_finite = bool(t.finite.all())
         t.I = np.where(t.finite, moment, 0.0)
         t.mass3 = np.stack([t.m, t.m, t.I])
+        # The same over every row (0 past the dynamic ones): products over whole rows.
+        t.m_rows = np.zeros(t.rows)
+        t.m_rows[:n] = t.m
+        t.mass3_rows = np.zeros((3, t.rows))
+        t.mass3_rows[:, :n] = t.mass3
         # A dynamic body of mass or moment 0 cannot be stepped (pymunk divides by them):
         # named in the build, and counted as if it had none.
         t.unsteppable = ~(t.m > 0) | ~(moment > 0)
@@ -162,6 +168,42 @@ class Table:
         t.drives[n: n + k] = True
         t.drives[:n] = ~t.finite
         t.any_driven = bool(t.drives.any())
+
+    #: Most rows for which the rows of a contact's bodies and their pair's slot are looked up
+    #: in dense maps (a body's place in memory -> its row; two rows -> their slot).
+    DENSE = 2048
+
+    def rows_of(self, at: np.ndarray) -> np.ndarray:
+        """The rows of the bodies at the addresses ``at`` (int64); -1 where none."""
+        span = self.pre.span
+        if span is None:
+            return np.full(at.shape, -1)
+        if not hasattr(self, "_rowmap"):
+            words = len(span.u8) >> 3
+            self._rowmap = None
+            if words <= max(1 << 20, 64 * self.rows):  # bodies close in memory: a map
+                self._rowmap = np.full(words + 1, -1, dtype=np.int64)  # last: outside
+                self._rowmap[(self.at.astype(np.int64) - span.lo) >> 3] = np.arange(self.rows)
+        if self._rowmap is None:
+            pos = np.minimum(np.searchsorted(self.sorted_i64, at), self.rows - 1)
+            return np.where(self.sorted_i64[pos] == at, self.order[pos], -1)
+        words = len(self._rowmap) - 1
+        w = (at - span.lo) >> 3
+        return self._rowmap[np.where((w >= 0) & (w < words), w, words)]
+
+    def slots_of(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
+        """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added: looked up
+        in a dense map of rows for a small table."""
+        if self.rows > self.DENSE:
+            return self.pair_slots(ra, rb, pairs)
+        if not hasattr(self, "_pairmap"):
+            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int64)
+        slots = self._pairmap[ra, rb]
+        if slots.min() < 0:
+            new = slots < 0
+            slots[new] = self.pair_slots(ra[new], rb[new], pairs)
+            self._pairmap[ra[new], rb[new]] = slots[new]
+        return slots
 
     def pair_slots(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
         """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added."""

@@ -121,10 +121,9 @@ def totals(b: Build, s: Snapshot) -> tuple[float, float, float, float, float]:
     """E and its parts at ``s`` (E, K, U_g, U_springs, U_fields), in totals only: what the
     ledger needs at each step's end (:func:`energy` gives each body's too)."""
     t = b.table
-    n = t.n
-    v = s.vel[:, :n]
-    K = 0.5 * float(np.vdot(t.mass3, v * v))
-    mp = s.pos[:2, :n] @ t.m
+    v = s.vel
+    K = 0.5 * float(np.vdot(t.mass3_rows, v * v))
+    mp = s.pos[:2] @ t.m_rows
     Ug = -(b.gravity[0] * float(mp[0]) + b.gravity[1] * float(mp[1]))
     Us = sum(float(np.sum(u)) for u in s.us) if b.springs else 0.0
     Ud = float(np.sum(s.ud)) if b.fields else 0.0
@@ -200,13 +199,18 @@ def gravity_over(b: Build, s: Snapshot, move: Move) -> tuple[float, np.ndarray |
     n, m = t.n, t.m
     gx, gy = b.gravity
     pos, start = move.pos, move.start
-    dU = -(gx * (m @ (pos[0, :n] - start[0, :n])) + gy * (m @ (pos[1, :n] - start[1, :n])))
+    d = (pos[:2] - start[:2]) @ t.m_rows
+    dU = -(gx * float(d[0]) + gy * float(d[1]))
     corr = 0.0
     bias = None
     if s.biased:
-        bias = s.bias[:, :n] * (move.step[:n] if isinstance(move.step, np.ndarray)
-                                else move.step)
-        corr = -(gx * (m @ bias[0]) + gy * (m @ bias[1]))
+        step = move.step
+        moved = (s.bias[:2] * step if isinstance(step, np.ndarray) else s.bias[:2]) @ t.m_rows
+        corr = -(gx * float(moved[0]) + gy * float(moved[1]))
+        if not isinstance(step, np.ndarray):
+            corr *= step
+        if b.any_custom:
+            bias = s.bias[:, :n] * (step[:n] if isinstance(step, np.ndarray) else step)
     g_rows = None
     if b.any_custom:
         g_rows = -m * (gx * (pos[0, :n] - start[0, :n]) + gy * (pos[1, :n] - start[1, :n]))

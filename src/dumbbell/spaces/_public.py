@@ -96,6 +96,7 @@ class _Table:
         self.labels = [names.labels[u] for u in self.uid.tolist()]
         self.pre = _Getters(self.bodies, post=False)
         self.post = _Getters(self.bodies, post=True)
+        self.state = self.pre
         first = self.pre.floats()
         self.settings = first[9:13].copy()
         self.static = np.isinf(first[13])

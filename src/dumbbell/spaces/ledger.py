@@ -70,6 +70,7 @@ from . import _memory as mem
 from . import _physics as phys
 from . import _public
 from ._changes import Changes
+from ._contacts import UnknownBody
 from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
@@ -151,7 +152,7 @@ class Ledger(Changes):
         self._bad: str | None = None
         self._frozen: Balance | None = None
         self._before: Before | None = None
-        self._push: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._push: tuple[np.ndarray, np.ndarray] | None = None
         self._awaiting_end = False
         self._dt_prev = float(space.current_time_step)
         self._attach()
@@ -365,8 +366,6 @@ class Ledger(Changes):
         """Before the constraints are prepared: positions have moved, velocities are the
         step's start. Count the program's changes and the move's energy; read the impulses
         carried in."""
-        from ._contacts import UnknownBody
-
         self._awaiting_end = False
         dt = float(self.space.current_time_step)
         t = self._b.table
@@ -420,9 +419,8 @@ class Ledger(Changes):
         ``corr`` to the pairs and the ``total``."""
         if self._push is None:
             return total, corr
-        gx, gy = self._b.gravity
-        slots, jx, jy = self._push
-        share = -(gx * jx + gy * jy) * dt
+        slots, work = self._push
+        share = work * dt
         self._pairs.push += np.bincount(slots, weights=share, minlength=len(self._pairs.push))
         pushed = float(np.sum(share))
         self._push = None
@@ -454,8 +452,10 @@ class Ledger(Changes):
             total += work
             if push.any():
                 c = self._contacts
+                # Gravity's work per unit time of each arbiter's push on its ends.
+                gx, gy = b.gravity
                 nx, ny = c.normals
-                self._push = (c.slots, nx * push, ny * push)
+                self._push = (c.slots, -(gx * nx + gy * ny) * push)
         lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
         total += phys.unexplained(b, step, p, (lin, ang, w_g), self._sums)
@@ -493,7 +493,7 @@ class Ledger(Changes):
             return
         self._awaiting_end = False
         t = self._b.table
-        self._catch_up(t.pre.floats(), "unattributed")
+        self._catch_up(t.state.floats(), "unattributed")
         if tuple(self.space.bodies) != t.body_key:
             self._restructure("bodies added or removed inside the step", None, "unattributed")
         elif tuple(self.space.constraints) != t.constraint_key:
