@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Callable
+from functools import cache
 from typing import Any
 
 from . import _memory as mem
@@ -75,10 +76,13 @@ class Hook:
         self._b = ffi.gc(lib.cpBodyNew(1.0, 1.0), lib.cpBodyFree)
         self._c = ffi.gc(lib.cpSimpleMotorNew(self._a, self._b, 0.0), lib.cpConstraintFree)
         lib.cpConstraintSetMaxForce(self._c, 0.0)  # it applies nothing
-        self._pre = ffi.callback("cpConstraintPreSolveFunc", self._on_pre)
-        self._post = ffi.callback("cpConstraintPostSolveFunc", self._on_post)
-        lib.cpConstraintSetPreSolveFunc(self._c, self._pre)
-        lib.cpConstraintSetPostSolveFunc(self._c, self._post)
+        # Two C callbacks for every hook (one closure each per process, not per hook): the
+        # constraint's user data leads them to this hook.
+        self._handle = ffi.new_handle(self)
+        lib.cpConstraintSetUserData(self._c, self._handle)
+        pre, post = _callbacks()
+        lib.cpConstraintSetPreSolveFunc(self._c, pre)
+        lib.cpConstraintSetPostSolveFunc(self._c, post)
         self.at = int(ffi.cast("uintptr_t", self._c))
         lib.cpSpaceAddConstraint(self._cspace, self._c)
         self.inside = True
@@ -95,11 +99,11 @@ class Hook:
         """True while the space is inside ``cpSpaceStep`` (callbacks run)."""
         return self._cspace is not None and bool(self._lib.cpSpaceIsLocked(self._cspace))
 
-    def _on_pre(self, constraint: Any, space: Any) -> None:
+    def _on_pre(self) -> None:
         if self._calls is not None:
             self._calls[0]()
 
-    def _on_post(self, constraint: Any, space: Any) -> None:
+    def _on_post(self) -> None:
         if self._calls is None:
             return
         self._calls[1]()
@@ -148,6 +152,21 @@ class Hook:
         lib.cpSpaceEachConstraint(self._cspace, lib.ext_cpSpaceConstraintIteratorFunc,
                                   ffi.new_handle(items))
         return bool(items) and int(ffi.cast("uintptr_t", items[-1])) == self.at
+
+
+@cache
+def _callbacks() -> tuple[Any, Any]:
+    """The C pre- and post-solve callbacks every hook shares."""
+    from pymunk._chipmunk_cffi import ffi, lib
+
+    def pre(constraint: Any, space: Any) -> None:
+        ffi.from_handle(lib.cpConstraintGetUserData(constraint))._on_pre()
+
+    def post(constraint: Any, space: Any) -> None:
+        ffi.from_handle(lib.cpConstraintGetUserData(constraint))._on_post()
+
+    return (ffi.callback("cpConstraintPreSolveFunc", pre),
+            ffi.callback("cpConstraintPostSolveFunc", post))
 
 
 def _end_of_step(space: Any, hook: Hook) -> None:

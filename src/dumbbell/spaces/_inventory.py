@@ -169,8 +169,9 @@ class Table:
         t.drives[:n] = ~t.finite
         t.any_driven = bool(t.drives.any())
 
-    #: Most rows for which the rows of a contact's bodies and their pair's slot are looked up
-    #: in dense maps (a body's place in memory -> its row; two rows -> their slot).
+    #: Most rows for which their pairs' slots are looked up in a dense map of rows (4 bytes
+    #: each: 16 MB at most); a body's row is looked up in a map of its place in memory when
+    #: the bodies lie close (the map at most 64 words a body).
     DENSE = 2048
 
     def rows_of(self, at: np.ndarray) -> np.ndarray:
@@ -181,8 +182,8 @@ class Table:
         if not hasattr(self, "_rowmap"):
             words = len(span.u8) >> 3
             self._rowmap = None
-            if words <= max(1 << 20, 64 * self.rows):  # bodies close in memory: a map
-                self._rowmap = np.full(words + 1, -1, dtype=np.int64)  # last: outside
+            if words <= 64 * self.rows + 4096:  # bodies close in memory: a small map
+                self._rowmap = np.full(words + 1, -1, dtype=np.int32)  # last: outside
                 self._rowmap[(self.at.astype(np.int64) - span.lo) >> 3] = np.arange(self.rows)
         if self._rowmap is None:
             pos = np.minimum(np.searchsorted(self.sorted_i64, at), self.rows - 1)
@@ -197,7 +198,7 @@ class Table:
         if self.rows > self.DENSE:
             return self.pair_slots(ra, rb, pairs)
         if not hasattr(self, "_pairmap"):
-            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int64)
+            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int32)
         slots = self._pairmap[ra, rb]
         if slots.min() < 0:
             new = slots < 0
