@@ -113,8 +113,10 @@ class Changes:
         ``kind`` ('program' or 'unattributed'); ``rows``: only those (dynamic) rows."""
         s = self._snap
         n = self._b.table.n
-        if rows is None and (F[0:3] == s.pos).all() and (F[3:6, :n] == s.vel[:, :n]).all():
-            return
+        if rows is None and ((F[0:3].tobytes() == s.pos.tobytes()
+                              and F[3:6].tobytes() == s.vel.tobytes())
+                             or ((F[0:3] == s.pos).all() and (F[3:6, :n] == s.vel[:, :n]).all())):
+            return  # the same bytes are the same values; other bytes may be too (-0, +0)
         pos, vel = F[0:3].copy(), F[3:6].copy()
         if rows is not None:
             pos = np.where(rows, pos, s.pos)

@@ -12,12 +12,12 @@ work of every contact impulse on the bodies' relative motion, J . (u0 + u1) / 2 
 contact point, is summed per pair of bodies, and per body.
 
 A pyramid's step has hundreds of arbiters, and each numpy call costs microseconds when the
-solver has just run: the reads are few, wide gathers (every field an arbiter needs in one,
-every field of both its contacts in another, laid out (field, contact, arbiter) so that
-each is a contiguous row), the arithmetic runs on both contacts at once, and the rows of
-an arbiter's bodies and its pair's slot are found in dense maps. Pointers are
-read as 8 bytes (:func:`._memory.platform_problem` sends other platforms to the
-public-API ledger).
+solver has just run: the reads are two gathers (every field an arbiter needs, then every
+field of both its contacts, each a row of consecutive words of :func:`._memory.memory`,
+so that no index is built per field and no span is found first), the arithmetic runs on
+both contacts at once, and the rows of an arbiter's bodies and its pair's slot are found
+in dense maps. Pointers are read as 8 bytes (:func:`._memory.platform_problem` sends
+other platforms to the public-API ledger).
 """
 
 from __future__ import annotations
@@ -38,26 +38,36 @@ class UnknownBody(Exception):
 
 
 class _Layout:
-    """Where the fields are, in 8-byte (or 4-byte) words from an arbiter's (or a
-    contact's) start."""
+    """Where the fields are, from pymunk's compiled declarations: the words of an arbiter
+    its reads cover (``first``, ``words``: from ``body_a`` to ``state``) and each field's
+    place among them (``count`` and ``state`` in 4-byte units); the words of a contact
+    they cover (from ``r1`` to ``jBias``), and each field's place."""
 
     def __init__(self) -> None:
         p = mem._pymunk_ffi()
         arb = {name: p.offsetof("cpArbiter", name) for name in
                ("body_a", "body_b", "contacts", "n", "count", "state")}
         self.asize, self.csize = p.sizeof("cpArbiter"), p.sizeof("cpContact")
-        # One gather of 8-byte words: body_a, body_b, contacts, n.x, n.y; one of 4-byte
-        # words: count, state.
-        self.arbiter = (np.array([arb["body_a"], arb["body_b"], arb["contacts"], arb["n"],
-                                  arb["n"] + 8]) // 8)[:, None]
-        self.ints = (np.array([arb["count"], arb["state"]]) // 4)[:, None]
-        con = {name: p.offsetof("cpContact", name) for name in
-               ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
-        # Per contact (jn, jt, r1.x, r2.x, r1.y, r2.y, jBias), for each of an arbiter's two
-        # contacts: (7, 2, 1) word offsets from its first contact.
-        one = np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r2"], con["r1"] + 8,
-                        con["r2"] + 8, con["jBias"]]) // 8
-        self.contacts = np.stack([one, one + self.csize // 8], axis=1)[:, :, None]
+        self.first = min(arb.values()) // 8
+        self.words = (max(arb.values()) + 8) // 8 - self.first
+        start = 8 * self.first
+        self.ends = (arb["body_a"] - start) // 8  # body_b follows (checked by the platform)
+        self.contacts = (arb["contacts"] - start) // 8
+        self.n = (arb["n"] - start) // 8
+        self.count = (arb["count"] - start) // 4
+        self.state = (arb["state"] - start) // 4
+        con = {name: p.offsetof("cpContact", name) // 8 for name in
+               ("r1", "r2", "jnAcc", "jtAcc", "jBias")}
+        self.cfirst = min(con.values())
+        self.cwords = max(con.values()) + 1 - self.cfirst
+        at = {name: w - self.cfirst for name, w in con.items()}
+        self.jn, self.jt, self.jb = at["jnAcc"], at["jtAcc"], at["jBias"]
+        # r1.x and r2.x (and their y) of a contact, as one strided slice.
+        gap = at["r2"] - at["r1"]
+        self.rx = slice(at["r1"], at["r2"] + 1, gap)
+        self.ry = slice(at["r1"] + 1, at["r2"] + 2, gap)
+        # A contact's words from its arbiter's first contact: (2, 1), the second one next.
+        self.pair = np.array([[0], [self.csize // 8]])
 
 
 class Contacts:
@@ -67,56 +77,47 @@ class Contacts:
         p = mem._pymunk_ffi()
         self.arr = p.cast("cpArray *", arbiters_at)
         self.buffer = p.buffer
-        self.L = _Layout()
-        self.span: mem.Span | None = None
-        self.cspan: mem.Span | None = None
-
-    @staticmethod
-    def _grown(span: mem.Span | None, low: int, high: int) -> mem.Span:
-        """``span``, or a new one covering it and [low, high)."""
-        if span is not None and low >= span.lo and high <= span.lo + len(span.u8):
-            return span
-        if span is not None:
-            low, high = min(low, span.lo), max(high, span.lo + len(span.u8))
-        return mem.Span(low, high)
+        self.L = L = _Layout()
+        memory = mem.memory()
+        self.lowest = memory.LOWEST
+        self.arbiters = memory.window(L.first, L.words)
+        self.contacts = memory.window(L.cfirst, L.cwords, floats=True)
 
     def before(self, table: Table, pairs: Pairs, coef: float) -> bool:
         """Read the step's contacts and the impulses they carry in; False if none. Raises
         :class:`UnknownBody` when a contact touches a body not in ``table``."""
-        num = int(self.arr.num)
-        if num == 0 or not 0 < num <= int(self.arr.max):
+        arr = self.arr
+        num = arr.num
+        if num == 0 or not 0 < num <= arr.max:
             return False
         L = self.L
-        arb = np.frombuffer(self.buffer(self.arr.arr, 8 * num), dtype=np.int64)
-        lo, hi = int(arb.min()), int(arb.max()) + L.asize
-        span = self.span
-        if span is None or lo < span.lo or hi > span.lo + len(span.u8):
-            span = self.span = self._grown(span, lo, hi)
-        words = (arb - span.lo) >> 3
-        g = span.i64[L.arbiter + words]  # (5, m): body_a, body_b, contacts, n.x, n.y
-        count, state = span.u32[L.ints + 2 * words]
+        arb = np.frombuffer(self.buffer(arr.arr, 8 * num), dtype=np.int64)
+        A = self.arbiters[(arb - self.lowest) >> 3]  # (m, words) from body_a to state
+        count = A.view(np.uint32)[:, L.count]
         if not count.all():  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
-            arb, g, count, state = arb[keep], g[:, keep], count[keep], state[keep]
-        self._rows(table, g[0:2], pairs)
-        self.n = g[3:5].view(np.float64)
-        self.first = state == 0
-        first_c = g[2]
-        self.single = None if (count > 1).all() else count < 2
-        cspan = self.cspan = self._grown(self.cspan, int(first_c.min()),
-                                         int(first_c.max()) + 2 * L.csize)
-        idx = L.contacts + ((first_c - cspan.lo) >> 3)  # (7, 2, m)
+            A, count = A[keep], count[keep]
+        self._rows(table, A[:, L.ends: L.ends + 2].T, pairs)
+        n = A[:, L.n: L.n + 2].view(np.float64)
+        self.nx, self.ny = n[:, 0], n[:, 1]
+        self.first = A.view(np.uint32)[:, L.state] == 0
+        self.single = None if count.min() > 1 else count < 2
+        # Each contact's row of words: (2, m), the first and the second contact.
+        cw = ((A[:, L.contacts] - self.lowest) >> 3) + L.pair
         if self.single is not None:  # no second contact: read the first twice, zeroed later
-            idx[:, 1, self.single] = idx[:, 0, self.single]
-        self.idx = idx
+            cw[1, self.single] = cw[0, self.single]
+        self.cw = cw
         # The impulses carried in that the step does not apply: all of a first contact's,
         # (1 - coef) of the others' (none when dt did not change).
-        self.carried = np.arange(len(first_c)) if coef != 1.0 else np.nonzero(self.first)[0]
-        if len(self.carried):  # (2, 2, k): jn, jt of each contact
-            kept = 1.0 - np.where(self.first[self.carried], 0.0, coef)
-            self.j0 = cspan.f64[idx[0:2, :, self.carried]] * kept
+        self.carried = None
+        if coef != 1.0 or self.first.any():
+            carried = np.arange(len(count)) if coef != 1.0 else np.nonzero(self.first)[0]
+            kept = (1.0 - np.where(self.first[carried], 0.0, coef))[:, None]
+            # (2, k, 2): jn, jt of each contact
+            self.j0 = self.contacts[cw[:, carried]][:, :, [L.jn, L.jt]] * kept
+            self.carried = carried
         return True
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
@@ -125,10 +126,9 @@ class Contacts:
         rows = table.rows_of(ends)
         if rows.min() < 0:
             raise UnknownBody
-        slots = table.slots_of(rows[0], rows[1], pairs)
-        self.rows, self.slots = rows, slots
-        free = table.lin_free[rows]
-        self.sign = free[1].astype(float) - free[0]
+        self.rows, self.slots = rows, table.slots_of(rows[0], rows[1], pairs)
+        free = table.lin_free_f[rows]
+        self.sign = free[1] - free[0]
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
@@ -136,22 +136,24 @@ class Contacts:
         row (its linear and angular parts) into ``step.work``; the work of driven ends into
         ``drive`` (rows); and the bias impulse along the normal on the dynamic ends of each
         arbiter (its position correction's push)."""
-        f = self.cspan.f64[self.idx]  # (7, 2, m): each field of both contacts
-        jn, jt = f[0], f[1]
-        if len(self.carried):
-            jn[:, self.carried] -= self.j0[0]
-            jt[:, self.carried] -= self.j0[1]
+        L = self.L
+        f = self.contacts[self.cw]  # (2, m, words): each field of both contacts
+        jn, jt = f[:, :, L.jn], f[:, :, L.jt]
+        if self.carried is not None:
+            jn[:, self.carried] -= self.j0[:, :, 0]
+            jt[:, self.carried] -= self.j0[:, :, 1]
         if self.single is not None:  # the first contact read twice: not a second one
-            f[:, 1, self.single] = 0.0
-        n = self.n
-        nx, ny = n[0], n[1]
+            f[1, self.single] = 0.0
+        nx, ny = self.nx, self.ny
         qx = nx * jn - ny * jt  # each contact's impulse on b, in world axes (2, m)
         qy = ny * jn + nx * jt
         px, py = qx[0] + qx[1], qy[0] + qy[1]
-        moment = f[2:4] * qy - f[4:6] * qx  # (2, 2, m): r1 x q and r2 x q of each contact
+        # r1 x q and r2 x q of each contact (2, m, 2), then of the arbiter (m, 2)
+        moment = f[:, :, L.rx] * qy[:, :, None] - f[:, :, L.ry] * qx[:, :, None]
+        moment = moment[0] + moment[1]
         U = step.u[:, self.rows]  # (3, 2, m): the velocities of ends a and b
         lin = (px * U[0] + py * U[1]) * _ENDS
-        ang = (moment[:, 0] + moment[:, 1]) * U[2] * _ENDS
+        ang = moment.T * U[2] * _ENDS
         rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
         rows, n = self.rows.ravel(), table.rows
@@ -167,12 +169,12 @@ class Contacts:
                        + np.where(table.ang_free, 0.0, ang_rows))
             drive += driven
             total += float(driven.sum())
-        return total, (f[6, 0] + f[6, 1]) * self.sign
+        return total, (f[0, :, L.jb] + f[1, :, L.jb]) * self.sign
 
     @property
     def normals(self) -> tuple[np.ndarray, np.ndarray]:
         """Each arbiter's normal: (x, y)."""
-        return self.n[0], self.n[1]
+        return self.nx, self.ny
 
 
 def arbiters_address(space_at: int) -> int:

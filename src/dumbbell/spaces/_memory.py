@@ -114,6 +114,9 @@ STRUCT = {"PinJoint": "pin", "SlideJoint": "slide", "PivotJoint": "pivot",
 _ARRAY_MAX = 1 << 28
 #: Lowest address a live object can have (the first page is never mapped).
 _LOWEST = 4096
+#: Past the highest address a live object can have: 2**56 bytes covers every 64-bit
+#: process's user space (x86-64's five-level paging, arm64's 52-bit addresses).
+_TOP = 1 << 56
 
 
 #: Spaces -> the addresses of the ledgers' hooks in them (:mod:`._hook`): what a space's
@@ -262,6 +265,12 @@ def _alignment_problem() -> str | None:
         for name in names:
             if p.offsetof(struct, name) % step:
                 return f"{struct}.{name} is not aligned for the gathers on this platform"
+    # The contacts' reads take an arbiter's two bodies as one pair of words, and a contact's
+    # r1.x and r2.x (and their y) as one strided slice.
+    if p.offsetof("cpArbiter", "body_b") != p.offsetof("cpArbiter", "body_a") + ptr:
+        return "cpArbiter.body_b does not follow body_a"
+    if p.offsetof("cpContact", "r2") <= p.offsetof("cpContact", "r1"):
+        return "cpContact.r2 does not follow r1"
     return None
 
 
@@ -294,7 +303,7 @@ def size(kind: str) -> int:
 
 def _plausible(at: int) -> bool:
     """An address a live, pointer-aligned object can have."""
-    top = 1 << (8 * pointer_size())
+    top = min(1 << (8 * pointer_size()), _TOP)
     return _LOWEST <= at < top and at % pointer_size() == 0
 
 
@@ -363,6 +372,44 @@ class Span:
     def i(self, at: np.ndarray, off: Any) -> np.ndarray:
         """32-bit unsigned fields at ``at + off``."""
         return self.u32[self._index(at, off) >> np.uint64(2)]
+
+
+class Memory:
+    """The process's memory from :data:`_LOWEST` to :data:`_TOP` as one read-only numpy
+    array of 8-byte words (``u64``, ``i64``, ``f64``): making it reads nothing, and indexing
+    it reads only the words indexed. The word at address ``a`` is ``(a - LOWEST) >> 3``.
+
+    The contacts' structs move every step (Munk2D takes each step's contacts from fresh
+    buffers): indexed here, their reads need no span found first (two numpy calls fewer
+    each, and no view made again when they land outside the last one). :meth:`window`
+    views the same words as rows of ``k`` consecutive words, so that one gather reads every
+    field a struct's reader needs. Only 8-byte platforms get here
+    (:func:`platform_problem`)."""
+
+    LOWEST = _LOWEST
+
+    def __init__(self) -> None:
+        f = ffi()
+        words = (_TOP - _LOWEST) >> 3
+        raw = np.frombuffer(f.buffer(f.cast("char *", _LOWEST), words << 3), dtype=np.uint64)
+        raw.flags.writeable = False
+        self.u64 = raw
+        self.i64 = raw.view(np.int64)
+        self.f64 = raw.view(np.float64)
+
+    def window(self, first: int, k: int, floats: bool = False) -> np.ndarray:
+        """Rows of ``k`` words (int64, or float64 with ``floats``): row ``w`` holds words
+        ``w + first`` to ``w + first + k`` (``first``: a field's word in its struct, so that
+        row ``(a - LOWEST) >> 3`` holds the fields of the struct at ``a``)."""
+        base = (self.f64 if floats else self.i64)[first:]
+        return np.lib.stride_tricks.as_strided(base, shape=(len(base) - k, k), strides=(8, 8),
+                                               writeable=False)
+
+
+@cache
+def memory() -> Memory:
+    """The process's memory as numpy views (see :class:`Memory`)."""
+    return Memory()
 
 
 class Reader:

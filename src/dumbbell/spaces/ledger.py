@@ -407,9 +407,9 @@ class Ledger(Changes):
                            "potential energy the contacts' position correction adds (beyond "
                            "each pair's part through gravity)")
         force = F[6:9, :n]
-        awake = P[0, :n] == 0
+        roots = P[0, :n]
         self._before = Before(dt, coef, move, force if force.any() else None,
-                              None if awake.all() else awake, g_int, g_rows, pots,
+                              roots == 0 if roots.any() else None, g_int, g_rows, pots,
                               [g.before.floats() for g in b.groups.values()], contacts,
                               total + corr)
 
@@ -422,7 +422,7 @@ class Ledger(Changes):
         slots, work = self._push
         share = work * dt
         self._pairs.push += np.bincount(slots, weights=share, minlength=len(self._pairs.push))
-        pushed = float(np.sum(share))
+        pushed = float(share.sum())
         self._push = None
         return total + pushed, corr - pushed
 
@@ -465,11 +465,14 @@ class Ledger(Changes):
         """Snapshot the end of the step (``Q``: the post reader's floats, ``root`` its
         pointers), check it against the terms, track the scale."""
         t = self._b.table
-        bias = Q[3:6].copy()
-        bias[:, t.n:] = 0.0
-        sleeping = root[0, : t.n] != 0
-        snap = Snapshot(p.move.pos, Q[0:3].copy(), bias, sleeping, p.potentials.u_end,
-                        p.potentials.d_end)
+        # Q and the move's positions are this step's own reads: the snapshot keeps them.
+        bias = Q[3:6]
+        if t.rows > t.n:
+            bias[:, t.n:] = 0.0
+        roots = root[0, : t.n]
+        asleep = bool(roots.any())
+        snap = Snapshot(p.move.pos, Q[0:3], bias, roots != 0 if asleep else t.none_asleep,
+                        p.potentials.u_end, p.potentials.d_end, asleep, bool(bias.any()))
         E, K, Ug, Us, Ud = phys.totals(self._b, snap)
         if not (math.isfinite(E) and math.isfinite(total)):
             self._blown(snap)
