@@ -686,7 +686,7 @@ def test_a_force_a_callback_sets_inside_the_step_is_kept_on_top_of_the_push():
         space = pymunk.Space()
         body = pymunk.Body(2.0, 1.0)
         hook = pymunk.DampedSpring(space.static_body, body, (0, 0), (0, 0), 0.0, 0.0, 0.0)
-        hook.post_solve = lambda c, s: setattr(body, "force", body.force + (1.0, 0.0))
+        hook.post_solve = lambda c, s: setattr(c.b, "force", c.b.force + (1.0, 0.0))
         space.add(body, hook)
         body.force = (6.0, 0.0)
         spaces.step(space, 0.2, substeps=n)

@@ -634,7 +634,7 @@ class _Push:
     program left them before the frame, and what the guard last set (``set_force``,
     ``set_torque``)."""
 
-    __slots__ = ("body", "force", "torque", "set_force", "set_torque")
+    __slots__ = ("body", "force", "set_force", "set_torque", "torque")
 
     def __init__(self, body: Any, force: Any, torque: float) -> None:
         self.body, self.force, self.torque = body, force, torque
