@@ -693,3 +693,97 @@ def test_a_force_a_callback_sets_inside_the_step_is_kept_on_top_of_the_push():
         assert body.velocity.x == pytest.approx((6.0 * 0.2 + (n - 1) * 1.0 * 0.2 / n) / 2.0,
                                                 rel=1e-12)
         assert body.force == (1.0, 0.0)
+
+
+# --- the centre of gravity, not the body's origin (issue 28's owed tests) ----------------------
+# pymunk's Body.position is the body's origin; its centre of gravity is the local point
+# Body.center_of_gravity, and Body.velocity is the velocity of that point. Each space here
+# puts the centre of gravity far from the origin, so an estimate taken from `position`
+# gives another number.
+
+
+def test_a_bar_pivoted_at_its_origin_falls_from_its_centre_of_gravity():
+    # The bar's origin is the pivot; its centre of gravity is L/2 along it. Level at the
+    # start, it can drop L/2 and turn about the pivot with I = I_cg + m (L/2)^2.
+    m, L, radius, g = 1.5, 2.0, 0.05, 9.81
+    space = pymunk.Space()
+    space.gravity = (0.0, -g)
+    i_cg = pymunk.moment_for_segment(m, (-L / 2, 0), (L / 2, 0), radius)
+    bar = pymunk.Body(m, i_cg)
+    bar.center_of_gravity = (L / 2, 0.0)
+    bar.position = (0.0, 0.0)
+    space.add(bar, pymunk.Segment(bar, (0, 0), (L, 0), radius),
+              pymunk.PivotJoint(space.static_body, bar, (0.0, 0.0)))
+    (r,) = spaces.reach(space, 1e-3)
+    omega = math.sqrt(2 * m * g * (L / 2) / (i_cg + m * (L / 2) ** 2))
+    assert r.point and r.fall == pytest.approx(L / 2, rel=1e-12)
+    assert r.level == pytest.approx(L / 2, rel=1e-12)          # depth along g: -y of the cg
+    assert r.speed == pytest.approx(omega * (L + radius), rel=1e-12)
+    fastest = 0.0
+    for _ in range(3000):
+        space.step(1e-3)
+        fastest = max(fastest, abs(bar.angular_velocity) * (L + radius))
+    assert 0.97 * r.speed < fastest <= r.speed * 1.001
+
+
+def test_a_bob_on_a_pin_falls_from_its_centre_of_gravity():
+    # The pin holds the bob's centre of gravity 2 m from the anchor; its origin is 3 m away
+    # from its centre of gravity. Level at the start: it can drop the pin's length.
+    space = pymunk.Space()
+    space.gravity = (0.0, -10.0)
+    bob = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    bob.center_of_gravity = (-3.0, 1.0)
+    bob.position = (5.0, -1.0)                    # centre of gravity at (2, 0)
+    space.add(bob, pymunk.Circle(bob, 0.1, (-3.0, 1.0)),
+              pymunk.PinJoint(space.static_body, bob, (0.0, 0.0), (-3.0, 1.0)))
+    (r,) = spaces.reach(space, 1e-4)
+    assert r.held == "PinJoint 0" and r.fall == pytest.approx(2.0, rel=1e-12)
+    h = 0.5 * 10.0 * 1e-4
+    assert r.speed == pytest.approx(h + math.sqrt(h * h + 2 * 10.0 * 2.0), rel=1e-12)
+
+
+def test_a_free_body_falls_to_the_floor_from_its_shapes_and_its_level_is_its_cg_s():
+    # Origin at y = 20, centre of gravity and ball 3 below it: the ball (r = 0.5) meets the
+    # floor (top at 0.1) after 20 - 3 - 0.5 - 0.1 = 16.4; its centre of gravity then is at
+    # y = 0.6 (depth -0.6).
+    space = pymunk.Space()
+    space.gravity = (0.0, -10.0)
+    body = pymunk.Body(2.0, pymunk.moment_for_circle(2.0, 0, 0.5))
+    body.center_of_gravity = (5.0, -3.0)
+    body.position = (0.0, 20.0)
+    space.add(body, pymunk.Circle(body, 0.5, (5.0, -3.0)),
+              pymunk.Segment(space.static_body, (-5, 0), (15, 0), 0.1))
+    (r,) = spaces.reach(space, 1e-3)
+    assert r.fall == pytest.approx(16.4, rel=1e-12)
+    assert r.level == pytest.approx(-0.6, rel=1e-12)
+    h = 0.5 * 10.0 * 1e-3
+    assert r.speed == pytest.approx(h + math.sqrt(h * h + 2 * 10.0 * 16.4), rel=1e-12)
+
+
+def test_tunnelling_takes_a_spinning_body_s_reach_from_its_centre_of_gravity():
+    # A ball of radius 1 centred on its centre of gravity, 3 from the origin, spinning at
+    # 10 rad/s, at rest otherwise, no gravity: its fastest point moves at 10 x 1, not 10 x 4.
+    space = pymunk.Space()
+    space.collision_slop = 1e-3
+    body = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 1.0))
+    body.center_of_gravity = (3.0, 0.0)
+    body.angular_velocity = 10.0
+    space.add(body, pymunk.Circle(body, 1.0, (3.0, 0.0)),
+              pymunk.Segment(space.static_body, (-10, -2), (10, -2), 0.1))
+    (r,) = spaces.reach(space, 1e-3)
+    assert r.now == pytest.approx(10.0, rel=1e-12)
+    limit = 0.5 * 0.2 + 0.5 * 2.0
+    (row,) = [f for f, _ in spaces.survey(space, 0.2, speeds="state") if f.kind == "tunnelling"]
+    assert row.value == pytest.approx(10.0 * 0.2, rel=1e-12) and row.limit == limit
+
+
+def test_a_spring_between_centres_of_gravity_moves_no_rotation():
+    # Anchors at each body's centre of gravity (far from their origins): w = sqrt(k / mu),
+    # the moments do not enter.
+    space = pymunk.Space()
+    a, b = pymunk.Body(1.0, 0.01), pymunk.Body(3.0, 0.02)
+    a.center_of_gravity, b.center_of_gravity = (0.0, 4.0), (-2.0, 0.0)
+    a.position, b.position = (0.0, 0.0), (3.0, 4.0)
+    spring = pymunk.DampedSpring(a, b, (0.0, 4.0), (-2.0, 0.0), 1.0, 300.0, 0.0)
+    space.add(a, b, spring)
+    assert spaces.spring_omega(spring) == pytest.approx(math.sqrt(300.0 / 0.75), rel=1e-12)
