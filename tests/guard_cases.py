@@ -109,7 +109,9 @@ def pendulum(joint: str = "PinJoint", length: float = 200.0, mass: float = 1.0,
     anchor = (300.0, 100.0)
     end = (anchor[0] + length * math.cos(angle), anchor[1] + length * math.sin(angle))
     if joint == "PivotJoint":
-        body = pymunk.Body(mass, pymunk.moment_for_segment(mass, (0, 0), (length, 0), 5.0))
+        body = pymunk.Body(mass, pymunk.moment_for_segment(mass, (-length / 2, 0),
+                                                           (length / 2, 0), 5.0))
+        body.center_of_gravity = (length / 2, 0.0)
         body.position, body.angle = anchor, angle
         shape = pymunk.Segment(body, (0, 0), (length, 0), 5.0)
         c = pymunk.PivotJoint(space.static_body, body, anchor, (0.0, 0.0))

@@ -1,0 +1,572 @@
+"""The step guard's probe: how much energy each constraint of a space puts in or takes out per
+second at a step, measured on a copy.
+
+pymunk's rigid joints hold their bodies by impulses that also correct the drift of the joint
+(``error_bias``, ``max_bias``), and that correction, with the step's own error, moves energy:
+a pendulum on a ``PinJoint`` loses about 1 % of m g L a second at 1/60 s in pixel units, ten
+times less at 1/600 s. No closed form covers a joint in an arbitrary space, so the guard
+measures it:
+
+- **the copy**: a new space built from pymunk's public attributes of the user's one (bodies,
+  shapes, constraints and their settings, the space's settings, the forces set now), so that
+  nothing in the user's space changes and no callback of the program runs (collision
+  handlers and a constraint's ``pre_solve``/``post_solve`` are not copied; a custom
+  ``velocity_func``, spring force or torque is, being part of the physics);
+- **the run**: :data:`PROBE_TIME` seconds of steps of ``dt`` (fewer when the space is big:
+  at most :data:`MAX_STEPS` steps and :data:`MAX_WORK` body-steps), the forces set now kept
+  on every step, as a program that sets them each frame;
+- **each constraint's impulse**, recovered every step from the momentum its bodies gained:
+  a body's gain in the step, less the kick of its ``velocity_func`` (gravity, damping, its
+  forces: read by wrapping that function on the copy) and the impulses of its contacts
+  (``Arbiter.total_impulse``, and its torque where the contact has one point), is the sum of
+  the impulses of its constraints. Each constraint's impulse has a known form (along the
+  axis of a pin, slide or spring; any direction at a pivot or groove; a torque for the
+  rotary kinds, a gear's scaled by its ratio on its first body), so the gains of all bodies
+  are a linear system in the impulses, solved by least squares. Each impulse found is
+  checked against the magnitude pymunk reports (``Constraint.impulse``); a constraint whose
+  impulse the system does not determine (two joints acting on the same motion, a body whose
+  contacts have two points and so an unknown torque) or whose impulse does not match is
+  *not separated*, and named so;
+- **the work**: each step, the impulse times the mean, over the step, of the relative
+  velocity it acts on (the velocities before and after the step; a static end at rest, a
+  kinematic end at its velocity): what :class:`~dumbbell.spaces.Ledger` books as the
+  constraint's term, here from public attributes only.
+
+The energy scale is the ledger's: the largest kinetic energy and change of the potentials
+(gravity, springs) over the probe.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ..model.energy import spring_potential
+from ._scan import batch
+
+#: Simulated time the probe covers (s), when the budget allows.
+PROBE_TIME = 2.0
+#: Most steps of a probe, and most body-steps (steps times bodies of the space).
+MAX_STEPS = 1200
+MAX_WORK = 400_000
+#: Fewest steps a probe is worth: past the budget with fewer, it is not run.
+MIN_STEPS = 20
+#: Most unknowns (impulse components) the probe solves for each step.
+MAX_UNKNOWNS = 400
+#: Relative agreement asked of a recovered impulse with pymunk's own magnitude.
+AGREE = 1e-6
+
+#: Constraint kinds whose impulse is a torque, and the springs (the guard's own rows).
+ROTARY = ("DampedRotarySpring", "RotaryLimitJoint", "RatchetJoint", "GearJoint", "SimpleMotor")
+SPRINGS = ("DampedSpring", "DampedRotarySpring")
+
+
+@dataclass(frozen=True)
+class Drift:
+    """One constraint over the probe: ``work`` (energy units) it put into the bodies (None
+    when it could not be separated), and ``why`` not."""
+
+    label: str
+    work: float | None
+    why: str = ""
+
+
+@dataclass
+class Probe:
+    """What the probe measured: ``steps`` of ``dt`` (s), ``seconds`` of simulated time,
+    ``cost`` (s of wall-clock time it took), the energy ``scale``, each constraint's
+    :class:`Drift` (by its place in ``space.constraints``), or ``problem``: why no probe
+    was run (the constraints are then not checked)."""
+
+    dt: float
+    steps: int = 0
+    cost: float = 0.0
+    scale: float = 0.0
+    drifts: dict[int, Drift] = field(default_factory=dict)
+    problem: str = ""
+
+    @property
+    def seconds(self) -> float:
+        return self.steps * self.dt
+
+
+class _Uncopyable(Exception):
+    """The space holds something the probe cannot copy (the message says what)."""
+
+
+def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
+    """Run the probe on a copy of ``space`` at steps of ``dt`` (s) for the constraints at
+    places ``wanted`` of ``space.constraints`` (see the module docstring)."""
+    started = time.perf_counter()
+    result = Probe(dt)
+    n_bodies = max(1, len(space.bodies))
+    steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // n_bodies)
+    if steps < MIN_STEPS:
+        result.problem = (f"a probe of {MIN_STEPS} steps of {n_bodies:,} bodies is past the "
+                          f"guard's budget ({MAX_WORK:,} body-steps)")
+        return result
+    try:
+        copy = _Copy(space)
+    except _Uncopyable as e:
+        result.problem = f"the probe cannot copy the space: {e}"
+        return result
+    run = _Run(copy, dt, wanted)
+    if run.problem:
+        result.problem = run.problem
+        return result
+    for _ in range(steps):
+        if not run.step():
+            break
+    result.steps = run.steps
+    result.scale = run.scale()
+    result.drifts = run.drifts()
+    result.problem = run.problem
+    result.cost = time.perf_counter() - started
+    return result
+
+
+# --- the copy --------------------------------------------------------------------------------
+
+
+class _Copy:
+    """A new space with the user's bodies, shapes and constraints, built from their public
+    attributes (see the module docstring); ``body`` maps id() of each user body to its copy,
+    ``constraints`` are the copies in the order of ``space.constraints``, ``pushes`` the
+    forces set now (copy body, force, torque)."""
+
+    def __init__(self, space: Any) -> None:
+        import pymunk
+
+        new = pymunk.Space()
+        for name in ("gravity", "damping", "iterations", "collision_slop", "collision_bias",
+                     "collision_persistence", "idle_speed_threshold", "sleep_time_threshold"):
+            setattr(new, name, getattr(space, name))
+        self.space = new
+        self.body: dict[int, Any] = {id(space.static_body): new.static_body}
+        self.pushes: list[tuple[Any, Any, float]] = []
+        for b in space.bodies:
+            self._body(b, pymunk)
+        for s in space.shapes:
+            self._shape(s, pymunk)
+        self.constraints = [self._constraint(c, pymunk) for c in space.constraints]
+        new.add(*self.constraints)
+
+    def _of(self, body: Any, pymunk: Any) -> Any:
+        """The copy of ``body`` (a body only shapes or constraints use is copied then)."""
+        found = self.body.get(id(body))
+        return found if found is not None else self._body(body, pymunk, add=False)
+
+    def _body(self, b: Any, pymunk: Any, add: bool = True) -> Any:
+        kind = b.body_type
+        if kind == pymunk.Body.DYNAMIC:
+            c = pymunk.Body(b.mass, b.moment)
+            c.center_of_gravity = b.center_of_gravity
+            if b.velocity_func is not pymunk.Body.update_velocity:
+                c.velocity_func = b.velocity_func
+            if b.position_func is not pymunk.Body.update_position:
+                c.position_func = b.position_func
+            if b.force != (0, 0) or b.torque != 0:
+                self.pushes.append((c, b.force, b.torque))
+        else:
+            c = pymunk.Body(body_type=kind)
+        c.position, c.angle = b.position, b.angle
+        if kind != pymunk.Body.STATIC:
+            c.velocity, c.angular_velocity = b.velocity, b.angular_velocity
+        self.body[id(b)] = c
+        if add and kind != pymunk.Body.STATIC:
+            self.space.add(c)
+        return c
+
+    def _shape(self, s: Any, pymunk: Any) -> None:
+        body = self._of(s.body, pymunk)
+        if isinstance(s, pymunk.Circle):
+            c = pymunk.Circle(body, s.radius, s.offset)
+        elif isinstance(s, pymunk.Segment):
+            c = pymunk.Segment(body, s.a, s.b, s.radius)
+        elif isinstance(s, pymunk.Poly):
+            c = pymunk.Poly(body, s.get_vertices(), radius=s.radius)
+        else:
+            raise _Uncopyable(f"a shape of kind {type(s).__name__}")
+        for name in ("friction", "elasticity", "surface_velocity", "sensor", "filter"):
+            setattr(c, name, getattr(s, name))
+        self.space.add(c)
+
+    def _constraint(self, c: Any, pymunk: Any) -> Any:
+        a, b = self._of(c.a, pymunk), self._of(c.b, pymunk)
+        kind = next((k for k in _MAKERS if isinstance(c, getattr(pymunk, k))), None)
+        if kind is None:
+            raise _Uncopyable(f"a constraint of kind {type(c).__name__}")
+        new = _MAKERS[kind](pymunk, c, a, b)
+        for name in ("max_force", "max_bias", "error_bias", "collide_bodies"):
+            setattr(new, name, getattr(c, name))
+        return new
+
+
+def _spring(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
+    new = pymunk.DampedSpring(a, b, c.anchor_a, c.anchor_b, c.rest_length, c.stiffness,
+                              c.damping)
+    if c.force_func is not pymunk.DampedSpring.spring_force:
+        new.force_func = c.force_func
+    return new
+
+
+def _rotary_spring(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
+    new = pymunk.DampedRotarySpring(a, b, c.rest_angle, c.stiffness, c.damping)
+    if c.torque_func is not pymunk.DampedRotarySpring.spring_torque:
+        new.torque_func = c.torque_func
+    return new
+
+
+def _pin(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
+    new = pymunk.PinJoint(a, b, c.anchor_a, c.anchor_b)
+    new.distance = c.distance
+    return new
+
+
+def _ratchet(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
+    new = pymunk.RatchetJoint(a, b, c.phase, c.ratchet)
+    new.angle = c.angle
+    return new
+
+
+#: How each constraint kind is copied (by its pymunk class name).
+_MAKERS = {
+    "PinJoint": _pin,
+    "SlideJoint": lambda pm, c, a, b: pm.SlideJoint(a, b, c.anchor_a, c.anchor_b, c.min, c.max),
+    "PivotJoint": lambda pm, c, a, b: pm.PivotJoint(a, b, c.anchor_a, c.anchor_b),
+    "GrooveJoint": lambda pm, c, a, b: pm.GrooveJoint(a, b, c.groove_a, c.groove_b, c.anchor_b),
+    "DampedSpring": _spring,
+    "DampedRotarySpring": _rotary_spring,
+    "RotaryLimitJoint": lambda pm, c, a, b: pm.RotaryLimitJoint(a, b, c.min, c.max),
+    "RatchetJoint": _ratchet,
+    "GearJoint": lambda pm, c, a, b: pm.GearJoint(a, b, c.phase, c.ratio),
+    "SimpleMotor": lambda pm, c, a, b: pm.SimpleMotor(a, b, c.rate),
+}
+
+
+# --- the run ---------------------------------------------------------------------------------
+
+#: The batch fields the run reads each step (x, y, angle, vx, vy, w per body).
+_FIELDS = ("POSITION", "ANGLE", "VELOCITY", "ANGULAR_VELOCITY")
+
+
+class _End(NamedTuple):
+    """One end of a constraint: its body's place in the batch rows (-1: the space's static
+    body, which the batch does not list), its row of equations (-1: not dynamic), whether
+    it is kinematic, and the anchor and centre of gravity in body coordinates."""
+
+    slot: int
+    row: int
+    kinematic: bool
+    anchor: tuple[float, float]
+    cog: tuple[float, float]
+
+
+class _Run:
+    """The copy stepped, each constraint's impulse recovered and its work summed."""
+
+    def __init__(self, copy: _Copy, dt: float, wanted: list[int]) -> None:
+        import pymunk
+
+        self.copy, self.dt, self.wanted = copy, dt, wanted
+        self.space = space = copy.space
+        space.sleep_time_threshold = math.inf     # every body stays in pymunk's batch rows
+        self.problem = ""
+        self.steps = 0
+        cons = copy.constraints
+        self.kinds = [next(k for k in _MAKERS if isinstance(c, getattr(pymunk, k)))
+                      for c in cons]
+        self.width = [1 if k in ROTARY or k in ("PinJoint", "SlideJoint", "DampedSpring")
+                      else 2 for k in self.kinds]
+        self.first = np.concatenate([[0], np.cumsum(self.width)]).astype(int)
+        if self.first[-1] > MAX_UNKNOWNS:
+            self.problem = (f"the probe solves for at most {MAX_UNKNOWNS} impulse components "
+                            f"a step; the constraints have {self.first[-1]}")
+            return
+        ids, rows = batch(space, _FIELDS)
+        self.ids = ids.copy()
+        slot = {int(k): j for j, k in enumerate(ids)}
+        by_slot: list[Any] = [space.static_body] * len(ids)   # what is not in space.bodies
+        for b in space.bodies:
+            by_slot[slot[int(b.id)]] = b
+        dynamic = np.array([b.body_type == pymunk.Body.DYNAMIC for b in by_slot], dtype=bool)
+        self.mass = np.array([b.mass if d else 0.0 for b, d in zip(by_slot, dynamic,
+                                                                   strict=True)])
+        self.moment = np.array([b.moment if d else 0.0 for b, d in zip(by_slot, dynamic,
+                                                                       strict=True)])
+        self.cog = np.array([tuple(b.center_of_gravity) for b in by_slot]).reshape(-1, 2)
+        self.dynamic = dynamic
+        # The dynamic bodies at an end of some constraint: three equations each.
+        self.row_slots: list[int] = []
+        row_of: dict[int, int] = {}
+        self.ends: list[tuple[_End, _End]] = []
+        self.static = space.static_body
+        for c, kind in zip(cons, self.kinds, strict=True):
+            pair = []
+            for body, which in ((c.a, "a"), (c.b, "b")):
+                j = slot.get(int(body.id), -1)
+                if j >= 0 and dynamic[j] and j not in row_of:
+                    row_of[j] = len(self.row_slots)
+                    self.row_slots.append(j)
+                anchor = (0.0, 0.0) if kind in ROTARY or (kind == "GrooveJoint"
+                                                          and which == "a") \
+                    else tuple(getattr(c, f"anchor_{which}"))
+                pair.append(_End(j, row_of.get(j, -1) if j >= 0 else -1,
+                                 body.body_type == pymunk.Body.KINEMATIC, anchor,
+                                 tuple(body.center_of_gravity)))
+            self.ends.append((pair[0], pair[1]))
+        self.rows = np.array(self.row_slots, dtype=int)
+        self.work = np.zeros(len(cons))
+        self.unsure: dict[int, str] = {}
+        self.kicks: dict[int, tuple[float, float, float, float, float, float]] = {}
+        self.row_bodies = [by_slot[j] for j in self.row_slots]
+        self.row_ends = [_End(j, i, False, (0.0, 0.0), tuple(self.cog[j]))
+                         for i, j in enumerate(self.row_slots)]
+        moments = self.moment[self.rows] if len(self.rows) else np.zeros(0)
+        self.turns = np.where(np.isfinite(moments), moments, 0.0)
+        for i, body in enumerate(self.row_bodies):
+            self._wrap(body, i)
+        self.start = rows.copy()
+        self.energy0 = self._energies(rows)
+        self.biggest = [0.0, 0.0, 0.0]  # kinetic, gravity's change, the springs' change
+
+    def _wrap(self, body: Any, i: int) -> None:
+        """Record the kick ``body``'s velocity update gives it each step."""
+        inner = body.velocity_func
+        kicks = self.kicks
+
+        def recorded(b: Any, gravity: Any, damping: float, dt: float) -> None:
+            v0, w0 = b.velocity, b.angular_velocity
+            inner(b, gravity, damping, dt)
+            v1 = b.velocity
+            kicks[i] = (v1.x - v0.x, v1.y - v0.y, b.angular_velocity - w0)
+
+        body.velocity_func = recorded
+
+    def step(self) -> bool:
+        """One step of the copy; False once its state is not finite (the probe stops)."""
+        for body, force, torque in self.copy.pushes:
+            body.force, body.torque = force, torque
+        self.kicks.clear()
+        self.space.step(self.dt)
+        self.steps += 1
+        ids, rows = batch(self.space, _FIELDS)
+        if not np.isfinite(rows).all():
+            self.problem = (f"the copy's state stopped being finite at step {self.steps} of "
+                            "the probe")
+            return False
+        if len(ids) != len(self.ids) or not np.array_equal(ids, self.ids):
+            order = np.argsort(ids)
+            rows = rows[order[np.searchsorted(ids[order], self.ids)]]
+        self._account(self.start, rows)
+        kinetic, gravity, springs = self._energies(rows)
+        big = self.biggest
+        big[0] = max(big[0], kinetic)
+        big[1] = max(big[1], abs(gravity - self.energy0[1]))
+        big[2] = max(big[2], abs(springs - self.energy0[2]))
+        self.start = rows.copy()
+        return True
+
+    def _account(self, before: np.ndarray, after: np.ndarray) -> None:
+        """Recover the step's impulse of every constraint from the rows' bodies' momentum
+        gains and add up each one's work (see the module docstring)."""
+        rows = self.rows
+        n, m = len(rows), int(self.first[-1])
+        kick = np.zeros((n, 3))
+        for i, k in self.kicks.items():
+            kick[i] = k
+        gain = after[rows, 3:6] - before[rows, 3:6] - kick
+        rhs = np.empty((n, 3))
+        rhs[:, :2] = self.mass[rows, None] * gain[:, :2]
+        rhs[:, 2] = self.turns * np.where(self.turns > 0, gain[:, 2], 0.0)
+        use = np.ones((n, 3), dtype=bool)
+        use[:, 2] = self.turns > 0                 # a body that cannot turn: no spin equation
+        pose = [after[:, 0].tolist(), after[:, 1].tolist(), np.cos(after[:, 2]).tolist(),
+                np.sin(after[:, 2]).tolist()]
+        for i, b in enumerate(self.row_bodies):
+            found = _arbiters(b)
+            if not found:
+                continue
+            cx, cy, _, _ = self._world(self.row_ends[i], self.row_ends[i].cog, pose)
+            for arb in found:
+                imp = arb.total_impulse
+                rhs[i, 0] -= imp.x
+                rhs[i, 1] -= imp.y
+                points = arb.contact_point_set.points
+                if len(points) == 1:
+                    p = points[0].point_a
+                    rhs[i, 2] -= (p.x - cx) * imp.y - (p.y - cy) * imp.x
+                elif points:
+                    use[i, 2] = False       # two contact points: their torque is not known
+        mean = (0.5 * (before[:, 3:6] + after[:, 3:6])).tolist()   # per batch row
+        moving = after[:, 3:6].tolist()
+        velocity = [0.0] * m          # the mean relative velocity each component acts on
+        where_r: list[int] = []
+        where_c: list[int] = []
+        value: list[float] = []
+        idle: list[int] = []          # components pymunk sets to 0 this step
+        for k, c in enumerate(self.copy.constraints):
+            columns, rest = self._columns(c, self.kinds[k], self.ends[k], pose)
+            first = int(self.first[k])
+            idle += [first + r for r in rest]
+            for col, ends in enumerate(columns, start=first):
+                for end, vec in zip(self.ends[k], ends, strict=True):
+                    if end.row >= 0:
+                        where_r += [3 * end.row, 3 * end.row + 1, 3 * end.row + 2]
+                        where_c += [col, col, col]
+                        value += vec
+                        u = mean[end.slot]
+                    elif end.kinematic and end.slot >= 0:
+                        u = moving[end.slot]
+                    else:
+                        continue
+                    velocity[col] += vec[0] * u[0] + vec[1] * u[1] + vec[2] * u[2]
+        mat = np.zeros((3 * n, m))
+        np.add.at(mat, (where_r, where_c), value)
+        keep = use.reshape(-1)
+        a_mat, values = mat[keep], rhs.reshape(-1)[keep]
+        if idle:
+            a_mat = np.vstack([a_mat, np.eye(m)[idle]])
+            values = np.concatenate([values, np.zeros(len(idle))])
+        solution, _, rank, _ = np.linalg.lstsq(a_mat, values, rcond=None)
+        if rank < m:
+            self._underdetermined(a_mat)
+        scale = max(1e-300, float(np.abs(values).max(initial=0.0)))
+        sol = solution.tolist()
+        for k, c in enumerate(self.copy.constraints):
+            lo, hi = int(self.first[k]), int(self.first[k + 1])
+            part = sol[lo:hi]
+            got, said = math.hypot(*part), abs(c.impulse)
+            if k not in self.unsure and abs(got - said) > AGREE * max(said, scale):
+                self.unsure[k] = (f"its impulse recovered from the bodies' motion ({got:.6g}) "
+                                  f"is not pymunk's ({said:.6g}) at step {self.steps}")
+            self.work[k] += sum(p * v for p, v in zip(part, velocity[lo:hi], strict=True))
+
+    def _underdetermined(self, a_mat: np.ndarray) -> None:
+        """Name the constraints whose impulses the bodies' motion does not determine."""
+        _, s, vt = np.linalg.svd(a_mat, full_matrices=True)
+        tol = max(a_mat.shape) * np.finfo(float).eps * (s[0] if len(s) else 1.0)
+        null = vt[int((s > tol).sum()):]
+        for k in range(len(self.copy.constraints)):
+            block = null[:, self.first[k]:self.first[k + 1]]
+            if k not in self.unsure and np.abs(block).max(initial=0.0) > 1e-9:
+                self.unsure[k] = ("its impulse is not separable from its neighbours' by the "
+                                  "bodies' motion (they act on the same motion, or a contact "
+                                  "of two points hides a torque)")
+
+    def _world(self, end: _End, point: tuple[float, float], pose: list[list[float]]
+               ) -> tuple[float, float, float, float]:
+        """``point`` (body coordinates of ``end``'s body) in the world, and its offset from
+        that body's centre of gravity."""
+        if end.slot >= 0:
+            j = end.slot
+            x, y, cos, sin = pose[0][j], pose[1][j], pose[2][j], pose[3][j]
+        else:
+            p = self.static.position
+            x, y, cos, sin = p.x, p.y, math.cos(self.static.angle), math.sin(self.static.angle)
+        px, py = point[0] - end.cog[0], point[1] - end.cog[1]
+        rx, ry = cos * px - sin * py, sin * px + cos * py
+        gx = x + cos * end.cog[0] - sin * end.cog[1]
+        gy = y + sin * end.cog[0] + cos * end.cog[1]
+        return gx + rx, gy + ry, rx, ry
+
+    def _columns(self, c: Any, kind: str, ends: tuple[_End, _End],
+                 pose: list[list[float]]) -> tuple[list[tuple[list[float], list[float]]],
+                                                    list[int]]:
+        """Each impulse component of ``c`` as what it gives its bodies a and b (a (px, py, L)
+        triple for each, per unit of the component), and the components pymunk leaves at 0
+        this step (a slide or rotary limit within its limits, a groove's component along it
+        while its anchor is inside its ends)."""
+        end_a, end_b = ends
+        if kind in ROTARY:
+            ratio = 1.0 / c.ratio if kind == "GearJoint" else 1.0
+            idle = []
+            if kind == "RotaryLimitJoint" and c.min <= c.b.angle - c.a.angle <= c.max:
+                idle = [0]
+            return [([0.0, 0.0, -ratio], [0.0, 0.0, 1.0])], idle
+        bx, by, rbx, rby = self._world(end_b, end_b.anchor, pose)
+        idle = []
+        if kind == "GrooveJoint":
+            (ax, ay, rax, ray), (tx, ty), inside = _on_groove(self, c, end_a, (bx, by), pose)
+            directions = [(-ty, tx), (tx, ty)]
+            idle = [1] if inside else []
+        else:
+            ax, ay, rax, ray = self._world(end_a, end_a.anchor, pose)
+            dx, dy = bx - ax, by - ay
+            length = math.hypot(dx, dy)
+            if kind in ("PinJoint", "SlideJoint", "DampedSpring"):
+                directions = [(dx / length, dy / length) if length > 0 else (1.0, 0.0)]
+            else:
+                directions = [(1.0, 0.0), (0.0, 1.0)]
+            if kind == "SlideJoint" and c.min <= length <= c.max:
+                idle = [0]
+        return [([-nx, -ny, -(rax * ny - ray * nx)], [nx, ny, rbx * ny - rby * nx])
+                for nx, ny in directions], idle
+
+    def _energies(self, rows: np.ndarray) -> tuple[float, float, float]:
+        """Kinetic energy, gravity's and the springs' potential of the copy (batch ``rows``)."""
+        import pymunk
+
+        d = self.dynamic
+        m, inertia = self.mass[d], self.moment[d]
+        v = rows[d, 3:5]
+        spin = np.where(np.isfinite(inertia), inertia, 0.0) * rows[d, 5] ** 2
+        kinetic = 0.5 * float((m * (v ** 2).sum(axis=1)).sum() + spin.sum())
+        cos, sin = np.cos(rows[d, 2]), np.sin(rows[d, 2])
+        cog = self.cog[d]
+        cx = rows[d, 0] + cos * cog[:, 0] - sin * cog[:, 1]
+        cy = rows[d, 1] + sin * cog[:, 0] + cos * cog[:, 1]
+        g = self.space.gravity
+        gravity = -float((m * (g.x * cx + g.y * cy)).sum())
+        springs = 0.0
+        for c in self.copy.constraints:
+            if isinstance(c, pymunk.DampedSpring):
+                extent = (c.b.local_to_world(c.anchor_b) - c.a.local_to_world(c.anchor_a)).length
+                springs += float(spring_potential(c.stiffness, extent, c.rest_length))
+            elif isinstance(c, pymunk.DampedRotarySpring):
+                springs += float(spring_potential(c.stiffness, c.a.angle - c.b.angle,
+                                                  c.rest_angle))
+        return kinetic, gravity, springs
+
+    def scale(self) -> float:
+        return max(self.biggest)
+
+    def drifts(self) -> dict[int, Drift]:
+        out = {}
+        for k in self.wanted:
+            label = f"{self.kinds[k]} {k}"
+            why = self.unsure.get(k, "")
+            out[k] = Drift(label, None if why else float(self.work[k]), why)
+        return out
+
+
+def _arbiters(body: Any) -> list[Any]:
+    """The arbiters of ``body`` from its last step, each seen from the body."""
+    found: list[Any] = []
+    body.each_arbiter(found.append)
+    return found
+
+
+def _on_groove(run: _Run, c: Any, end_a: _End, anchor_b: tuple[float, float],
+               pose: list[list[float]]
+               ) -> tuple[tuple[float, float, float, float], tuple[float, float], bool]:
+    """Where a groove (on body a) holds its anchor (on body b, at ``anchor_b`` in the world):
+    the anchor's projection on the groove, clamped to its ends, as pymunk's groove joint
+    takes it (world point and offset from a's centre of gravity); the groove's direction (a
+    unit vector), and whether the anchor is inside its ends (then pymunk's impulse has no
+    part along the groove)."""
+    ta = run._world(end_a, tuple(c.groove_a), pose)
+    tb = run._world(end_a, tuple(c.groove_b), pose)
+    ax, ay = tb[0] - ta[0], tb[1] - ta[1]
+    length = math.hypot(ax, ay)
+    tx, ty = (ax / length, ay / length) if length > 0 else (1.0, 0.0)
+    s = (anchor_b[0] - ta[0]) * tx + (anchor_b[1] - ta[1]) * ty
+    if s <= 0.0:
+        return ta, (tx, ty), False
+    if s >= length:
+        return tb, (tx, ty), False
+    return (ta[0] + tx * s, ta[1] + ty * s, ta[2] + tx * s, ta[3] + ty * s), (tx, ty), True
