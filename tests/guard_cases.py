@@ -123,3 +123,66 @@ def pendulum(joint: str = "PinJoint", length: float = 200.0, mass: float = 1.0,
              else pymunk.SlideJoint(space.static_body, body, anchor, (0.0, 0.0), 0.0, length))
     space.add(body, shape, c)
     return space
+
+
+def every_constraint() -> Any:
+    """One of each pymunk constraint kind, in this order: a bob on a PinJoint, a slack
+    SlideJoint that snaps taut, a bar on a PivotJoint, a block in a sloping GrooveJoint, a
+    bob on a DampedSpring, a wheel on a DampedRotarySpring, a bar against a
+    RotaryLimitJoint, a wheel turning a RatchetJoint, a GearJoint between two wheels, and a
+    SimpleMotor; each part 300 px from the next, so that nothing touches (pixel units, y
+    down). Wheels and bars turn on pivots to the static body (added after the ten)."""
+    import pymunk
+
+    space = pymunk.Space()
+    space.gravity = (0.0, G_PX)
+    static = space.static_body
+    pivots = []
+
+    def bob(x: float, y: float, radius: float = 10.0) -> Any:
+        b = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0.0, radius))
+        b.position = (x, y)
+        space.add(b, pymunk.Circle(b, radius))
+        return b
+
+    def bar(x: float, y: float) -> Any:
+        b = pymunk.Body(1.0, pymunk.moment_for_segment(1.0, (-50, 0), (50, 0), 4.0))
+        b.center_of_gravity = (50.0, 0.0)
+        b.position = (x, y)
+        space.add(b, pymunk.Segment(b, (0, 0), (100, 0), 4.0))
+        pivots.append(pymunk.PivotJoint(static, b, (x, y)))
+        return b
+
+    def wheel(x: float, y: float, spin: float = 0.0) -> Any:
+        b = bob(x, y, 20.0)
+        b.angular_velocity = spin
+        pivots.append(pymunk.PivotJoint(static, b, (x, y)))
+        return b
+
+    pin = pymunk.PinJoint(static, bob(200.0, 100.0), (100.0, 100.0), (0.0, 0.0))
+    slide = pymunk.SlideJoint(static, bob(400.0, 200.0), (400.0, 100.0), (0.0, 0.0), 0.0, 160.0)
+    pivot = pymunk.PivotJoint(static, _bar(space, 700.0), (700.0, 100.0))
+    block = bob(1000.0, 100.0)
+    groove = pymunk.GrooveJoint(static, block, (1000.0, 100.0), (1200.0, 180.0), (0.0, 0.0))
+    spring = pymunk.DampedSpring(static, bob(1300.0, 150.0), (1300.0, 100.0), (0.0, 0.0),
+                                 30.0, 50.0, 0.0)
+    turned = wheel(1600.0, 100.0, 3.0)
+    rotary = pymunk.DampedRotarySpring(static, turned, 0.0, 2e5, 0.0)
+    limit = pymunk.RotaryLimitJoint(static, bar(1900.0, 100.0), -0.5, 0.5)
+    ratchet = pymunk.RatchetJoint(static, wheel(2200.0, 100.0, 4.0), 0.0, math.pi / 4)
+    gear = pymunk.GearJoint(wheel(2500.0, 100.0, 2.0), wheel(2560.0, 100.0), 0.0, 2.0)
+    motor = pymunk.SimpleMotor(static, wheel(2900.0, 100.0), 5.0)
+    space.add(pin, slide, pivot, groove, spring, rotary, limit, ratchet, gear, motor, *pivots)
+    return space
+
+
+def _bar(space: Any, x: float) -> Any:
+    """A 100 px bar with its origin at (x, 100) and its centre of gravity 50 px along it,
+    level (for the PivotJoint of :func:`every_constraint`)."""
+    import pymunk
+
+    b = pymunk.Body(1.0, pymunk.moment_for_segment(1.0, (-50, 0), (50, 0), 4.0))
+    b.center_of_gravity = (50.0, 0.0)
+    b.position = (x, 100.0)
+    space.add(b, pymunk.Segment(b, (0, 0), (100, 0), 4.0))
+    return b

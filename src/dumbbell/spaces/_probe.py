@@ -13,12 +13,15 @@ measures it:
   handlers and a constraint's ``pre_solve``/``post_solve`` are not copied; a custom
   ``velocity_func``, spring force or torque is, being part of the physics);
 - **the run**: :data:`PROBE_TIME` seconds of steps of ``dt`` (fewer when the space is big:
-  at most :data:`MAX_STEPS` steps and :data:`MAX_WORK` body-steps), the forces set now kept
-  on every step, as a program that sets them each frame;
+  at most :data:`MAX_STEPS` steps, and steps times the work of one step at most
+  :data:`MAX_WORK`, a step's work being its bodies, its impulse components and
+  :data:`PART_COST` for each part solved), the forces set now kept on every step, as a
+  program that sets them each frame; no body falls asleep on the copy;
 - **each constraint's impulse**, recovered every step from the momentum its bodies gained:
   a body's gain in the step, less the kick of its ``velocity_func`` (gravity, damping, its
   forces: read by wrapping that function on the copy) and the impulses of its contacts
-  (``Arbiter.total_impulse``, and its torque where the contact has one point), is the sum of
+  (``Arbiter.total_impulse``, and its torque where the contact has one point, at that
+  point on the body's own shape), is the sum of
   the impulses of its constraints. Each constraint's impulse has a known form (along the
   axis of a pin, slide or spring; any direction at a pivot or groove; a torque for the
   rotary kinds, a gear's scaled by its ratio on its first body), so the gains of all bodies
@@ -50,13 +53,16 @@ from ._scan import batch
 
 #: Simulated time the probe covers (s), when the budget allows.
 PROBE_TIME = 2.0
-#: Most steps of a probe, and most body-steps (steps times bodies of the space).
+#: Most steps of a probe, and most work: steps times (bodies of the space plus impulse
+#: components solved for).
 MAX_STEPS = 1200
 MAX_WORK = 400_000
 #: Fewest steps a probe is worth: past the budget with fewer, it is not run.
 MIN_STEPS = 20
-#: Most unknowns (impulse components) the probe solves for each step.
-MAX_UNKNOWNS = 400
+#: What solving for one part of the constraints costs a step, in bodies stepped (about).
+PART_COST = 50
+#: Most impulse components the probe solves for together (constraints tied by their bodies).
+MAX_UNKNOWNS = 120
 #: Relative agreement asked of a recovered impulse with pymunk's own magnitude.
 AGREE = 1e-6
 
@@ -103,20 +109,19 @@ def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
     places ``wanted`` of ``space.constraints`` (see the module docstring)."""
     started = time.perf_counter()
     result = Probe(dt)
-    n_bodies = max(1, len(space.bodies))
-    steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // n_bodies)
-    if steps < MIN_STEPS:
-        result.problem = (f"a probe of {MIN_STEPS} steps of {n_bodies:,} bodies is past the "
-                          f"guard's budget ({MAX_WORK:,} body-steps)")
-        return result
     try:
         copy = _Copy(space)
     except _Uncopyable as e:
         result.problem = f"the probe cannot copy the space: {e}"
         return result
     run = _Run(copy, dt, wanted)
-    if run.problem:
-        result.problem = run.problem
+    work = len(copy.space.bodies) + run.unknowns() + PART_COST * len(run.parts)
+    steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // max(1, work))
+    if steps < MIN_STEPS:
+        n = len(copy.space.bodies)
+        result.problem = (f"{n:,} bod{'y' if n == 1 else 'ies'} to step and {run.unknowns():,} "
+                          f"impulse components to solve for: fewer than {MIN_STEPS} steps fit "
+                          "in the probe's budget")
         return result
     for _ in range(steps):
         if not run.step():
@@ -255,15 +260,27 @@ _FIELDS = ("POSITION", "ANGLE", "VELOCITY", "ANGULAR_VELOCITY")
 
 
 class _End(NamedTuple):
-    """One end of a constraint: its body's place in the batch rows (-1: the space's static
-    body, which the batch does not list), its row of equations (-1: not dynamic), whether
-    it is kinematic, and the anchor and centre of gravity in body coordinates."""
+    """One end of a constraint: its body's place in the batch rows (-1: a body the batch
+    does not list, such as a static or kinematic body only joints use: read from ``body``),
+    its row of equations (-1: not dynamic), whether it is kinematic, and the anchor and
+    centre of gravity in body coordinates."""
 
     slot: int
     row: int
     kinematic: bool
     anchor: tuple[float, float]
     cog: tuple[float, float]
+    body: Any = None
+
+
+class _Part(NamedTuple):
+    """Constraints tied together through the dynamic bodies they join (solved together):
+    ``cons`` their places, ``first`` where each one's impulse components start (and the
+    count at the end), ``rows`` the rows' bodies (numbers of :attr:`_Run.row_bodies`)."""
+
+    cons: list[int]
+    first: list[int]
+    rows: list[int]
 
 
 class _Run:
@@ -282,11 +299,6 @@ class _Run:
                       for c in cons]
         self.width = [1 if k in ROTARY or k in ("PinJoint", "SlideJoint", "DampedSpring")
                       else 2 for k in self.kinds]
-        self.first = np.concatenate([[0], np.cumsum(self.width)]).astype(int)
-        if self.first[-1] > MAX_UNKNOWNS:
-            self.problem = (f"the probe solves for at most {MAX_UNKNOWNS} impulse components "
-                            f"a step; the constraints have {self.first[-1]}")
-            return
         ids, rows = batch(space, _FIELDS)
         self.ids = ids.copy()
         slot = {int(k): j for j, k in enumerate(ids)}
@@ -300,39 +312,88 @@ class _Run:
                                                                        strict=True)])
         self.cog = np.array([tuple(b.center_of_gravity) for b in by_slot]).reshape(-1, 2)
         self.dynamic = dynamic
-        # The dynamic bodies at an end of some constraint: three equations each.
-        self.row_slots: list[int] = []
-        row_of: dict[int, int] = {}
-        self.ends: list[tuple[_End, _End]] = []
         self.static = space.static_body
-        for c, kind in zip(cons, self.kinds, strict=True):
-            pair = []
-            for body, which in ((c.a, "a"), (c.b, "b")):
-                j = slot.get(int(body.id), -1)
-                if j >= 0 and dynamic[j] and j not in row_of:
-                    row_of[j] = len(self.row_slots)
-                    self.row_slots.append(j)
-                anchor = (0.0, 0.0) if kind in ROTARY or (kind == "GrooveJoint"
-                                                          and which == "a") \
-                    else tuple(getattr(c, f"anchor_{which}"))
-                pair.append(_End(j, row_of.get(j, -1) if j >= 0 else -1,
-                                 body.body_type == pymunk.Body.KINEMATIC, anchor,
-                                 tuple(body.center_of_gravity)))
-            self.ends.append((pair[0], pair[1]))
-        self.rows = np.array(self.row_slots, dtype=int)
         self.work = np.zeros(len(cons))
         self.unsure: dict[int, str] = {}
-        self.kicks: dict[int, tuple[float, float, float, float, float, float]] = {}
-        self.row_bodies = [by_slot[j] for j in self.row_slots]
-        self.row_ends = [_End(j, i, False, (0.0, 0.0), tuple(self.cog[j]))
-                         for i, j in enumerate(self.row_slots)]
-        moments = self.moment[self.rows] if len(self.rows) else np.zeros(0)
-        self.turns = np.where(np.isfinite(moments), moments, 0.0)
+        self.parts = self._parts(cons, slot, by_slot, pymunk)
+        self.kicks: dict[int, tuple[float, float, float]] = {}
         for i, body in enumerate(self.row_bodies):
             self._wrap(body, i)
+        moments = self.moment[self.rows] if len(self.rows) else np.zeros(0)
+        self.turns = np.where(np.isfinite(moments), moments, 0.0)
         self.start = rows.copy()
         self.energy0 = self._energies(rows)
         self.biggest = [0.0, 0.0, 0.0]  # kinetic, gravity's change, the springs' change
+
+    def _parts(self, cons: list[Any], slot: dict[int, int], by_slot: list[Any],
+               pymunk: Any) -> list[_Part]:
+        """The constraints in parts tied together through dynamic bodies, those with a
+        wanted constraint kept; the ends of every constraint (``ends``) and the rows'
+        bodies (``rows``: their batch rows, ``row_bodies``, ``row_ends``)."""
+        parent: dict[int, int] = {}
+
+        def root(j: int) -> int:
+            while parent.setdefault(j, j) != j:
+                parent[j] = parent[parent[j]]
+                j = parent[j]
+            return j
+
+        self.ends: list[tuple[_End, _End]] = []
+        tied: list[int | None] = []
+        for c, kind in zip(cons, self.kinds, strict=True):
+            pair, moving = [], []
+            for body, which in ((c.a, "a"), (c.b, "b")):
+                j = slot.get(int(body.id), -1)
+                if j >= 0 and self.dynamic[j]:
+                    moving.append(j)
+                anchor = (0.0, 0.0) if kind in ROTARY or (kind == "GrooveJoint"
+                                                          and which == "a") \
+                    else tuple(getattr(c, f"anchor_{which}"))
+                pair.append(_End(j, -1, body.body_type == pymunk.Body.KINEMATIC, anchor,
+                                 tuple(body.center_of_gravity), body))
+            if len(moving) == 2:
+                parent[root(moving[0])] = root(moving[1])
+            tied.append(moving[0] if moving else None)
+            self.ends.append((pair[0], pair[1]))
+        groups: dict[int, list[int]] = {}
+        for k, j in enumerate(tied):
+            if j is None:
+                if k in self.wanted:
+                    self.unsure[k] = "it joins no dynamic body: there is no motion to measure"
+                continue
+            groups.setdefault(root(j), []).append(k)
+        wanted = set(self.wanted)
+        self.row_slots: list[int] = []
+        row_of: dict[int, int] = {}
+        parts = []
+        for members in groups.values():
+            if not wanted & set(members):
+                continue
+            first = [0]
+            for k in members:
+                first.append(first[-1] + self.width[k])
+            if first[-1] > MAX_UNKNOWNS:
+                for k in wanted & set(members):
+                    self.unsure[k] = (f"it is tied to {len(members)} constraints through the "
+                                      f"bodies they join, more than the probe solves together "
+                                      f"({MAX_UNKNOWNS} impulse components)")
+                continue
+            rows = []
+            for k in members:
+                for e, end in enumerate(self.ends[k]):
+                    if end.slot >= 0 and self.dynamic[end.slot]:
+                        if end.slot not in row_of:
+                            row_of[end.slot] = len(self.row_slots)
+                            self.row_slots.append(end.slot)
+                        self.ends[k] = _replace_end(self.ends[k], e, row_of[end.slot])
+                        if row_of[end.slot] not in rows:
+                            rows.append(row_of[end.slot])
+            parts.append(_Part(members, first, rows))
+        self.rows = np.array(self.row_slots, dtype=int)
+        self.row_bodies = [by_slot[j] for j in self.row_slots]
+        self.row_ends = [_End(j, i, False, (0.0, 0.0), tuple(self.cog[j]))
+                         for i, j in enumerate(self.row_slots)]
+        return parts
 
     def _wrap(self, body: Any, i: int) -> None:
         """Record the kick ``body``'s velocity update gives it each step."""
@@ -375,7 +436,7 @@ class _Run:
         """Recover the step's impulse of every constraint from the rows' bodies' momentum
         gains and add up each one's work (see the module docstring)."""
         rows = self.rows
-        n, m = len(rows), int(self.first[-1])
+        n = len(rows)
         kick = np.zeros((n, 3))
         for i, k in self.kicks.items():
             kick[i] = k
@@ -393,66 +454,88 @@ class _Run:
                 continue
             cx, cy, _, _ = self._world(self.row_ends[i], self.row_ends[i].cog, pose)
             for arb in found:
-                imp = arb.total_impulse
+                # total_impulse is what the arbiter's first shape's body got; the contact
+                # point of each body is on its own shape.
+                mine = arb.shapes[0].body is b
+                imp = arb.total_impulse if mine else -arb.total_impulse
                 rhs[i, 0] -= imp.x
                 rhs[i, 1] -= imp.y
                 points = arb.contact_point_set.points
                 if len(points) == 1:
-                    p = points[0].point_a
+                    p = points[0].point_a if mine else points[0].point_b
                     rhs[i, 2] -= (p.x - cx) * imp.y - (p.y - cy) * imp.x
                 elif points:
                     use[i, 2] = False       # two contact points: their torque is not known
         mean = (0.5 * (before[:, 3:6] + after[:, 3:6])).tolist()   # per batch row
         moving = after[:, 3:6].tolist()
+        self.momentum = (self.mass[rows] * np.hypot(after[rows, 3], after[rows, 4])
+                         + self.turns * np.abs(after[rows, 5]))
+        for part in self.parts:
+            if not all(k in self.unsure for k in part.cons):
+                self._solve(part, rhs, use, pose, mean, moving)
+
+    def _solve(self, part: _Part, rhs: np.ndarray, use: np.ndarray, pose: list[list[float]],
+               mean: list[list[float]], moving: list[list[float]]) -> None:
+        """Recover the impulses of one part's constraints and add up their work."""
+        cons = self.copy.constraints
+        m = part.first[-1]
+        local = {r: i for i, r in enumerate(part.rows)}
         velocity = [0.0] * m          # the mean relative velocity each component acts on
         where_r: list[int] = []
         where_c: list[int] = []
         value: list[float] = []
         idle: list[int] = []          # components pymunk sets to 0 this step
-        for k, c in enumerate(self.copy.constraints):
-            columns, rest = self._columns(c, self.kinds[k], self.ends[k], pose)
-            first = int(self.first[k])
+        silent: set[int] = set()      # constraints that apply nothing whatever they report
+        for at, k in enumerate(part.cons):
+            columns, rest = self._columns(cons[k], self.kinds[k], self.ends[k], pose)
+            if not any(any(v) for pair in columns for v in pair):
+                silent.add(k)
+            first = part.first[at]
             idle += [first + r for r in rest]
             for col, ends in enumerate(columns, start=first):
                 for end, vec in zip(self.ends[k], ends, strict=True):
                     if end.row >= 0:
-                        where_r += [3 * end.row, 3 * end.row + 1, 3 * end.row + 2]
+                        i = local[end.row]
+                        where_r += [3 * i, 3 * i + 1, 3 * i + 2]
                         where_c += [col, col, col]
                         value += vec
                         u = mean[end.slot]
-                    elif end.kinematic and end.slot >= 0:
-                        u = moving[end.slot]
+                    elif end.kinematic:
+                        u = (moving[end.slot] if end.slot >= 0 else
+                             [*end.body.velocity, end.body.angular_velocity])
                     else:
                         continue
                     velocity[col] += vec[0] * u[0] + vec[1] * u[1] + vec[2] * u[2]
-        mat = np.zeros((3 * n, m))
-        np.add.at(mat, (where_r, where_c), value)
-        keep = use.reshape(-1)
-        a_mat, values = mat[keep], rhs.reshape(-1)[keep]
+        mat = np.zeros((3 * len(part.rows), m))
+        mat[where_r, where_c] = value          # each (row, column) once: a body per end
+        keep = use[part.rows].reshape(-1)
+        a_mat, values = mat[keep], rhs[part.rows].reshape(-1)[keep]
         if idle:
             a_mat = np.vstack([a_mat, np.eye(m)[idle]])
             values = np.concatenate([values, np.zeros(len(idle))])
         solution, _, rank, _ = np.linalg.lstsq(a_mat, values, rcond=None)
-        if rank < m:
-            self._underdetermined(a_mat)
-        scale = max(1e-300, float(np.abs(values).max(initial=0.0)))
+        if rank < m and not all(k in self.unsure for k in part.cons):
+            self._underdetermined(a_mat, part)
+        # The size of the part's impulses: what it moved and the momentum of its bodies.
+        rows = part.rows
+        scale = max(float(np.abs(values).max(initial=0.0)), self.momentum[rows].max(), 1e-300)
         sol = solution.tolist()
-        for k, c in enumerate(self.copy.constraints):
-            lo, hi = int(self.first[k]), int(self.first[k + 1])
-            part = sol[lo:hi]
-            got, said = math.hypot(*part), abs(c.impulse)
+        for at, k in enumerate(part.cons):
+            lo, hi = part.first[at], part.first[at + 1]
+            got, said = math.hypot(*sol[lo:hi]), 0.0 if k in silent else abs(cons[k].impulse)
             if k not in self.unsure and abs(got - said) > AGREE * max(said, scale):
                 self.unsure[k] = (f"its impulse recovered from the bodies' motion ({got:.6g}) "
                                   f"is not pymunk's ({said:.6g}) at step {self.steps}")
-            self.work[k] += sum(p * v for p, v in zip(part, velocity[lo:hi], strict=True))
+            self.work[k] += sum(p * v for p, v in zip(sol[lo:hi], velocity[lo:hi],
+                                                      strict=True))
 
-    def _underdetermined(self, a_mat: np.ndarray) -> None:
+    def _underdetermined(self, a_mat: np.ndarray, part: _Part) -> None:
         """Name the constraints whose impulses the bodies' motion does not determine."""
         _, s, vt = np.linalg.svd(a_mat, full_matrices=True)
         tol = max(a_mat.shape) * np.finfo(float).eps * (s[0] if len(s) else 1.0)
         null = vt[int((s > tol).sum()):]
-        for k in range(len(self.copy.constraints)):
-            block = null[:, self.first[k]:self.first[k + 1]]
+        for at, k in enumerate(part.cons):
+            block = null[:, part.first[at]:part.first[at + 1]]
             if k not in self.unsure and np.abs(block).max(initial=0.0) > 1e-9:
                 self.unsure[k] = ("its impulse is not separable from its neighbours' by the "
                                   "bodies' motion (they act on the same motion, or a contact "
@@ -466,8 +549,9 @@ class _Run:
             j = end.slot
             x, y, cos, sin = pose[0][j], pose[1][j], pose[2][j], pose[3][j]
         else:
-            p = self.static.position
-            x, y, cos, sin = p.x, p.y, math.cos(self.static.angle), math.sin(self.static.angle)
+            body = end.body if end.body is not None else self.static
+            p = body.position
+            x, y, cos, sin = p.x, p.y, math.cos(body.angle), math.sin(body.angle)
         px, py = point[0] - end.cog[0], point[1] - end.cog[1]
         rx, ry = cos * px - sin * py, sin * px + cos * py
         gx = x + cos * end.cog[0] - sin * end.cog[1]
@@ -499,7 +583,10 @@ class _Run:
             dx, dy = bx - ax, by - ay
             length = math.hypot(dx, dy)
             if kind in ("PinJoint", "SlideJoint", "DampedSpring"):
-                directions = [(dx / length, dy / length) if length > 0 else (1.0, 0.0)]
+                # Of length 0 pymunk's axis is 0: whatever it accumulates, it applies nothing.
+                directions = [(dx / length, dy / length) if length > 0 else (0.0, 0.0)]
+                if length == 0:
+                    idle = [0]
             else:
                 directions = [(1.0, 0.0), (0.0, 1.0)]
             if kind == "SlideJoint" and c.min <= length <= c.max:
@@ -535,6 +622,10 @@ class _Run:
     def scale(self) -> float:
         return max(self.biggest)
 
+    def unknowns(self) -> int:
+        """The impulse components solved for each step."""
+        return sum(part.first[-1] for part in self.parts)
+
     def drifts(self) -> dict[int, Drift]:
         out = {}
         for k in self.wanted:
@@ -542,6 +633,13 @@ class _Run:
             why = self.unsure.get(k, "")
             out[k] = Drift(label, None if why else float(self.work[k]), why)
         return out
+
+
+def _replace_end(pair: tuple[_End, _End], e: int, row: int) -> tuple[_End, _End]:
+    """``pair`` with end ``e``'s row set."""
+    ends = list(pair)
+    ends[e] = ends[e]._replace(row=row)
+    return ends[0], ends[1]
 
 
 def _arbiters(body: Any) -> list[Any]:

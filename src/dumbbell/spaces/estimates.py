@@ -126,6 +126,14 @@ def length_unit(units: Any) -> str:
     return text
 
 
+def energy_units(unit: str) -> tuple[str, str]:
+    """The units of energy and power of a space whose length unit is ``unit`` (mass in kg,
+    time in s, as pymunk programs take them): ('J', 'W') in metres."""
+    if unit == "m":
+        return "J", "W"
+    return f"kg {unit}²/s²", f"kg {unit}²/s³"
+
+
 # --- what cannot be stepped ------------------------------------------------------------------
 
 

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -48,7 +48,7 @@ from ..errors import UsageError
 from ..model import args
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from .accounting import settings_problem
-from .estimates import Estimates, estimate, length_unit, state_problem
+from .estimates import Estimates, energy_units, estimate, length_unit, state_problem
 
 __all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",
            "substeps", "suggest_dt", "survey"]
@@ -81,7 +81,11 @@ class Finding:
     springs, length units moved per step for tunnelling, length units for slop, the bias for
     bias), the ``relation`` a good value keeps to the limit ('<', '<=' or '>='; 'finite' for a
     state no step fixes), the ``fix`` with its reason in words, the largest step that clears it,
-    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none)."""
+    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none).
+    A constraint's row (kind ``joint``) may instead be ``relation`` 'measured' (a number
+    with no limit: a motor's work, a loss the step does not change; ok) or 'unchecked' (not
+    measured: ``fix`` says why; not ok, and not a failure :func:`check` lists); ``note`` says
+    in words what the number is."""
 
     kind: str
     subject: str
@@ -91,10 +95,18 @@ class Finding:
     dt_max: float | None = None
     relation: str = "<"
     unit: str = ""
+    note: str = ""
+
+    @property
+    def checked(self) -> bool:
+        """Whether the row was measured (False: 'unchecked')."""
+        return self.relation != "unchecked"
 
     @property
     def ok(self) -> bool:
         """Whether the value keeps its relation to the limit."""
+        if self.relation == "measured":
+            return True
         if self.relation == "<":
             return self.value < self.limit
         if self.relation == "<=":
@@ -106,10 +118,12 @@ class Finding:
     def comparison(self) -> str:
         """'value relation limit' with the relation that holds, the numbers printed with
         enough digits to show it."""
+        unit = f" {self.unit}" if self.unit else ""
+        if self.relation == "measured":
+            return f"{self.value:.4g}{unit}"
         if self.relation not in _FAILS:
             return ""
         rel = self.relation if self.ok else _FAILS[self.relation]
-        unit = f" {self.unit}" if self.unit else ""
         a, b = _distinct(self.value, self.limit, rel)
         return f"{_QUANTITY.get(self.kind, '')}{a}{unit} {rel} {b}{unit}"
 
@@ -248,9 +262,12 @@ def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
         if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
             continue
         w = spring_omega(c)
-        if w == 0.0:
-            continue
         kind = "rotary-spring" if isinstance(c, pymunk.DampedRotarySpring) else "spring"
+        if w == 0.0:
+            rows.append(Finding(kind, f"{type(c).__name__} {j}", 0.0, _swing_limit(tolerance),
+                                "it moves nothing (no stiffness, or no end that can move)",
+                                None, "<", note="moves nothing"))
+            continue
         rows.append(_spring_row(kind, f"{type(c).__name__} {j}", w, _Judged(dt, tolerance)))
     return rows
 
@@ -363,6 +380,91 @@ def _contact_settings(sc: Scan, dt: float, unit: str) -> list[Finding]:
     return rows
 
 
+#: A drift that falls by less than this factor at half the step does not shrink with it.
+SHRINKS = 0.75
+#: Constraint kinds whose work is what they are for: a motor's drive.
+DRIVES = ("SimpleMotor",)
+
+
+def _joints(space: Any, dt: float, tolerance: float, unit: str) -> tuple[list[Finding], str]:
+    """A row for each constraint that is not a spring, from the probe (:mod:`._probe`): its
+    energy drift per second at ``dt`` against ``tolerance`` of the energy scale a second;
+    and what the probe cost, in words ('' when no constraint needed it)."""
+    import pymunk
+
+    from ._probe import probe
+
+    constraints = list(space.constraints)
+    wanted = [j for j, c in enumerate(constraints)
+              if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
+    if not wanted:
+        return [], ""
+    energy, power = energy_units(unit)
+    found = probe(space, dt, wanted)
+    if found.problem or not found.steps:
+        why = f"not checked: {found.problem}; spaces.Ledger measures it on your own run"
+        return [Finding("joint", f"{type(constraints[j]).__name__} {j}", math.nan, math.nan,
+                        why, None, "unchecked") for j in wanted], \
+            f"  joints not checked: {found.problem}"
+    limit = tolerance * found.scale
+    rows: dict[int, Finding] = {}
+    rates: dict[int, float] = {}
+    for j, d in found.drifts.items():
+        if d.work is None:
+            rows[j] = Finding("joint", d.label, math.nan, math.nan,
+                              f"not checked: {d.why}; spaces.Ledger measures it on your run",
+                              None, "unchecked")
+            continue
+        rates[j] = rate = d.work / found.seconds
+        verb = "puts in" if rate > 0 else "takes out"
+        share = (f"{_percent(abs(rate) / found.scale)}/s of the energy scale, "
+                 f"{found.scale:.4g} {energy}" if found.scale > 0 else "")
+        note = f"{verb} {share}" if share else "nothing moved in the probe"
+        if type(constraints[j]).__name__ in DRIVES:
+            rows[j] = Finding("joint", d.label, abs(rate), math.nan,
+                              f"{verb} {abs(rate):.4g} {power}: a motor's work is its drive, "
+                              "not the step's error", None, "measured", power,
+                              f"{note}: a motor's drive, not the step's error")
+            continue
+        fix = f"{note}, at this step: more than {_percent(tolerance)}/s"
+        rows[j] = Finding("joint", d.label, abs(rate), limit, fix, None, "<=", power, note)
+    failing = [j for j, f in rows.items() if f.relation == "<=" and not f.ok]
+    bodies = len(space.bodies)
+    cost = (f"  joints measured on a copy of the space over {found.seconds:.4g} s: "
+            f"{found.steps:,} steps of this dt ({bodies:,} bodies)")
+    if failing:
+        half = probe(space, dt / 2, failing)
+        if not half.problem:
+            cost += f", and the failing over {half.seconds:.4g} s at dt/2 ({half.steps:,} steps)"
+        for j in failing:
+            rows[j] = _at_half(rows[j], rates[j], half, j, dt)
+    return [rows[j] for j in wanted], cost
+
+
+def _at_half(row: Finding, rate: float, half: Any, j: int, dt: float) -> Finding:
+    """A failing joint row judged again from its drift at ``dt / 2`` (``half``, a probe):
+    the step that clears it when the drift shrinks with the step (as dt^p, p measured), a
+    measured row (no step changes it) when it does not."""
+    d = half.drifts.get(j)
+    if half.problem or d is None or d.work is None or not half.steps:
+        dt_max = dt * row.limit / row.value
+        fix = (f"{row.fix}; dt < {dt_max:.4g} s keeps it under (if it shrinks in proportion "
+               "to dt, as a joint's error does; not measured at dt/2 here)")
+        return replace(row, fix=fix, dt_max=dt_max)
+    slower = abs(d.work / half.seconds)
+    ratio = slower / row.value
+    if ratio > SHRINKS:
+        note = (f"{row.note}; about as much at dt/2, {slower:.4g} {row.unit}: the joint's "
+                "own loss (a stop, a snap, a slip), which no step changes")
+        return replace(row, relation="measured", limit=math.nan, note=note,
+                       fix=f"{row.fix}; at dt/2, {slower:.4g} {row.unit}: no step changes it")
+    order = min(3.0, max(0.5, math.log2(1.0 / ratio))) if ratio > 0 else 3.0
+    dt_max = dt * (row.limit / row.value) ** (1.0 / order)
+    fix = (f"{row.fix}; at dt/2, {slower:.4g} {row.unit} (it goes as dt^{order:.2g}): "
+           f"dt < {dt_max:.4g} s keeps it under")
+    return replace(row, fix=fix, dt_max=dt_max)
+
+
 @dataclass(frozen=True)
 class _Advice:
     rows: list[Finding]
@@ -372,6 +474,7 @@ class _Advice:
     tolerance: float
     swing: float | None
     unit: str
+    probe: str = ""
 
 
 def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
@@ -383,7 +486,8 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
                        None, tolerance, None, unit)
     est = estimate(sc, dt, unit)
-    rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance)
+    joints, probed = _joints(space, dt, tolerance, unit)
+    rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance) + joints
             + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
     failing = [f for f in rows if not f.ok and f.dt_max is not None]
     tightest = min(failing, key=lambda f: f.dt_max) if failing else None
@@ -394,7 +498,7 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
     ws = [f.value / dt for f in rows if f.kind in ("spring", "rotary-spring", "spring-network")]
     swing = (energy_swing(max(ws) * dt / n) if ws and n is not None and math.isfinite(max(ws))
              else None)
-    return _Advice(rows, dt, n, tightest, tolerance, swing, unit)
+    return _Advice(rows, dt, n, tightest, tolerance, swing, unit, probed)
 
 
 def _refuse(advice: _Advice) -> int:
@@ -425,8 +529,9 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
 def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
           units: str | None = None) -> list[Finding]:
     """The checks that fail at step ``dt`` (s): each a :class:`Finding` with its fix (see
-    :func:`survey` for the arguments)."""
-    return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok]
+    :func:`survey` for the arguments; rows not checked are in :func:`survey` and
+    :func:`report`, not here)."""
+    return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok and f.checked]
 
 
 def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
@@ -448,16 +553,25 @@ def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = T
 
 
 def _line(f: Finding) -> str:
-    mark = "ok  " if f.ok else "FAIL"
+    mark = "ok  " if f.ok else ("FAIL" if f.checked else "--  ")
     shown = f.comparison()
+    if not f.checked:
+        return f"  {mark} {f.kind:14s} {f.subject:22s} {f.fix}"
     fix = "" if f.ok else (f"; {f.fix}" if shown else f.fix)
-    return f"  {mark} {f.kind:14s} {f.subject:22s} {shown}{fix}"
+    note = f" ({f.note})" if f.ok and f.note else ""
+    return f"  {mark} {f.kind:14s} {f.subject:22s} {shown}{note}{fix}"
 
 
 def _summary(kind: str, rows: list[Finding], ok: bool) -> str:
     """One line for the rows of ``kind`` beyond the ones listed."""
     mark = "ok  " if ok else "FAIL"
-    worst = max(rows, key=lambda f: f.value / f.limit if f.limit else math.inf)
+    judged = [f for f in rows if f.relation in _FAILS] or rows
+
+    def closeness(f: Finding) -> float:
+        ratio = f.value / f.limit if f.limit else math.inf
+        return ratio if not math.isnan(ratio) else -math.inf
+
+    worst = max(judged, key=closeness)
     what = "passed; the closest to its limit" if ok else "failed; the farthest past it"
     return f"  {mark} {kind:14s} {len(rows)} more {what}: {worst.subject}, {worst.comparison()}"
 
@@ -472,17 +586,22 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     named = (f"lengths in {unit}" if units is not None
              else "lengths in the space's own units: pass units='m' or 'px' to name them")
     tol = ("stability only" if math.isinf(tolerance)
-           else f"energy swing of springs under {_percent(tolerance)}")
+           else f"energy swing of springs under {_percent(tolerance)}, joints' drift under "
+                f"{_percent(tolerance)}/s of the energy scale")
     lines = [f"step-size guard at dt = {dt:g} s ({named}; {tol}):"]
     kinds: dict[str, list[Finding]] = {}
     for f in advice.rows:
         kinds.setdefault(f.kind, []).append(f)
     for kind, rows in kinds.items():
         for ok in (False, True):
-            these = [f for f in rows if f.ok == ok]
+            these = [f for f in rows if f.ok == ok and f.checked]
             lines += [_line(f) for f in these[:SHOWN]]
             if len(these) > SHOWN:
                 lines.append(_summary(kind, these[SHOWN:], ok))
+        lines += [_line(f) for f in rows if not f.checked]
+        if kind == "joint" and advice.probe:
+            lines.append(advice.probe)
+    unchecked = [f.subject for f in advice.rows if not f.checked]
     n = advice.substeps
     swing = ("" if advice.swing is None else
              f"; the springs' energy swing at it: at most {_percent(advice.swing)}")
@@ -496,8 +615,17 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
         t = advice.tightest
         lines.append(f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
                      f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
-    elif any(not f.ok for f in advice.rows):
+    elif any(not f.ok and f.checked for f in advice.rows):
         lines.append(f"  the step is fine; the failures are settings{swing}")
+    elif unchecked:
+        lines.append(f"  nothing to fix in what was checked{swing}; not checked: "
+                     f"{_listed(unchecked)}")
     else:
         lines.append(f"  nothing to fix{swing}")
     return "\n".join(lines)
+
+
+def _listed(names: list[str]) -> str:
+    """``names`` in a line: the first few and how many more."""
+    shown = ", ".join(names[:SHOWN])
+    return shown + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN else "")
