@@ -20,8 +20,9 @@ measures it:
 - **each constraint's impulse**, recovered every step from the momentum its bodies gained:
   a body's gain in the step, less the kick of its ``velocity_func`` (gravity, damping, its
   forces: read by wrapping that function on the copy) and the impulses of its contacts
-  (``Arbiter.total_impulse``, and its torque where the contact has one point, at that
-  point on the body's own shape), is the sum of
+  (``Arbiter.total_impulse``, less what a contact touching again carried in and pymunk did
+  not apply; and its torque where the contact has one point, at that point on the body's
+  own shape), is the sum of
   the impulses of its constraints. Each constraint's impulse has a known form (along the
   axis of a pin, slide or spring; any direction at a pivot or groove; a torque for the
   rotary kinds, a gear's scaled by its ratio on its first body), so the gains of all bodies
@@ -317,6 +318,8 @@ class _Run:
         self.unsure: dict[int, str] = {}
         self.parts = self._parts(cons, slot, by_slot, pymunk)
         self.kicks: dict[int, tuple[float, float, float]] = {}
+        # Each contact's last step, and its impulse along and across its normal then.
+        self.contacts: dict[tuple[int, int], tuple[int, float, float]] = {}
         for i, body in enumerate(self.row_bodies):
             self._wrap(body, i)
         moments = self.moment[self.rows] if len(self.rows) else np.zeros(0)
@@ -458,6 +461,17 @@ class _Run:
                 # point of each body is on its own shape.
                 mine = arb.shapes[0].body is b
                 imp = arb.total_impulse if mine else -arb.total_impulse
+                key = (id(arb.shapes[0]), id(arb.shapes[1])) if mine else \
+                    (id(arb.shapes[1]), id(arb.shapes[0]))
+                n = arb.normal if mine else -arb.normal
+                carried = self.contacts.get(key)
+                self.contacts[key] = (self.steps, imp.dot(n), imp.cross(n))
+                if (arb.is_first_contact and carried is not None
+                        and self.steps - carried[0] <= self.space.collision_persistence):
+                    # A contact that touches again within the persistence keeps what it had
+                    # accumulated (along its normal and across it), which pymunk does not
+                    # apply on a first contact.
+                    imp = imp - n * carried[1] + n.perpendicular() * carried[2]
                 rhs[i, 0] -= imp.x
                 rhs[i, 1] -= imp.y
                 points = arb.contact_point_set.points

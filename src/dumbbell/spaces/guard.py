@@ -480,7 +480,7 @@ class _Advice:
 def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
     """Every check at ``dt`` and the sub-steps that clear the ones a step can clear."""
     sc = scan(space)
-    problem = settings_problem(space) or state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc, unit)
     if problem is not None:
         who, what, value = problem
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
@@ -585,9 +585,11 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     advice = _advise(space, dt, speeds, tolerance, unit)
     named = (f"lengths in {unit}" if units is not None
              else "lengths in the space's own units: pass units='m' or 'px' to name them")
+    joints = any(f.kind == "joint" for f in advice.rows)
     tol = ("stability only" if math.isinf(tolerance)
-           else f"energy swing of springs under {_percent(tolerance)}, joints' drift under "
-                f"{_percent(tolerance)}/s of the energy scale")
+           else f"energy swing of springs under {_percent(tolerance)}"
+                + (f", joints' drift under {_percent(tolerance)}/s of the energy scale"
+                   if joints else ""))
     lines = [f"step-size guard at dt = {dt:g} s ({named}; {tol}):"]
     kinds: dict[str, list[Finding]] = {}
     for f in advice.rows:
