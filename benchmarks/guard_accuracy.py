@@ -78,7 +78,7 @@ def forces() -> None:
     base = speeds["1 sub-step (Driver)"]
     print(f"\ncar on wheel torques, 2 s at 1/60 s, the guard's sub-steps: {n}")
     for label, v in speeds.items():
-        print(f"  {label:34s} {v:9.3f} px/s  ({100 * v / base:.4g} % of one sub-step's)")
+        print(f"  {label:34s} {v:12.6f} px/s  (v / v_1 - 1 = {v / base - 1:+.2g})")
 
 
 def joints() -> None:

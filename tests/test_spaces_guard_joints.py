@@ -127,7 +127,7 @@ def test_a_space_past_the_probe_s_budget_is_not_checked(monkeypatch):
     monkeypatch.setattr(_probe, "MAX_WORK", 10)
     text = spaces.report(pendulum(), 1 / 60, units="px")
     assert ("--   joint          PinJoint 0             not checked: 1 body to step and 1 "
-            "impulse components to solve for: fewer than 20 steps fit in the probe's budget; "
+            "impulse component to solve for: fewer than 20 steps fit in the probe's budget; "
             "spaces.Ledger measures it on your own run" in text)
     assert text.endswith("not checked: PinJoint 0")
 

@@ -120,9 +120,10 @@ def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
     steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // max(1, work))
     if steps < MIN_STEPS:
         n = len(copy.space.bodies)
-        result.problem = (f"{n:,} bod{'y' if n == 1 else 'ies'} to step and {run.unknowns():,} "
-                          f"impulse components to solve for: fewer than {MIN_STEPS} steps fit "
-                          "in the probe's budget")
+        k = run.unknowns()
+        result.problem = (f"{n:,} bod{'y' if n == 1 else 'ies'} to step and {k:,} impulse "
+                          f"component{'' if k == 1 else 's'} to solve for: fewer than "
+                          f"{MIN_STEPS} steps fit in the probe's budget")
         return result
     for _ in range(steps):
         if not run.step():
@@ -527,9 +528,11 @@ class _Run:
         if idle:
             a_mat = np.vstack([a_mat, np.eye(m)[idle]])
             values = np.concatenate([values, np.zeros(len(idle))])
-        solution, _, rank, _ = np.linalg.lstsq(a_mat, values, rcond=None)
-        if rank < m and not all(k in self.unsure for k in part.cons):
-            self._underdetermined(a_mat, part)
+        solution = _solved(a_mat, values)
+        if solution is None:                  # not of full rank: least squares, and why
+            solution, _, _, _ = np.linalg.lstsq(a_mat, values, rcond=None)
+            if not all(k in self.unsure for k in part.cons):
+                self._underdetermined(a_mat, part)
         # The size of the part's impulses: what it moved and the momentum of its bodies.
         rows = part.rows
         scale = max(float(np.abs(values).max(initial=0.0)), self.momentum[rows].max(), 1e-300)
@@ -647,6 +650,21 @@ class _Run:
             why = self.unsure.get(k, "")
             out[k] = Drift(label, None if why else float(self.work[k]), why)
         return out
+
+
+def _solved(a_mat: np.ndarray, values: np.ndarray) -> np.ndarray | None:
+    """The least-squares solution of ``a_mat x = values`` by its normal equations, or None
+    when ``a_mat`` is not clearly of full column rank (its Cholesky factor has a pivot under
+    1e-6 of the largest: the caller then takes numpy's least squares)."""
+    normal = a_mat.T @ a_mat
+    try:
+        factor = np.linalg.cholesky(normal)
+    except np.linalg.LinAlgError:
+        return None
+    pivots = np.abs(np.diagonal(factor))
+    if not len(pivots) or pivots.min() <= 1e-6 * pivots.max():
+        return None
+    return np.linalg.solve(normal, a_mat.T @ values)
 
 
 def _replace_end(pair: tuple[_End, _End], e: int, row: int) -> tuple[_End, _End]:

@@ -431,7 +431,7 @@ def _joints(space: Any, dt: float, tolerance: float, unit: str) -> tuple[list[Fi
     failing = [j for j, f in rows.items() if f.relation == "<=" and not f.ok]
     bodies = len(space.bodies)
     cost = (f"  joints measured on a copy of the space over {found.seconds:.4g} s: "
-            f"{found.steps:,} steps of this dt ({bodies:,} bodies)")
+            f"{found.steps:,} steps of this dt ({bodies:,} bod{'y' if bodies == 1 else 'ies'})")
     if failing:
         half = probe(space, dt / 2, failing)
         if not half.problem:
