@@ -787,3 +787,15 @@ def test_a_spring_between_centres_of_gravity_moves_no_rotation():
     spring = pymunk.DampedSpring(a, b, (0.0, 4.0), (-2.0, 0.0), 1.0, 300.0, 0.0)
     space.add(a, b, spring)
     assert spaces.spring_omega(spring) == pytest.approx(math.sqrt(300.0 / 0.75), rel=1e-12)
+
+
+def test_a_state_no_step_fixes_carries_the_space_s_units():
+    space, body = _ball_space()
+    body.velocity = (math.nan, 0.0)
+    assert "velocity = (nan, 0) m/s is not a finite number" in spaces.report(space, 0.01,
+                                                                             units="m")
+    space, body = _ball_space()
+    body.position = (math.inf, 1.0)
+    assert "position = (inf, 1) px is not" in spaces.report(space, 0.01, units="px")
+    space = _broken("mass 0")
+    assert "mass = 0 kg: pymunk steps" in spaces.report(space, 0.01)
