@@ -61,11 +61,11 @@ def test_every_constraint_kind_gets_a_row():
     assert "joints measured on a copy of the space over 2 s: 120 steps of this dt" in text
 
 
-@pytest.mark.parametrize("dt", [1 / 60, 1 / 600])
-@pytest.mark.parametrize("joint, kw", [("PinJoint", {}), ("PinJoint", {"length": 100.0}),
-                                       ("PinJoint", {"angle": 1.0}),
-                                       ("PinJoint", {"mass": 3.0, "gravity": 500.0}),
-                                       ("SlideJoint", {}), ("PivotJoint", {})])
+@pytest.mark.parametrize("dt, joint, kw", [
+    (1 / 60, "PinJoint", {}), (1 / 600, "PinJoint", {}),
+    (1 / 60, "PinJoint", {"length": 100.0}), (1 / 60, "PinJoint", {"angle": 1.0}),
+    (1 / 60, "PinJoint", {"mass": 3.0, "gravity": 500.0}), (1 / 60, "SlideJoint", {}),
+    (1 / 60, "PivotJoint", {}), (1 / 600, "PivotJoint", {})])
 def test_a_pendulum_s_joint_row_states_the_ledger_s_drift(dt, joint, kw):
     # Issue 28's number: on a pendulum (pixel units, released from rest) the drift per
     # second the guard states is within a factor 2 of the ledger's joint term over 2 s of

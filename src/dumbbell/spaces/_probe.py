@@ -325,6 +325,7 @@ class _Run:
             self._wrap(body, i)
         moments = self.moment[self.rows] if len(self.rows) else np.zeros(0)
         self.turns = np.where(np.isfinite(moments), moments, 0.0)
+        self.springs = _springs(copy.constraints, slot, pymunk)
         self.start = rows.copy()
         self.energy0 = self._energies(rows)
         self.biggest = [0.0, 0.0, 0.0]  # kinetic, gravity's change, the springs' change
@@ -613,8 +614,6 @@ class _Run:
 
     def _energies(self, rows: np.ndarray) -> tuple[float, float, float]:
         """Kinetic energy, gravity's and the springs' potential of the copy (batch ``rows``)."""
-        import pymunk
-
         d = self.dynamic
         m, inertia = self.mass[d], self.moment[d]
         v = rows[d, 3:5]
@@ -627,13 +626,20 @@ class _Run:
         g = self.space.gravity
         gravity = -float((m * (g.x * cx + g.y * cy)).sum())
         springs = 0.0
-        for c in self.copy.constraints:
-            if isinstance(c, pymunk.DampedSpring):
-                extent = (c.b.local_to_world(c.anchor_b) - c.a.local_to_world(c.anchor_a)).length
-                springs += float(spring_potential(c.stiffness, extent, c.rest_length))
-            elif isinstance(c, pymunk.DampedRotarySpring):
-                springs += float(spring_potential(c.stiffness, c.a.angle - c.b.angle,
-                                                  c.rest_angle))
+        if self.springs is not None:
+            ends, stiff, rest, rotary = self.springs
+            x, y, angle = rows[:, 0], rows[:, 1], rows[:, 2]
+            world = []
+            for slot, ax, ay, fixed in ends:             # each spring end in the world
+                live = slot >= 0
+                j = np.where(live, slot, 0)
+                c, s_ = np.cos(angle[j]), np.sin(angle[j])
+                world.append((np.where(live, x[j] + c * ax - s_ * ay, fixed[:, 0]),
+                              np.where(live, y[j] + s_ * ax + c * ay, fixed[:, 1]),
+                              np.where(live, angle[j], fixed[:, 2])))
+            (xa, ya, ta), (xb, yb, tb) = world
+            extent = np.where(rotary, ta - tb, np.hypot(xb - xa, yb - ya))
+            springs = float(np.sum(spring_potential(stiff, extent, rest)))
         return kinetic, gravity, springs
 
     def scale(self) -> float:
@@ -650,6 +656,31 @@ class _Run:
             why = self.unsure.get(k, "")
             out[k] = Drift(label, None if why else float(self.work[k]), why)
         return out
+
+
+def _springs(cons: list[Any], slot: dict[int, int], pymunk: Any) -> Any:
+    """The springs of ``cons`` for their energy from the batch rows: for ends a and b, the
+    batch row of the body (-1: not listed, then its world anchor and angle, fixed), the
+    anchor in body coordinates; stiffness, rest length (or angle), whether rotary. None
+    without springs."""
+    springs = [c for c in cons if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
+    if not springs:
+        return None
+    rotary = np.array([isinstance(c, pymunk.DampedRotarySpring) for c in springs])
+    ends = []
+    for which in ("a", "b"):
+        bodies = [getattr(c, which) for c in springs]
+        anchors = [(0.0, 0.0) if r else tuple(getattr(c, f"anchor_{which}"))
+                   for c, r in zip(springs, rotary, strict=True)]
+        slots = np.array([slot.get(int(b.id), -1) for b in bodies])
+        fixed = np.array([(*b.local_to_world(p), b.angle) for b, p in zip(bodies, anchors,
+                                                                           strict=True)])
+        ends.append((slots, np.array([p[0] for p in anchors]), np.array([p[1] for p in anchors]),
+                     fixed))
+    stiff = np.array([float(c.stiffness) for c in springs])
+    rest = np.array([float(c.rest_angle if r else c.rest_length)
+                     for c, r in zip(springs, rotary, strict=True)])
+    return ends, stiff, rest, rotary
 
 
 def _solved(a_mat: np.ndarray, values: np.ndarray) -> np.ndarray | None:

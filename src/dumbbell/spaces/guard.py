@@ -23,6 +23,11 @@ the fix and the reason for it):
 - ``slop``: ``space.collision_slop`` is the overlap pymunk leaves between touching shapes;
 - ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart, which
   adds energy at elastic contacts (flagged where any contact is elastic);
+- ``joint``: every constraint that is not a spring, its energy drift per second at this
+  step against ``tolerance`` of the energy scale a second, measured on a copy of the space
+  (:mod:`._probe`; a row past it is measured again at dt/2, to say which step clears it, or
+  that no step changes it); a motor's work is reported, not judged, and what the probe
+  cannot separate is a row "not checked" naming why;
 - ``state``: a body whose position or velocity is not a finite number, or a dynamic body
   without a valid mass or moment: no step fixes it.
 
