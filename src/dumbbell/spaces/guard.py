@@ -409,22 +409,23 @@ def _joints(space: Any, dt: float, tolerance: float, unit: str) -> tuple[list[Fi
     if found.problem or not found.steps:
         why = f"not checked: {found.problem}; spaces.Ledger measures it on your own run"
         return [Finding("joint", f"{type(constraints[j]).__name__} {j}", math.nan, math.nan,
-                        why, None, "unchecked") for j in wanted], \
-            f"  joints not checked: {found.problem}"
+                        why, None, "unchecked") for j in wanted], ""
     limit = tolerance * found.scale
     rows: dict[int, Finding] = {}
     rates: dict[int, float] = {}
     for j, d in found.drifts.items():
         if d.work is None:
             rows[j] = Finding("joint", d.label, math.nan, math.nan,
-                              f"not checked: {d.why}; spaces.Ledger measures it on your run",
+                              f"not checked: {d.why}; spaces.Ledger measures it on your own "
+                              "run",
                               None, "unchecked")
             continue
         rates[j] = rate = d.work / found.seconds
         verb = "puts in" if rate > 0 else "takes out"
         share = (f"{_percent(abs(rate) / found.scale)}/s of the energy scale, "
                  f"{found.scale:.4g} {energy}" if found.scale > 0 else "")
-        note = f"{verb} {share}" if share else "nothing moved in the probe"
+        note = (f"{verb} {share}" if share and rate != 0 else
+                "no energy in or out" if share else "nothing moved in the probe")
         if type(constraints[j]).__name__ in DRIVES:
             rows[j] = Finding("joint", d.label, abs(rate), math.nan,
                               f"{verb} {abs(rate):.4g} {power}: a motor's work is its drive, "

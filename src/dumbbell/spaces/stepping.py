@@ -55,6 +55,9 @@ def _frame_step(dt: Any, substeps: int) -> float:
         raise UsageError(f"dt = {args.show(dt)}: must be a finite number > 0 and <= "
                          f"{MAX_DT:g} (s): a frame longer than that is not a step a pymunk "
                          "space can take (its state overflows)", param="dt")
+    if not dt / substeps > 0:
+        raise UsageError(f"dt = {args.show(dt)}: must be long enough to divide into "
+                         f"{substeps:,} sub-steps that are not 0 s", param="dt")
     return dt / substeps
 
 
