@@ -12,7 +12,8 @@ measures it:
   nothing in the user's space changes and no callback of the program runs (collision
   handlers and a constraint's ``pre_solve``/``post_solve`` are not copied; a custom
   ``velocity_func``, spring force or torque is, being part of the physics);
-- **the run**: :data:`PROBE_TIME` seconds of steps of ``dt`` (fewer when the space is big:
+- **the run** (on a space of at most :data:`MAX_BODIES` bodies): :data:`PROBE_TIME` seconds
+  of steps of ``dt`` (fewer when the space is big:
   at most :data:`MAX_STEPS` steps, and steps times the work of one step at most
   :data:`MAX_WORK`, a step's work being its bodies, its impulse components and
   :data:`PART_COST` for each part solved), the forces set now kept on every step, as a
@@ -55,13 +56,14 @@ from ._scan import batch
 #: Simulated time the probe covers (s), when the budget allows.
 PROBE_TIME = 2.0
 #: Most steps of a probe, and most work: steps times (bodies of the space plus impulse
-#: components solved for).
+#: components solved for); most bodies a probe copies.
 MAX_STEPS = 1200
-MAX_WORK = 400_000
+MAX_WORK = 100_000
+MAX_BODIES = 2_000
 #: Fewest steps a probe is worth: past the budget with fewer, it is not run.
 MIN_STEPS = 20
 #: What solving for one part of the constraints costs a step, in bodies stepped (about).
-PART_COST = 50
+PART_COST = 20
 #: Most impulse components the probe solves for together (constraints tied by their bodies).
 MAX_UNKNOWNS = 120
 #: Relative agreement asked of a recovered impulse with pymunk's own magnitude.
@@ -110,6 +112,11 @@ def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
     places ``wanted`` of ``space.constraints`` (see the module docstring)."""
     started = time.perf_counter()
     result = Probe(dt)
+    bodies = len(space.bodies)
+    if bodies > MAX_BODIES:
+        result.problem = (f"the space has {bodies:,} bodies, more than the probe copies "
+                          f"({MAX_BODIES:,})")
+        return result
     try:
         copy = _Copy(space)
     except _Uncopyable as e:
