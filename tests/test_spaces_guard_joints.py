@@ -192,3 +192,11 @@ def test_joint_rows_speak_the_space_s_units():
         assert len(numbers) == 4
         for n in numbers:
             assert any(line[n.end():].startswith(f" {u}") for u in (power, energy, "%/s")), line
+
+
+def test_a_space_past_the_bodies_the_probe_copies_is_not_checked(monkeypatch):
+    monkeypatch.setattr(_probe, "MAX_BODIES", 5)
+    rows = _joint_rows(every_constraint(), 1 / 60)
+    assert len(rows) == 14 and all(not f.checked for f in rows.values())
+    assert all("the space has 11 bodies, more than the probe copies (5)" in f.fix
+               for f in rows.values())
