@@ -175,7 +175,7 @@ def state_problem(sc: Scan, unit: str = "units") -> tuple[str, str, float] | Non
         shape = sc.shapes[int(j)]
         name, vals = _bad_geometry(shape)
         shown = (f"({vals[0]:g}, {vals[1]:g}) {unit}" if len(vals) == 2
-                 else f"{vals[0]:g} {unit}")
+                 else f"{vals[0]:g}")              # a radius that is not a number has no unit
         who = f"shape {int(j)} ({type(shape).__name__} on {sc.label(int(sc.owner[j]))})"
         what = (f"{name} = {shown} is not a finite number: no step fixes it (its contacts and "
                 "sizes would be NaN); give the shape finite geometry")
