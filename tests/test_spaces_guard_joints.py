@@ -12,7 +12,7 @@ import pymunk
 import pytest
 
 from dumbbell import spaces
-from dumbbell.spaces import _probe
+from dumbbell.spaces import _copy, _probe
 
 from .guard_cases import car, every_constraint, pendulum
 
@@ -168,7 +168,7 @@ def test_the_probe_s_work_is_the_ledger_s_constraint_term(make, dt):
     wanted = [j for j, c in enumerate(space.constraints)
               if type(c).__name__ not in SPRING_KINDS]
     found = _probe.probe(space, dt, wanted)
-    copy = _probe._Copy(space)
+    copy = _copy.Copy(space)
     copy.space.sleep_time_threshold = math.inf
     terms, scale = _ledger_terms(copy.space, dt, found.steps)
     assert found.scale == pytest.approx(scale, rel=1e-9)

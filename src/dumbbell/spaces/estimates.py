@@ -126,6 +126,11 @@ def length_unit(units: Any) -> str:
     return text
 
 
+def percent(fraction: float) -> str:
+    """A fraction in words for messages: '1.5 %', or 'without bound' when infinite."""
+    return "without bound" if math.isinf(fraction) else f"{100 * fraction:.3g} %"
+
+
 def energy_units(unit: str) -> tuple[str, str]:
     """The units of energy and power of a space whose length unit is ``unit`` (mass in kg,
     time in s, as pymunk programs take them): ('J', 'W') in metres."""

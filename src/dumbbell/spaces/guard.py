@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -53,7 +53,7 @@ from ..errors import UsageError
 from ..model import args
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from .accounting import settings_problem
-from .estimates import Estimates, energy_units, estimate, length_unit, state_problem
+from .estimates import Estimates, estimate, length_unit, percent, state_problem
 
 __all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",
            "substeps", "suggest_dt", "survey"]
@@ -165,10 +165,6 @@ def _swing_limit(tolerance: float) -> float:
     return SPRING_LIMIT if math.isinf(tolerance) else 2.0 * tolerance / (2.0 + tolerance)
 
 
-def _percent(fraction: float) -> str:
-    return "without bound" if math.isinf(fraction) else f"{100 * fraction:.3g} %"
-
-
 #: What ``speeds`` may be: the present speeds, the reach estimates, or the larger.
 SPEEDS = ("state", "energy", "both")
 
@@ -249,11 +245,11 @@ def _spring_row(kind: str, subject: str, w: float, at: _Judged, extra: str = "")
     dt_max = limit / w
     swing = energy_swing(z) if math.isfinite(z) else math.inf
     keeps = ("stays stable (w dt < 2)" if math.isinf(tolerance)
-             else f"keeps the swing under {_percent(tolerance)}")
+             else f"keeps the swing under {percent(tolerance)}")
     if z >= SPRING_LIMIT:
         now = "unstable: the energy grows without bound from w dt = 2"
     else:
-        now = f"the energy swings by {_percent(swing)} at this step (2 w dt / (2 - w dt))"
+        now = f"the energy swings by {percent(swing)} at this step (2 w dt / (2 - w dt))"
     fix = f"{extra}w = {w:.4g} rad/s: {now}; dt < {dt_max:.4g} s {keeps}"
     return Finding(kind, subject, z, limit, fix, dt_max, "<")
 
@@ -385,92 +381,6 @@ def _contact_settings(sc: Scan, dt: float, unit: str) -> list[Finding]:
     return rows
 
 
-#: A drift that falls by less than this factor at half the step does not shrink with it.
-SHRINKS = 0.75
-#: Constraint kinds whose work is what they are for: a motor's drive.
-DRIVES = ("SimpleMotor",)
-
-
-def _joints(space: Any, dt: float, tolerance: float, unit: str) -> tuple[list[Finding], str]:
-    """A row for each constraint that is not a spring, from the probe (:mod:`._probe`): its
-    energy drift per second at ``dt`` against ``tolerance`` of the energy scale a second;
-    and what the probe cost, in words ('' when no constraint needed it)."""
-    import pymunk
-
-    from ._probe import probe
-
-    constraints = list(space.constraints)
-    wanted = [j for j, c in enumerate(constraints)
-              if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
-    if not wanted:
-        return [], ""
-    energy, power = energy_units(unit)
-    found = probe(space, dt, wanted)
-    if found.problem or not found.steps:
-        why = f"not checked: {found.problem}; spaces.Ledger measures it on your own run"
-        return [Finding("joint", f"{type(constraints[j]).__name__} {j}", math.nan, math.nan,
-                        why, None, "unchecked") for j in wanted], ""
-    limit = tolerance * found.scale
-    rows: dict[int, Finding] = {}
-    rates: dict[int, float] = {}
-    for j, d in found.drifts.items():
-        if d.work is None:
-            rows[j] = Finding("joint", d.label, math.nan, math.nan,
-                              f"not checked: {d.why}; spaces.Ledger measures it on your own "
-                              "run",
-                              None, "unchecked")
-            continue
-        rates[j] = rate = d.work / found.seconds
-        verb = "puts in" if rate > 0 else "takes out"
-        share = (f"{_percent(abs(rate) / found.scale)}/s of the energy scale, "
-                 f"{found.scale:.4g} {energy}" if found.scale > 0 else "")
-        note = (f"{verb} {share}" if share and rate != 0 else
-                "no energy in or out" if share else "nothing moved in the probe")
-        if type(constraints[j]).__name__ in DRIVES:
-            rows[j] = Finding("joint", d.label, abs(rate), math.nan,
-                              f"{verb} {abs(rate):.4g} {power}: a motor's work is its drive, "
-                              "not the step's error", None, "measured", power,
-                              f"{note}: a motor's drive, not the step's error")
-            continue
-        fix = f"{note}, at this step: more than {_percent(tolerance)}/s"
-        rows[j] = Finding("joint", d.label, abs(rate), limit, fix, None, "<=", power, note)
-    failing = [j for j, f in rows.items() if f.relation == "<=" and not f.ok]
-    bodies = len(space.bodies)
-    cost = (f"  joints measured on a copy of the space over {found.seconds:.4g} s: "
-            f"{found.steps:,} steps of this dt ({bodies:,} bod{'y' if bodies == 1 else 'ies'})")
-    if failing:
-        half = probe(space, dt / 2, failing)
-        if not half.problem:
-            cost += f", and the failing over {half.seconds:.4g} s at dt/2 ({half.steps:,} steps)"
-        for j in failing:
-            rows[j] = _at_half(rows[j], rates[j], half, j, dt)
-    return [rows[j] for j in wanted], cost
-
-
-def _at_half(row: Finding, rate: float, half: Any, j: int, dt: float) -> Finding:
-    """A failing joint row judged again from its drift at ``dt / 2`` (``half``, a probe):
-    the step that clears it when the drift shrinks with the step (as dt^p, p measured), a
-    measured row (no step changes it) when it does not."""
-    d = half.drifts.get(j)
-    if half.problem or d is None or d.work is None or not half.steps:
-        dt_max = dt * row.limit / row.value
-        fix = (f"{row.fix}; dt < {dt_max:.4g} s keeps it under (if it shrinks in proportion "
-               "to dt, as a joint's error does; not measured at dt/2 here)")
-        return replace(row, fix=fix, dt_max=dt_max)
-    slower = abs(d.work / half.seconds)
-    ratio = slower / row.value
-    if ratio > SHRINKS:
-        note = (f"{row.note}; about as much at dt/2, {slower:.4g} {row.unit}: the joint's "
-                "own loss (a stop, a snap, a slip), which no step changes")
-        return replace(row, relation="measured", limit=math.nan, note=note,
-                       fix=f"{row.fix}; at dt/2, {slower:.4g} {row.unit}: no step changes it")
-    order = min(3.0, max(0.5, math.log2(1.0 / ratio))) if ratio > 0 else 3.0
-    dt_max = dt * (row.limit / row.value) ** (1.0 / order)
-    fix = (f"{row.fix}; at dt/2, {slower:.4g} {row.unit} (it goes as dt^{order:.2g}): "
-           f"dt < {dt_max:.4g} s keeps it under")
-    return replace(row, fix=fix, dt_max=dt_max)
-
-
 @dataclass(frozen=True)
 class _Advice:
     rows: list[Finding]
@@ -492,7 +402,10 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
                        None, tolerance, None, unit)
     est = estimate(sc, dt, unit)
-    joints, probed = _joints(space, dt, tolerance, unit)
+    from ._joints import joint_rows
+
+    rows_of_joints, probed = joint_rows(space, dt, tolerance, unit)
+    joints = [Finding(*r) for r in rows_of_joints]
     rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance) + joints
             + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
     failing = [f for f in rows if not f.ok and f.dt_max is not None]
@@ -593,8 +506,8 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
              else "lengths in the space's own units: pass units='m' or 'px' to name them")
     joints = any(f.kind == "joint" for f in advice.rows)
     tol = ("stability only" if math.isinf(tolerance)
-           else f"energy swing of springs under {_percent(tolerance)}"
-                + (f", joints' drift under {_percent(tolerance)}/s of the energy scale"
+           else f"energy swing of springs under {percent(tolerance)}"
+                + (f", joints' drift under {percent(tolerance)}/s of the energy scale"
                    if joints else ""))
     lines = [f"step-size guard at dt = {dt:g} s ({named}; {tol}):"]
     kinds: dict[str, list[Finding]] = {}
@@ -612,7 +525,7 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     unchecked = [f.subject for f in advice.rows if not f.checked]
     n = advice.substeps
     swing = ("" if advice.swing is None else
-             f"; the springs' energy swing at it: at most {_percent(advice.swing)}")
+             f"; the springs' energy swing at it: at most {percent(advice.swing)}")
     if any(f.kind == "state" for f in advice.rows):
         lines.append("  no step is suggested: fix the state first")
     elif n is None:
