@@ -799,3 +799,12 @@ def test_a_state_no_step_fixes_carries_the_space_s_units():
     assert "position = (inf, 1) px is not" in spaces.report(space, 0.01, units="px")
     space = _broken("mass 0")
     assert "mass = 0 kg: pymunk steps" in spaces.report(space, 0.01)
+
+
+def test_a_spring_s_row_states_its_closed_form_no_drift_and_its_swing():
+    # Issue 28: every constraint's row gives its drift; a spring's step keeps a modified
+    # energy, so its closed form is no drift and a swing of 2 w dt / (2 - w dt).
+    w = math.sqrt(200.0 / 0.05)
+    ((row, ok),) = spaces.survey(_pair(0.1, 0.1, 200.0), 0.5 / w, tolerance=STABILITY)
+    assert ok and row.note == "no drift: its energy swings by at most 66.7 % and back"
+    assert spaces.energy_swing(0.5) == pytest.approx(2 / 3)

@@ -251,7 +251,10 @@ def _spring_row(kind: str, subject: str, w: float, at: _Judged, extra: str = "")
     else:
         now = f"the energy swings by {percent(swing)} at this step (2 w dt / (2 - w dt))"
     fix = f"{extra}w = {w:.4g} rad/s: {now}; dt < {dt_max:.4g} s {keeps}"
-    return Finding(kind, subject, z, limit, fix, dt_max, "<")
+    # The closed form of its drift: none (the step keeps a modified energy), a bounded swing.
+    note = ("" if extra or z >= SPRING_LIMIT else
+            f"no drift: its energy swings by at most {percent(swing)} and back")
+    return Finding(kind, subject, z, limit, fix, dt_max, "<", note=note)
 
 
 def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
