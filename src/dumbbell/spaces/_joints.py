@@ -85,7 +85,7 @@ def joint_rows(space: Any, dt: float, tolerance: float, unit: str
     cost = (f"  joints measured on a copy of the space over {found.seconds:.4g} s: "
             f"{found.steps:,} steps of this dt ({bodies:,} bod{'y' if bodies == 1 else 'ies'})")
     if failing:
-        half = probe(space, dt / 2, failing)
+        half = probe(space, dt / 2, failing, steps=2 * found.steps)   # the same time
         if not half.problem:
             cost += f", and the failing over {half.seconds:.4g} s at dt/2 ({half.steps:,} steps)"
         for j in failing:

@@ -104,9 +104,11 @@ class Probe:
         return self.steps * self.dt
 
 
-def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
+def probe(space: Any, dt: float, wanted: list[int], steps: int | None = None) -> Probe:
     """Run the probe on a copy of ``space`` at steps of ``dt`` (s) for the constraints at
-    places ``wanted`` of ``space.constraints`` (see the module docstring)."""
+    places ``wanted`` of ``space.constraints`` (see the module docstring): over
+    :data:`PROBE_TIME` within the budget, or ``steps`` steps when given (to cover the time
+    another probe covered)."""
     started = time.perf_counter()
     result = Probe(dt)
     bodies = len(space.bodies)
@@ -121,7 +123,8 @@ def probe(space: Any, dt: float, wanted: list[int]) -> Probe:
         return result
     run = _Run(copy, dt, wanted)
     work = len(copy.space.bodies) + run.unknowns() + PART_COST * len(run.parts)
-    steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // max(1, work))
+    if steps is None:
+        steps = min(math.ceil(PROBE_TIME / dt - 1e-9), MAX_STEPS, MAX_WORK // max(1, work))
     if steps < MIN_STEPS:
         n = len(copy.space.bodies)
         k = run.unknowns()

@@ -522,7 +522,12 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
             lines += [_line(f) for f in these[:SHOWN]]
             if len(these) > SHOWN:
                 lines.append(_summary(kind, these[SHOWN:], ok))
-        lines += [_line(f) for f in rows if not f.checked]
+        unchecked = [f for f in rows if not f.checked]
+        lines += [_line(f) for f in unchecked[:SHOWN]]
+        if len(unchecked) > SHOWN:
+            rest = unchecked[SHOWN:]
+            lines.append(f"  --   {kind:14s} {len(rest)} more not checked: "
+                         f"{_listed([f.subject for f in rest])}")
         if kind == "joint" and advice.probe:
             lines.append(advice.probe)
     unchecked = [f.subject for f in advice.rows if not f.checked]
