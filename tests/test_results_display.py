@@ -170,7 +170,7 @@ def test_the_spaces_objects_say_what_they_hold_in_a_line(tmp_path):
     # but for the step's error (pymunk's symplectic Euler: g dt^2 terms).
     e0 = 0.5 * 2.0 * 9.0 + 2.0 * 9.81 * 1.0
     assert f"E0={e0:.6g}" in shown[ledger] and "steps=10" in shown[ledger]
-    assert shown[heat] == "HeatCounter(attached, total=0)"
+    assert shown[heat] == "HeatCounter(attached, total=0 energy units)"
     assert "frames=2" in shown[rec] and "..." in shown[rec]
     heat.detach()
     assert repr(heat).startswith("HeatCounter(detached")

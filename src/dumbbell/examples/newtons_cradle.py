@@ -99,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("newtons_cradle", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle") as rec:
+    with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle", units="m") as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec)
     results = [(args.dt, first), (args.dt / 10, measure(args.dt / 10, args.seconds, args.fps))]

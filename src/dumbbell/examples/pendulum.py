@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("pendulum", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring",
+    with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring", units="m",
                          world=(-0.45, 0.45, -0.55, 0.55)) as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec)

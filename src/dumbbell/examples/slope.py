@@ -60,7 +60,7 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
 
     dt, seconds, fps = check_run(dt, seconds, fps, space, recorder, heat)
     space = build() if space is None else space
-    heat = spaces.HeatCounter(space) if heat is None else heat
+    heat = spaces.HeatCounter(space, units="m") if heat is None else heat
     box = next(iter(space.bodies))
     start = box.position
     e0 = spaces.energy(space).E
@@ -80,9 +80,9 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("slope", __doc__, 2.0, argv)
     space = build()
     print_guard(space, args)
-    heat = spaces.HeatCounter(space)
+    heat = spaces.HeatCounter(space, units="m")
     c, s = math.cos(ANGLE), math.sin(ANGLE)
-    with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope",
+    with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope", units="m",
                          world=(-0.1, RAMP * c + 0.05, -0.15, RAMP * s + 0.45)) as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec, heat)
