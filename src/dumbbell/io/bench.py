@@ -101,7 +101,7 @@ def markdown(result: BenchResult) -> str:
             time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
         else:
             time_s = f"~{_ms(p.seconds)} (estimate)"
-        verdict = p.status if p.ok else f"**{p.status}**" + (
+        verdict = p.status if p.complete else f"**{p.status}**" + (
             f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
         imp = _sci(p.impact_time_error)
         if p.impacts_truth:
@@ -116,7 +116,8 @@ def markdown(result: BenchResult) -> str:
             f"{len(f.dts)} points{'' if f.expected is None else f'; its order {f.expected}'})"
             for n, f in result.fits.items())
         lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
-                     f"(least squares in log-log over the ok points with error between "
+                     f"(least squares in log-log over the points that reached their end with "
+                     f"error between "
                      f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")
     sp = result.speedups()
     if sp and sp.get("seconds"):

@@ -35,7 +35,10 @@ if TYPE_CHECKING:
 FIRST_IMPACTS = 5
 
 #: Verdict statuses, from good to bad.
-VERDICTS = ("ok", "unstable", "tunnelled", "failed")
+VERDICTS = ("ok", "inaccurate", "unstable", "tunnelled", "failed")
+#: The statuses of a run that reached its end with every sample kept (stable): ``ok``, and
+#: ``inaccurate`` (its energy error passed ``run.inaccurate_energy``).
+COMPLETE = ("ok", "inaccurate")
 
 _FINITE = math.isfinite
 
@@ -115,8 +118,10 @@ class Contact:
 
 @dataclass(frozen=True)
 class Verdict:
-    """How a run ended. ``status`` is one of ok, unstable, tunnelled, failed; ``t`` is the
-    time of failure (s, None when ok); ``reason`` says why in words."""
+    """How a run ended. ``status`` is one of ok, inaccurate, unstable, tunnelled, failed
+    (:data:`VERDICTS`); ``t`` is the time of failure (s, None when ok; for ``inaccurate`` the
+    step where the energy error first passed ``run.inaccurate_energy``, the run going on to
+    its end); ``reason`` says why in words and what to change."""
 
     status: str = "ok"
     t: float | None = None
@@ -132,7 +137,13 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
+        """Stable, and within the scene's ``run.inaccurate_energy`` to the end."""
         return self.status == "ok"
+
+    @property
+    def complete(self) -> bool:
+        """The run reached its end with every sample kept: ``ok`` or ``inaccurate``."""
+        return self.status in COMPLETE
 
     def __str__(self) -> str:
         if self.ok:

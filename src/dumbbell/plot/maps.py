@@ -13,6 +13,7 @@ from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
+from ..model.trajectory import COMPLETE
 from .style import FAIL_COLOURS, _subplots, legend_outside
 
 __all__ = ["stability_map", "sweep_map"]
@@ -105,7 +106,8 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
     xe, ye = _edges(xs, xlog), _edges(ys, ylog)
     with np.errstate(divide="ignore", invalid="ignore"):
         level = np.log10(np.maximum(err, 1e-17))
-    level = np.ma.masked_where((verdict != "ok") | ~np.isfinite(level), level)
+    # Runs that reached their end (ok or inaccurate) are coloured by their error.
+    level = np.ma.masked_where(~np.isin(verdict, COMPLETE) | ~np.isfinite(level), level)
     if limits is None:
         lo = math.floor(float(level.min())) if level.count() else -16
         limits = (lo, max(lo + 1, math.ceil(float(level.max()))) if level.count() else 2)
@@ -164,8 +166,10 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     rows = [rows[i] for i in order]
     err = np.array([r.max_rel_energy_error for r in rows], float)
     verdicts = [r.verdict for r in rows]
-    ok = np.array([v == "ok" for v in verdicts])
-    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label="ok")
+    ok = np.array([v in COMPLETE for v in verdicts])
+    label = ("ok" if all(v == "ok" for v in verdicts if v in COMPLETE)
+             else "stable: ok or inaccurate")
+    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label=label)
     top = np.nanmax(err[np.isfinite(err)]) if np.isfinite(err).any() else 1.0
     for name, colour in FAIL_COLOURS.items():
         mask = np.array([v == name for v in verdicts])
@@ -203,7 +207,7 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
     y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
     errs = [r.max_rel_energy_error for rows in maps.values() for r in rows
-            if r.verdict == "ok" and r.max_rel_energy_error > 0]
+            if r.verdict in COMPLETE and r.max_rel_energy_error > 0]
     lo = math.floor(math.log10(min(errs))) if errs else -16
     hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
     mesh = None
