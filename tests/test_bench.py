@@ -195,3 +195,17 @@ def test_every_csv_column_has_a_unit():
     from dumbbell.analysis.bench import CSV_UNITS
 
     assert set(CSV_UNITS) == set(CSV_COLUMNS)
+
+
+def test_the_table_counts_its_runs_and_times_share_one_precision(one_second):
+    """Issue 29: "at least 1 runs", and a JIT line that mixed precisions ("0.03 s; verlet
+    0.0192 s"). The table and every line after it write times alike: three significant
+    digits, trailing zeros kept, in the unit that suits them."""
+    euler, verlet = ([p for p in one_second.points if p.solver == name][0]
+                     for name in ("euler-cromer", "verlet"))
+    points = [replace(euler, compile_seconds=0.03), replace(verlet, compile_seconds=0.0192)]
+    once = replace(one_second, points=points, repeat=1)
+    table = markdown(once)
+    assert "at least 1 run after a warm-up" in table and "1 runs" not in table
+    assert "euler-cromer 30.0 ms; verlet 19.2 ms (the first numba solver" in table
+    assert "at least 3 runs" in markdown(replace(once, repeat=3))

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene
@@ -194,8 +195,8 @@ class BenchResult:
         solvers = list(dict.fromkeys(p.solver for p in self.points))
         speed = self.speedups().get("speedup", {})
         fast = ", ".join(f"{n} {v:.3g}x" for n, v in speed.items() if n != self.baseline)
-        return one_line(f"<BenchResult {self.scene}: {len(self.points)} points of "
-                        f"{len(solvers)} solvers ({ok} ok), truth {self.truth or '-'}, error "
+        return one_line(f"<BenchResult {self.scene}: {counted(len(self.points), 'point')} of "
+                        f"{counted(len(solvers), 'solver')} ({ok} ok), truth {self.truth or '-'}, error "
                         f"over [0, {self.window:g}] s"
                         + (f"; speed-up at {self.baseline}'s error: {fast}" if fast else "")
                         + ">")
@@ -480,7 +481,7 @@ def _stepper_points(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any,
         estimate = None if cost_per_step is None else cost_per_step * options.n_steps
         if estimate is not None and estimate * (o.repeat + 1) > o.budget:
             base.verdict, base.seconds = None, estimate
-            base.reason = (f"estimated {estimate:.3g} s per run x {o.repeat + 1} runs > "
+            base.reason = (f"estimated {estimate:.3g} s per run x {counted(o.repeat + 1, 'run')} > "
                            f"budget {o.budget:g} s")
             points.append(base)
             pb.update(1)

@@ -109,12 +109,12 @@ class StabilityResult:
 
     def __repr__(self) -> str:
         """One line: runs, cases, and which runs disagree with the theory."""
-        from .._display import one_line
+        from .._display import counted, one_line
 
         bad = self.disagreements
         which = "; ".join(f"{r.case} {r.solver}" for r in bad)
-        return one_line(f"<StabilityResult: {len(self.rows)} runs of "
-                        f"{len({r.case for r in self.rows})} cases, "
+        return one_line(f"<StabilityResult: {counted(len(self.rows), 'run')} of "
+                        f"{counted(len({r.case for r in self.rows}), 'case')}, "
                         f"{len(self.rows) - len(bad)} agree with the theory, {len(bad)} "
                         f"disagree{' (' + which + ')' if bad else ''}>")
 

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._display import counted
 from ..errors import DumbbellError, UsageError
 from ..model import args
 from ..model.scene import Scene
@@ -327,7 +328,7 @@ class SweepResult:
         grid = " x ".join(f"{a.key} ({len(a.values)})" for a in self.axes)
         counts = ", ".join(f"{n:,} {v}" for v, n in sorted(self.counts().items()))
         took = f"; {self.wall_time:.3g} s on {self.backend}" if self.backend else ""
-        return one_line(f"<SweepResult {self.scene.name}: {len(self.rows):,} points over "
+        return one_line(f"<SweepResult {self.scene.name}: {counted(len(self.rows), 'point')} over "
                         f"{grid}, solver {self.solver}, t_end {self.t_end:g} s: "
                         f"{counts or 'none'}{took}>")
 
@@ -338,7 +339,8 @@ class SweepResult:
 
         bad = [r for r in self.rows if r.verdict != "ok"]
         shown = bad or self.rows
-        note = (f"the {len(bad):,} points that did not end ok" if bad else "every point ended ok")
+        note = (f"the {counted(len(bad), 'point')} that did not end ok" if bad
+                else "every point ended ok")
         return html_table(repr(self), self.columns, (r.cells for r in shown), [note])
 
     def to_pandas(self) -> pandas.DataFrame:

@@ -298,12 +298,12 @@ class Trajectory:
         any), verdict."""
         dt = "-" if self.dt is None else f"{self.dt:g} s"
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
-        from .._display import one_line
+        from .._display import counted, one_line
 
         verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
-        contacts = f", {len(self.contacts)} contacts" if self.contacts else ""
+        contacts = f", {counted(len(self.contacts), 'contact')}" if self.contacts else ""
         return one_line(f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, "
-                        f"t={span}, {len(self.t)} samples, {len(self.events)} impacts"
+                        f"t={span}, {counted(len(self.t), 'sample')}, {counted(len(self.events), 'impact')}"
                         f"{contacts}, verdict: {verdict}>")
 
     def _repr_html_(self) -> str:

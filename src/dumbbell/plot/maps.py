@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP_WDT
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
@@ -68,7 +69,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     if own:
         fig, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
     title = (f"Sweep of {result.scene.name}: {result.solver}, t_end = {result.t_end:g} s, "
-             f"{len(result.rows)} runs")
+             f"{counted(len(result.rows), 'run')}")
     if len(result.axes) == 2:
         draw_map(ax.figure, ax, result.axes[0], result.axes[1], result.rows, title)
     else:
@@ -123,7 +124,7 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
             ax.pcolormesh(xe, ye, np.ma.masked_where(~mask, np.full(mask.shape, code)),
                           cmap=ListedColormap([colour]), shading="flat")
             handles.append(Patch(facecolor=colour, edgecolor="0.3",
-                                 label=f"{name} ({int(mask.sum())} runs)"))
+                                 label=f"{name} ({counted(int(mask.sum()), 'run')})"))
     if x_axis.key == "w_dt":
         ax.axvline(2.0, color="red", lw=2.2, ls="--")
         handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
@@ -177,7 +178,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
             # At the error reached before the run stopped; off the top if none was finite.
             ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
             ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
-                    label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
+                    label=f"{name} ({counted(int(mask.sum()), 'run')}, error when it stopped)")
     w_dt = np.array([r.w_dt for r in rows], float)
     cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
     if cross.size:

@@ -66,6 +66,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._display import counted
 from . import _memory as mem
 
 __all__ = ["Balance", "Ledger", "Term"]
@@ -158,7 +159,7 @@ class Balance:
         from ..model import args
 
         top = args.whole(top, "top", "sources", lo=0)
-        lines = [f"energy ledger over {self.steps} steps, t = {self.t:.6g}",
+        lines = [f"energy ledger over {counted(self.steps, 'step')}, t = {self.t:.6g}",
                  f"  E(0) = {self.E0:.9g}   E(t) = {self.E:.9g}   scale = {self.scale:.4g}"]
         for kind, total in sorted(self.by_kind().items(), key=lambda kv: -abs(kv[1])):
             terms = self.sources(kind)
