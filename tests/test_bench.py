@@ -201,7 +201,7 @@ def test_the_table_counts_its_runs_and_times_share_one_precision(one_second):
     """Issue 29: "at least 1 runs", and a JIT line that mixed precisions ("0.03 s; verlet
     0.0192 s"). The table and every line after it write times alike: three significant
     digits, trailing zeros kept, in the unit that suits them."""
-    euler, verlet = ([p for p in one_second.points if p.solver == name][0]
+    euler, verlet = (next(p for p in one_second.points if p.solver == name)
                      for name in ("euler-cromer", "verlet"))
     points = [replace(euler, compile_seconds=0.03), replace(verlet, compile_seconds=0.0192)]
     once = replace(one_second, points=points, repeat=1)

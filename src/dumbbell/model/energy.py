@@ -420,11 +420,11 @@ ROUNDING_FLOOR = 1e-12
 def scene_energy(system: System) -> float:
     """The energy the scene's own numbers give, whatever its start (J): the larger of the
     spring's 1/2 k l^2 and the weight's M g l, with l the dumbbell's length (the largest of
-    the spring's rest length, the rod, the particles' starting distance and their two
-    radii); 0 for a dumbbell with neither spring nor gravity."""
+    the spring's rest length, the rod and the particles' starting distance); 0 for a
+    dumbbell with neither spring nor gravity, or of no length."""
     A, B = system.A, system.B
     length = max(system.b, system.rigid.length if system.rigid is not None else 0.0,
-                 float(np.hypot(A.x - B.x, A.height - B.height)), A.radius + B.radius)
+                 float(np.hypot(A.x - B.x, A.height - B.height)))
     return max(0.5 * system.k * length**2, system.M * abs(system.g) * length)
 
 

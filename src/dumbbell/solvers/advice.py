@@ -12,9 +12,10 @@ scene's ``run.inaccurate_energy`` (the :data:`MARGIN`):
 - the impacts, from theory (:func:`impact_bound`): each impact is caught up to a step late,
   which costs up to w*dt of the energy (w the spring's, or the speed at impact over the
   dumbbell's length for a rod), so N impacts in the run need N w dt within the margin;
-- the error the run itself measured (:func:`measured_bound`): an error e by the time t_m,
-  grown linearly to ``t_end`` and scaled down as dt^p (p the solver's ``order``), replaces the
-  impact theory when there is one (it is this scene's own);
+- the error the run itself measured (:func:`measured_bound`): an error e (at most
+  :data:`MEASURED_MAX`) by the time t_m, grown linearly to ``t_end`` and scaled down as dt^p
+  (p the solver's ``order``), replaces the impact theory when there is one (it is this
+  scene's own);
 - a floor of finite thickness (:func:`catch_bound`): half the step at which a contact is just
   caught.
 
@@ -37,6 +38,10 @@ if TYPE_CHECKING:
 #: Nothing public: the verdicts' messages use it.
 __all__: list[str] = []
 
+#: The largest measured error that is scaled to a step: past it (the energy changed by more
+#: than itself) the run is out of the regime where the error goes as dt^p, and the theory's
+#: bounds stand alone.
+MEASURED_MAX = 1.0
 #: The share of ``run.inaccurate_energy`` a suggested step aims at: the bounds are estimates,
 #: and the motion chaotic, so a step is suggested for a quarter of the threshold.
 MARGIN = 0.25
@@ -146,7 +151,7 @@ def measured_bound(cls: type[Solver], scene: Scene, dt: float, error: float, unt
     """The step at which the relative energy error ``error`` this run measured by ``until``
     (s) at step ``dt``, grown linearly to the scene's ``t_end`` and scaled as dt^order, stays
     within the margin (None when nothing was measured)."""
-    if not (error > 0 and math.isfinite(error) and until > 0):
+    if not (0 < error <= MEASURED_MAX and until > 0):
         return None
     grown = error * max(1.0, scene.run.t_end / until)
     order = cls.order or 1

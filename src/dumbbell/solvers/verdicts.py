@@ -104,10 +104,12 @@ def tunnel_reason(scene: Scene, sinking: Sinking, dt: float | None) -> str:
     if dt is None:
         return text
     travel = speed * dt
-    if depth is not None and depth > 0:
+    if depth is not None and depth > 0 and travel > depth:
         text += (f": it moves {travel:.3g} m per step, more than the {depth:.3g} m in which "
                  f"a contact is caught (at dt < {seconds(depth / speed)} s, or with a larger "
                  "radius, it would be)")
+    elif depth is not None and depth > 0:
+        text += f", past the {depth:.3g} m in which a contact is caught"
     else:
         text += f" ({travel:.3g} m per step): the velocity flip came too late to stop it"
     return text
@@ -194,7 +196,8 @@ def _energy_errors(scene: Scene, E: np.ndarray, E0: float, scale: float) -> np.n
     energy by design, only a gain counts."""
     err = np.subtract(E, E0)  # |E - E0| / scale, in one array
     np.abs(err, out=err)
-    err /= scale
+    with np.errstate(over="ignore"):  # a blown-up state's 1e300 J over a small scale: inf
+        err /= scale
     return np.where(E > E0, err, 0.0) if scene.system.dissipative else err
 
 
@@ -228,7 +231,8 @@ def _accuracy_errors(scene: Scene, energy: Mapping[str, np.ndarray], E0: float, 
     else:
         err = np.subtract(E, E0)
     np.abs(err, out=err)
-    err /= scale
+    with np.errstate(over="ignore"):
+        err /= scale
     return err
 
 
