@@ -411,9 +411,9 @@ def partition_from_terms(
 
 #: Energies below this fraction of a scene's own energy (:func:`scene_energy`) are rounding,
 #: not motion: the floor of the energy scale. A dumbbell at rest carries a spring energy of
-#: the rounding of its stretch, about (2.2e-16 H / l)^2 of 1/2 k l^2 at a height H (3e-31 J,
-#: 8e-32 of it, for the textbook's at rest); 1e-12 lies far above that and far below any
-#: motion simulated on purpose (a stretch of 1.4e-6 l carries 1e-12 of 1/2 k l^2).
+#: the rounding of its stretch, about (2.2e-16 H / l)^2 of 1/2 k l^2 at a height H at most
+#: (the textbook's at rest: 3e-31 J, 8e-32 of it); 1e-12 lies far above that and far below
+#: any motion simulated on purpose (a stretch of 1.4e-6 l carries 1e-12 of 1/2 k l^2).
 ROUNDING_FLOOR = 1e-12
 
 

@@ -56,6 +56,15 @@ class Bound:
     why: str
 
 
+def seconds(value: float) -> str:
+    """A time as people write it: '0.031', '3.16e-3' (s, without the unit)."""
+    if value == 0 or 1e-2 <= abs(value) < 1e4:
+        return f"{value:.3g}"
+    mantissa, exponent = f"{value:.2e}".split("e")
+    mantissa = mantissa.rstrip("0").rstrip(".")
+    return f"{mantissa}e{int(exponent)}"
+
+
 def one_digit(value: float) -> float:
     """``value`` (> 0) rounded down to one significant digit: 4.88e-5 -> 4e-5."""
     exponent = math.floor(math.log10(value))
@@ -107,8 +116,8 @@ def spring_bound(cls: type[Solver], scene: Scene) -> Bound | None:
     if ratio is None or ratio <= 0:
         return None
     error = step_error(cls, ratio, periods)
-    why = (f"w*dt = {ratio:.2g}, where a stable step moves the vibration energy by at most "
-           f"{error:.2g}" if error is not None else f"w*dt = {ratio:.2g}, a tenth of the "
+    why = (f"w*dt <= {ratio:.2g}, where a stable step moves the vibration energy by at most "
+           f"{error:.2g}" if error is not None else f"w*dt <= {ratio:.2g}, a tenth of the "
            f"step limit {cls.step_limit:.3g}")
     return Bound(ratio / w, why)
 
@@ -199,7 +208,6 @@ def step_text(scene: Scene, dt: float, bounds: Sequence[Bound | None]) -> str:
     """``"try dt = X s (why)"`` for the tightest bound, with what it costs when that is
     more steps than a run may take; empty when no bound asks for a smaller step."""
     from .base import MAX_SAMPLES, MAX_STEPS
-    from .verdicts import seconds
 
     found = suggest(dt, bounds)
     if found is None:
@@ -218,9 +226,9 @@ def step_text(scene: Scene, dt: float, bounds: Sequence[Bound | None]) -> str:
 def holding_solvers(scene: Scene) -> list[str]:
     """The registered solvers that hold a particle in lasting contact (no flip floor) and
     can run ``scene``."""
-    from . import METHODS
+    from .base import REGISTRY
 
-    return [cls.name for cls in METHODS.values()
+    return [cls.name for cls in REGISTRY.values()
             if not cls.flip_floor and cls._supports(scene) is None]
 
 
@@ -237,8 +245,6 @@ def rest_text(scene: Scene, t: float) -> str:
 def seconds_below(t: float) -> str:
     """A time just below ``t`` (s) as people write it: two significant digits, rounded
     down."""
-    from .verdicts import seconds
-
     if not t > 0:
         return "0"
     exponent = math.floor(math.log10(t)) - 1

@@ -220,6 +220,12 @@ class ExplicitSpring:
         return ratio / (2.0 - ratio) if ratio < 2.0 else math.inf
 
 
+#: The registered solvers by name: :data:`dumbbell.solvers.METHODS` is this dict, filled
+#: there; kept here so that the solvers' own modules can read it without importing the
+#: package that imports them.
+REGISTRY: dict[str, type[Solver]] = {}
+
+
 def contract_problems(cls: Any) -> list[str]:
     """What keeps ``cls`` from being a solver: not a :class:`Solver` subclass, a fact left out
     or of the wrong type (:attr:`Solver.CAPABILITIES`) or out of its range, ``supports`` or

@@ -36,6 +36,7 @@ from ..model.energy import _partition, _start_scale
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import advice
+from .advice import seconds
 from .kernels import BIG
 
 if TYPE_CHECKING:
@@ -48,15 +49,6 @@ __all__: list[str] = []
 def step_ratio(scene: Scene, dt: float | None) -> float:
     """w*dt (dimensionless) for step ``dt`` (s); 0 without a spring or without a step."""
     return scene.system.omega * dt if dt else 0.0
-
-
-def seconds(value: float) -> str:
-    """A time as people write it: '0.031', '3.16e-3' (s, without the unit)."""
-    if value == 0 or 1e-2 <= abs(value) < 1e4:
-        return f"{value:.3g}"
-    mantissa, exponent = f"{value:.2e}".split("e")
-    mantissa = mantissa.rstrip("0").rstrip(".")
-    return f"{mantissa}e{int(exponent)}"
 
 
 def ratio_text(ratio: float, limit: float) -> str:
