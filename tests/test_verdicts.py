@@ -235,3 +235,17 @@ def test_the_catalogue_reports_the_verdict_its_threshold_and_the_theory_s_predic
     assert "- stiff-wdt-1.9, euler-cromer: inaccurate at t = 0.0019 s: energy error" in table
     df = report.to_pandas()
     assert df.attrs["units"]["inaccurate_energy"] == "1"
+
+
+def test_the_theory_predicts_each_threshold_the_swing_passes():
+    """The catalogue's theory for a spring alone: a stable step's swing (19 at w*dt = 1.9)
+    against the scene's two thresholds."""
+    from dumbbell.analysis.stability import predict
+
+    base = dumbbell.load_scene(EXTREME / "stiff-wdt-1.9.toml")
+    for unstable, inaccurate, status in ((100.0, 0.1, "inaccurate"), (10.0, 0.1, "unstable"),
+                                         (100.0, 20.0, "ok")):
+        scene = base.with_values({"run.unstable_energy": unstable,
+                                  "run.inaccurate_energy": inaccurate})
+        assert predict(scene, "euler-cromer", scene.run.dt, scene.run.t_end).status == status
+        assert simulate(scene, "euler-cromer").verdict.status == status

@@ -224,6 +224,11 @@ def _predict(scene: Scene, cls: type[Solver], dt: float, t_end: float) -> Predic
                                     f"< t_end = {t_end:g} s")
     if limit is not None:
         swing = _swing_share(scene, cls, w_dt)
+        if swing is not None and swing > scene.run.unstable_energy:
+            return Prediction("unstable", (
+                f"w*dt = {w_dt:.2g} < {limit:.3g}: stable, but the step moves the energy by "
+                f"up to {swing:.3g} of its scale > run.unstable_energy = "
+                f"{scene.run.unstable_energy:g}"))
         if swing is not None and swing > scene.run.inaccurate_energy:
             return Prediction("inaccurate", (
                 f"w*dt = {w_dt:.2g} < {limit:.3g}: stable, but the step moves the energy by "
