@@ -25,7 +25,8 @@ ALLOWED = re.compile(r"budget|MAX_|\{[A-Z_]+(:,)?\}|more than|at most|:\.[0-9]g\
 
 def test_counted_agrees_with_its_count():
     assert counted(1, "run") == "1 run" and counted(3, "run") == "3 runs"
-    assert counted(0, "impact") == "0 impacts" and counted(12_000, "point") == "12,000 points"
+    assert counted(0, "impact") == "0 impacts" and counted(12_000, "point") == "12000 points"
+    assert counted(12_000, "point", grouped=True) == "12,000 points"
     assert counted(1, "body", "bodies") == "1 body" and counted(2, "body", "bodies") == "2 bodies"
 
 

@@ -25,11 +25,11 @@ def one_line(text: str) -> str:
     return text[: MAX_REPR - 3 - len(tail)] + "..." + tail
 
 
-def counted(n: int, noun: str, plural: str | None = None) -> str:
-    """``n`` things, the noun agreeing with the count: '1 run', '3 runs', '1,000 impacts'
-    (``plural`` where adding 's' is wrong)."""
+def counted(n: int, noun: str, plural: str | None = None, grouped: bool = False) -> str:
+    """``n`` things, the noun agreeing with the count: '1 run', '3 runs' (``plural`` where
+    adding 's' is wrong); ``grouped`` writes thousands apart: '12,000 points'."""
     word = noun if n == 1 else (plural or noun + "s")
-    return f"{n:,} {word}"
+    return f"{n:,} {word}" if grouped else f"{n} {word}"
 
 
 def significant(value: float, digits: int = 3) -> str:

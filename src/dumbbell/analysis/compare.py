@@ -98,11 +98,12 @@ class Parting:
         return (d[-1] / d[0]) ** (1.0 / (len(d) - 1))
 
     def why(self, label: str, truth: str) -> str:
-        """One line: when and why ``label`` and ``truth`` part."""
+        """One line: when and why the run(s) ``label`` and the truth ``truth`` part."""
         shown = ", ".join(f"{abs(x) * 1e3:.3g}" for x in self.differences)
         growth = (f", about {self.growth:.2g}x per impact" if math.isfinite(self.growth)
                   else "")
-        return (f"{label} and the truth ({truth}) part at {self.t:.4g} s (the truth's impact "
+        return (f"{label} part{'' if ' and ' in label else 's'} from the truth ({truth}) at "
+                f"{self.t:.4g} s (the truth's impact "
                 f"{self.impact}), by chaos: each impact turns a small difference in when it "
                 f"happens into a larger one (|impact time - truth's|: {shown} ms at impacts "
                 f"1-{len(self.differences)}{growth}), and the position error then passed "

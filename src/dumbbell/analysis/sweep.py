@@ -328,7 +328,8 @@ class SweepResult:
         grid = " x ".join(f"{a.key} ({len(a.values)})" for a in self.axes)
         counts = ", ".join(f"{n:,} {v}" for v, n in sorted(self.counts().items()))
         took = f"; {self.wall_time:.3g} s on {self.backend}" if self.backend else ""
-        return one_line(f"<SweepResult {self.scene.name}: {counted(len(self.rows), 'point')} over "
+        points = counted(len(self.rows), "point", grouped=True)
+        return one_line(f"<SweepResult {self.scene.name}: {points} over "
                         f"{grid}, solver {self.solver}, t_end {self.t_end:g} s: "
                         f"{counts or 'none'}{took}>")
 
@@ -339,7 +340,7 @@ class SweepResult:
 
         bad = [r for r in self.rows if r.verdict != "ok"]
         shown = bad or self.rows
-        note = (f"the {counted(len(bad), 'point')} that did not end ok" if bad
+        note = (f"the {counted(len(bad), 'point', grouped=True)} that did not end ok" if bad
                 else "every point ended ok")
         return html_table(repr(self), self.columns, (r.cells for r in shown), [note])
 

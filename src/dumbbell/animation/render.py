@@ -77,7 +77,7 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
         n = frame_count(t_end, fps)
         if n <= max_frames:
             return n
-        count = counted(n, "frame")
+        count = counted(n, "frame", grouped=True)
     else:
         count = (f"{math.ceil(t_end * fps):,} frames" if math.isfinite(t_end * fps)
                  else "more than 1e308 frames")
