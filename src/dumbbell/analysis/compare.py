@@ -206,7 +206,9 @@ class Comparison:
         """One line: the scene, the truth, and each run's largest position error."""
         from .._display import one_line
 
-        runs = ", ".join(f"{r.label} {r.window_error:.3g} m" for r in self.rows)
+        runs = ", ".join(f"{r.label} {r.window_error:.3g} m"
+                         + (f" (to {r.error_until:.3g} s, where the runs part)"
+                            if r.error_until < self.window else "") for r in self.rows)
         return one_line(f"<Comparison {self.scene.name}: truth {self.truth.solver}; largest "
                         f"position error over [0, {self.window:g}] s: {runs or 'no runs'}>")
 
