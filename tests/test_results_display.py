@@ -99,7 +99,7 @@ def test_reprs_say_what_was_measured(results):
     comparison = results["Comparison"]
     assert f"euler-cromer {comparison.rows[0].window_error:.3g} m" in repr(comparison)
     stability = results["StabilityResult"]
-    assert repr(stability).startswith("<StabilityResult: 1 runs of 1 cases, 1 agree")
+    assert repr(stability).startswith("<StabilityResult: 1 run of 1 case, 1 agree")
     sweep = results["SweepResult"]
     assert "2 points over spring.stiffness (2) x run.dt (1)" in repr(sweep)
     assert "1 ok, 1 unstable" in repr(sweep)  # w*dt = 0.45 and 4.5 at k = 1e2, 1e6

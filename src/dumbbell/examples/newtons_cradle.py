@@ -16,6 +16,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.newtons_cradle``.
@@ -107,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"dt = {dt:.3g} s over {args.seconds:g} s: energy drift max "
               f"{m['energy_drift_max']:.2e}, at the end {m['energy_drift_end']:.2e}; momentum "
               f"change across an impact max {m['momentum_change_max']:.2e}")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

@@ -20,6 +20,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.pendulum``.
@@ -114,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{(m['period'] - T0) / T0:+.3%} from the small-angle formula, "
               f"{(m['period'] - T1) / T1:+.1e} from the corrected one; energy drift max "
               f"{m['energy_drift_max']:.2e}")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

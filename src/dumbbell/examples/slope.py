@@ -16,6 +16,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.slope``.
@@ -91,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"dt = {dt:.3g} s: E(0) = {m['E0']:.5f} J, E(t) = {m['E']:.5f} J, heat "
               f"{m['heat']:.5f} J over {m['distance']:.3f} m; E(0) - E(t) - heat = {left:+.2e} J "
               f"({left / m['heat']:+.2e} of the heat)")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

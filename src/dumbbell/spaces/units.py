@@ -78,7 +78,7 @@ def _g(value: float) -> str:
 def shown(record: Any) -> str:
     """The one-line repr of a record of :func:`dumbbell.spaces.energy` (``SpaceEnergy``,
     ``BodyEnergy``, ``SpringEnergy``), every value with its unit."""
-    from .._display import one_line
+    from .._display import counted, one_line
 
     u = record.units
     e = energy_unit(u)
@@ -93,5 +93,6 @@ def shown(record: Any) -> str:
         f"SpaceEnergy(E = {_g(record.E)} {e}: K_trans = {_g(record.K_trans)}, K_rot = "
         f"{_g(record.K_rot)}, U_g = {_g(record.U_g)}, U_spring = {_g(record.U_spring)} {e}; "
         f"momentum = {p}, L_cm = {_g(record.L_cm)} {angular_unit(u)}; "
-        f"{len(record.bodies)} bodies, {len(record.springs)} springs, complete = "
+        f"{counted(len(record.bodies), 'body', 'bodies')}, "
+        f"{counted(len(record.springs), 'spring')}, complete = "
         f"{record.complete})")
