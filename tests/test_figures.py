@@ -130,9 +130,7 @@ def test_restitution_figure(elasticity):
         {"floor.elasticity": elasticity})
     thetas = [0, 30, 45, 60, 80] if SHIPPED else [0, 60]
     result = restitution(scene, thetas, (200.0, 2e3, 2e4), 1e-5 if SHIPPED else 1e-4)
-    fig = draw(result)[0].figure
-    fig.tight_layout()                      # as `dumbbell restitution` does
-    assert_fit(fig)
+    assert_fit(draw(result)[0].figure)
 
 
 def test_the_energy_figure_of_a_1d_scene(runs):
