@@ -111,7 +111,8 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
                   size: float = 7.5) -> None:
     """Write each (text, x, y, colour) beside its point, at the first spot whose box (as the
     text is drawn: measured) stays inside the axes and overlaps neither a marker, a label
-    already placed, the legend nor a line (else at the first spot)."""
+    already placed, the legend nor a line: near the point first, then farther out; where no
+    spot is free, at the one with the fewest of those."""
     px = ax.figure.dpi / 72.0
     xy = ax.transData.transform([(x, y) for _, x, y, _ in labels]) if labels else []
     taken = [(u - 6, v - 6, u + 6, v + 6) for u, v in xy]  # the markers
@@ -121,24 +122,29 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
         taken.append((box.x0, box.y0, box.x1, box.y1))
     frame = ax.get_window_extent()
     gap = 2 * px
+    spots = [(dx * f, dy * f, ha) for f in (1.0, 1.8, 2.6) for dx, dy, ha in _LABEL_SPOTS]
     for (text, x, y, colour), (u, v) in zip(labels, xy, strict=True):
-        note = ax.annotate(text, (x, y), textcoords="offset points", xytext=_LABEL_SPOTS[0][:2],
-                           ha=_LABEL_SPOTS[0][2], fontsize=size, color=colour)
-        for dx, dy, ha in _LABEL_SPOTS:
+        note = ax.annotate(text, (x, y), textcoords="offset points", xytext=spots[0][:2],
+                           ha=spots[0][2], fontsize=size, color=colour)
+        best: tuple[int, Any, Any] | None = None
+        for spot in spots:
+            dx, dy, ha = spot
             note.set_position((dx, dy))
             note.set_ha(ha)
             b = note.get_window_extent()
             box = (b.x0 - gap, b.y0, b.x1 + gap, b.y1)
             inside = (frame.x0 <= b.x0 and b.x1 <= frame.x1 and frame.y0 <= b.y0
                       and b.y1 <= frame.y1)
-            if inside and not any(box[0] < t[2] and t[0] < box[2] and box[1] < t[3]
-                                  and t[1] < box[3] for t in taken) and not _crossed(ax, box):
-                taken.append(box)
+            clashes = (sum(box[0] < t[2] and t[0] < box[2] and box[1] < t[3] and t[1] < box[3]
+                           for t in taken) + (not inside) + _crossed(ax, box))
+            if best is None or clashes < best[0]:
+                best = (clashes, spot, box)
+            if clashes == 0:
                 break
-        else:
-            dx, dy, ha = _LABEL_SPOTS[0]
-            note.set_position((dx, dy))
-            note.set_ha(ha)
+        _, (dx, dy, ha), box = best
+        note.set_position((dx, dy))
+        note.set_ha(ha)
+        taken.append(box)
 
 
 def convergence(result: BenchResult, ax: Any = None) -> Any:

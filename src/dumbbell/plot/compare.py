@@ -99,8 +99,10 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     ax.set_ylabel("largest |position error| [m]")
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, which="major", color="0.9", lw=0.6)
-    ax.set_title(f"{scene.title}: position error against {truth.solver}"
-                 + ("" if own else f"; max {within}"), fontsize=9)
+    # On the user's axes the scene's title is theirs to give (a figure's title): not repeated
+    # over each axes.
+    ax.set_title(f"{scene.title}: position error against {truth.solver}" if own
+                 else f"Position error against {truth.solver}; max {within}", fontsize=9)
     _end(ax, own)
     return ax
 
@@ -145,7 +147,7 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, color="0.9", lw=0.6)
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
-                 fontsize=9)
+    ax.set_title((f"{scene.title}: total" if own else "Total")
+                 + f" energy per solver, relative to E(0) = {E0:.4g} J", fontsize=9)
     _end(ax, own)
     return ax

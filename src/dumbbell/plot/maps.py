@@ -78,8 +78,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
         cbar = fig.colorbar(mesh, ax=ax, pad=0.02)
         cbar.set_label("log10 of the largest |E - E0| / |E0| [1]")
         if own:
-            fig.draw_without_rendering()  # laid out: the legend's width is the axes'
-            legend_below(ax, handles=handles)
+            legend_below(ax, handles=handles)   # its columns fitted again once laid out
         else:
             wrap_texts(cbar.ax)
             legend_inside(ax, handles=handles)
@@ -258,21 +257,17 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     lo = math.floor(math.log10(min(errs))) if errs else -16
     hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
     mesh = None
-    keys = []
     for ax, (solver, rows) in zip(axes[0], maps.items(), strict=True):
         wdt = np.array([[r.w_dt for r in rows[i::len(MAP_RATIOS)]]
                         for i in range(len(MAP_RATIOS))], float)
         mesh, handles = draw_map(ax, x_axis, y_axis, rows, solver,
                                  x_label="w*dt, w = sqrt(k/mu) [1]",
                                  y_label="mass ratio mB/mA [1]", wdt=wdt, limits=(lo, hi))
-        keys.append(handles)
+        legend_below(ax, handles=handles)   # its columns fitted again once laid out
     cbar = fig.colorbar(mesh, ax=list(axes[0]), pad=0.02, aspect=30)
     cbar.set_label("log10 of the largest relative energy error [1]")
     fig.suptitle(f"Stability of the explicit spring step: {MAP_STEPS} steps per run, no floor, "
                  f"no gravity;\n'unstable' = non-finite or energy error > "
                  f"{MAP_UNSTABLE_ENERGY:g}", fontsize=10)
-    fig.draw_without_rendering()        # laid out: each legend's width is its panel's
-    for ax, handles in zip(axes[0], keys, strict=True):
-        legend_below(ax, handles=handles)
     finish(fig)
     return list(axes[0])

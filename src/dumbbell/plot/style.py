@@ -244,7 +244,9 @@ def _ticks_under(inner: Any, top: float) -> Any:
 def legend_below(ax: Any, *args: Any, **kwargs: Any) -> Any:
     """``ax.legend(*args, **kwargs)`` below the axes ``ax``, under its tick labels and x label
     (measured), without a frame, in as many columns as fit the axes' width: for a map, whose
-    data fill the axes. ``fontsize`` is 8 unless given. Returns the legend."""
+    data fill the axes (on a figure of the package's own, :func:`finish` fits the columns
+    again to the axes' width as laid out). ``fontsize`` is 8 unless given. Returns the
+    legend."""
     from matplotlib.transforms import ScaledTranslation
 
     kwargs.setdefault("fontsize", 8)
@@ -273,11 +275,11 @@ def legend(ax: Any, own: bool, *args: Any, **kwargs: Any) -> Any:
     return (legend_outside if own else legend_inside)(ax, *args, **kwargs)
 
 
-def wrap_text(text: Any, length: float) -> None:
+def wrap_text(text: Any, length: float) -> bool:
     """Break ``text`` (a matplotlib Text: a title, an axis label) at spaces into lines no
     longer than ``length`` px where it is longer (along its direction: across for a level
     text, up for a rotated one); its own line breaks stay. A line with mathtext (``$``) is
-    left whole (breaking it could split a formula)."""
+    left whole (breaking it could split a formula). Returns whether the text changed."""
     def size() -> float:
         box = text.get_window_extent()
         return box.height if abs(text.get_rotation() - 90.0) % 180.0 < 1.0 else box.width
@@ -297,7 +299,7 @@ def wrap_text(text: Any, length: float) -> None:
 
     whole = text.get_text()
     if not whole.strip() or not text.get_visible() or size() <= length:
-        return
+        return False
     lines = []
     for line in whole.split("\n"):
         if "$" in line and text.get_parse_math():
@@ -305,23 +307,41 @@ def wrap_text(text: Any, length: float) -> None:
             continue
         # Whole phrases first (a break after a comma, colon or semicolon), so that "t_end =
         # 0.2 s" stays on one line; words only within a phrase too long for a line.
+        # A unit in brackets stays with the word before it ("error [1]").
         for phrase in greedy(re.split(r"(?<=[,:;]) ", line)):
-            lines.extend(greedy(phrase.split(" ")) if not fits(phrase) else [phrase])
+            lines.extend(greedy(re.split(r" (?!\[)", phrase)) if not fits(phrase)
+                         else [phrase])
     text.set_text("\n".join(lines))
+    return text.get_text() != whole
 
 
-def wrap_texts(ax: Any) -> None:
+def wrap_texts(ax: Any) -> bool:
     """Wrap each title of ``ax`` (centre, left, right: the texts among its children that are
     neither its own texts nor its axis labels) and its x label to the axes' width, its y label
-    to the axes' height."""
+    to the axes' height. Returns whether any changed."""
     from matplotlib.text import Text
 
     frame = ax.get_window_extent()
-    for child in ax.get_children():
-        if isinstance(child, Text) and child not in ax.texts:
-            wrap_text(child, frame.width)
-    wrap_text(ax.xaxis.label, frame.width)
-    wrap_text(ax.yaxis.label, frame.height)
+    changed = [wrap_text(child, frame.width) for child in ax.get_children()
+               if isinstance(child, Text) and child not in ax.texts]
+    changed += [wrap_text(ax.xaxis.label, frame.width), wrap_text(ax.yaxis.label, frame.height)]
+    return any(changed)
+
+
+def _refit_below(ax: Any) -> bool:
+    """A legend hanging below ``ax`` (:func:`legend_below`) in the most columns that fit the
+    axes' width as laid out. Returns whether it changed."""
+    legend = ax.get_legend()
+    frame = ax.get_window_extent()
+    if legend is None or legend.get_window_extent().y1 > frame.y0:
+        return False
+    before = legend.get_window_extent().width
+    count = len(legend.get_texts())
+    for ncol in range(max(count, 1), 0, -1):
+        legend.set_ncols(ncol)
+        if legend.get_window_extent().width <= frame.width:
+            break
+    return legend.get_window_extent().width != before
 
 
 #: Room kept round the figure's contents when its canvas grows (inches).
@@ -331,20 +351,25 @@ _PAD = 0.06
 def finish(fig: Any) -> Any:
     """The last step of each figure the package makes: lay it out (constrained layout), wrap
     each axes' titles and labels to its size and the figure's title to the figure's width
-    (:func:`wrap_texts`), then grow the canvas wherever a text still reaches past its edge
-    (by as much, laid out again), until every text fits. Returns ``fig``."""
-    fig.draw_without_rendering()
-    for ax in fig.axes:
-        wrap_texts(ax)
-    for text in fig.texts:      # the figure's title (suptitle) among them
-        wrap_text(text, 0.96 * fig.bbox.width)
-    for _ in range(4):
+    (:func:`wrap_texts`), give each legend below an axes the columns that fit its width, then
+    grow the canvas wherever a text still reaches past its edge (by as much, laid out again),
+    until every text fits. Returns ``fig``."""
+    for _ in range(6):
         fig.draw_without_rendering()
+        changed = [wrap_texts(ax) | _refit_below(ax) for ax in fig.axes]
+        # The figure's title (suptitle) among the figure's texts.
+        changed += [wrap_text(text, 0.96 * fig.bbox.width) for text in fig.texts]
+        if any(changed):
+            continue                  # laid out again before it is measured
         box = fig.get_tightbbox()     # inches
         w, h = fig.get_size_inches()
         grow_w = max(0.0, -box.x0) + max(0.0, box.x1 - w)
         grow_h = max(0.0, -box.y0) + max(0.0, box.y1 - h)
         if max(grow_w, grow_h) * fig.dpi < 0.5:
+            # Laid out and unchanged since: measuring only placed the titles again as the
+            # draw did (and marked the figure stale for it). Not stale, a figure written as
+            # it is keeps this layout (dumbbell.io.figures.write_figure).
+            fig.stale = False
             break
         fig.set_size_inches(w + (grow_w + 2 * _PAD if grow_w > 0 else 0.0),
                             h + (grow_h + 2 * _PAD if grow_h > 0 else 0.0))
