@@ -101,6 +101,14 @@ def legend_inside(ax: Any, *args: Any, **kwargs: Any) -> Any:
     kwargs.setdefault("fontsize", 8)
     count = len(kwargs["handles"]) if "handles" in kwargs else len(
         ax.get_legend_handles_labels()[1])
+    old = ax.get_axes_locator()
+    if isinstance(old, _Band):       # drawn on again: the old legend's band goes with it
+        ax.set_axes_locator(old.before)
+        for axis_locator, set_locator in (
+                (ax.yaxis.get_major_locator(), ax.yaxis.set_major_locator),
+                (ax.yaxis.get_minor_locator(), ax.yaxis.set_minor_locator)):
+            if hasattr(axis_locator, "inner"):
+                set_locator(axis_locator.inner)
     frame = ax.get_window_extent()
     for size in dict.fromkeys((kwargs["fontsize"], min(kwargs["fontsize"], 7))):
         legend = ax.legend(*args, **{**kwargs, "fontsize": size}, loc="upper center")
@@ -152,7 +160,7 @@ class _Band:
         return box
 
     def fit(self, width: float, height: float, renderer: Any = None,
-            most: float = 1.0) -> float:
+            most: float = 0.9) -> float:
         """Fit the legend and its band to an axes ``width`` x ``height`` px: the most columns
         that fit, then the top of the y range raised (in the axis' own scale) so that the
         data fill the lowest 1 - band. Returns the band (a fraction of the height)."""
@@ -228,6 +236,9 @@ def _ticks_under(inner: Any, top: float) -> Any:
         return values[values <= top + 1e-9 * abs(top)]
 
     class TicksUnder(Locator):
+        #: The locator it filters.
+        inner: Any = None
+
         def set_axis(self, axis: Any) -> None:
             super().set_axis(axis)
             inner.set_axis(axis)
@@ -238,7 +249,9 @@ def _ticks_under(inner: Any, top: float) -> Any:
         def tick_values(self, vmin: float, vmax: float) -> Any:
             return under(inner.tick_values(vmin, vmax))
 
-    return TicksUnder()
+    ticks = TicksUnder()
+    ticks.inner = inner
+    return ticks
 
 
 def legend_below(ax: Any, *args: Any, **kwargs: Any) -> Any:
@@ -278,8 +291,9 @@ def legend(ax: Any, own: bool, *args: Any, **kwargs: Any) -> Any:
 def wrap_text(text: Any, length: float) -> bool:
     """Break ``text`` (a matplotlib Text: a title, an axis label) at spaces into lines no
     longer than ``length`` px where it is longer (along its direction: across for a level
-    text, up for a rotated one); its own line breaks stay. A line with mathtext (``$``) is
-    left whole (breaking it could split a formula). Returns whether the text changed."""
+    text, up for a rotated one); its own line breaks stay. A line with mathtext (an unescaped
+    ``$``, where the text parses math) is left whole: breaking it could split a formula.
+    Returns whether the text changed."""
     def size() -> float:
         box = text.get_window_extent()
         return box.height if abs(text.get_rotation() - 90.0) % 180.0 < 1.0 else box.width
@@ -302,7 +316,7 @@ def wrap_text(text: Any, length: float) -> bool:
         return False
     lines = []
     for line in whole.split("\n"):
-        if "$" in line and text.get_parse_math():
+        if text.get_parse_math() and re.search(r"(?<!\\)\$", line):
             lines.append(line)
             continue
         # Whole phrases first (a break after a comma, colon or semicolon), so that "t_end =
