@@ -166,7 +166,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
         label = name + (f":\nfitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
                         f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
         if fit and fit.expected is not None:
-            label += f"; its own order {fit.expected}: dashed"
+            label += f"\nits own order {fit.expected}: dashed"
         ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
                 lw=0, label=label)
         if fit:
