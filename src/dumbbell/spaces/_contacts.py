@@ -25,48 +25,36 @@ from __future__ import annotations
 import numpy as np
 
 from . import _memory as mem
-from ._inventory import Pairs, Table
+from ._inventory import Pairs, Table, UnknownBody
 from ._records import Step
 
-#: Work on end a and on end b of an impulse applied to b (and its opposite to a).
-_ENDS = np.array([[-1.0], [1.0]])
+__all__ = ["Contacts", "UnknownBody", "arbiters_address"]
 
-
-class UnknownBody(Exception):
-    """A contact touches a body that is not in the ledger's table (one pymunk made since:
-    the space's static body, say): the table must be built again."""
+#: The x, y and angular components of a row's impulse, in :meth:`Contacts.work`'s sums.
+_XYW = np.arange(3)[:, None, None]
 
 
 class _Layout:
-    """Where the fields are, from pymunk's compiled declarations: the words of an arbiter
-    its reads cover (``first``, ``words``: from ``body_a`` to ``state``) and each field's
-    place among them (``count`` and ``state`` in 4-byte units); the words of a contact
-    they cover (from ``r1`` to ``jBias``), and each field's place."""
+    """Where the fields are, in 8-byte words from an arbiter's (or a contact's) start,
+    from pymunk's compiled declarations: an arbiter's (body_a, body_b, contacts, n.x, n.y,
+    and the words holding count and state, each 4 bytes: ``count`` and ``state`` say which
+    half); a contact's (jnAcc, jtAcc, r1.x, r2.x, r1.y, r2.y, jBias)."""
 
     def __init__(self) -> None:
         p = mem._pymunk_ffi()
         arb = {name: p.offsetof("cpArbiter", name) for name in
                ("body_a", "body_b", "contacts", "n", "count", "state")}
         self.asize, self.csize = p.sizeof("cpArbiter"), p.sizeof("cpContact")
-        self.first = min(arb.values()) // 8
-        self.words = (max(arb.values()) + 8) // 8 - self.first
-        start = 8 * self.first
-        self.ends = (arb["body_a"] - start) // 8  # body_b follows (checked by the platform)
-        self.contacts = (arb["contacts"] - start) // 8
-        self.n = (arb["n"] - start) // 8
-        self.count = (arb["count"] - start) // 4
-        self.state = (arb["state"] - start) // 4
-        con = {name: p.offsetof("cpContact", name) // 8 for name in
-               ("r1", "r2", "jnAcc", "jtAcc", "jBias")}
-        self.cfirst = min(con.values())
-        self.cwords = max(con.values()) + 1 - self.cfirst
-        at = {name: w - self.cfirst for name, w in con.items()}
-        self.jn, self.jt, self.jb = at["jnAcc"], at["jtAcc"], at["jBias"]
-        # r1.x and r2.x (and their y) of a contact, as one strided slice.
-        gap = at["r2"] - at["r1"]
-        self.rx = slice(at["r1"], at["r2"] + 1, gap)
-        self.ry = slice(at["r1"] + 1, at["r2"] + 2, gap)
-        # A contact's words from its arbiter's first contact: (2, 1), the second one next.
+        self.arbiter = (np.array([arb["body_a"], arb["body_b"], arb["contacts"], arb["n"],
+                                  arb["n"] + 8, arb["count"], arb["state"]]) // 8)[:, None]
+        # Each 4-byte field is one half of its word (the same bytes, whatever the order).
+        self.count, self.state = arb["count"] % 8 // 4, arb["state"] % 8 // 4
+        con = {name: p.offsetof("cpContact", name) for name in
+               ("jnAcc", "jtAcc", "jBias", "r1", "r2")}
+        self.contact = (np.array([con["jnAcc"], con["jtAcc"], con["r1"], con["r2"],
+                                  con["r1"] + 8, con["r2"] + 8, con["jBias"]]) // 8
+                        )[:, None, None]
+        # An arbiter's second contact, in words from its first: (2, 1).
         self.pair = np.array([[0], [self.csize // 8]])
 
 
@@ -77,11 +65,10 @@ class Contacts:
         p = mem._pymunk_ffi()
         self.arr = p.cast("cpArray *", arbiters_at)
         self.buffer = p.buffer
-        self.L = L = _Layout()
+        self.L = _Layout()
         memory = mem.memory()
         self.lowest = memory.LOWEST
-        self.arbiters = memory.window(L.first, L.words)
-        self.contacts = memory.window(L.cfirst, L.cwords, floats=True)
+        self.words, self.floats = memory.i64, memory.f64
 
     def before(self, table: Table, pairs: Pairs, coef: float) -> bool:
         """Read the step's contacts and the impulses they carry in; False if none. Raises
@@ -92,43 +79,45 @@ class Contacts:
             return False
         L = self.L
         arb = np.frombuffer(self.buffer(arr.arr, 8 * num), dtype=np.int64)
-        A = self.arbiters[(arb - self.lowest) >> 3]  # (m, words) from body_a to state
-        count = A.view(np.uint32)[:, L.count]
+        # (7, m): body_a, body_b, contacts, n.x, n.y, the words of count and state
+        A = self.words.take(L.arbiter + ((arb - self.lowest) >> 3))
+        count = A[5].view(np.uint32)[L.count::2]
         if not count.all():  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
-            A, count = A[keep], count[keep]
-        self._rows(table, A[:, L.ends: L.ends + 2].T, pairs)
-        n = A[:, L.n: L.n + 2].view(np.float64)
-        self.nx, self.ny = n[:, 0], n[:, 1]
-        self.first = A.view(np.uint32)[:, L.state] == 0
+            A, count = A[:, keep], count[keep]
+        self._rows(table, A[0:2], pairs)
+        n = A[3:5].view(np.float64)
+        self.nx, self.ny = n[0], n[1]
+        self.first = A[6].view(np.uint32)[L.state::2] == 0
         self.single = None if count.min() > 1 else count < 2
-        # Each contact's row of words: (2, m), the first and the second contact.
-        cw = ((A[:, L.contacts] - self.lowest) >> 3) + L.pair
+        # Each contact's first word: (2, m), the first and the second contact.
+        cw = ((A[2] - self.lowest) >> 3) + L.pair
         if self.single is not None:  # no second contact: read the first twice, zeroed later
             cw[1, self.single] = cw[0, self.single]
-        self.cw = cw
+        self.at = L.contact + cw  # (7, 2, m): each field of both contacts
         # The impulses carried in that the step does not apply: all of a first contact's,
         # (1 - coef) of the others' (none when dt did not change).
         self.carried = None
-        if coef != 1.0 or self.first.any():
-            carried = np.arange(len(count)) if coef != 1.0 else np.nonzero(self.first)[0]
-            kept = (1.0 - np.where(self.first[carried], 0.0, coef))[:, None]
-            # (2, k, 2): jn, jt of each contact
-            self.j0 = self.contacts[cw[:, carried]][:, :, [L.jn, L.jt]] * kept
-            self.carried = carried
+        if coef != 1.0:
+            self.carried = slice(None)
+            self.j0 = self.floats.take(self.at[0:2]) * (1.0 - np.where(self.first, 0.0, coef))
+        elif self.first.any():  # all of it (x 1.0)
+            self.carried = np.nonzero(self.first)[0]
+            self.j0 = self.floats.take(self.at[0:2, :, self.carried])  # (2, 2, k): jn, jt
         return True
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
         """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), its
-        pair's slot and the sign of the push on its ends, through the table's maps."""
+        pair's slot and the sign of the push on its ends, through the table's maps; and
+        where each end's impulse adds up per row (``rows3``: x, y and angular)."""
         rows = table.rows_of(ends)
-        if rows.min() < 0:
-            raise UnknownBody
-        self.rows, self.slots = rows, table.slots_of(rows[0], rows[1], pairs)
-        free = table.lin_free_f[rows]
+        self.slots = table.slots_of(rows, pairs)  # raises UnknownBody on a row -1
+        self.rows = rows
+        free = table.lin_free_f.take(rows)
         self.sign = free[1] - free[0]
+        self.rows3 = rows + table.rows * _XYW
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
              ) -> tuple[float, np.ndarray]:
@@ -136,29 +125,33 @@ class Contacts:
         row (its linear and angular parts) into ``step.work``; the work of driven ends into
         ``drive`` (rows); and the bias impulse along the normal on the dynamic ends of each
         arbiter (its position correction's push)."""
-        L = self.L
-        f = self.contacts[self.cw]  # (2, m, words): each field of both contacts
-        jn, jt = f[:, :, L.jn], f[:, :, L.jt]
+        f = self.floats.take(self.at)  # (7, 2, m): jn, jt, r1.x, r2.x, r1.y, r2.y, jBias
         if self.carried is not None:
-            jn[:, self.carried] -= self.j0[:, :, 0]
-            jt[:, self.carried] -= self.j0[:, :, 1]
+            f[0:2, :, self.carried] -= self.j0
         if self.single is not None:  # the first contact read twice: not a second one
-            f[1, self.single] = 0.0
+            f[:, 1, self.single] = 0.0
+        jn, jt = f[0], f[1]
         nx, ny = self.nx, self.ny
         qx = nx * jn - ny * jt  # each contact's impulse on b, in world axes (2, m)
         qy = ny * jn + nx * jt
-        px, py = qx[0] + qx[1], qy[0] + qy[1]
-        # r1 x q and r2 x q of each contact (2, m, 2), then of the arbiter (m, 2)
-        moment = f[:, :, L.rx] * qy[:, :, None] - f[:, :, L.ry] * qx[:, :, None]
-        moment = moment[0] + moment[1]
-        U = step.u[:, self.rows]  # (3, 2, m): the velocities of ends a and b
-        lin = (px * U[0] + py * U[1]) * _ENDS
-        ang = moment.T * U[2] * _ENDS
+        # The impulse on each end (3, 2, m): x, y and angular; on a, the opposite of b's.
+        imp = np.empty((3, 2, len(nx)))
+        np.add(qx[0], qx[1], out=imp[0, 1])
+        np.add(qy[0], qy[1], out=imp[1, 1])
+        moment = f[2:4] * qy - f[4:6] * qx  # (2, 2, m): r1 x q and r2 x q of each contact
+        np.add(moment[:, 0], moment[:, 1], out=imp[2])
+        np.negative(imp[0:2, 1], out=imp[0:2, 0])
+        np.negative(imp[2, 0], out=imp[2, 0])
+        # Its work on the velocities of the ends: linear (x + y) and angular, (2, m) each
+        # (-a + -b is -(a + b) bit for bit: the work on a is the same as on b, negated).
+        np.multiply(imp, step.u.take(self.rows, axis=1), out=imp)
+        lin, ang = imp[0], imp[2]
+        lin += imp[1]
         rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
-        rows, n = self.rows.ravel(), table.rows
-        lin_rows = np.bincount(rows, weights=lin.ravel(), minlength=n)
-        ang_rows = np.bincount(rows, weights=ang.ravel(), minlength=n)
+        n = table.rows
+        per_row = np.bincount(self.rows3.ravel(), weights=imp.ravel(), minlength=3 * n)
+        lin_rows, ang_rows = per_row[:n], per_row[2 * n:]
         step.work[0] += lin_rows
         step.work[1] += ang_rows
         total = float(rel.sum())
@@ -169,7 +162,7 @@ class Contacts:
                        + np.where(table.ang_free, 0.0, ang_rows))
             drive += driven
             total += float(driven.sum())
-        return total, (f[0, :, L.jb] + f[1, :, L.jb]) * self.sign
+        return total, (f[6, 0] + f[6, 1]) * self.sign
 
     @property
     def normals(self) -> tuple[np.ndarray, np.ndarray]:

@@ -47,6 +47,11 @@ PAIR = 1 << 31
 NAME_CHARS = 60
 
 
+class UnknownBody(Exception):
+    """A contact touches a body that is not in the ledger's table (one pymunk made since:
+    the space's static body, say): the table must be built again."""
+
+
 class Names:
     """Stable ids and labels of the bodies the ledger has seen, and the bodies themselves
     (kept, so that an id is never reused while the ledger lives)."""
@@ -214,15 +219,22 @@ class Table:
         rowmap[(at - lo) >> shift] = np.arange(self.rows)
         return lo, shift, rowmap
 
-    def slots_of(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
-        """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added: looked up
-        in a dense map of rows for a small table."""
+    def slots_of(self, rows: np.ndarray, pairs: Pairs) -> np.ndarray:
+        """The slots in ``pairs`` of the pairs of rows (``rows``: (2, m), -1 where a body
+        is not in the table, which raises :class:`UnknownBody`), new ones added: looked up
+        in a dense map of rows for a small table (a row and a column of -1 past its end,
+        which row -1 reads)."""
+        ra, rb = rows[0], rows[1]
         if self.rows > self.DENSE:
+            if rows.min() < 0:
+                raise UnknownBody
             return self.pair_slots(ra, rb, pairs)
         if not hasattr(self, "_pairmap"):
-            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int32)
+            self._pairmap = np.full((self.rows + 1, self.rows + 1), -1, dtype=np.int32)
         slots = self._pairmap[ra, rb]
         if slots.min() < 0:
+            if rows.min() < 0:
+                raise UnknownBody
             new = slots < 0
             slots[new] = self.pair_slots(ra[new], rb[new], pairs)
             self._pairmap[ra[new], rb[new]] = slots[new]

@@ -271,6 +271,8 @@ def _alignment_problem() -> str | None:
         return "cpArbiter.body_b does not follow body_a"
     if p.offsetof("cpContact", "r2") <= p.offsetof("cpContact", "r1"):
         return "cpContact.r2 does not follow r1"
+    if p.offsetof("cpContact", "jtAcc") != p.offsetof("cpContact", "jnAcc") + 8:
+        return "cpContact.jtAcc does not follow jnAcc"
     return None
 
 
