@@ -439,7 +439,7 @@ class Reader:
     def floats(self) -> np.ndarray:
         if self.span is None:
             return np.zeros((self.shape[0], 0))
-        return self.span.f64[self.fi]
+        return self.span.f64.take(self.fi)
 
     def both(self) -> tuple[np.ndarray, np.ndarray]:
         """``floats()`` and ``pointers()``, in one gather where pointers are 8 bytes."""
@@ -447,14 +447,14 @@ class Reader:
             return self.floats(), self.pointers()
         if self._all is None:
             self._all = np.concatenate([self.fi, self.pi])
-        out = self.span.u64[self._all]
+        out = self.span.u64.take(self._all)
         nf = len(self.fi)
         return out[:nf].view(np.float64), out[nf:]
 
     def pointers(self) -> np.ndarray:
         if self.span is None:
             return np.zeros((self.shape[1], 0), dtype=np.uint64)
-        out = self.span.ptr[self.pi]
+        out = self.span.ptr.take(self.pi)
         return out if out.dtype == np.uint64 else out.astype(np.uint64)
 
 
