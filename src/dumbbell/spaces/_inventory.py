@@ -185,8 +185,9 @@ class Table:
     #: each: 16 MB at most).
     DENSE = 2048
     #: Most entries of the map from a body's address to its row (4 bytes each: 8 MB at
-    #: most): one entry every 16 bytes from the lowest body to the highest; farther
-    #: apart, rows are searched for in the sorted addresses.
+    #: most): one entry every 2**k bytes from the lowest body to the highest (2**k at most
+    #: a body's size: 256 bytes); farther apart, rows are searched for in the sorted
+    #: addresses.
     MAP = 1 << 21
 
     def rows_of(self, at: np.ndarray) -> np.ndarray:
@@ -204,13 +205,15 @@ class Table:
 
     def _address_map(self) -> tuple[int, int, np.ndarray] | None:
         """(lo, shift, map): the row of the body at address a is ``map[(a - lo) >>
-        shift]`` (-1 where no body of the table is). A body's struct is more than 16
-        bytes long, so that no other live body's address falls on a table body's entry; the
-        first and the last entry hold no body. None when the map would pass :data:`MAP`."""
+        shift]`` (-1 where no body of the table is). An entry covers 2**shift bytes, at most
+        a body's struct: two live bodies' addresses are at least that far apart, so that no
+        other live body's address falls on a table body's entry (and the map is small
+        enough to stay in the caches); the first and the last entry hold no body. None when
+        the map would pass :data:`MAP`."""
         if not self.rows:
             return None
         at = self.at.astype(np.int64)
-        shift = 4 if not np.any((at - at.min()) % 16) and mem.size("body") > 16 else 3
+        shift = max(3, mem.size("body").bit_length() - 1)
         lo = int(at.min()) - (1 << shift)
         entries = ((int(at.max()) - lo) >> shift) + 2
         if entries > self.MAP:
