@@ -107,10 +107,10 @@ def large() -> tuple[object, float]:
 SPACES = {"pyramid": ("box2d_pyramid", pyramid), "large": ("the large space", large)}
 
 
-def cost(steps: int, repeat: int, which: str = "pyramid", block: int = 10) -> None:
+def cost(steps: int, repeat: int, space: str = "pyramid", block: int = 10) -> None:
     from dumbbell import spaces
 
-    name, make = SPACES[which]
+    name, make = SPACES[space]
     base, dt = make()
     bare_t: list[float] = []
     with_t: list[float] = []
@@ -146,7 +146,7 @@ def cost(steps: int, repeat: int, which: str = "pyramid", block: int = 10) -> No
     print(f"  space.step + ledger   {both * 1e3:.3f} ms")
     print(f"  ledger                {(both - step) * 1e3:.3f} ms  = "
           f"{statistics.median(ratios):.2f} x space.step (quartiles {q[0]:.2f}-{q[2]:.2f})")
-    if which != "pyramid":
+    if space != "pyramid":
         return
     calls = []
     for _ in range(50):
