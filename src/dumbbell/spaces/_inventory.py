@@ -273,43 +273,65 @@ def _per_dt(t: Any, name: str, dt: float, make: Callable[[], np.ndarray]) -> np.
 
 class Pairs:
     """Running contact work, and gravity's part of the position correction, per pair of
-    bodies (stable ids). A pair's slot is given when it first touches and never moves."""
+    bodies (stable ids). A pair's slot is given when it first touches and never moves.
+
+    ``keys``, ``work`` and ``push`` are the first slots of buffers that grow by doubling
+    (pairs come a few at a time, step after step); the sorted keys a search needs are
+    sorted again only when a search comes after pairs were added."""
 
     #: Most keys looked up one by one in a dict (more are searched for in the sorted keys).
     FEW = 32
 
     def __init__(self) -> None:
-        self.keys = np.zeros(0, dtype=np.int64)      # by slot
-        self.sorted = np.zeros(0, dtype=np.int64)    # keys, sorted
+        self._bufs = (np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
+        self.keys, self.work, self.push = self._bufs  # by slot
+        self.sorted = np.zeros(0, dtype=np.int64)    # keys, sorted (when a search needs it)
         self.slot_of = np.zeros(0, dtype=np.int64)   # slot of each sorted key
         self.slot: dict[int, int] = {}               # key -> slot
-        self.work = np.zeros(0)
-        self.push = np.zeros(0)
 
     def lookup(self, keys: np.ndarray) -> np.ndarray:
         """The slots of ``keys`` (-1 where new)."""
         if len(keys) <= self.FEW:
             slot = self.slot
             return np.array([slot.get(k, -1) for k in keys.tolist()], dtype=np.int64)
-        if not len(self.sorted):
+        if not len(self.keys):
             return np.full(len(keys), -1, dtype=np.int64)
+        if len(self.sorted) != len(self.keys):  # pairs added since the last search
+            order = np.argsort(self.keys, kind="stable")
+            self.sorted, self.slot_of = self.keys[order], order
         pos = np.minimum(np.searchsorted(self.sorted, keys), len(self.sorted) - 1)
         return np.where(self.sorted[pos] == keys, self.slot_of[pos], -1)
 
     def slots(self, keys: np.ndarray) -> np.ndarray:
         """The slots of ``keys``, adding the new ones (in the order of their keys)."""
+        if len(keys) <= self.FEW:  # a few: in Python
+            slot = self.slot
+            listed = keys.tolist()
+            fresh = sorted({k for k in listed if k not in slot})
+            if fresh:
+                self._add(fresh)
+            return np.array([slot[k] for k in listed], dtype=np.int64)
         found = self.lookup(keys)
         if found.min(initial=0) >= 0:
             return found
-        fresh = np.unique(keys[found < 0])
-        self.slot.update(zip(fresh.tolist(), range(len(self.keys), len(self.keys) + len(fresh)),
-                             strict=True))
-        self.keys = np.concatenate([self.keys, fresh])
-        self.work = np.concatenate([self.work, np.zeros(len(fresh))])
-        self.push = np.concatenate([self.push, np.zeros(len(fresh))])
-        order = np.argsort(self.keys, kind="stable")
-        self.sorted, self.slot_of = self.keys[order], order
+        self._add(np.unique(keys[found < 0]).tolist())
         return self.lookup(keys)
+
+    def _add(self, fresh: list[int]) -> None:
+        """Give the new keys ``fresh`` (sorted) the next slots."""
+        k, f = len(self.keys), len(fresh)
+        if k + f > len(self._bufs[0]):
+            cap = max(64, 2 * (k + f))
+            grown = []
+            for old in self._bufs:
+                buf = np.zeros(cap, dtype=old.dtype)
+                buf[:k] = old[:k]
+                grown.append(buf)
+            self._bufs = (grown[0], grown[1], grown[2])
+        keys, work, push = self._bufs
+        keys[k: k + f] = fresh
+        self.slot.update(zip(fresh, range(k, k + f), strict=True))
+        self.keys, self.work, self.push = keys[: k + f], work[: k + f], push[: k + f]
 
 
 class Members(NamedTuple):
