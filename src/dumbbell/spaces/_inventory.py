@@ -371,6 +371,9 @@ class Group:
         self.work, self.extra, self.pot, self.kin_a, self.kin_b = (z.copy() for _ in range(5))
         self.settings = self.before.floats().copy() if self.spring else None
         self.funcs = self.before.pointers().copy() if self.spring else None
+        # The same bytes are the same settings (unless one is NaN, never equal to itself).
+        self._same = None if not self.spring or np.isnan(self.settings).any() else (
+            self.settings.tobytes(), self.funcs.tobytes())
         if kind == "spring":
             self.anchor = np.array(
                 [[c.anchor_a[0] - c.a.center_of_gravity[0],
@@ -381,8 +384,13 @@ class Group:
 
     def changed(self) -> bool:
         """A spring's settings or force function changed since the build."""
-        return self.spring and not (np.array_equal(self.before.floats(), self.settings)
-                                    and np.array_equal(self.before.pointers(), self.funcs))
+        if not self.spring:
+            return False
+        settings, funcs = self.before.both()
+        if self._same is not None and (settings.tobytes(), funcs.tobytes()) == self._same:
+            return False
+        return not (np.array_equal(settings, self.settings)
+                    and np.array_equal(funcs, self.funcs))
 
 
 class Field(NamedTuple):
