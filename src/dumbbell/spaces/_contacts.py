@@ -12,12 +12,13 @@ work of every contact impulse on the bodies' relative motion, J . (u0 + u1) / 2 
 contact point, is summed per pair of bodies, and per body.
 
 A pyramid's step has hundreds of arbiters, and each numpy call costs microseconds when the
-solver has just run: the reads are two gathers (every field an arbiter needs, then every
-field of both its contacts, each a row of consecutive words of :func:`._memory.memory`,
-so that no index is built per field and no span is found first), the arithmetic runs on
-both contacts at once, and the rows of an arbiter's bodies and its pair's slot are found
-in dense maps. Pointers are read as 8 bytes (:func:`._memory.platform_problem` sends
-other platforms to the public-API ledger).
+solver has just run: the reads are two gathers from :func:`._memory.memory` (every word an
+arbiter needs, then each field of both its contacts; an arbiter with one contact reads its
+second from a contact of zeros, which adds nothing), the arithmetic runs on both contacts
+at once, and the rows of an arbiter's bodies and its pair's slot are found in dense maps,
+or kept from the last step while the same arbiters touch the same bodies (about half the
+steps of the awake pyramid). Pointers are read as 8 bytes (:func:`._memory.platform_problem` sends other
+platforms to the public-API ledger).
 """
 
 from __future__ import annotations

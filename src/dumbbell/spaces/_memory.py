@@ -383,9 +383,8 @@ class Memory:
 
     The contacts' structs move every step (Munk2D takes each step's contacts from fresh
     buffers): indexed here, their reads need no span found first (two numpy calls fewer
-    each, and no view made again when they land outside the last one). :meth:`window`
-    views the same words as rows of ``k`` consecutive words, so that one gather reads every
-    field a struct's reader needs. Only 8-byte platforms get here
+    each, and no view made again when they land outside the last one): one ``take`` reads
+    what a step needs of all its arbiters, another of all its contacts. Only 8-byte platforms get here
     (:func:`platform_problem`)."""
 
     LOWEST = _LOWEST
@@ -398,14 +397,6 @@ class Memory:
         self.u64 = raw
         self.i64 = raw.view(np.int64)
         self.f64 = raw.view(np.float64)
-
-    def window(self, first: int, k: int, floats: bool = False) -> np.ndarray:
-        """Rows of ``k`` words (int64, or float64 with ``floats``): row ``w`` holds words
-        ``w + first`` to ``w + first + k`` (``first``: a field's word in its struct, so that
-        row ``(a - LOWEST) >> 3`` holds the fields of the struct at ``a``)."""
-        base = (self.f64 if floats else self.i64)[first:]
-        return np.lib.stride_tricks.as_strided(base, shape=(len(base) - k, k), strides=(8, 8),
-                                               writeable=False)
 
 
 @cache
