@@ -110,6 +110,14 @@ def parameters(obj: Any) -> list[str]:
     ``self``/``cls``, a class's constructor's; ``*args`` and ``**kwargs`` spelt so."""
     try:
         signature = inspect.signature(obj)
+        if inspect.isclass(obj):
+            # A class whose own __new__ passes *args, **kwargs on to its __init__ (a ledger
+            # that is one per space) is made with the __init__'s parameters.
+            init = next((c.__init__ for c in obj.__mro__ if "__init__" in vars(c)
+                         and c.__module__.startswith("dumbbell")), None)
+            kinds = {p.kind for p in signature.parameters.values()}
+            if init is not None and inspect.Parameter.VAR_POSITIONAL in kinds:
+                signature = inspect.signature(init)
     except (TypeError, ValueError):
         return []
     out = []
