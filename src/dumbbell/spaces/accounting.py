@@ -39,6 +39,7 @@ from ..model.energy import (
     spring_potential,
     translational_ke,
 )
+from .units import UNNAMED
 
 __all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
@@ -672,7 +673,7 @@ class _Sampler:
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
     momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
-    space's ``units`` (length, mass, time), SI unless :func:`energy` was told.
+    space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not).
 
     Parameters
     ----------
@@ -686,8 +687,8 @@ class BodyEnergy:
         (px, py) (kg m/s).
     L_about : float
         Angular momentum about the point asked for (kg m²/s).
-    units : tuple of str, default ('m', 'kg', 's')
-        (length, mass, time).
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
 
     Examples
     --------
@@ -700,7 +701,7 @@ class BodyEnergy:
     >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
     ...                              200.0, 0.0)
     >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space)
+    >>> e = spaces.energy(space, units="m")
     >>> e.bodies[0]
     BodyEnergy('body 0': K_trans = 0 J, K_rot = 0 J, U_g = 0.98 J, momentum = (0, 0) kg m/s)
     """
@@ -713,7 +714,7 @@ class BodyEnergy:
     U_g: float
     momentum: tuple[float, float]
     L_about: float
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     def __repr__(self) -> str:
         from .units import shown
@@ -733,8 +734,8 @@ class SpringEnergy:
         Its pymunk class.
     U : float
         Its potential energy (J).
-    units : tuple of str, default ('m', 'kg', 's')
-        (length, mass, time).
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
 
     Examples
     --------
@@ -747,7 +748,7 @@ class SpringEnergy:
     >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
     ...                              200.0, 0.0)
     >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space)
+    >>> e = spaces.energy(space, units="m")
     >>> e.springs[0]
     SpringEnergy('DampedSpring 0', DampedSpring: U = 3.35238484 J)
     """
@@ -755,7 +756,7 @@ class SpringEnergy:
     subject: str
     kind: str
     U: float
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     def __repr__(self) -> str:
         from .units import shown
@@ -765,7 +766,7 @@ class SpringEnergy:
 
 @dataclass(frozen=True, repr=False)
 class SpaceEnergy:
-    """Energy and momentum of a space's dynamic bodies (SI units, or the ``units``
+    """Energy and momentum of a space's dynamic bodies (in the ``units``
     :func:`energy` was given: (length, mass, time)).
 
     K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
@@ -792,8 +793,8 @@ class SpaceEnergy:
         accounting does not know.
     notes : tuple of str
         What else to know.
-    units : tuple of str, default ('m', 'kg', 's')
-        (length, mass, time).
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
 
     Examples
     --------
@@ -806,7 +807,7 @@ class SpaceEnergy:
     >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
     ...                              200.0, 0.0)
     >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space)
+    >>> e = spaces.energy(space, units="m")
     >>> round(e.U_g, 6), round(e.U_spring, 6), round(e.E, 6)          # J
     (0.98, 3.352385, 4.332385)
     >>> e.momentum, e.skipped, e.unknown, e.notes
@@ -830,7 +831,7 @@ class SpaceEnergy:
     skipped: tuple[Skipped, ...]
     unknown: tuple[Skipped, ...]
     notes: tuple[str, ...]
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     @property
     def complete(self) -> bool:
@@ -844,10 +845,11 @@ class SpaceEnergy:
 
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
-           units: Any = ("m", "kg", "s")) -> SpaceEnergy:
-    """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
+           units: Any = None) -> SpaceEnergy:
+    """Energy and momentum of ``space`` now; angular momentum also about ``about``.
     ``units`` names the space's units as the recorder takes them (the length unit alone,
-    'px', or (length, mass, time)): the values are the same, their reprs carry them. See
+    'px' or 'm', or (length, mass, time); None: not named, and the reprs say "energy units",
+    never J for what may be pixels): the values are the same, their reprs carry them. See
     the module docstring for what is counted.
 
     Parameters
@@ -856,9 +858,9 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
         Any space.
     about : tuple of float, default (0.0, 0.0)
         The point (length units) the angular momentum ``L_about`` is taken about.
-    units : str or tuple of str, default ('m', 'kg', 's')
-        The space's units as the recorder takes them: the length unit alone ('px'), or
-        (length, mass, time).
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
 
     Returns
     -------
@@ -881,10 +883,10 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
     >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
     ...                              200.0, 0.0)
     >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space)
+    >>> e = spaces.energy(space, units="m")
     >>> e
-    SpaceEnergy(E = 4.33238484 J: K_trans = 0, K_rot = 0, U_g = 0.98, U_spring = 3.35238484 J; momentum = (0, 0) kg m/s, L_cm = 0 kg m²/s; 1 bodies, 1 springs, complete = True)
-    >>> spaces.energy(space, units="px").E             # the same number, in the space's units
+    SpaceEnergy(E = 4.33238484 J: K_trans = 0, K_rot = 0, U_g = 0.98, U_spring = 3.35238484 J; momentum = (0, 0) kg m/s, L_cm = 0 kg m²/s; 1 body, 1 spring, complete = True)
+    >>> spaces.energy(space).E          # units not named: the same number, no J in its repr
     4.33238484...
     """
     from ..model import args

@@ -186,16 +186,11 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
 
 
 def length_unit(units: Any) -> str:
-    """The name of the space's length unit for messages: ``units`` checked (a short str), or
-    'units' when None."""
-    if units is None:
-        return "units"
-    text = args.text(units, "units", "a str naming the length unit, such as 'm' or 'px'")
-    if not 0 < len(text) <= 12 or not text.isprintable() or text != text.strip():
-        raise UsageError(f"units = {args.show(units)}: must be a short name of the "
-                              "length unit (1 to 12 printable characters, e.g. 'm' or 'px')",
-                              param="units")
-    return text
+    """The name of the space's length unit for messages: ``units`` checked as
+    :func:`.units.check_units` checks it ('units' when None)."""
+    from .units import check_units
+
+    return check_units(units)[0]
 
 
 def percent(fraction: float) -> str:
@@ -205,10 +200,12 @@ def percent(fraction: float) -> str:
 
 def energy_units(unit: str) -> tuple[str, str]:
     """The units of energy and power of a space whose length unit is ``unit`` (mass in kg,
-    time in s, as pymunk programs take them): ('J', 'W') in metres."""
-    if unit == "m":
-        return "J", "W"
-    return f"kg {unit}²/s²", f"kg {unit}²/s³"
+    time in s, as pymunk programs take them; 'units', the unnamed length, gives 'energy
+    units'): ('J', 'W') in metres."""
+    from .units import SI, UNNAMED, energy_unit, power_unit
+
+    u = UNNAMED if unit == UNNAMED[0] else (unit, SI[1], SI[2])
+    return energy_unit(u), power_unit(u)
 
 
 # --- what cannot be stepped ------------------------------------------------------------------

@@ -60,9 +60,9 @@ class HeatCounter:
     ----------
     space : pymunk.Space
         The space to count.
-    units : str or tuple of str, default ('m', 'kg', 's')
-        The space's units as the recorder takes them: the length unit alone ('px'), or
-        (length, mass, time).
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
 
     Raises
     ------
@@ -89,7 +89,7 @@ class HeatCounter:
     >>> heat.detach()
     """
 
-    def __init__(self, space: Any, units: Any = ("m", "kg", "s")) -> None:
+    def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
         from .units import check_units
 
@@ -151,10 +151,10 @@ class HeatCounter:
 
     def __repr__(self) -> str:
         from .._display import one_line
-        from .units import energy_unit
+        from .units import UNNAMED, energy_unit
 
         state = "attached" if self.attached else (self.stopped or "not attached")
-        unit = energy_unit(self.__dict__.get("units", ("m", "kg", "s")))
+        unit = energy_unit(self.__dict__.get("units", UNNAMED))
         return one_line(f"HeatCounter({state}, total={self.total:.6g} {unit})")
 
     def detach(self) -> None:

@@ -75,7 +75,7 @@ from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
-from .units import SI, check_units, energy_unit
+from .units import check_units, energy_unit
 
 __all__ = ["Ledger"]  # Balance and Term: balance.py
 
@@ -118,7 +118,7 @@ class Ledger(Changes):
     ``tolerance`` (relative to the energy scale) is what ``complete`` allows for the closure
     and for anything unattributed or changed by the program. ``units`` names the space's
     units as the recorder takes them (the length unit alone, 'px', or (length, mass, time));
-    energies are printed in them (J in SI). See the module docstring for the terms. A copy
+    energies are printed in them (J in SI; "energy units" when not named). See the module docstring for the terms. A copy
     or a pickle of a ledger holds its account so far and does not count; a copy of the
     space has no ledger attached.
 
@@ -128,9 +128,9 @@ class Ledger(Changes):
         The space to count.
     tolerance : float, default 1e-6
         What ``complete`` allows, relative to the energy scale.
-    units : str or tuple of str, default ('m', 'kg', 's')
-        The space's units as the recorder takes them: the length unit alone ('px'), or
-        (length, mass, time).
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
 
     Raises
     ------
@@ -148,7 +148,7 @@ class Ledger(Changes):
     >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
     ...                              200.0, 0.0)
     >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> ledger = spaces.Ledger(space)                 # counts every later space.step
+    >>> ledger = spaces.Ledger(space, units="m")      # counts every later space.step
     >>> for _ in range(60):
     ...     space.step(1 / 600)
     >>> balance = ledger.balance()
@@ -167,7 +167,7 @@ class Ledger(Changes):
                 return super().__new__(PublicLedger)
         return super().__new__(cls)
 
-    def __init__(self, space: Any, tolerance: float = 1e-6, units: Any = SI) -> None:
+    def __init__(self, space: Any, tolerance: float = 1e-6, units: Any = None) -> None:
         from ..model import args
 
         self.space = args.space(space)

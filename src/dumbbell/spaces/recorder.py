@@ -540,8 +540,8 @@ class Recorder:
         The time the strip shows.
     y_up : bool or None, default None
         Which way y points on screen; None: as the program's window does.
-    units : str or tuple of str, default ('m', 'kg', 's')
-        The space's units.
+    units : str or tuple of str or None, default None
+        The space's units ('m', 'px' or (length, mass, time)); None: not named.
     reference : str or float, default 'start'
         Where the potentials are counted from.
     t0 : float, default 0.0
@@ -581,7 +581,7 @@ class Recorder:
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
                  camera: Any = "auto", span: float | None = None, y_up: bool | None = None,
-                 units: str | tuple[str, str, str] = SI, reference: Any = "start",
+                 units: str | tuple[str, str, str] | None = None, reference: Any = "start",
                  t0: float = 0.0,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
         import pymunk
