@@ -185,6 +185,8 @@ class Solver:
     <Trajectory textbook-1d: solver=verlet, dt=0.001 s, t=0..0.01 s, 3 samples, 0 impacts, verdict: ok>
     >>> verlet.swing(1.0)             # the largest energy swing of a stable run at w*dt = 1
     1.0
+    >>> verlet.drift(1.0, 1000) is None           # a symplectic step: no steady drift
+    True
     >>> exact = METHODS["exact"]
     >>> exact.truth_for(scene), verlet.truth_for(scene), exact.catch_depth(scene)
     (True, False, None)
@@ -331,7 +333,20 @@ class Solver:
         """How far (relative) the vibration energy has moved after ``steps`` stable steps
         at w*dt = ``ratio``, for a step that loses or gains energy steadily rather than
         swinging about it (classic Runge-Kutta loses it: 1 - |R(i h)|^(2 steps)); None for a
-        step that keeps it (the default). The accuracy theory reads it beside :meth:`swing`."""
+        step that keeps it (the default). The accuracy theory reads it beside :meth:`swing`.
+
+        Parameters
+        ----------
+        ratio : float
+            w*dt, w = sqrt(k/mu).
+        steps : float
+            Stable steps taken.
+
+        Returns
+        -------
+        float or None
+            The drift (relative); None for a step that keeps the energy.
+        """
         return None
 
     @classmethod
