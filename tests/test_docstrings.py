@@ -4,11 +4,9 @@ section runs as a doctest, in a fresh folder, against the installed package."""
 
 from __future__ import annotations
 
-import contextlib
 import doctest
 import inspect
 import io
-import os
 import sys
 
 import pytest

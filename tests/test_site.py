@@ -110,6 +110,15 @@ def test_every_link_and_anchor_of_the_site_resolves(built, pages):
     assert broken == []
 
 
+def test_no_sphinx_role_is_left_in_a_rendered_docstring(built):
+    """``:func:`energy``` in a docstring shows as a code span (linked where the reference has
+    the name), never as the role's text."""
+    left = [f"{path.relative_to(built)}: {m.group(0)}" for path in built.rglob("*.html")
+            for m in re.finditer(r":(class|func|meth|attr|data|exc|mod|obj):<code>",
+                                 path.read_text(encoding="utf-8"))]
+    assert left == []
+
+
 def test_the_readme_links_into_the_docs(pages, built):
     readme = pages[built / "readme.html"]
     docs = {Path(urlsplit(link).path).stem for link in readme.links

@@ -201,6 +201,49 @@ def dynamic_methods() -> list[tuple[str, str, object]]:
     return out
 
 
+def run_time_signatures() -> list[tuple[str, object]]:
+    """(path, object) of each public function or class whose parameters the source does not
+    show: a function given its options' keywords as ``__signature__`` when its module runs
+    (``dumbbell.compare(scene, **options)``), a class made by ``__new__`` or a NamedTuple
+    (no ``__init__`` in its source)."""
+    out = []
+    for paths in public_names().values():
+        for path in paths:
+            module = importlib.import_module(_module_of(path))
+            obj = module
+            for part in path[len(module.__name__) + 1:].split("."):
+                obj = getattr(obj, part, None)
+            set_at_run_time = inspect.isfunction(obj) and "__signature__" in vars(obj)
+            no_init = (inspect.isclass(obj) and "<locals>" not in obj.__qualname__
+                       and not any("__init__" in vars(k) for k in obj.__mro__[:-1]
+                                   if k.__module__.startswith("dumbbell"))
+                       and ("__new__" in vars(obj) or hasattr(obj, "_fields")))
+            if set_at_run_time or no_init:
+                out.append((path, obj))
+    return out
+
+
+def _griffe_parameters(griffe, signature: inspect.Signature):
+    """Griffe's parameters for ``signature`` (annotations and defaults as source text)."""
+    kinds = {inspect.Parameter.POSITIONAL_ONLY: griffe.ParameterKind.positional_only,
+             inspect.Parameter.POSITIONAL_OR_KEYWORD: griffe.ParameterKind.positional_or_keyword,
+             inspect.Parameter.VAR_POSITIONAL: griffe.ParameterKind.var_positional,
+             inspect.Parameter.KEYWORD_ONLY: griffe.ParameterKind.keyword_only,
+             inspect.Parameter.VAR_KEYWORD: griffe.ParameterKind.var_keyword}
+
+    def text(annotation):
+        if annotation is inspect.Parameter.empty:
+            return None
+        if isinstance(annotation, str):
+            return annotation
+        return getattr(annotation, "__forward_arg__", None) or inspect.formatannotation(annotation)
+
+    return griffe.Parameters(*[
+        griffe.Parameter(p.name, annotation=text(p.annotation), kind=kinds[p.kind],
+                         default=None if p.default is p.empty else repr(p.default))
+        for p in signature.parameters.values()])
+
+
 def _inspected(griffe, name: str, obj, parts):
     """Griffe's object for ``obj`` inspected at run time under ``name``: the inspector takes
     an object defined elsewhere for an alias, so ``parts`` (the object and its functions)
@@ -252,6 +295,19 @@ def _griffe_extension():
                 owner = pkg[path.removeprefix("dumbbell.")]
                 inspected.parent = owner
                 owner.set_member(name, inspected)
+            for path, obj in run_time_signatures():
+                found = pkg[path.removeprefix("dumbbell.")]
+                if inspect.isclass(obj):
+                    # The class's call as an __init__ (hidden by the filters; its
+                    # parameters are the class's, as merge_init_into_class shows them).
+                    params = list(inspect.signature(obj).parameters.values())
+                    self_ = inspect.Parameter("self", inspect.Parameter.POSITIONAL_ONLY)
+                    init = griffe.Function("__init__", parameters=_griffe_parameters(
+                        griffe, inspect.Signature([self_, *params])))
+                    init.parent = found
+                    found.set_member("__init__", init)
+                else:
+                    found.parameters = _griffe_parameters(griffe, inspect.signature(obj))
 
     return LazyClasses
 
@@ -357,3 +413,58 @@ def on_page_markdown(markdown, page, config, files):
     if not (ROOT / repo_page).is_file():
         return markdown
     return rewrite(markdown, repo_page, src)[0]
+
+
+#: A Sphinx role left in a rendered docstring: ``:func:`~dumbbell.compare``` as
+#: mkdocstrings renders it (the role's name before the code span).
+_ROLE = re.compile(r":(?:class|func|meth|attr|data|exc|mod|obj):<code>(~?)\.?([\w.]+)</code>")
+
+
+def _targets() -> tuple[dict[str, str], dict[str, list[str]]]:
+    """Each rendered path -> its reference page, and each last name -> the paths ending in it."""
+    where = {path: page for page, paths in public_names().items() for path in paths}
+    by_name: dict[str, list[str]] = {}
+    for path in where:
+        by_name.setdefault(path.rsplit(".", 1)[-1], []).append(path)
+    return where, by_name
+
+
+def _resolve(target: str, where: dict[str, str], by_name: dict[str, list[str]]) -> str | None:
+    """The rendered path a role's target names: the path itself, what ``dumbbell.NAME`` is,
+    a method of a rendered class, or the one rendered name ending as the target does."""
+    if target in where:
+        return target
+    if target.startswith("dumbbell."):
+        module_name, _, rest = target.partition(".")
+        obj = importlib.import_module(module_name)
+        try:
+            for part in rest.split("."):
+                obj = getattr(obj, part)
+        except AttributeError:
+            obj = None
+        if obj is not None and (inspect.isclass(obj) or inspect.isfunction(obj)):
+            path = f"{obj.__module__}.{obj.__qualname__}"
+            if path in where:
+                return path
+    ends = [p for p in by_name.get(target.rsplit(".", 1)[-1], ())
+            if p == target or p.endswith("." + target)]
+    return ends[0] if len(ends) == 1 else None
+
+
+def on_page_content(html, page, config, files):
+    """On the API reference, a Sphinx role of a docstring (``:func:`energy```) becomes a code
+    span, linked to the name's entry when the reference renders it (``~`` shows the last
+    name only, as Sphinx does)."""
+    if not page.file.src_uri.startswith("reference/"):
+        return html
+    where, by_name = _targets()
+
+    def fix(match: re.Match) -> str:
+        tilde, target = match.groups()
+        shown = target.rsplit(".", 1)[-1] if tilde else target
+        path = _resolve(target, where, by_name)
+        if path is None:
+            return f"<code>{shown}</code>"
+        return f'<a href="{where[path]}.html#{path}"><code>{shown}</code></a>'
+
+    return _ROLE.sub(fix, html)
