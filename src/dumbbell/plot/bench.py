@@ -205,7 +205,8 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
     ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
     >>> ax = dumbbell.plot.convergence(result)
-    >>> ax.figure.savefig("convergence.png")
+    >>> ax.get_ylabel()
+    'largest position error over [0, 1 s] [m]'
     """
     result, ax = _checked(result, ax)
     own = ax is None

@@ -80,7 +80,8 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
     >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
     ...                           window=1.0)
     >>> ax = dumbbell.plot.compare_positions(result)
-    >>> ax.figure.savefig("compare-positions.png")
+    >>> ax.get_ylabel()
+    'x_B [m]'
     """
     result, ax = _checked(result, ax)
     if ax is not None:
@@ -215,7 +216,8 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
     ...                           window=1.0)
     >>> ax = dumbbell.plot.compare_energy(result)
-    >>> ax.figure.savefig("compare-energy.png")
+    >>> ax.get_ylabel()
+    'E(t) / E(0) - 1 [1]'
     """
     result, ax = _checked(result, ax)
     own = ax is None

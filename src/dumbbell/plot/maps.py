@@ -93,7 +93,8 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e4, 2e6], "dt": [1e-5, 1e-4, 1e-3]},
     ...                         t_end=0.2, workers=1)
     >>> ax = dumbbell.plot.sweep_map(result)
-    >>> ax.figure.savefig("sweep-map.png")
+    >>> ax.get_ylabel()
+    'dt, time step [s]'
     """
     result = args.instance(result, "result", SweepResult, "a SweepResult (from dumbbell.sweep)")
     ax = args.axes(ax)

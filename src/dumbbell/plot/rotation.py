@@ -97,7 +97,8 @@ def rotation(s: Series, ax: Any = None) -> Any:
     >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
     >>> runs = series(scene, dt=1e-4, t_end=0.5, stiffnesses=(200.0, 2000.0))
     >>> ax = dumbbell.plot.rotation(runs)
-    >>> ax.figure.savefig("rotation.png")
+    >>> ax.get_ylabel()
+    'E [J]'
     """
     from ..model import args
 

@@ -170,7 +170,8 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     >>> scene = dumbbell.load_scene(scenes_dir() / "topple-2d.toml")
     >>> run = dumbbell.simulate(scene, dt=1e-4, every=1, t_end=0.45)
     >>> axes = dumbbell.plot.topple(closed_form(scene), measure(run))
-    >>> axes[0].figure.savefig("topple.png")
+    >>> axes[0].get_ylabel()
+    'tilt θ [degrees]'
     """
     from ..analysis.topple import ToppleClosedForm, ToppleMeasure
     from ..model import args
@@ -262,7 +263,8 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
     >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
     >>> run = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
     >>> ax = dumbbell.plot.contact_momentum(about_contact(run), solver="exact")
-    >>> ax.figure.savefig("contact.png")
+    >>> ax.get_ylabel()
+    'angular momentum [kg m²/s]'
     """
     from ..analysis.contact import ContactMomentum
     from ..model import args

@@ -349,7 +349,8 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
     >>> traj = dumbbell.simulate(scene, dt=1e-4, t_end=1.0)
     >>> ax = dumbbell.plot.energy(traj)              # positions, plane, energies, L_cm
-    >>> ax.figure.savefig("energy.png")
+    >>> ax.get_ylabel()
+    'E [J]'
     """
     traj, ax, window = _checked(traj, ax, window)
     cols = traj.columns
