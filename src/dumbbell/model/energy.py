@@ -491,7 +491,7 @@ def partition_from_terms(
     split the dumbbell's way, which the general accounting does not know: K_rot and K_vib of
     the axis from :func:`partition_2d`, and K_spin, the particles' own spin (the bodies' K_rot
     when each particle is a body; the discs' share of the one body when rigid). Equal to
-    :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces.md)."""
+    :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces-reference.md)."""
     parts = {name: terms[name] for name in ("K_cm", "U_g", "U_spring", "E")}
     if scene.system.dimensions == 1:
         parts["K_int"] = terms["K_int"]
