@@ -223,6 +223,24 @@ def run_time_signatures() -> list[tuple[str, object]]:
     return out
 
 
+def private_bases() -> dict[str, set[str]]:
+    """Public class path -> the names of its bases defined in a private module (a reader
+    of the reference cannot look them up: ``Ledger``'s ``_changes.Changes``)."""
+    out = {}
+    for paths in public_names().values():
+        for path in paths:
+            module = importlib.import_module(_module_of(path))
+            obj = getattr(module, path[len(module.__name__) + 1:].split(".")[0], None)
+            if not inspect.isclass(obj) or path != f"{module.__name__}.{obj.__name__}":
+                continue
+            names = {b.__name__ for b in obj.__bases__
+                     if any(part.startswith("_") for part in b.__module__.split("."))
+                     and b.__module__ != "builtins"}
+            if names:
+                out[path] = names
+    return out
+
+
 def _griffe_parameters(griffe, signature: inspect.Signature):
     """Griffe's parameters for ``signature`` (annotations and defaults as source text)."""
     kinds = {inspect.Parameter.POSITIONAL_ONLY: griffe.ParameterKind.positional_only,
@@ -295,6 +313,9 @@ def _griffe_extension():
                 owner = pkg[path.removeprefix("dumbbell.")]
                 inspected.parent = owner
                 owner.set_member(name, inspected)
+            for path, names in private_bases().items():
+                found = pkg[path.removeprefix("dumbbell.")]
+                found.bases = [b for b in found.bases if str(b).rsplit(".", 1)[-1] not in names]
             for path, obj in run_time_signatures():
                 found = pkg[path.removeprefix("dumbbell.")]
                 if inspect.isclass(obj):
