@@ -54,7 +54,40 @@ class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
     the contact-steps counted. ``detach()`` stops counting; ``stopped`` says why counting
     stopped (None while it counts). ``units`` names the space's units as the recorder takes
-    them (its repr prints the total in them)."""
+    them (its repr prints the total in them).
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space to count.
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
+
+    Raises
+    ------
+    UsageError
+        A ``space`` that is not a pymunk Space, or units not allowed.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    >>> ball.position = (0.0, 1.0)
+    >>> floor = pymunk.Segment(space.static_body, (-1.0, 0.0), (1.0, 0.0), 0.01)
+    >>> ball_shape = pymunk.Circle(ball, 0.1)
+    >>> ball_shape.elasticity, floor.elasticity = 0.5, 1.0     # a bounce that loses energy
+    >>> space.add(ball, ball_shape, floor)
+    >>> heat = spaces.HeatCounter(space)
+    >>> for _ in range(1000):
+    ...     space.step(1e-3)
+    >>> heat.total > 0, heat.stopped                 # J, dissipated by the bounces
+    (True, None)
+    >>> heat.detach()
+    """
 
     def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
@@ -126,7 +159,10 @@ class HeatCounter:
 
     def detach(self) -> None:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are
-        the ones it had before the first counter attached."""
+        the ones it had before the first counter attached.
+
+
+        """
         self._look()
         d = self._dispatch()
         if d is not None:
