@@ -1,0 +1,256 @@
+"""dumbbell.spaces on programs written here the way pymunk users write them (issue 28's
+corpus, tests/outside_corpus.py): for each program, its energy terms against a hand
+computation; the ledger counting over the whole run and closing, or naming why not; each
+``program``, ``entered``, ``left`` and callback term against what the program did, measured
+by hand just before and just after it; the recorder drawing y as the program's window does,
+every dynamic body at least 4 px or named; the guard with a row for every constraint."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+
+import numpy as np
+import pymunk
+import pytest
+
+from .outside_corpus import PROGRAMS, hand_energy, run
+from .recorder_corpus import body_size, extent, frame, picture, scene_mask
+
+pytest.importorskip("pygame")
+
+NAMES = list(PROGRAMS)
+#: Kinds of terms that say what a program did (between steps or from a callback).
+DONE = ("program", "entered", "left", "unattributed")
+#: Drawn at least this many pixels across (issue 28).
+MIN_PX = 4
+
+#: What each program must have done in its run (kind, source prefix), so that the checks
+#: of its terms are not vacuous.
+DID = {
+    "pool_table": [("program", "program: body 0"), ("left", "body ")],
+    "car": [("program", "program: body ")],
+    "ragdoll": [("program", "program: body ")],
+    "cloth": [("entered", "body "), ("program", "program: constraints added or removed"),
+              ("program", "program: springs stretched by moved bodies"),
+              ("program", "program: body ")],
+    "gas": [("program", "program: body "), ("entered", "body "), ("left", "body ")],
+    "bumpers": [("entered", "body "), ("left", "body "), ("unattributed", "body ")],
+    "spawner": [("entered", "body "), ("left", "body "), ("program", "program: body "),
+                ("program", "program: constraints added or removed")],
+    "planet": [("program", "program: body 0"), ("entered", "body 30")],
+    "planet_declared": [("program", "program: body 0"), ("entered", "body 30")],
+    "conveyor": [("entered", "body "), ("left", "body ")],
+    "chain": [("program", "program: body ")],
+    "hammer": [("program", "program: body 0")],
+}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    cache = {}
+
+    def get(name):
+        if name not in cache:
+            cache[name] = run(name, tmp_path_factory.mktemp(name))
+        return cache[name]
+
+    return get
+
+
+def _by_source(balance, kinds=DONE) -> dict[tuple[str, str], float]:
+    out: dict[tuple[str, str], float] = {}
+    for t in balance.terms:
+        if t.kind in kinds:
+            out[(t.kind, t.source)] = out.get((t.kind, t.source), 0.0) + t.energy
+    return out
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_energy_terms_are_the_hand_computation(name, runs):
+    tape = runs(name)
+    assert len(tape.checkpoints) >= 2
+    for cp in tape.checkpoints:
+        hand, lib = cp.hand, cp.lib
+        for term in ("K_trans", "K_rot", "U_g", "U_spring", "E"):
+            h, got = getattr(hand, term), getattr(lib, term)
+            assert abs(got - h) <= 1e-12 * hand.size[term] + 1e-300, (cp.step, term, got, h)
+        for k in (0, 1):
+            assert abs(lib.momentum[k] - hand.momentum[k]) <= 1e-12 * hand.size["momentum"]
+        if hand.mass:
+            k_cm = 0.5 * (hand.momentum[0] ** 2 + hand.momentum[1] ** 2) / hand.mass
+            assert abs(lib.K_cm - k_cm) <= 1e-12 * hand.size["K_trans"] + 1e-300
+    moving = [cp for cp in tape.checkpoints if cp.hand.K_trans > 0]
+    assert moving, "nothing moved: the comparison says nothing"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_ledger_counts_over_the_whole_run(name, runs):
+    tape = runs(name)
+    b = tape.balance
+    assert "ledger" not in dict(b.unaccounted), dict(b.unaccounted).get("ledger")
+    assert b.steps == len(tape.dts)
+    assert b.t == pytest.approx(math.fsum(tape.dts), rel=1e-12)
+    # Its E(t) is the space's energy by hand at the end (the declared field's included).
+    end = tape.checkpoints[-1]
+    assert end.step == len(tape.dts)
+    assert abs(b.E - end.hand.E_total) <= 1e-9 * b.scale
+
+
+def _expected_unaccounted(tape) -> tuple[set[str], set[str]]:
+    """The sources the ledger must name as unaccounted, and those it may (at the edge of
+    its tolerance): what the program changed by more than the tolerance of the scale, and
+    bodies with a velocity_func whose potential was not declared."""
+    b = tape.balance
+    limit = b.tolerance * b.scale
+    must, may = set(), set()
+    for (kind, source), value in tape.events.items():
+        if kind in ("program", "unattributed"):
+            if abs(value) > 2 * limit:
+                must.add(source)
+            elif abs(value) > 0.5 * limit:
+                may.add(source)
+    if not tape.declared:
+        for body in tape.kept:
+            if body.velocity_func in tape.velocity_funcs:
+                must.add(tape.labels[id(body)])
+    return must, may
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_ledger_closes_or_names_the_cause(name, runs):
+    tape = runs(name)
+    b = tape.balance
+    assert type(b.complete) is bool
+    json.dumps({"complete": b.complete, "E": b.E, "closure": b.closure})
+    assert b.relative_closure <= 1e-6 and b.worst_step <= 1e-6
+    must, may = _expected_unaccounted(tape)
+    named = set(dict(b.unaccounted))
+    assert must <= named, sorted(must - named)[:10]
+    assert named <= must | may, sorted(named - must - may)[:10]
+    assert b.complete is (not named)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_what_the_program_did_is_each_term(name, runs):
+    tape = runs(name)
+    b = tape.balance
+    assert tape.unannounced == [], "the program added bodies it did not measure"
+    for kind, prefix in DID[name]:
+        assert any(k == kind and s.startswith(prefix) for k, s in tape.events), (kind, prefix)
+    found = _by_source(b)
+    wrong = {}
+    for key in found.keys() | tape.events.keys():
+        ledger, measured = found.get(key, 0.0), tape.events.get(key, 0.0)
+        if abs(ledger - measured) > 1e-9 * b.scale:
+            wrong[key] = (ledger, measured)
+    assert not wrong, (f"{len(wrong)} terms differ from what the program did (ledger, "
+                       f"measured), scale {b.scale:.4g}: {dict(sorted(wrong.items())[:8])}")
+
+
+def _in_view(rec, body) -> bool:
+    """Whether the body's origin is inside the recording's view."""
+    x0, x1, y0, y1 = rec.view
+    p = body.position
+    return min(x0, x1) <= p.x <= max(x0, x1) and min(y0, y1) <= p.y <= max(y0, y1)
+
+
+def _screen_height(tape, body) -> float:
+    """How high a body is on the program's own screen (y up: its y; y down: -y)."""
+    y = body.local_to_world(body.center_of_gravity).y
+    return y if tape.y_up else -y
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_recorder_draws_y_as_the_window_does(name, runs):
+    tape = runs(name)
+    rec, space = tape.rec, tape.space
+    x0, x1, bottom, top = rec.view
+    assert (top > bottom) == tape.y_up, (rec.view, getattr(rec, "orientation", None))
+    # On the pixels: of two bodies far apart on the program's screen, the higher one is
+    # drawn higher in the picture.
+    bodies = [i for i, b in enumerate(space.bodies) if b.body_type == pymunk.Body.DYNAMIC
+              and b.shapes and _in_view(rec, b)]
+    listed = list(space.bodies)
+    hi = max(bodies, key=lambda i: _screen_height(tape, listed[i]))
+    lo = min(bodies, key=lambda i: _screen_height(tape, listed[i]))
+    gap = _screen_height(tape, listed[hi]) - _screen_height(tape, listed[lo])
+    if gap <= 2 * max(body_size(listed[hi]), body_size(listed[lo])):
+        pytest.skip("no two bodies far enough apart on the screen")
+    high = np.nonzero(picture(space, rec, bodies=[hi]))[0]
+    low = np.nonzero(picture(space, rec, bodies=[lo]))[0]
+    assert np.median(high) < np.median(low)
+
+
+def _named(note: str, label: str) -> bool:
+    return re.search(rf"(?<![\w#]){re.escape(label)}(?!\d)", note) is not None
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_dynamic_body_is_drawn_4_px_or_named(name, runs):
+    tape = runs(name)
+    rec, space = tape.rec, tape.space
+    note = getattr(rec, "note", None) or ""
+    listed = list(space.bodies)
+    dynamic = [i for i, b in enumerate(listed) if b.body_type == pymunk.Body.DYNAMIC and b.shapes]
+    shown = scene_mask(frame(rec.path, -1), rec)
+    # Out of the picture at the end: named (the note lists the first few and how many more).
+    out = [tape.labels[id(listed[i])] for i in dynamic if not _in_view(rec, listed[i])]
+    unnamed = [label for label in out if not _named(note, label)]
+    more = [int(n) for n in re.findall(r"and (\d+) more", note)]
+    assert len(unnamed) <= sum(more), (unnamed[:8], note)
+    # In the picture: the smallest bodies, each drawn alone through the same view, are 4 px
+    # across on their pixels (and are what the frame shows there), or named.
+    visible = sorted((i for i in dynamic if _in_view(rec, listed[i])),
+                     key=lambda i: body_size(listed[i]))
+    assert visible
+    for i in visible[:3]:
+        alone = picture(space, rec, bodies=[i])
+        assert alone.sum() > 0
+        assert (alone & shown).sum() >= 0.9 * alone.sum()
+        label = tape.labels[id(listed[i])]
+        assert extent(alone) >= MIN_PX or _named(note, label), (
+            f"{label} drawn {extent(alone):g} px across, and the note does not name it: "
+            f"{note!r}")
+
+
+WITH_CONSTRAINTS = [n for n in NAMES if n not in ("gas", "bumpers", "planet",
+                                                   "planet_declared", "conveyor")]
+
+
+@pytest.mark.parametrize("name", WITH_CONSTRAINTS)
+def test_the_guard_has_a_row_for_every_constraint(name, runs):
+    from dumbbell import spaces
+
+    tape = runs(name)
+    space = tape.space
+    assert space.constraints
+    unit = tape.units[0]
+    subjects = {f.subject for f, _ in spaces.survey(space, tape.dt, units=unit)}
+    text = spaces.report(space, tape.dt, units=unit)
+    names = [f"{type(c).__name__} {j}" for j, c in enumerate(space.constraints)]
+    missing = [n for n in names if n not in subjects]
+    assert not missing, f"{len(missing)} of {len(names)} constraints have no row: {missing[:6]}"
+    assert all(re.search(rf"\b{n}\b", text) for n in names)
+
+
+def test_the_hand_computation_is_the_textbook_s():
+    # The hand energy on a space small enough to write out: a 2 kg body with its centre of
+    # gravity 0.5 m off its origin, turned 90 degrees, moving and spinning, under a slanted
+    # gravity, on a spring to the static body.
+    space = pymunk.Space()
+    space.gravity = (1.0, -9.0)
+    body = pymunk.Body(2.0, 3.0)
+    body.center_of_gravity = (0.5, 0.0)
+    body.angle = math.pi / 2  # (pymunk turns a body about its centre of gravity)
+    body.position = (1.0, 2.0)
+    body.velocity, body.angular_velocity = (3.0, 4.0), 2.0
+    spring = pymunk.DampedSpring(space.static_body, body, (0.0, 0.0), (0.5, 0.0), 1.0, 10.0, 0)
+    space.add(body, spring)
+    h = hand_energy(space)
+    cog = (1.0, 2.5)  # the origin plus (0.5, 0) turned by 90 degrees
+    assert h.K_trans == pytest.approx(0.5 * 2.0 * 25.0, rel=1e-15)
+    assert h.K_rot == pytest.approx(0.5 * 3.0 * 4.0, rel=1e-15)
+    assert h.U_g == pytest.approx(-2.0 * (1.0 * cog[0] - 9.0 * cog[1]), rel=1e-15)
+    assert h.U_spring == pytest.approx(0.5 * 10.0 * (math.hypot(*cog) - 1.0) ** 2, rel=1e-14)
