@@ -634,7 +634,7 @@ def car(tape: Tape) -> None:
                 with tape.act(self.space, *self.wheels):
                     for wheel in self.wheels:
                         wheel.angular_velocity = 0.0
-            throttle = 600.0 if self.frame < 120 else 0.0
+            throttle = 400.0 if self.frame < 120 else 0.0
             for _ in range(4):
                 for wheel in self.wheels:
                     wheel.torque = -throttle
@@ -764,11 +764,11 @@ def cloth(tape: Tape) -> None:
             if i == 0:
                 space.add(pymunk.PivotJoint(space.static_body, b, b.position))
             if j + 1 < cols:
-                s = pymunk.DampedSpring(b, grid[i][j + 1], (0, 0), (0, 0), gap, 150, 1.0)
+                s = pymunk.DampedSpring(b, grid[i][j + 1], (0, 0), (0, 0), gap, 1000, 1.0)
                 springs[(i, j, "h")] = s
                 space.add(s)
             if i + 1 < rows:
-                s = pymunk.DampedSpring(b, grid[i + 1][j], (0, 0), (0, 0), gap, 150, 1.0)
+                s = pymunk.DampedSpring(b, grid[i + 1][j], (0, 0), (0, 0), gap, 1000, 1.0)
                 springs[(i, j, "v")] = s
                 space.add(s)
             if i + 1 < rows and j + 1 < cols:
@@ -1127,7 +1127,7 @@ def conveyor(tape: Tape) -> None:
         return int(100 * p.x), int(600 - 100 * p.y)
 
     belt = pymunk.Segment(space.static_body, (0.5, 2.0), (6.0, 2.0), 0.05)
-    belt.friction, belt.surface_velocity = 0.9, (-1.5, 0)
+    belt.friction, belt.surface_velocity = 0.9, (1.5, 0)
     space.add(belt)
     lift = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
     lift.position = (7.0, 1.5)
