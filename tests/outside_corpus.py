@@ -1114,8 +1114,8 @@ def planet(tape: Tape, declare: bool = False) -> None:
 def conveyor(tape: Tape) -> None:
     """pygame drawing by hand with y flipped (SI, y up, gravity 9.81 m/s^2 down): crates
     dropped on a conveyor belt (a static segment with a surface_velocity) carrying them to
-    a lift (a kinematic platform the program sends up and down); crates that fall off the
-    screen are removed."""
+    a lift (a kinematic platform the program sends up and down); crates delivered onto the
+    lift, or fallen off the screen, are removed."""
     import pygame
     import pymunk
 
@@ -1127,7 +1127,7 @@ def conveyor(tape: Tape) -> None:
         return int(100 * p.x), int(600 - 100 * p.y)
 
     belt = pymunk.Segment(space.static_body, (0.5, 2.0), (6.0, 2.0), 0.05)
-    belt.friction, belt.surface_velocity = 0.9, (1.5, 0)
+    belt.friction, belt.surface_velocity = 0.9, (2.5, 0)
     space.add(belt)
     lift = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
     lift.position = (7.0, 1.5)
@@ -1151,7 +1151,7 @@ def conveyor(tape: Tape) -> None:
         if frame % 60 == 0:
             with tape.act(space, lift):
                 lift.velocity = (0, 0.6 if (frame // 60) % 2 == 0 else -0.6)
-        gone = [c for c in crates if c.position.y < -1.0]
+        gone = [c for c in crates if c.position.y < -1.0 or c.position.x > 6.6]  # delivered
         if gone:
             with tape.act(space, *gone):
                 for c in gone:
@@ -1252,7 +1252,7 @@ def hammer(tape: Tape) -> None:
             space.add(pymunk.PivotJoint(space.static_body, hammer, (0.0, 1.5)),
                       pymunk.DampedRotarySpring(space.static_body, hammer, 0.3, 15.0, 0.2))
             self.block = block = pymunk.Body()
-            block.position = (0.85, 0.52)
+            block.position = (0.5, 0.52)
             foot = pymunk.Poly(block, [(0, 0), (0.4, 0), (0.4, 0.08), (0, 0.08)])
             post = pymunk.Poly(block, [(0, 0.08), (0.08, 0.08), (0.08, 0.45), (0, 0.45)])
             for s in (foot, post):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import types
 
 import numpy as np
 import pymunk
@@ -168,19 +169,33 @@ def test_the_recorder_draws_y_as_the_window_does(name, runs):
     rec, space = tape.rec, tape.space
     x0, x1, bottom, top = rec.view
     assert (top > bottom) == tape.y_up, (rec.view, getattr(rec, "orientation", None))
-    # On the pixels: of two bodies far apart on the program's screen, the higher one is
-    # drawn higher in the picture.
-    bodies = [i for i, b in enumerate(space.bodies) if b.body_type == pymunk.Body.DYNAMIC
-              and b.shapes and _in_view(rec, b)]
-    listed = list(space.bodies)
-    hi = max(bodies, key=lambda i: _screen_height(tape, listed[i]))
-    lo = min(bodies, key=lambda i: _screen_height(tape, listed[i]))
-    gap = _screen_height(tape, listed[hi]) - _screen_height(tape, listed[lo])
-    if gap <= 2 * max(body_size(listed[hi]), body_size(listed[lo])):
-        pytest.skip("no two bodies far enough apart on the screen")
-    high = np.nonzero(picture(space, rec, bodies=[hi]))[0]
-    low = np.nonzero(picture(space, rec, bodies=[lo]))[0]
-    assert np.median(high) < np.median(low)
+    # On the pixels: of two parts (moving bodies, static shapes) one above the other on the
+    # program's screen, the higher one is drawn higher in the picture.
+    parts = []  # (bottom, top, kind, index): heights on the program's screen
+    for i, b in enumerate(space.bodies):
+        if b.body_type != pymunk.Body.STATIC and b.shapes and _in_view(rec, b):
+            parts.append((*_screen_span(tape, [s.cache_bb() for s in b.shapes]), "body", i))
+    for i, s in enumerate(space.shapes):
+        if s.body.body_type == pymunk.Body.STATIC and not s.sensor:
+            bb = s.cache_bb()
+            middle = pymunk.Vec2d((bb.left + bb.right) / 2, (bb.bottom + bb.top) / 2)
+            if _in_view(rec, types.SimpleNamespace(position=middle)):
+                parts.append((*_screen_span(tape, [bb]), "static", i))
+    hi = max(parts)                          # its lowest point the highest
+    lo = min(parts, key=lambda p: p[1])      # its highest point the lowest
+    assert hi[0] > lo[1], "no part is above another on the program's screen"
+    rows = []
+    for _, _, kind, i in (hi, lo):
+        mask = picture(space, rec, **{"bodies" if kind == "body" else "statics": [i]})
+        assert mask.any()
+        rows.append(np.median(np.nonzero(mask)[0]))
+    assert rows[0] < rows[1]
+
+
+def _screen_span(tape, boxes) -> tuple[float, float]:
+    """The lowest and highest points of boxes on the program's own screen (heights)."""
+    lo, hi = min(bb.bottom for bb in boxes), max(bb.top for bb in boxes)
+    return (lo, hi) if tape.y_up else (-hi, -lo)
 
 
 def _named(note: str, label: str) -> bool:
