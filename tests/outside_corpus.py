@@ -175,6 +175,7 @@ class Tape:
     path: Path | None = None
     dt: float = 0.0
     velocity_funcs: list[Any] = field(default_factory=list)
+    pushes: dict[str, float] | None = None
 
     # -- what the harness does ---------------------------------------------------------
 
@@ -205,6 +206,27 @@ class Tape:
 
         self.checkpoints.append(Checkpoint(len(self.dts), hand_energy(self.space, self.fields),
                                            spaces.energy(self.space)))
+
+    def before_step(self) -> list[tuple[Any, Any, Any]]:
+        """Each dynamic body's centre of gravity and velocity before a step."""
+        import pymunk
+
+        return [(b, b.local_to_world(b.center_of_gravity), b.velocity)
+                for b in self.space.bodies if b.body_type == pymunk.Body.DYNAMIC]
+
+    def after_step(self, before: list[tuple[Any, Any, Any]], dt: float) -> None:
+        """Gravity's part of each body's push out of what it overlaps, over the step: pymunk
+        moves a centre of gravity by (v + v_bias) dt, v the velocity the step starts with
+        and v_bias what the last step's contacts gave to push overlapping shapes apart, so
+        the push is c1 - c0 - v dt, and gravity's part of its energy -m g . that."""
+        g = self.space.gravity
+        for body, c0, v0 in before:
+            if body.space is not self.space:
+                continue
+            c1 = body.local_to_world(body.center_of_gravity)
+            dx, dy = c1.x - c0.x - v0.x * dt, c1.y - c0.y - v0.y * dt
+            label = self.labels[id(body)]
+            self.pushes[label] = self.pushes.get(label, 0.0) - body.mass * (g.x * dx + g.y * dy)
 
     def stepped(self, dt: float) -> None:
         """After each of the space's steps: count it, capture a frame at each 1/fps."""
@@ -414,10 +436,16 @@ def _stand_in(name: str, tape: Tape) -> dict[str, types.ModuleType]:
 
 
 class _Clock:
-    """pygame's Clock, without the sleeping."""
+    """pygame's Clock, without the sleeping: ``tick`` returns the milliseconds a busy
+    machine's frames take (16 or 17, now and then a dropped frame of 33 or 50)."""
+
+    def __init__(self) -> None:
+        self.frames = 0
 
     def tick(self, *a: Any) -> int:
-        return 16
+        self.frames += 1
+        k = self.frames
+        return 50 if k % 23 == 0 else 33 if k % 7 == 0 else 16 + (k * 5) % 3 // 2
 
 
 @contextlib.contextmanager
@@ -451,9 +479,14 @@ def _window(tape: Tape) -> Iterator[None]:
     flag = getattr(sys.modules.get("pymunk.pygame_util"), "positive_y_is_up", None)
 
     def step(space: Any, dt: float) -> None:
+        if space is not tape.space:
+            real_step(space, dt)
+            return
+        before = tape.before_step() if tape.pushes is not None else None
         real_step(space, dt)
-        if space is tape.space:
-            tape.stepped(dt)
+        if before is not None:
+            tape.after_step(before, dt)
+        tape.stepped(dt)
 
     pymunk.Space.step = step
     state = random.getstate()
@@ -1279,6 +1312,187 @@ def hammer(tape: Tape) -> None:
     WorkshopApp().run()
 
 
+def frame_drops(tape: Tape) -> None:
+    """pygame with pymunk.pygame_util (pixels, y down, gravity 900), stepped by the frame
+    time it measures (``dt = clock.tick(60) / 1000``: 16 or 17 ms, 33 or 50 when a frame is
+    dropped): balls placed sunk into the floor (pushed out by pymunk's position correction
+    over the next steps) and balls dropped one by one, each on its own part of the floor."""
+    import pygame
+    import pymunk
+    import pymunk.pygame_util
+
+    screen = pygame.display.set_mode((800, 600))
+    options = pymunk.pygame_util.DrawOptions(screen)
+    clock = pygame.time.Clock()
+    space = pymunk.Space()
+    space.gravity = (0, 900)
+    floor = pymunk.Segment(space.static_body, (40, 550), (760, 550), 5)  # its top at y = 545
+    floor.friction = 0.8
+    space.add(floor)
+    balls = []
+
+    def ball(x: float, y: float, r: float = 15) -> pymunk.Body:
+        b = pymunk.Body(1, pymunk.moment_for_circle(1, 0, r))
+        b.position = (x, y)
+        shape = pymunk.Circle(b, r)
+        shape.friction = 0.8
+        return b
+
+    for x, sunk in ((100, 8), (180, 3), (260, 12)):  # placed partly inside the floor
+        b = ball(x, 545 - 15 + sunk)
+        space.add(b, *b.shapes)
+        balls.append(b)
+    tape.start(space)
+    frame = 0
+    while tape.running:
+        for event in pygame.event.get():
+            if event.type == pygame.QUIT:
+                return
+        dt = clock.tick(60) / 1000.0
+        if frame % 15 == 5 and len(balls) < 9:
+            b = ball(340 + 70 * (len(balls) - 3), 150)
+            with tape.act(space, b):
+                space.add(b, *b.shapes)
+            balls.append(b)
+        space.step(dt)
+        screen.fill((255, 255, 255))
+        space.debug_draw(options)
+        pygame.display.flip()
+        frame += 1
+        tape.frame()
+
+
+def ship(tape: Tape, substeps: int = 1) -> None:
+    """An arcade game in space (pixels, y up, no gravity): a ship steered by thrusters that
+    push along the screen's axes and a turning torque, set once per frame (``Body.force``,
+    ``Body.torque``), its centre of gravity behind its nose (the body's origin); it fires a
+    bullet every 15 frames (removed 40 frames later); rocks drift far away. With
+    ``substeps`` > 1 the player applies the guard's advice: each frame is
+    ``spaces.step(space, dt, substeps)``."""
+    import arcade
+    import pymunk
+
+    from dumbbell import spaces
+
+    class Asteroids(arcade.Window):
+        def __init__(self) -> None:
+            super().__init__(1024, 768, "Asteroids")
+            self.space = space = pymunk.Space()
+            crew = pymunk.ShapeFilter(group=1)
+            nose = [(0, 0), (-60, 20), (-60, -20)]
+            self.ship = ship = pymunk.Body(10, pymunk.moment_for_poly(10, nose))
+            hull = pymunk.Poly(ship, nose)
+            ship.center_of_gravity = hull.center_of_gravity
+            ship.position = (200, 380)
+            hull.filter = crew
+            space.add(ship, hull)
+            rng = random.Random(5)
+            for _ in range(5):
+                rock = pymunk.Body(40, pymunk.moment_for_circle(40, 0, 30))
+                rock.position = (rng.uniform(3000, 4000), rng.uniform(-500, 500))
+                rock.velocity = (rng.uniform(-20, 20), rng.uniform(-20, 20))
+                space.add(rock, pymunk.Circle(rock, 30))
+            self.bullets: list[tuple[int, pymunk.Body]] = []
+            self.crew, self.frame = crew, 0
+            tape.start(space)
+
+        def on_update(self, delta_time: float) -> None:
+            k = self.frame
+            self.ship.force = (1500 * math.cos(k / 9), 900 * math.sin(k / 13))
+            self.ship.torque = 4000 * math.sin(k / 7)
+            if k % 15 == 0:
+                bullet = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 3))
+                bullet.position = self.ship.local_to_world((5, 0))
+                bullet.velocity = self.ship.velocity + (600, 0)
+                dot = pymunk.Circle(bullet, 3)
+                dot.filter = self.crew
+                with tape.act(self.space, bullet):
+                    self.space.add(bullet, dot)
+                self.bullets.append((k, bullet))
+            old = [b for when, b in self.bullets if k - when >= 40]
+            if old:
+                with tape.act(self.space, *old):
+                    for b in old:
+                        self.space.remove(b, *b.shapes)
+                self.bullets = [(w, b) for w, b in self.bullets if b not in old]
+            if substeps == 1:
+                self.space.step(delta_time)
+            else:
+                spaces.step(self.space, delta_time, substeps=substeps)
+            self.frame += 1
+
+        def on_draw(self) -> None:
+            self.clear()
+            tape.frame()
+
+    Asteroids()
+    arcade.run()
+
+
+def recentred(space: Any) -> Any:
+    """The same world as ``space`` with every dynamic body's origin moved to its centre of
+    gravity: a new space whose bodies have the same mass, moment, pose of their shapes,
+    velocity and spin, their shapes' geometry and their constraints' anchors shifted in the
+    body's own coordinates to match. Static and kinematic bodies are copied as they are."""
+    import pymunk
+
+    out = pymunk.Space()
+    out.gravity, out.damping, out.iterations = space.gravity, space.damping, space.iterations
+    out.collision_slop, out.collision_bias = space.collision_slop, space.collision_bias
+    made: dict[int, tuple[Any, Any]] = {id(space.static_body): (out.static_body, (0.0, 0.0))}
+    for b in space.bodies:
+        if b.body_type == pymunk.Body.DYNAMIC:
+            new = pymunk.Body(b.mass, b.moment)
+            off = b.center_of_gravity
+            new.angle = b.angle
+            new.position = b.local_to_world(off)
+        else:
+            new = pymunk.Body(body_type=b.body_type)
+            off = pymunk.Vec2d(0.0, 0.0)
+            new.angle, new.position = b.angle, b.position
+        new.velocity, new.angular_velocity = b.velocity, b.angular_velocity
+        made[id(b)] = (new, off)
+        out.add(new)
+    for s in space.shapes:
+        new, off = made[id(s.body)]
+        if isinstance(s, pymunk.Circle):
+            shape = pymunk.Circle(new, s.radius, s.offset - off)
+        elif isinstance(s, pymunk.Segment):
+            shape = pymunk.Segment(new, s.a - off, s.b - off, s.radius)
+        else:
+            shape = pymunk.Poly(new, [v - off for v in s.get_vertices()], radius=s.radius)
+        for attr in ("friction", "elasticity", "sensor", "collision_type", "filter",
+                     "surface_velocity"):
+            setattr(shape, attr, getattr(s, attr))
+        out.add(shape)
+    for c in space.constraints:
+        (a, oa), (b, ob) = made[id(c.a)], made[id(c.b)]
+        if isinstance(c, pymunk.GrooveJoint):
+            new_c = pymunk.GrooveJoint(a, b, c.groove_a - oa, c.groove_b - oa, c.anchor_b - ob)
+        elif isinstance(c, pymunk.DampedSpring):
+            new_c = pymunk.DampedSpring(a, b, c.anchor_a - oa, c.anchor_b - ob, c.rest_length,
+                                        c.stiffness, c.damping)
+        elif isinstance(c, pymunk.SlideJoint):
+            new_c = pymunk.SlideJoint(a, b, c.anchor_a - oa, c.anchor_b - ob, c.min, c.max)
+        elif isinstance(c, pymunk.PinJoint):
+            new_c = pymunk.PinJoint(a, b, c.anchor_a - oa, c.anchor_b - ob)
+            new_c.distance = c.distance  # (made from the bodies' present places otherwise)
+        elif isinstance(c, pymunk.PivotJoint):
+            new_c = pymunk.PivotJoint(a, b, c.anchor_a - oa, c.anchor_b - ob)
+        elif isinstance(c, pymunk.DampedRotarySpring):
+            new_c = pymunk.DampedRotarySpring(a, b, c.rest_angle, c.stiffness, c.damping)
+        elif isinstance(c, pymunk.RotaryLimitJoint):
+            new_c = pymunk.RotaryLimitJoint(a, b, c.min, c.max)
+        elif isinstance(c, pymunk.GearJoint):
+            new_c = pymunk.GearJoint(a, b, c.phase, c.ratio)
+        else:
+            raise TypeError(f"recentred: {type(c).__name__} is not handled")
+        for attr in ("max_force", "max_bias", "error_bias", "collide_bodies"):
+            setattr(new_c, attr, getattr(c, attr))
+        out.add(new_c)
+    return out
+
+
 @dataclass(frozen=True)
 class Program:
     """A corpus entry: the program, its window library and which way y points in that
@@ -1291,6 +1505,7 @@ class Program:
     frames: int
     check_every: int = 60
     kwargs: tuple = ()
+    pushes: bool = False
 
 
 PX = ("px", "kg", "s")
@@ -1309,13 +1524,17 @@ PROGRAMS = {
     "conveyor": Program(conveyor, "pygame", True, SI, 240),
     "chain": Program(chain, "pygame_util", False, PX, 180),
     "hammer": Program(hammer, "kivy", True, SI, 120, 80),
+    "frame_drops": Program(frame_drops, "pygame_util", False, PX, 150, pushes=True),
+    "ship": Program(ship, "arcade", True, PX, 90),
+    "ship_substeps": Program(ship, "arcade", True, PX, 90, kwargs=(("substeps", 6),)),
 }
 
 
 def run(name: str, folder: str | Path) -> Tape:
     """Run corpus program ``name`` headless with its tape; the GIF goes into ``folder``."""
     p = PROGRAMS[name]
-    tape = Tape(name, Path(folder), p.frames, p.window, p.y_up, p.units, p.check_every)
+    tape = Tape(name, Path(folder), p.frames, p.window, p.y_up, p.units, p.check_every,
+                pushes={} if p.pushes else None)
     with _window(tape):
         p.run(tape, **dict(p.kwargs))
     tape.finish()
