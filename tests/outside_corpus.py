@@ -25,6 +25,7 @@ program runs) and records a frame at each 1/fps of simulated time.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import random
 import sys
@@ -626,7 +627,7 @@ def car(tape: Tape) -> None:
             self.space = space = pymunk.Space()
             space.gravity = (0.0, -9.81)
             road = [(-20, 0), (30, 0), (38, 0.6), (42, 0.6), (46, 0), (300, 0)]
-            for a, b in zip(road, road[1:]):
+            for a, b in itertools.pairwise(road):
                 seg = pymunk.Segment(space.static_body, a, b, 0.05)
                 seg.friction = 1.0
                 space.add(seg)

@@ -170,7 +170,7 @@ def _screen_height(tape, body) -> float:
 def test_the_recorder_draws_y_as_the_window_does(name, runs):
     tape = runs(name)
     rec, space = tape.rec, tape.space
-    x0, x1, bottom, top = rec.view
+    _, _, bottom, top = rec.view
     assert (top > bottom) == tape.y_up, (rec.view, getattr(rec, "orientation", None))
     # On the pixels: of two parts (moving bodies, static shapes) one above the other on the
     # program's screen, the higher one is drawn higher in the picture.
