@@ -38,16 +38,20 @@ MAX_ECHO = 200
 
 def clip(text: str, limit: int = MAX_ECHO) -> str:
     """``text`` with every word (a run without spaces) longer than ``limit`` characters cut
-    to its first ``limit - 23`` and last 20 around '...': a message echoing a huge value
-    (10,000 tilts, a 5,000-digit number, a 4,000-character path) stays short."""
-    return " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
-                    for w in str(text).split(" "))
+    to its first ``limit - 23`` and last 20 around '...', and the whole at most ``5 *
+    limit`` characters (its first ``3 * limit - 3`` and last ``2 * limit`` around '...'): a
+    message echoing a huge value (10,000 tilts, a 5,000-digit number, a 4,000-character
+    path, a key of many words) stays short, and keeps its end, which says what is allowed."""
+    out = " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
+                   for w in str(text).split(" "))
+    return out if len(out) <= 5 * limit else f"{out[:3 * limit - 3]}...{out[-2 * limit:]}"
 
 
 def one_line(text: str) -> str:
     """``text`` with every character that is not printable (newlines, control characters,
     line and record separators) escaped, so that a message echoing user input stays one line,
-    and no word longer than :data:`MAX_ECHO` characters (:func:`clip`)."""
+    and no word longer than :data:`MAX_ECHO` characters, nor the whole longer than five
+    times that (:func:`clip`)."""
     return clip("".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text)))
 
 
