@@ -391,6 +391,11 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "strip": True, "t_end": 0.2, "timing": {}, "max_frames": 100},
     "dumbbell.animation.render.Gif": lambda f: {"data": b"GIF89a"},
     "dumbbell.animation.render.Gif.save": lambda f: {"path": f.tmp / "g.gif"},
+    "dumbbell.animation.player.player": lambda f: {
+        "source": f.traj, "fps": 10, "size": "64x64", "strip": True, "t_end": 0.2,
+        "labels": ["x"], "max_samples": 1000},
+    "dumbbell.animation.player.Player": lambda f: {"html_text": "<p>x</p>", "size": (64, 64)},
+    "dumbbell.animation.player.Player.save": lambda f: {"path": f.tmp / "p.html"},
     "dumbbell.analysis.api.compare": lambda f: {
         "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
         "t_end": 0.02, "quiet": True},
@@ -590,6 +595,7 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
+    "dumbbell.animation.player.Player.save": lambda f: __import__("dumbbell").Player("<p></p>"),
     "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,
     "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: f.topple_cf,

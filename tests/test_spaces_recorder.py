@@ -92,7 +92,7 @@ def test_bad_arguments_are_one_clear_error(tmp_path):
 
     with pytest.raises(UsageError, match="fps = 0"):
         spaces.Recorder(_space(), tmp_path / "a.gif", fps=0)
-    with pytest.raises(UsageError, match=r"\.gif or \.mp4"):
+    with pytest.raises(UsageError, match=r"\.gif, \.mp4 or \.html"):
         spaces.Recorder(_space(), tmp_path / "a.png")
     with pytest.raises(DumbbellError, match="no frames"), spaces.Recorder(_space(),
                                                                          tmp_path / "a.gif"):

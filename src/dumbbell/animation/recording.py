@@ -62,9 +62,9 @@ from PIL import Image, ImageDraw
 from ..errors import DumbbellError
 from ..io.files import atomic_output
 from .backdrop import SS, Backdrop
-from .bars import EnergyScale, bar_rows, draw_legend, draw_values
+from .bars import SWATCH, SWATCH_GAP, EnergyScale, bar_rows, draw_legend, draw_values
 from .gif import write_frames
-from .glyphs import Stamps, fmt_tick, font, nice_step
+from .glyphs import TEXT_PX, Stamps, fmt_tick, font, nice_step
 from .layout import unit
 from .palette import (
     GREY,
@@ -96,6 +96,10 @@ STATIC_FILL = (232, 232, 232)
 SHAPE_COLOURS = (*((rgb, blend(rgb, 0.33)) for rgb in BODY_INKS), (GREY, STATIC_FILL))
 #: Height of an energy bar's row at most (px at 640x360).
 ROW_MAX = 26
+#: The bars start at least this far right of the panel's left edge (px at 640x360) ...
+LABEL_ROOM = 70
+#: ... and this far right of the end of the longest row name.
+NAME_GAP = 4
 #: The camera: a moving body's position counts unless it lies more than this many
 #: interquartile ranges beyond the middle half of all positions (Tukey's far-out fences) ...
 FENCE = 3.0
@@ -1173,7 +1177,14 @@ class Painter(Backdrop):
         bx0, _, bx1, _ = self.bars_box
         widest = max(abs(scale.lo), scale.hi)
         self.value_w = round(self.st_text.width(f"-{widest:.{scale.decimals}f}") + 8 * self.u)
-        self.bar_left = bx0 + round(70 * self.u)
+        # The bars start right of the longest name (a negative bar reaching the scale's
+        # low end must not paint over it: issue 29), and at least LABEL_ROOM from the left.
+        labels = self.rec.labels or {}
+        name_font = font(round(TEXT_PX * self.u))
+        names_end = (round(SWATCH * self.u) + SWATCH_GAP * self.u
+                     + max(name_font.getlength(labels.get(n, n)) for n in self.names))
+        self.bar_left = bx0 + max(round(LABEL_ROOM * self.u),
+                                  math.ceil(names_end + NAME_GAP * self.u))
         self.bar_right = bx1 - self.value_w
         self.bar_scale = (self.bar_right - self.bar_left) / scale.span
         self.bar_zero = self.bar_left - scale.lo * self.bar_scale
@@ -1593,6 +1604,7 @@ def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) ->
     with _signals_end_cleanly():
         if path.suffix.lower() == ".mp4":
             _write_mp4(path, painter, rec.fps)
+
         else:
             with atomic_output(path) as tmp, open(tmp, "wb") as fh:
                 stats["draw"], stats["encode"] = write_frames(

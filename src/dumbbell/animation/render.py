@@ -256,6 +256,7 @@ def render_gif(
     from ..model import args
     from .drawing import Painter
     from .gif import write_frames
+    from .picture import describe
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
@@ -277,7 +278,7 @@ def render_gif(
     check_frames(t_end, fps, max_frames)
     t0 = time.perf_counter()
     frames = frames_of(traj, fps, t_end)
-    painter = Painter(traj.scene, frames, (width, height), strip)
+    painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
     delays = delays_cs(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"

@@ -24,7 +24,7 @@ from ..errors import DumbbellError, UsageError
 from ..parallel import STOP_SIGNALS
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep",
+COMMANDS = ("run", "simulate", "compare", "render", "play", "bench", "stability", "sweep",
             "restitution")
 
 EXIT_USAGE = 2

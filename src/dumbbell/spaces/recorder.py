@@ -350,8 +350,9 @@ def _check_path(path: Any) -> Path:
     text = path
     path = args.path(path, "path")
     suffix = path.suffix.lower()
-    if suffix not in (".gif", ".mp4"):
-        raise UsageError(f"path {args.show(str(path))}: must end in .gif or .mp4", param="path")
+    if suffix not in (".gif", ".mp4", ".html", ".htm"):
+        raise UsageError(f"path {args.show(str(path))}: must end in .gif, .mp4 or .html (the "
+                         "interactive player)", param="path")
     try:
         # As spelt (a Path drops a final '/': 'a.gif/' names a folder, not a file).
         check_writable(text, "path")
@@ -728,7 +729,12 @@ class Recorder:
         if not self._captured:
             raise DumbbellError(f"{self.path}: no frames captured (call capture() after each "
                                 "frame's steps)")
-        painter = recording.write(self.path, self.recording(), self.timing)
+        if self.path.suffix.lower() in (".html", ".htm"):  # the interactive player
+            from ..animation import space_player
+
+            painter = space_player.write(self.path, self.recording(), self.timing)
+        else:
+            painter = recording.write(self.path, self.recording(), self.timing)
         x0, x1, y0, y1 = painter.view
         self.view = (x0, x1, y0, y1) if painter.rec.y_up else (x0, x1, y1, y0)
         self.note = self._note(painter)
