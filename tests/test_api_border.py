@@ -522,15 +522,15 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.guard.Driver.step": lambda f: {"frames": 2},
     # dumbbell.spaces.heat, recorder
     "dumbbell.spaces.heat.HeatCounter": lambda f: {"space": f.space()},
-    # dumbbell.spaces.ledger
+    # dumbbell.spaces.ledger, balance
     "dumbbell.spaces.ledger.Ledger": lambda f: {"space": f.space(), "tolerance": 1e-6},
     "dumbbell.spaces.ledger.Ledger.declare_potential": lambda f: {
         "target": list(f.space().bodies), "potential": lambda x, y, m: 0.0 * x,
         "name": "field"},
-    "dumbbell.spaces.ledger.Balance": lambda f: fields(f.balance),
-    "dumbbell.spaces.ledger.Balance.sources": lambda f: {"kind": "contact", "at_least": 0.0},
-    "dumbbell.spaces.ledger.Balance.table": lambda f: {"top": 4},
-    "dumbbell.spaces.ledger.Term": lambda f: fields(f.balance.terms[0]),
+    "dumbbell.spaces.balance.Balance": lambda f: fields(f.balance),
+    "dumbbell.spaces.balance.Balance.sources": lambda f: {"kind": "contact", "at_least": 0.0},
+    "dumbbell.spaces.balance.Balance.table": lambda f: {"top": 4},
+    "dumbbell.spaces.balance.Term": lambda f: fields(f.balance.terms[0]),
     "dumbbell.spaces.recorder.Recorder": lambda f: {
         "space": f.space(), "path": f.tmp / "r.gif", "fps": 10, "energy": True,
         "size": "64x64", "strip": False, "heat": f.heat(), "world": (-1.0, 1.0, -0.2, 1.0),
@@ -581,8 +581,8 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
         f.space(), 1e-2, 1),
     "dumbbell.spaces.ledger.Ledger.declare_potential": lambda f: importlib.import_module(
         "dumbbell.spaces").Ledger(f.space()),
-    "dumbbell.spaces.ledger.Balance.sources": lambda f: f.balance,
-    "dumbbell.spaces.ledger.Balance.table": lambda f: f.balance,
+    "dumbbell.spaces.balance.Balance.sources": lambda f: f.balance,
+    "dumbbell.spaces.balance.Balance.table": lambda f: f.balance,
     "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),

@@ -30,7 +30,7 @@ _WHERE = {
     "spring_omega": "guard", "shape_size": "guard", "energy_swing": "guard",
     "reach": "estimates", "Reach": "estimates",
     "HeatCounter": "heat",
-    "Ledger": "ledger", "Balance": "ledger", "Term": "ledger",
+    "Ledger": "ledger", "Balance": "balance", "Term": "balance",
     "Recorder": "recorder", "PaletteDrawOptions": "recorder", "draw_options": "recorder",
 }
 

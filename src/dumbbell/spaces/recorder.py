@@ -46,16 +46,17 @@ import numpy as np
 
 from ..errors import DumbbellError, UsageError
 
+# The units' rule, the one every printed value of a space follows.
+from .units import SI, UNIT_CHARS  # noqa: F401 - re-exported
+from .units import check_units as _check_units
+from .units import energy_unit as _energy_unit
+
 #: Energy terms shown: the fields of :func:`dumbbell.spaces.energy` they come from.
 TERMS = ("K_trans", "K_rot", "U_g", "U_spring", "E")
 #: Potential terms, shown from a reference (their value at t0, or one you set).
 POTENTIALS = ("U_g", "U_spring")
 #: Labels of the rows when the potentials are shown from a reference.
 DELTA_LABELS = {"U_g": "ΔU_g", "U_spring": "ΔU_spring", "E": "K + ΔU"}
-#: Units of a space (length, mass, time) in SI, whose energy is the joule.
-SI = ("m", "kg", "s")
-#: Longest unit name.
-UNIT_CHARS = 12
 #: Largest magnitude of a frame's time (``t0``, ``capture(t=...)``; the space's time unit):
 #: its label, with two decimals or more, fits the frame.
 TIME_MAX = 1e9
@@ -403,29 +404,10 @@ def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, f
     return x0, x1, y0, y1
 
 
-def _check_units(units: Any) -> tuple[str, str, str]:
-    from ..model import args
-
-    allowed = (f"must be the length unit ('px', as the guard takes it; mass in kg, time in s) "
-               f"or three names (length, mass, time), each 1 to {UNIT_CHARS} characters, e.g. "
-               "('m', 'kg', 's')")
-    names = (units, SI[1], SI[2]) if isinstance(units, str) else units
-    if not isinstance(names, tuple | list) or len(names) != 3 or not all(
-            isinstance(u, str) and 0 < len(u) <= UNIT_CHARS and u.isprintable() for u in names):
-        raise UsageError(f"units = {args.show(units)}: {allowed}", param="units")
-    return tuple(names)  # type: ignore[return-value]
-
-
 def _listed(names: list[str], most: int = 8) -> str:
     """``names`` joined by commas, the first ``most`` of them and how many more."""
     shown = ", ".join(names[:most])
     return shown if len(names) <= most else f"{shown} and {len(names) - most} more"
-
-
-def _energy_unit(units: tuple[str, str, str]) -> str:
-    """The energy unit of a space in ``units`` (length, mass, time): J in SI."""
-    length, mass, t = units
-    return "J" if tuple(units) == SI else f"{mass} {length}²/{t}²"
 
 
 def _check_reference(reference: Any, unit: str = "energy units") -> str | dict[str, float]:
