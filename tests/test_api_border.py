@@ -513,13 +513,13 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.estimates.reach": lambda f: {"space": f.space(), "dt": 1e-3, "units": "m"},
     "dumbbell.spaces.estimates.Reach": lambda f: fields(
         importlib.import_module("dumbbell.spaces").reach(f.space(), 1e-3)[0]),
-    "dumbbell.spaces.guard.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
+    "dumbbell.spaces.stepping.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
     "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
     "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
     "dumbbell.spaces.guard.Finding": lambda f: fields(f.finding),
-    "dumbbell.spaces.guard.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
+    "dumbbell.spaces.stepping.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
                                                "speeds": "both", "tolerance": math.inf},
-    "dumbbell.spaces.guard.Driver.step": lambda f: {"frames": 2},
+    "dumbbell.spaces.stepping.Driver.step": lambda f: {"frames": 2},
     # dumbbell.spaces.heat, recorder
     "dumbbell.spaces.heat.HeatCounter": lambda f: {"space": f.space()},
     # dumbbell.spaces.ledger, balance
@@ -577,7 +577,7 @@ VALID.update(_solver_rows())
 
 #: Method case -> f -> the object whose method it is (fresh at each call).
 OWNER: dict[str, Callable[[Fixtures], Any]] = {
-    "dumbbell.spaces.guard.Driver.step": lambda f: importlib.import_module("dumbbell.spaces").Driver(
+    "dumbbell.spaces.stepping.Driver.step": lambda f: importlib.import_module("dumbbell.spaces").Driver(
         f.space(), 1e-2, 1),
     "dumbbell.spaces.ledger.Ledger.declare_potential": lambda f: importlib.import_module(
         "dumbbell.spaces").Ledger(f.space()),

@@ -105,7 +105,7 @@ def _untimed(markdown: str) -> str:
     for line in markdown.splitlines():
         if line.startswith(("Run time to reach", "JIT compile")):
             continue
-        line = re.sub(r"at least \d+ runs", "at least N runs", line)
+        line = re.sub(r"at least \d+ runs?\b", "at least N runs", line)
         line = re.sub(r"until [\d.]+ s are timed", "until T s are timed", line)
         cells = line.split(" | ")
         if line.startswith("| ") and len(cells) == 8:

@@ -324,7 +324,10 @@ def test_units_are_printed_with_every_value_of_a_space():
                  repr(spaces.energy(space, units="px").bodies[0]), repr(heat)):
         assert unit in text, text
     assert "kg px/s" in repr(spaces.energy(space, units="px"))
-    assert " J" in repr(spaces.Ledger(space).balance())  # SI by default, as the recorder
+    assert " J" in repr(spaces.Ledger(space, units="m").balance())
+    # Units not named: nothing is claimed (this space is in pixels; its energy is not in J).
+    assert " J" not in repr(spaces.Ledger(space).balance())
+    assert "energy units" in repr(spaces.Ledger(space).balance())
     with pytest.raises(UsageError, match="units"):
         spaces.Ledger(space, units="p\nx")
 

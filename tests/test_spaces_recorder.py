@@ -665,6 +665,9 @@ def test_refusals_name_the_spaces_units(tmp_path):
             spaces.Recorder(space, tmp_path / "a.gif", units="px", **kw)
         assert unit in str(info.value)
     with pytest.raises(UsageError, match=r"\(J\)$"):
+        spaces.Recorder(space, tmp_path / "a.gif", units="m", reference={"U_g": math.nan})
+    # Units not named: no unit is claimed (a pixel space's energy is not in J).
+    with pytest.raises(UsageError, match=r"\(energy units\)$"):
         spaces.Recorder(space, tmp_path / "a.gif", reference={"U_g": math.nan})
 
 

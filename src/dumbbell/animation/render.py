@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Self, overload
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..io.files import atomic_output
 from ..model.scene import GifSettings
@@ -76,7 +77,7 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
         n = frame_count(t_end, fps)
         if n <= max_frames:
             return n
-        count = f"{n:,} frames"
+        count = counted(n, "frame", grouped=True)
     else:
         count = (f"{math.ceil(t_end * fps):,} frames" if math.isfinite(t_end * fps)
                  else "more than 1e308 frames")

@@ -2,8 +2,10 @@
 :mod:`dumbbell.cli` and provides ``register(subparsers)``.
 
 Exit status: 0 done; 2 bad input (one line naming the file, key or flag and what is allowed;
-nothing written); 3 a run ended with a verdict other than ``ok``; 128+N stopped by signal N
-(SIGINT, SIGTERM, SIGHUP; nothing written, pool workers stopped).
+nothing written); 3 a run ended early (a verdict unstable, tunnelled or failed); 4 a run
+reached its end but is ``inaccurate`` (its energy error passed ``run.inaccurate_energy``;
+every output written); 128+N stopped by signal N (SIGINT, SIGTERM, SIGHUP; nothing
+written, pool workers stopped).
 """
 
 from __future__ import annotations
@@ -29,6 +31,25 @@ COMMANDS = ("run", "simulate", "compare", "render", "play", "bench", "stability"
 
 EXIT_USAGE = 2
 EXIT_VERDICT = 3
+EXIT_INACCURATE = 4
+#: The exit statuses of runs, from best to worst: a command that makes several runs exits
+#: with the worst (an early end is worse than an inaccurate run).
+RUN_STATUSES = (0, EXIT_INACCURATE, EXIT_VERDICT)
+
+
+def verdict_status(verdict: Any) -> int:
+    """The exit status of a run's verdict: 0 ``ok``, :data:`EXIT_INACCURATE` for a run that
+    reached its end but is ``inaccurate``, :data:`EXIT_VERDICT` for one that ended early."""
+    if verdict.ok:
+        return 0
+    return EXIT_INACCURATE if verdict.complete else EXIT_VERDICT
+
+
+def worst_status(*statuses: int) -> int:
+    """The worst of exit statuses: a status outside :data:`RUN_STATUSES` (a usage error,
+    a signal) first, then by that order."""
+    return max(statuses, key=lambda s: RUN_STATUSES.index(s) if s in RUN_STATUSES
+               else len(RUN_STATUSES) + s, default=0)
 
 
 #: Longest run of characters without a space a message may echo (a value, a path): longer
@@ -161,7 +182,9 @@ def build_parser(commands: Sequence[str] = COMMANDS) -> Parser:
         prog="dumbbell",
         description="How a body's mechanical energy is shared between centre-of-mass and "
                     "internal motion: the bouncing dumbbell of textbook section 13.5.1.",
-        epilog="Exit status: 0 done, 2 bad input, 3 a run ended with a verdict other than ok.",
+        epilog="Exit status: 0 done, 2 bad input, 3 a run ended early (unstable, tunnelled or "
+               "failed), 4 a run reached its end but is inaccurate (its energy error passed "
+               "run.inaccurate_energy; every output written).",
     )
     parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
@@ -326,8 +349,8 @@ def as_flags(exc: DumbbellError, args: argparse.Namespace | None = None) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status: 0 done, 2 bad
-    input, 3 a verdict other than ok, 128+N stopped by signal N (SIGINT 130, SIGTERM 143,
-    SIGHUP 129)."""
+    input, 3 a run ended early, 4 a run is inaccurate, 128+N stopped by signal N (SIGINT 130,
+    SIGTERM 143, SIGHUP 129)."""
     command = "dumbbell"
     state: dict[str, object] = {}
     # Without argv, this is the process's own command (the console script, python -m):

@@ -115,6 +115,7 @@ def run_pieces(out: Path, quiet: bool = False, max_samples: int | None = None,
     line and scene are read before the first one runs. ``max_samples`` and ``max_frames``
     are the budgets of the ``run`` pieces (their defaults when None)."""
     from ..io.files import check_writable
+    from .app import worst_status
 
     pieces = [(piece, parse(piece, out, quiet)) for piece in PIECES]
     # Every showcase file can be written, before the first piece runs (each piece then
@@ -131,5 +132,5 @@ def run_pieces(out: Path, quiet: bool = False, max_samples: int | None = None,
                 args.max_frames = max_frames
         if not quiet:
             sys.stderr.write(f"dumbbell run --all: {piece.command}\n")
-        status = max(status, int(args.func(args) or 0))
+        status = worst_status(status, int(args.func(args) or 0))
     return status

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..solvers.base import MAX_SAMPLES, MAX_STEPS
-from .app import EXIT_VERDICT, add_quiet, add_scene, positive_float, positive_int, read_scene
+from .app import add_quiet, add_scene, positive_float, positive_int, read_scene, verdict_status
 
 #: What ``dumbbell simulate --help`` says the command does.
 DESCRIPTION = """\
@@ -62,5 +62,4 @@ def run(args: argparse.Namespace) -> int:
         write_events(traj, Path(args.events))
     if not traj.verdict.ok:
         sys.stderr.write(f"dumbbell simulate: {traj.solver}: {traj.verdict}\n")
-        return EXIT_VERDICT
-    return 0
+    return verdict_status(traj.verdict)

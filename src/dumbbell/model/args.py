@@ -16,6 +16,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._display import counted
 from .._pymunk import require as require_pymunk
 from ..errors import UsageError
 
@@ -236,7 +237,7 @@ def columns(value: Any, n: int, name: str) -> dict[str, Any]:
            for key, col in mapping(value, name, "a dict of columns by name").items()}
     for key, col in out.items():
         if len(col) != n:
-            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
+            raise UsageError(f"{name}[{key!r}] has {counted(len(col), 'sample')}: must have as many as "
                              f"t ({n})", param=name)
     return out
 

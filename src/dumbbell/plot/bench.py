@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
 from ..model import args
 from ..solvers import solver_class
@@ -67,7 +68,7 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.margins(x=0.07, y=0.06)  # room for the labels of the outermost points
-    ax.set_xlabel(f"run time [s], fastest of at least {result.repeat} runs")
+    ax.set_xlabel(f"run time [s], fastest of at least {counted(result.repeat, 'run')}")
     ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
     ax.set_title(f"Work-precision: {result.scene}, {result.t_end:g} s simulated; "
                  f"labels: dt (s)", fontsize=10)

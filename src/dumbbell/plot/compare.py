@@ -10,9 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.compare import DIVERGED, Comparison
+from ..analysis.compare import PART_FRACTION, Comparison
 from ..analysis.metrics import energy_error
 from ..model import args
+from ..solvers.advice import length as dumbbell_length
 from .style import ROW_COLOURS, ROW_DASHES, _subplots, legend_outside
 
 __all__ = ["compare", "compare_energy", "compare_positions"]
@@ -79,11 +80,15 @@ def compare(result: Comparison, ax: Any = None) -> Any:
         t = row.traj.t[: len(row.error)]
         ax.semilogy(t, np.maximum(row.error, 1e-17), color=colour, lw=1.1,
                     ls=ROW_DASHES[result.rows.index(row) % len(ROW_DASHES)],
-                    label=f"{row.label}: {row.window_error:.2g} m max\nin [0, {result.window:g}] s")
+                    label=f"{row.label}: {row.window_error:.2g} m max\nin [0, "
+                          f"{row.error_until:.3g}] s"
+                          + (" (then parted)" if row.error_until < result.window else ""))
     ax.axvline(result.window, color="0.4", ls="--", lw=0.8,
                label=f"end of the {result.window:g} s window")
-    ax.axhline(DIVERGED, color="0.6", ls=":", lw=0.8,
-               label=f"{DIVERGED * 1e3:g} mm: the runs have parted")
+    distance = PART_FRACTION * dumbbell_length(scene.system)
+    ax.axhline(distance, color="0.6", ls=":", lw=0.8,
+               label=f"{distance * 1e3:.3g} mm ({PART_FRACTION:.0%} of the dumbbell): past it,"
+                     "\nthe runs have parted (at the impact before)")
     for i, ev in enumerate(truth.events):
         ax.axvline(ev.t, color="0.85", lw=0.6, zorder=0,
                    label=f"impacts of the truth ({truth.solver})" if i == 0 else None)

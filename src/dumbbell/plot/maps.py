@@ -9,10 +9,12 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP_WDT
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
+from ..model.trajectory import COMPLETE
 from .style import FAIL_COLOURS, _subplots, legend_outside
 
 __all__ = ["stability_map", "sweep_map"]
@@ -67,7 +69,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     if own:
         fig, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
     title = (f"Sweep of {result.scene.name}: {result.solver}, t_end = {result.t_end:g} s, "
-             f"{len(result.rows)} runs")
+             f"{counted(len(result.rows), 'run')}")
     if len(result.axes) == 2:
         draw_map(ax.figure, ax, result.axes[0], result.axes[1], result.rows, title)
     else:
@@ -105,7 +107,8 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
     xe, ye = _edges(xs, xlog), _edges(ys, ylog)
     with np.errstate(divide="ignore", invalid="ignore"):
         level = np.log10(np.maximum(err, 1e-17))
-    level = np.ma.masked_where((verdict != "ok") | ~np.isfinite(level), level)
+    # Runs that reached their end (ok or inaccurate) are coloured by their error.
+    level = np.ma.masked_where(~np.isin(verdict, COMPLETE) | ~np.isfinite(level), level)
     if limits is None:
         lo = math.floor(float(level.min())) if level.count() else -16
         limits = (lo, max(lo + 1, math.ceil(float(level.max()))) if level.count() else 2)
@@ -121,7 +124,7 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
             ax.pcolormesh(xe, ye, np.ma.masked_where(~mask, np.full(mask.shape, code)),
                           cmap=ListedColormap([colour]), shading="flat")
             handles.append(Patch(facecolor=colour, edgecolor="0.3",
-                                 label=f"{name} ({int(mask.sum())} runs)"))
+                                 label=f"{name} ({counted(int(mask.sum()), 'run')})"))
     if x_axis.key == "w_dt":
         ax.axvline(2.0, color="red", lw=2.2, ls="--")
         handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
@@ -164,8 +167,10 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     rows = [rows[i] for i in order]
     err = np.array([r.max_rel_energy_error for r in rows], float)
     verdicts = [r.verdict for r in rows]
-    ok = np.array([v == "ok" for v in verdicts])
-    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label="ok")
+    ok = np.array([v in COMPLETE for v in verdicts])
+    label = ("ok" if all(v == "ok" for v in verdicts if v in COMPLETE)
+             else "stable: ok or inaccurate")
+    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label=label)
     top = np.nanmax(err[np.isfinite(err)]) if np.isfinite(err).any() else 1.0
     for name, colour in FAIL_COLOURS.items():
         mask = np.array([v == name for v in verdicts])
@@ -173,7 +178,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
             # At the error reached before the run stopped; off the top if none was finite.
             ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
             ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
-                    label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
+                    label=f"{name} ({counted(int(mask.sum()), 'run')}, error when it stopped)")
     w_dt = np.array([r.w_dt for r in rows], float)
     cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
     if cross.size:
@@ -203,7 +208,7 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
     y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
     errs = [r.max_rel_energy_error for rows in maps.values() for r in rows
-            if r.verdict == "ok" and r.max_rel_energy_error > 0]
+            if r.verdict in COMPLETE and r.max_rel_energy_error > 0]
     lo = math.floor(math.log10(min(errs))) if errs else -16
     hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
     mesh = None

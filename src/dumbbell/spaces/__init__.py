@@ -26,7 +26,7 @@ _WHERE = {
     "energy": "accounting", "SpaceEnergy": "accounting", "BodyEnergy": "accounting",
     "SpringEnergy": "accounting", "Skipped": "accounting",
     "check": "guard", "survey": "guard", "suggest_dt": "guard", "substeps": "guard",
-    "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
+    "report": "guard", "Finding": "guard", "step": "stepping", "Driver": "stepping",
     "spring_omega": "guard", "shape_size": "guard", "energy_swing": "guard",
     "reach": "estimates", "Reach": "estimates",
     "HeatCounter": "heat",

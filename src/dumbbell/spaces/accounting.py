@@ -39,6 +39,7 @@ from ..model.energy import (
     spring_potential,
     translational_ke,
 )
+from .units import UNNAMED
 
 __all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
@@ -648,7 +649,7 @@ class _Sampler:
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
     momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
-    space's ``units`` (length, mass, time), SI unless :func:`energy` was told."""
+    space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not)."""
 
     subject: str
     mass: float
@@ -658,7 +659,7 @@ class BodyEnergy:
     U_g: float
     momentum: tuple[float, float]
     L_about: float
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     def __repr__(self) -> str:
         from .units import shown
@@ -673,7 +674,7 @@ class SpringEnergy:
     subject: str
     kind: str
     U: float
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     def __repr__(self) -> str:
         from .units import shown
@@ -683,7 +684,7 @@ class SpringEnergy:
 
 @dataclass(frozen=True, repr=False)
 class SpaceEnergy:
-    """Energy and momentum of a space's dynamic bodies (SI units, or the ``units``
+    """Energy and momentum of a space's dynamic bodies (in the ``units``
     :func:`energy` was given: (length, mass, time)).
 
     K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
@@ -708,7 +709,7 @@ class SpaceEnergy:
     skipped: tuple[Skipped, ...]
     unknown: tuple[Skipped, ...]
     notes: tuple[str, ...]
-    units: tuple[str, str, str] = ("m", "kg", "s")
+    units: tuple[str, str, str] = UNNAMED
 
     @property
     def complete(self) -> bool:
@@ -722,10 +723,11 @@ class SpaceEnergy:
 
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
-           units: Any = ("m", "kg", "s")) -> SpaceEnergy:
-    """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
+           units: Any = None) -> SpaceEnergy:
+    """Energy and momentum of ``space`` now; angular momentum also about ``about``.
     ``units`` names the space's units as the recorder takes them (the length unit alone,
-    'px', or (length, mass, time)): the values are the same, their reprs carry them. See
+    'px' or 'm', or (length, mass, time); None: not named, and the reprs say "energy units",
+    never J for what may be pixels): the values are the same, their reprs carry them. See
     the module docstring for what is counted."""
     from ..model import args
     from .units import check_units

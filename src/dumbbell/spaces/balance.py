@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .._display import one_line
+from .._display import counted, one_line
 
 __all__ = ["Balance", "Term"]
 
@@ -129,7 +129,7 @@ class Balance:
     def __repr__(self) -> str:
         u = self.unit
         return one_line(
-            f"Balance({self.steps} steps, t = {self.t:.6g} {self.time_unit}, E0 = "
+            f"Balance({counted(self.steps, 'step')}, t = {self.t:.6g} {self.time_unit}, E0 = "
             f"{self.E0:.9g} {u}, "
             f"E = {self.E:.9g} {u}, closure = {self.closure:+.3g} {u}, complete = "
             f"{self.complete}; {len(self.terms)} terms: .table())")
@@ -141,7 +141,7 @@ class Balance:
 
         top = args.whole(top, "top", "sources", lo=0)
         u = self.unit
-        lines = [(f"energy ledger over {self.steps} steps, t = {self.t:.6g} {self.time_unit}, "
+        lines = [(f"energy ledger over {counted(self.steps, 'step')}, t = {self.t:.6g} {self.time_unit}, "
                  f"energies in {u}"),
                  f"  E(0) = {self.E0:.9g}   E(t) = {self.E:.9g}   scale = {self.scale:.4g}"]
         for kind, total in sorted(self.by_kind().items(), key=lambda kv: -abs(kv[1])):

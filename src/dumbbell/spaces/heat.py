@@ -56,7 +56,7 @@ class HeatCounter:
     stopped (None while it counts). ``units`` names the space's units as the recorder takes
     them (its repr prints the total in them)."""
 
-    def __init__(self, space: Any, units: Any = ("m", "kg", "s")) -> None:
+    def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
         from .units import check_units
 
@@ -118,10 +118,10 @@ class HeatCounter:
 
     def __repr__(self) -> str:
         from .._display import one_line
-        from .units import energy_unit
+        from .units import UNNAMED, energy_unit
 
         state = "attached" if self.attached else (self.stopped or "not attached")
-        unit = energy_unit(self.__dict__.get("units", ("m", "kg", "s")))
+        unit = energy_unit(self.__dict__.get("units", UNNAMED))
         return one_line(f"HeatCounter({state}, total={self.total:.6g} {unit})")
 
     def detach(self) -> None:

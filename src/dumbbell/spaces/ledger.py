@@ -75,7 +75,7 @@ from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
-from .units import SI, check_units, energy_unit
+from .units import check_units, energy_unit
 
 __all__ = ["Ledger"]  # Balance and Term: balance.py
 
@@ -118,7 +118,7 @@ class Ledger(Changes):
     ``tolerance`` (relative to the energy scale) is what ``complete`` allows for the closure
     and for anything unattributed or changed by the program. ``units`` names the space's
     units as the recorder takes them (the length unit alone, 'px', or (length, mass, time));
-    energies are printed in them (J in SI). See the module docstring for the terms. A copy
+    energies are printed in them (J in SI; "energy units" when not named). See the module docstring for the terms. A copy
     or a pickle of a ledger holds its account so far and does not count; a copy of the
     space has no ledger attached."""
 
@@ -132,7 +132,7 @@ class Ledger(Changes):
                 return super().__new__(PublicLedger)
         return super().__new__(cls)
 
-    def __init__(self, space: Any, tolerance: float = 1e-6, units: Any = SI) -> None:
+    def __init__(self, space: Any, tolerance: float = 1e-6, units: Any = None) -> None:
         from ..model import args
 
         self.space = args.space(space)

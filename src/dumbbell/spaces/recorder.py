@@ -462,7 +462,7 @@ class Recorder:
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
                  camera: Any = "auto", span: float | None = None, y_up: bool | None = None,
-                 units: str | tuple[str, str, str] = SI, reference: Any = "start",
+                 units: str | tuple[str, str, str] | None = None, reference: Any = "start",
                  t0: float = 0.0,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
         import pymunk
