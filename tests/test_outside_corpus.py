@@ -1,9 +1,12 @@
 """dumbbell.spaces on programs written here the way pymunk users write them (issue 28's
-corpus, tests/outside_corpus.py): for each program, its energy terms against a hand
-computation; the ledger counting over the whole run and closing, or naming why not; each
-``program``, ``entered``, ``left`` and callback term against what the program did, measured
-by hand just before and just after it; the recorder drawing y as the program's window does,
-every dynamic body at least 4 px or named; the guard with a row for every constraint."""
+corpus: tests/outside_corpus.py, measured through tests/outside_tape.py): for each program,
+its energy terms against a hand computation; the ledger counting over the whole run and
+closing, or naming why not; each ``program``, ``entered``, ``left`` and callback term
+against what the program did, measured by hand just before and just after it; the recorder
+drawing y as the program's window does, every dynamic body at least 4 px or named; the
+guard with a row for every constraint. Then, on the same programs: each pair's push apart
+as dt changes, sub-steps that keep the program's forces, and the guard reading centres of
+gravity, not origins."""
 
 from __future__ import annotations
 
@@ -16,7 +19,8 @@ import numpy as np
 import pymunk
 import pytest
 
-from .outside_corpus import PROGRAMS, hand_energy, recentred, run
+from .outside_corpus import PROGRAMS, run
+from .outside_tape import hand_energy, recentred
 from .recorder_corpus import body_size, extent, frame, picture, scene_mask
 
 pytest.importorskip("pygame")
