@@ -78,14 +78,15 @@ def run(args: argparse.Namespace) -> int:
     if out.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"-o {out}: must end in .html")
     solvers = args.solvers or [None]
-    if len(set(solvers)) < len(solvers):
-        raise UsageError(f"--solvers {' '.join(solvers)}: each solver once")
-    for name in solvers:
+    for name in dict.fromkeys(solvers):
         if name is not None:
             try:
                 runnable(solver_class(name), scene)
             except UsageError as exc:
                 raise UsageError(f"--solvers: {exc}") from None
+    twice = next((name for i, name in enumerate(solvers) if name in solvers[:i]), None)
+    if twice is not None:
+        raise UsageError(f"--solvers: {twice} named twice; give each solver once")
     from .app import plan_outputs
 
     if not args.output:  # -o itself was checked with the other flags

@@ -216,13 +216,9 @@ def _figure(name: str, traj: Any) -> Any:
     if name == "contact":
         from ..analysis.contact import about_contact
 
-        ax = plot.contact_momentum(about_contact(traj), solver=traj.solver)
-        ax.figure.tight_layout()
-        return ax
+        return plot.contact_momentum(about_contact(traj), solver=traj.solver)
     if name == "topple":
         from ..analysis.topple import closed_form, measure
 
-        axes = plot.topple(closed_form(traj.scene), measure(traj), solver=traj.solver)
-        axes[0].figure.tight_layout()
-        return axes[0]
+        return plot.topple(closed_form(traj.scene), measure(traj), solver=traj.solver)[0]
     return getattr(plot, name)(traj)
