@@ -23,23 +23,7 @@ from .outside_corpus import PROGRAMS, run
 from .outside_tape import hand_energy, recentred
 from .recorder_corpus import body_size, extent, frame, picture, scene_mask
 
-pytest.importorskip("pygame")
-
 NAMES = list(PROGRAMS)
-#: Open bugs the corpus finds (program -> why), marked where they fail.
-SPRING_NAMED_BY_BODIES = (
-    "open bug (issue 28 item 2): a spring added or removed in a gap where bodies are also "
-    "added or removed has its potential booked as 'program: bodies added or removed' (the "
-    "first change the ledger notices), not 'program: constraints added or removed' as the "
-    "docs name it; spawner frame 48 adds a ball and a stretched spring")
-
-
-def _names(**open_bugs: str) -> list:
-    """The programs, those with an open bug marked xfail (strict) with its reason."""
-    return [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=open_bugs[n]))
-            if n in open_bugs else n for n in NAMES]
-
-
 #: Kinds of terms that say what a program did (between steps or from a callback).
 DONE = ("program", "entered", "left", "unattributed")
 #: Drawn at least this many pixels across (issue 28).
@@ -140,7 +124,7 @@ def _expected_unaccounted(tape) -> tuple[set[str], set[str]]:
     return must, may
 
 
-@pytest.mark.parametrize("name", _names(spawner=SPRING_NAMED_BY_BODIES))
+@pytest.mark.parametrize("name", NAMES)
 def test_the_ledger_closes_or_names_the_cause(name, runs):
     tape = runs(name)
     b = tape.balance
@@ -154,7 +138,7 @@ def test_the_ledger_closes_or_names_the_cause(name, runs):
     assert b.complete is (not named)
 
 
-@pytest.mark.parametrize("name", _names(spawner=SPRING_NAMED_BY_BODIES))
+@pytest.mark.parametrize("name", NAMES)
 def test_what_the_program_did_is_each_term(name, runs):
     tape = runs(name)
     b = tape.balance
@@ -381,24 +365,3 @@ def test_the_guard_reads_centres_of_gravity_not_origins(name, runs):
     for key, value in rows0.items():
         if key[0] in ("tunnelling", "spring", "rotary-spring", "spring-network"):
             assert rows1[key] == pytest.approx(value, rel=1e-6, abs=1e-12), key
-
-
-@pytest.mark.xfail(strict=True, reason=SPRING_NAMED_BY_BODIES)
-def test_a_spring_added_beside_a_new_body_is_booked_as_a_constraint_change():
-    # The spawner's open bug, alone: a spring stretched by 6 (k = 2: 36 J) is added between
-    # two bodies while an unrelated body is added in the same gap between steps.
-    from dumbbell import spaces
-
-    space = pymunk.Space()
-    a, b = pymunk.Body(1, 1), pymunk.Body(1, 1)
-    a.position, b.position = (0, 0), (10, 0)
-    space.add(a, b, pymunk.Circle(a, 1), pymunk.Circle(b, 1))
-    ledger = spaces.Ledger(space)
-    space.step(0.01)
-    space.add(pymunk.DampedSpring(a, b, (0, 0), (0, 0), 4.0, 2.0, 0.0))
-    c = pymunk.Body(1, 1)
-    c.position = (50, 50)
-    space.add(c, pymunk.Circle(c, 1))
-    space.step(0.01)
-    program = {t.source: t.energy for t in ledger.balance().terms if t.kind == "program"}
-    assert program == {"program: constraints added or removed": 36.0}
