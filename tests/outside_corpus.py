@@ -120,7 +120,7 @@ def pool_table(tape: Tape) -> None:
             with tape.act(space):
                 state["cue"] = new_ball(*cue_spot)
                 balls.append(state["cue"])
-        if frame % 70 == 40 and state["cue"] is not None and len(balls) > 1:
+        if frame % 50 == 40 and state["cue"] is not None and len(balls) > 1:
             # the player aims at the ball nearest a pocket
             target = min(balls[1:], key=lambda b: min(b.position.get_distance(c)
                                                       for c in corners))
@@ -185,14 +185,14 @@ def car(tape: Tape) -> None:
             tape.start(space)
 
         def on_update(self, delta_time: float) -> None:
-            if self.frame == 60:  # nitro
+            if self.frame == 30:  # nitro
                 with tape.act(self.space, self.chassis):
                     self.chassis.apply_impulse_at_local_point((1500.0, 0.0), (0.0, 0.1))
-            if self.frame == 120:  # handbrake: the wheels stop turning
+            if self.frame == 60:  # handbrake: the wheels stop turning
                 with tape.act(self.space, *self.wheels):
                     for wheel in self.wheels:
                         wheel.angular_velocity = 0.0
-            throttle = 400.0 if self.frame < 120 else 0.0
+            throttle = 400.0 if self.frame < 60 else 0.0
             for _ in range(4):
                 for wheel in self.wheels:
                     wheel.torque = -throttle
@@ -277,10 +277,10 @@ def ragdoll(tape: Tape) -> None:
         if frame == 10:  # thrown towards the stairs
             with tape.act(space, torso):
                 torso.apply_impulse_at_world_point((3000, -2500), torso.position + (0, -20))
-        if frame == 80:  # kicked in the shin
+        if frame == 40:  # kicked in the shin
             with tape.act(space, legs[1]):
                 legs[1].apply_impulse_at_local_point((-300, -200), (0, 30))
-        if frame == 140:  # the head yanked up by the mouse
+        if frame == 70:  # the head yanked up by the mouse
             with tape.act(space, head):
                 head.velocity = (0, -400)
         space.step(1 / 60)
@@ -338,16 +338,16 @@ def cloth(tape: Tape) -> None:
 
     def update(dt: float) -> None:
         frame = clock["frame"]
-        if frame == 30:  # a ball thrown at the curtain
+        if frame == 15:  # a ball thrown at the curtain
             ball = pymunk.Body(5, pymunk.moment_for_circle(5, 0, 25))
             ball.position, ball.velocity = (150, 400), (700, 150)
             with tape.act(space, ball):
                 space.add(ball, pymunk.Circle(ball, 25))
-        if frame == 70:  # torn in the middle
+        if frame == 35:  # torn in the middle
             with tape.act(space, *everyone):
                 for j in range(5, 9):
                     space.remove(springs[(5, j, "v")])
-        if frame == 90:  # the bottom-left corner dragged by the mouse
+        if frame == 45:  # the bottom-left corner dragged by the mouse
             corner = grid[-1][0]
             with tape.act(space):
                 corner.position += (-30, 10)
@@ -407,11 +407,11 @@ def gas(tape: Tape, n_side: int = 100) -> None:
             return p
 
         def update(self, dt: float) -> None:
-            if self.frame == 2:  # the thermostat
+            if self.frame == 1:  # the thermostat
                 with tape.act(self.space):
                     for p in self.particles:
                         p.velocity *= 1.02
-            if self.frame == 4:  # the rightmost particles let out, as many let in
+            if self.frame == 2:  # the rightmost particles let out, as many let in
                 out = sorted(self.particles, key=lambda p: -p.position.x)[:25]
                 new = [self.particle((10.0 + 10 * k, 10.0), self.rng) for k in range(25)]
                 with tape.act(self.space, *out, *new):
@@ -657,10 +657,10 @@ def planet(tape: Tape, declare: bool = False) -> None:
         moons.append(b)
     tape.start(space, fields=((planet_gravity, sun_potential),), declare=declare)
     for frame in range(tape.frames):
-        if frame == 30:  # a rocket burn
+        if frame == 15:  # a rocket burn
             with tape.act(space, moons[0]):
                 moons[0].apply_impulse_at_local_point((0, 40))
-        if frame == 60:  # a launch
+        if frame == 30:  # a launch
             b = moon(200, 0.5)
             with tape.act(space, b):
                 space.add(b, pymunk.Circle(b, 5))
@@ -700,7 +700,7 @@ def conveyor(tape: Tape) -> None:
                 return
         if frame % 30 == 0:
             crate = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (0.3, 0.3)))
-            crate.position = (1.0, 2.3)
+            crate.position = (3.0, 2.3)
             box = pymunk.Poly.create_box(crate, (0.3, 0.3))
             box.friction = 0.9
             with tape.act(space, crate):
@@ -764,13 +764,13 @@ def chain(tape: Tape) -> None:
         for event in pygame.event.get():
             if event.type == pygame.QUIT:
                 return
-        if frame == 60:  # flicked
+        if frame == 30:  # flicked
             with tape.act(space, bobs[-1]):
                 bobs[-1].velocity += (0, -400)
-        if frame == 100:  # a link cut
+        if frame == 50:  # a link cut
             with tape.act(space, bobs[2], bobs[3]):
                 space.remove(links[3])
-        if frame == 130:  # a bob caught
+        if frame == 65:  # a bob caught
             with tape.act(space, bobs[1]):
                 bobs[1].velocity = (0, 0)
                 bobs[1].angular_velocity = 0
@@ -820,7 +820,7 @@ def hammer(tape: Tape) -> None:
             tape.start(space)
 
         def update(self, dt: float) -> None:
-            if self.frame == 40:  # a swing
+            if self.frame == 20:  # a swing
                 with tape.act(self.space, self.hammer):
                     self.hammer.angular_velocity = -6.0
             for _ in range(2):
@@ -874,7 +874,7 @@ def frame_drops(tape: Tape) -> None:
             if event.type == pygame.QUIT:
                 return
         dt = clock.tick(60) / 1000.0
-        if frame % 15 == 5 and len(balls) < 9:
+        if frame % 8 == 5 and len(balls) < 9:
             b = ball(340 + 70 * (len(balls) - 3), 150)
             with tape.act(space, b):
                 space.add(b, *b.shapes)
@@ -973,19 +973,19 @@ PX = ("px", "kg", "s")
 SI = ("m", "kg", "s")
 
 PROGRAMS = {
-    "pool_table": Program(pool_table, "pygame", False, PX, 200, 100),
-    "car": Program(car, "arcade", True, SI, 150, 150),
-    "ragdoll": Program(ragdoll, "pygame_util", False, PX, 180),
-    "cloth": Program(cloth, "pyglet", True, PX, 120, 90),
-    "gas": Program(gas, "kivy", True, PX, 6, 1000),
-    "bumpers": Program(bumpers, "arcade", True, PX, 180),
-    "spawner": Program(spawner, "pygame_util", False, PX, 240),
-    "planet": Program(planet, "none", True, PX, 120),
-    "planet_declared": Program(planet, "none", True, PX, 120, kwargs=(("declare", True),)),
-    "conveyor": Program(conveyor, "pygame", True, SI, 240),
-    "chain": Program(chain, "pygame_util", False, PX, 180),
-    "hammer": Program(hammer, "kivy", True, SI, 120, 80),
-    "frame_drops": Program(frame_drops, "pygame_util", False, PX, 150, pushes=True),
+    "pool_table": Program(pool_table, "pygame", False, PX, 120, 100),
+    "car": Program(car, "arcade", True, SI, 75, 150),
+    "ragdoll": Program(ragdoll, "pygame_util", False, PX, 90),
+    "cloth": Program(cloth, "pyglet", True, PX, 60, 90),
+    "gas": Program(gas, "kivy", True, PX, 3, 1000),
+    "bumpers": Program(bumpers, "arcade", True, PX, 130),
+    "spawner": Program(spawner, "pygame_util", False, PX, 120),
+    "planet": Program(planet, "none", True, PX, 45),
+    "planet_declared": Program(planet, "none", True, PX, 45, kwargs=(("declare", True),)),
+    "conveyor": Program(conveyor, "pygame", True, SI, 120),
+    "chain": Program(chain, "pygame_util", False, PX, 80),
+    "hammer": Program(hammer, "kivy", True, SI, 60, 80),
+    "frame_drops": Program(frame_drops, "pygame_util", False, PX, 120, pushes=True),
     "ship": Program(ship, "arcade", True, PX, 90),
     "ship_substeps": Program(ship, "arcade", True, PX, 90, kwargs=(("substeps", 6),)),
 }

@@ -34,7 +34,7 @@ from typing import Any
 from .pymunk_corpus import _Anything, _StandInModule
 
 #: Frames per second of the recordings.
-FPS = 25
+FPS = 10
 #: Window libraries whose stand-ins a program can import.
 STAND_INS = ("pyglet", "arcade", "kivy")
 
