@@ -196,23 +196,13 @@ def test_what_the_program_did_is_each_term(name, runs):
                        f"measured), scale {b.scale:.4g}: {dict(sorted(wrong.items())[:8])}")
 
 
-#: Open defects the corpus finds (program -> why), marked where they fail.
-HEAT_AFTER_CALLBACKS = (
-    "open defect (HeatCounter): pymunk calls a post_solve set for particular collision "
-    "types before the wildcard one the counter listens on, so a callback that changes a "
-    "velocity there (the bumpers' kick x1.2 and mud x0.5) is counted as the contact's heat "
-    "(979,276 against the ledger's 1,035,880); no public callback runs between the "
-    "solver's end and the collision callbacks but a constraint's post_solve")
-
-
-@pytest.mark.parametrize("name", [
-    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=HEAT_AFTER_CALLBACKS))
-    if n == "bumpers" else n for n in NAMES])
+@pytest.mark.parametrize("name", NAMES)
 def test_the_heat_counter_is_the_ledger_s_contact_heat(name, runs):
     # The heat counter (each contact's impulses against the relative velocity at its point)
     # and the ledger (each pair's work in its account) count the same dissipation in two
     # ways: what the contacts took out, on every program, with its callbacks and bodies
-    # coming and going.
+    # coming and going. (The bumpers' post_solve callbacks, set for particular collision
+    # types, kick and slow balls: what they do is the program's, not heat.)
     tape = runs(name)
     b = tape.balance
     contact = math.fsum(t.energy for t in b.terms if t.source.startswith("contact "))
