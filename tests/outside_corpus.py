@@ -991,11 +991,12 @@ PROGRAMS = {
 }
 
 
-def run(name: str, folder: str | Path) -> Tape:
-    """Run corpus program ``name`` headless with its tape; the GIF goes into ``folder``."""
+def run(name: str, folder: str | Path, tools: bool = True) -> Tape:
+    """Run corpus program ``name`` headless with its tape; the GIF goes into ``folder``.
+    ``tools=False``: bare, with no ledger, heat counter or recorder attached."""
     p = PROGRAMS[name]
     tape = Tape(name, Path(folder), p.frames, p.window, p.y_up, p.units, p.check_every,
-                pushes={} if p.pushes else None)
+                pushes={} if p.pushes else None, tools=tools)
     with window(tape):
         p.run(tape, **dict(p.kwargs))
     tape.finish()

@@ -172,6 +172,9 @@ class Tape:
     dt: float = 0.0
     velocity_funcs: list[Any] = field(default_factory=list)
     pushes: dict[str, float] | None = None
+    #: False: the program runs bare (no ledger, heat counter or recorder attached), to
+    #: compare its motion with the run that has them.
+    tools: bool = True
 
     # -- what the harness does ---------------------------------------------------------
 
@@ -188,6 +191,9 @@ class Tape:
         for i, b in enumerate(space.bodies):
             self.labels[id(b)] = f"{_kind(b)}{i}"
             self.kept.append(b)
+        if not self.tools:
+            self.checkpoint()
+            return
         self.ledger = spaces.Ledger(space)
         if declare:
             for func, potential in fields:
@@ -230,7 +236,7 @@ class Tape:
         self.dt = dt
         self._label_new("step")
         t = math.fsum(self.dts)
-        if t >= self.next_frame / FPS - 1e-9:
+        if self.tools and t >= self.next_frame / FPS - 1e-9:
             self.rec.capture(t=t)
             self.next_frame = math.floor(t * FPS + 1e-9) + 1
         if len(self.dts) % self.check_every == 0:
@@ -241,6 +247,8 @@ class Tape:
         the run leaves it), the GIF; tools detached."""
         if self.space is None:
             raise RuntimeError(f"{self.name}: the program never started its tape")
+        if not self.tools:
+            return
         self.balance = self.ledger.balance()
         t = math.fsum(self.dts)
         if t > self.rec.times[-1]:
