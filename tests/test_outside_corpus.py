@@ -4,8 +4,9 @@ its energy terms against a hand computation; the ledger counting over the whole 
 closing, or naming why not; each ``program``, ``entered``, ``left`` and callback term
 against what the program did, measured by hand just before and just after it; the recorder
 drawing y as the program's window does, every dynamic body at least 4 px or named; the
-guard with a row for every constraint. Then, on the same programs: each pair's push apart
-as dt changes, sub-steps that keep the program's forces, and the guard reading centres of
+guard with a row for every constraint; the heat counter against the ledger's contact terms.
+Then, on the same programs: the tools leaving the motion alone, each pair's push apart as
+dt changes, sub-steps that keep the program's forces, and the guard reading centres of
 gravity, not origins."""
 
 from __future__ import annotations
