@@ -318,13 +318,14 @@ def _motion(space) -> list[tuple[float, ...]]:
     return [(*b.position, *b.velocity, b.angle, b.angular_velocity) for b in space.bodies]
 
 
-@pytest.mark.parametrize("name", ["pool_table", "bumpers", "spawner", "cloth"])
+@pytest.mark.parametrize("name", ["pool_table", "bumpers", "spawner", "ship"])
 def test_the_tools_leave_the_program_s_motion_alone(name, runs, tmp_path):
     # Issue 28: the ledger, heat counter and recorder attached together leave a program
     # alone: the same program run bare ends bit for bit where it ends with them, with its
     # post-step callbacks (the pockets, the crates), collision callbacks for particular
     # types (the bumpers' kick and mud, which the heat counter runs before), bodies and
-    # joints added and removed every few frames, and per-frame forces (the cloth's wind).
+    # joints added and removed every few frames, and per-frame forces and torques (the
+    # ship's thrusters).
     bare = run(name, tmp_path, tools=False)
     tape = runs(name)
     assert bare.dts == tape.dts
