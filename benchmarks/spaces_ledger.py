@@ -1,7 +1,7 @@
 """spaces.Ledger: how well it closes on pymunk's own examples, and what it costs per step.
 
     python benchmarks/spaces_ledger.py            # the closure table, then the costs
-    python benchmarks/spaces_ledger.py --table    # only the table (the one in docs/spaces.md)
+    python benchmarks/spaces_ledger.py --table    # only the table (the one in docs/spaces-reference.md)
     python benchmarks/spaces_ledger.py --cost [--steps 300] [--repeat 3] [--space pyramid]
 
 The table runs every case of ``tests/ledger_cases.py``: each constraint kind of pymunk's
