@@ -8,6 +8,7 @@ nothing written); 3 a run ended with a verdict other than ``ok``; 128+N stopped 
 
 from __future__ import annotations
 
+import _thread
 import argparse
 import contextlib
 import dataclasses
@@ -17,7 +18,7 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from ..errors import DumbbellError, UsageError
@@ -201,11 +202,81 @@ class Stopped(KeyboardInterrupt):
         self.signum = signum
 
 
+class _StopState:
+    """The stop signals of the running command: the first one (``signum``, None before any),
+    kept until the command ends whatever swallowed the exception it raised."""
+
+    signum: int | None = None
+    #: The command is over (its handlers are being given back): a late signal is ignored.
+    closing = False
+    #: Inside :func:`_unraisable`'s hook, where an exception would only be printed.
+    in_hook = False
+    #: The timer that delivers a swallowed stop again.
+    retry: threading.Timer | None = None
+
+
+_stopping = _StopState()
+
+#: How soon (s) a stop that C code swallowed is delivered again.
+RETRY_STOP = 0.005
+
+
+def _handling_a_stop() -> bool:
+    """True while a :class:`Stopped` is being handled (an ``except`` or ``finally`` on its
+    way out, the command's own handler): its cleanup must not be broken by a second one."""
+    exc = sys.exc_info()[1]
+    seen = 0
+    while exc is not None and seen < 100:
+        if isinstance(exc, Stopped):
+            return True
+        exc, seen = exc.__context__, seen + 1
+    return False
+
+
 def _stop(signum: int, frame: object) -> None:
-    # Once is enough: a second signal must not break the cleanup the first one started.
-    for name in STOP_SIGNALS:
-        signal.signal(getattr(signal, name), signal.SIG_IGN)
-    raise Stopped(signum)
+    """A stop signal: raise :class:`Stopped` for the first one. Another one while the first
+    one's cleanup runs is ignored; any other time (the first one's exception was swallowed)
+    it raises again, for the first signal."""
+    if _stopping.closing or _handling_a_stop():
+        return
+    if _stopping.signum is None:
+        _stopping.signum = signum
+    if _stopping.in_hook:
+        _retry_stop()
+        return
+    raise Stopped(_stopping.signum)
+
+
+def _retry_stop() -> None:
+    """Deliver the stop again in :data:`RETRY_STOP` s (a thread simulates the signal: the
+    main thread runs :func:`_stop` at its next Python instruction), unless that is planned."""
+    if _stopping.retry is None or not _stopping.retry.is_alive():
+        _stopping.retry = threading.Timer(RETRY_STOP, _thread.interrupt_main,
+                                          (_stopping.signum,))
+        _stopping.retry.daemon = True
+        _stopping.retry.start()
+
+
+def _unraisable(previous: Callable[[Any], object]) -> Callable[[Any], object]:
+    """A ``sys.unraisablehook`` that takes back a :class:`Stopped` that C code swallowed: an
+    exception raised in a pymunk collision callback is printed by cffi ('Exception ignored
+    from cffi callback') and the step goes on. No message then, and the stop is delivered
+    again a moment later (:func:`_retry_stop`): in a later callback (swallowed again, and
+    retried) or, at the latest, once ``Space.step`` has returned. Anything else goes to
+    ``previous``."""
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, Stopped) and _stopping.signum is not None \
+                and threading.current_thread() is threading.main_thread():
+            _stopping.in_hook = True
+            try:
+                _retry_stop()
+            finally:
+                _stopping.in_hook = False
+            return
+        previous(unraisable)
+
+    return hook
 
 
 @contextlib.contextmanager
@@ -217,14 +288,24 @@ def _stop_signals() -> Iterator[None]:
         return
     numbers = [getattr(signal, n) for n in STOP_SIGNALS if hasattr(signal, n)]
     before = {n: signal.getsignal(n) for n in numbers}
+    hook = sys.unraisablehook
+    _stopping.signum, _stopping.closing = None, False
     for n in numbers:
         if before[n] is not signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
             signal.signal(n, _stop)
+    sys.unraisablehook = _unraisable(hook)
     try:
         yield
     finally:
+        _stopping.closing = True
+        if _stopping.retry is not None:
+            _stopping.retry.cancel()
+            _stopping.retry.join()  # a stop it simulated is ignored now (closing)
+            _stopping.retry = None
         for n, handler in before.items():
             signal.signal(n, handler if handler is not None else signal.SIG_DFL)
+        sys.unraisablehook = hook
+        _stopping.signum, _stopping.closing = None, False
 
 
 #: How a scene read from standard input (SCENE ``-``) is named in messages and outputs.
@@ -382,7 +463,10 @@ def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> in
         with output_transaction() as transaction:
             state["outputs"] = args.outputs = transaction
             _check_paths(args, transaction)
-            return int(args.func(args) or 0)
+            status = int(args.func(args) or 0)
+            if _stopping.signum is not None:  # a stop something swallowed: keep nothing
+                raise Stopped(_stopping.signum)
+            return status
     except DumbbellError as exc:
         return error(as_flags(exc, args))
     except BrokenPipeError:

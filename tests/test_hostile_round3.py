@@ -1,0 +1,192 @@
+"""Hostile input, third round (issue 30): a stop always stops, no output emptied or written
+through a link, exit 0 only when the outputs exist, no traceback a CLI user sees, the
+Python API's output paths, bounded messages and bounded scene reads.
+
+Every test that needs a process in a given state waits for an event (a line on a marker pipe
+written by the process when it gets there), never for a time; every process is started in
+a session of its own and its whole group is killed on the way out, pass or fail
+(:func:`tests.hostile.started`)."""
+
+from __future__ import annotations
+
+import signal
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import SCENES
+from tests.hostile import (
+    files_in,
+    finish,
+    group_left,
+    marker_pipe,
+    one_line,
+    started,
+    wait_mark,
+)
+
+STOPS = [signal.SIGTERM, signal.SIGHUP, signal.SIGINT]
+
+
+# --- 1. a stop always stops -----------------------------------------------------------------
+
+#: Run before ``main`` in the child: the first floor callback pymunk makes in this process
+#: (MARK_AT: the _FloorLog method, '_begin' or '_post_solve') either sends the process
+#: MARK_SIGNAL itself (MARK_HOW=self: the signal arrives inside the callback for sure) or
+#: writes a line on the marker pipe MARK_FD and sleeps inside the callback until the test's
+#: signal ends the sleep (MARK_HOW=wait).
+IN_CALLBACK = """
+import os, time
+from dumbbell.solvers import engine as _engine
+_main = os.getpid()
+_real = getattr(_engine._FloorLog, os.environ["MARK_AT"])
+_done = []
+def _marked(self, arbiter, space, data):
+    if not _done and os.getpid() == _main:
+        _done.append(1)
+        if os.environ["MARK_HOW"] == "self":
+            os.kill(_main, int(os.environ["MARK_SIGNAL"]))
+        else:
+            os.write(int(os.environ["MARK_FD"]), b"in a pymunk callback\\n")
+            time.sleep(3600)
+    return _real(self, arbiter, space, data)
+setattr(_engine._FloorLog, os.environ["MARK_AT"], _marked)
+"""
+
+
+def _stopped_in_a_callback(argv: list[object], sig: int, how: str, at: str,
+                           cwd: Path) -> tuple[int, str]:
+    """Run ``dumbbell ARGV`` and stop it by ``sig`` inside pymunk's first floor callback
+    ``at``; (exit status, stderr)."""
+    with marker_pipe() as (r, w):
+        env = {"MARK_FD": str(w), "MARK_AT": at, "MARK_HOW": how, "MARK_SIGNAL": str(int(sig))}
+        with started(*argv, cwd=cwd, prelude=IN_CALLBACK, env=env, pass_fds=(w,)) as proc:
+            if how == "wait":
+                wait_mark(proc, r)
+                proc.send_signal(sig)
+            _, err = finish(proc)
+            assert not group_left(proc), "a process of the command outlived it"
+            return proc.returncode, err
+
+
+def _old_outputs(folder: Path, names) -> dict[str, bytes]:
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        (folder / name).write_bytes(f"old {name}\n".encode())
+    return {name: (folder / name).read_bytes() for name in names}
+
+
+@pytest.mark.parametrize("sig", STOPS, ids=lambda s: signal.Signals(s).name)
+@pytest.mark.parametrize("how,at", [("wait", "_post_solve"), ("self", "_post_solve"),
+                                    ("self", "_begin")])
+def test_a_stop_inside_a_pymunk_callback_stops_run(tmp_path, sig, how, at):
+    """`dumbbell run scenes/topple-2d.toml --out r -q` stopped while pymunk ran a contact
+    callback: cffi printed 'Exception ignored from cffi callback ... Stopped: 15', the run
+    went on and exited 0, replacing the old GIF. Now: 128+N, the old outputs, nothing else."""
+    old = _old_outputs(tmp_path / "r", ["topple-2d.gif", "topple-2d-topple.png"])
+    status, err = _stopped_in_a_callback(
+        ["run", SCENES / "topple-2d.toml", "--out", "r", "-q"], sig, how, at, tmp_path)
+    assert status == 128 + sig, err
+    line = one_line(err)
+    assert signal.Signals(sig).name in line and "cffi" not in err, err
+    assert {n: (tmp_path / "r" / n).read_bytes() for n in files_in(tmp_path / "r")} == old
+
+
+@pytest.mark.parametrize("command", ["simulate", "render", "compare"])
+def test_a_stop_inside_a_pymunk_callback_stops_every_command(tmp_path, command):
+    """The same for the other commands that step pymunk: the rigid drop of
+    scenes/rigid-2d.toml (impacts, then contact) in simulate, render and compare."""
+    out = tmp_path / "out"
+    argv = {"simulate": ["simulate", SCENES / "rigid-2d.toml", "--solver", "pymunk", "-o",
+                         out / "x.csv", "--events", out / "e.csv"],
+            "render": ["render", SCENES / "rigid-2d.toml", "-o", out / "x.gif"],
+            "compare": ["compare", SCENES / "rigid-2d.toml", "--solvers", "pymunk", "exact",
+                        "--out", out]}[command]
+    old = _old_outputs(out, ["x.csv"])
+    status, err = _stopped_in_a_callback(argv, signal.SIGTERM, "wait", "_begin", tmp_path)
+    assert status == 128 + signal.SIGTERM, err
+    assert "SIGTERM" in one_line(err)
+    assert {n: (out / n).read_bytes() for n in files_in(out)} == old
+
+
+@pytest.mark.parametrize("second", [False, True], ids=["alone", "then HUP"])
+def test_a_stop_swallowed_by_python_code_still_stops(tmp_path, second):
+    """A stop whose exception some code swallows (here a callback of the user's, in Python,
+    that catches everything) is not forgotten: the command goes on but keeps nothing, and
+    exits 128+N; a second signal meanwhile is not ignored (it stops the command at once)."""
+    prelude = """
+import os, time
+from dumbbell.solvers import engine as _engine
+_real = _engine._FloorLog._begin
+_done = []
+def _swallow(self, arbiter, space, data):
+    if not _done:
+        _done.append(1)
+        try:
+            os.write(int(os.environ["MARK_FD"]), b"ready\\n")
+            time.sleep(3600)
+        except BaseException:
+            pass
+        os.write(int(os.environ["MARK_FD"]), b"swallowed\\n")
+        if os.environ["SECOND"]:
+            time.sleep(3600)  # only a second signal ends this
+    return _real(self, arbiter, space, data)
+_engine._FloorLog._begin = _swallow
+"""
+    out = tmp_path / "out"
+    old = _old_outputs(out, ["x.csv"])
+    env = {"MARK_FD": "", "SECOND": "1" if second else ""}
+    with marker_pipe() as (r, w):
+        env["MARK_FD"] = str(w)
+        with started("simulate", SCENES / "rigid-2d.toml", "-o", out / "x.csv", cwd=tmp_path,
+                     prelude=prelude, env=env, pass_fds=(w,)) as proc:
+            assert wait_mark(proc, r) == b"ready\n"
+            proc.send_signal(signal.SIGTERM)
+            assert wait_mark(proc, r) == b"swallowed\n"
+            if second:
+                proc.send_signal(signal.SIGHUP)
+            _, err = finish(proc)
+            assert not group_left(proc)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "SIGTERM" in one_line(err)
+    assert {n: (out / n).read_bytes() for n in files_in(out)} == old
+
+
+def test_a_second_signal_during_the_cleanup_is_ignored_but_not_after():
+    """The handler: a second stop while the first one's exception is being handled (its
+    cleanup) does nothing; outside that (the first was swallowed) it raises again, for the
+    first signal."""
+    from dumbbell.cli import app
+
+    with app._stop_signals():
+        handler = signal.getsignal(signal.SIGTERM)
+        with pytest.raises(app.Stopped) as first:
+            handler(signal.SIGTERM, None)
+        assert first.value.signum == signal.SIGTERM
+        try:
+            raise first.value
+        except app.Stopped:
+            handler(signal.SIGHUP, None)      # ignored: the cleanup goes on
+            try:
+                raise OSError("a cleanup's own error")
+            except OSError:
+                handler(signal.SIGHUP, None)  # still ignored: the stop is its context
+        with pytest.raises(app.Stopped) as again:
+            handler(signal.SIGHUP, None)      # the first was swallowed: it stops again
+        assert again.value.signum == signal.SIGTERM
+    assert signal.getsignal(signal.SIGTERM) is not handler
+
+
+@pytest.mark.slow
+def test_run_all_stops_inside_a_pymunk_callback(tmp_path):
+    """`run --all` hit by HUP at 9 s (in a pymunk callback) was still running 30 s later:
+    the lost stop had set every stop signal to ignored. It stops, the 21 showcase files
+    stay old, nothing is left."""
+    from dumbbell.cli.showcase import tracked
+
+    old = _old_outputs(tmp_path / "r", sorted(tracked()))
+    status, err = _stopped_in_a_callback(["run", "--all", "--out", "r", "-q"], signal.SIGHUP,
+                                         "wait", "_post_solve", tmp_path)
+    assert status == 128 + signal.SIGHUP, err
+    assert "SIGHUP" in one_line(err)
+    assert {n: (tmp_path / "r" / n).read_bytes() for n in files_in(tmp_path / "r")} == old
