@@ -21,6 +21,7 @@ from tests.hostile import (
     group_left,
     marker_pipe,
     one_line,
+    refused,
     started,
     wait_mark,
 )
@@ -190,3 +191,74 @@ def test_run_all_stops_inside_a_pymunk_callback(tmp_path):
     assert status == 128 + signal.SIGHUP, err
     assert "SIGHUP" in one_line(err)
     assert {n: (tmp_path / "r" / n).read_bytes() for n in files_in(tmp_path / "r")} == old
+
+
+# --- 2. a figure named twice empties no file ------------------------------------------------
+
+
+@pytest.mark.parametrize("scene,figures", [
+    ("textbook-1d", ["positions", "positions"]),
+    ("textbook-1d", ["kinetic", "positions", "kinetic"]),
+    ("tilted-2d", ["energy", "rotation", "energy"]),
+    ("textbook-1d", ["positions"] * 60_000),
+])
+def test_a_figure_named_twice_is_refused_at_load(tmp_path, scene, figures):
+    """`figures = ["positions", "positions"]`: `run` exited 0 and an existing valid
+    r/NAME-positions.png became 0 bytes (60,000 entries alike). Refused when the scene is
+    read: one line naming the key and the figure, nothing written, the old file kept."""
+    from dumbbell import SceneError, load_scene
+    from tests.hostile import cli
+
+    text = (SCENES / f"{scene}.toml").read_text()
+    start = text.index("figures = [")
+    text = text[:start] + "figures = [" + ", ".join(f'"{f}"' for f in figures) + "]" \
+        + text[text.index("]", start) + 1:]
+    path = tmp_path / "twice.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError, match=rf"outputs\.figures .*'{figures[-1]}' more than once"):
+        load_scene(path)
+    with pytest.raises(SceneError, match="more than once"):
+        load_scene(SCENES / f"{scene}.toml").with_values({"outputs.figures": figures})
+    out = tmp_path / "r"
+    out.mkdir()
+    png = out / f"twice-{figures[-1]}.png"
+    png.write_bytes(b"\x89PNG old")
+    status, _, err = cli("run", path, "--out", out, "-q")
+    line = refused(status, err, out, keep=(png.name,))
+    assert "outputs.figures" in line and len(line) < 400, line
+    assert png.read_bytes() == b"\x89PNG old"
+
+
+def test_the_output_plan_refuses_two_outputs_on_one_path(tmp_path, monkeypatch):
+    """Whatever builds the list: a plan naming one file twice is refused before the work,
+    and a command that writes one file twice fails before its commit, the old file kept."""
+    import dataclasses
+
+    from dumbbell import DumbbellError, load_scene
+    from dumbbell.cli import run as run_command
+    from dumbbell.io.files import OutputTransaction, atomic_output, output_transaction
+    from tests.hostile import cli
+
+    out = tmp_path / "r"
+    out.mkdir()
+    with pytest.raises(DumbbellError, match="same file"):
+        OutputTransaction().plan([out / "a.png", out / "." / "a.png"], f"--out {out}")
+    # A scene built around the check (figures listed twice) reaches the plan: refused there.
+    scene = load_scene(SCENES / "textbook-1d.toml")
+    twice = dataclasses.replace(scene, outputs=dataclasses.replace(
+        scene.outputs, figures=("positions", "kinetic", "positions")))
+    monkeypatch.setattr("dumbbell.cli.app.read_scene", lambda *a, **k: twice)
+    (out / "textbook-1d-positions.png").write_bytes(b"old")
+    status, _, err = cli("run", SCENES / "textbook-1d.toml", "--out", out, "-q")
+    line = refused(status, err, out, keep=("textbook-1d-positions.png",))
+    assert "textbook-1d-positions.png" in line and "same file" in line, line
+    assert run_command.outputs(twice, out).count(
+        ("positions", out / "textbook-1d-positions.png")) == 2
+    # Two writes of one file in one transaction: the second is refused, nothing committed.
+    with pytest.raises(DumbbellError, match="written twice"), output_transaction():
+        with atomic_output(out / "textbook-1d-positions.png") as tmp:
+            tmp.write_bytes(b"new")
+        with atomic_output(out / "./textbook-1d-positions.png") as tmp:
+            tmp.write_bytes(b"")
+    assert files_in(out) == ["textbook-1d-positions.png"]
+    assert (out / "textbook-1d-positions.png").read_bytes() == b"old"

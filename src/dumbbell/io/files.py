@@ -184,6 +184,8 @@ class OutputTransaction:
         self.planned: set[str] = set()
         #: Outputs written that were not planned (a command that forgot one: a test finds it).
         self.unplanned: list[Path] = []
+        #: Real paths written so far (:func:`atomic_output`): none may be written twice.
+        self.written: set[str] = set()
         #: (finished temporary file, final path, the name the user gave): renamed at commit.
         self.pending: list[tuple[Path, Path, str]] = []
         self.created: list[Path] = []
@@ -218,7 +220,15 @@ class OutputTransaction:
         if what:
             self.claimed[key] = what
             self.planned.add(key)
-        elif key not in self.planned and not is_special(path) and not _under_system(path):
+            return
+        special = is_special(path) or _under_system(path)
+        if key in self.written and not special:
+            # Two writes of one file: the commit would rename the second over the first,
+            # whichever finished last (an empty one, say).
+            raise UsageError(f"{label}: written twice by one command; each output is one "
+                             "file")
+        self.written.add(key)
+        if key not in self.planned and not special:
             self.unplanned.append(path)
 
     def plan(self, paths: Iterable[str | Path], flag: str) -> list[Path]:

@@ -675,6 +675,11 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
         value = co.table["figures"]
         if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
             co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+        twice = next((v for i, v in enumerate(value) if v in value[:i]), None) \
+            if len(set(value)) < len(value) else None
+        if twice is not None:
+            co.fail("outputs.figures", value, f"names '{twice}' more than once: each figure "
+                    "is one file, list it once")
         if "rotation" in value and dims != 2:
             co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
         if "contact" in value and (dims != 2 or not has_floor):
