@@ -9,6 +9,7 @@ a session of its own and its whole group is killed on the way out, pass or fail
 
 from __future__ import annotations
 
+import os
 import signal
 from pathlib import Path
 
@@ -16,12 +17,14 @@ import pytest
 
 from tests.conftest import SCENES
 from tests.hostile import (
+    cli,
     files_in,
     finish,
     group_left,
     marker_pipe,
     one_line,
     refused,
+    short_scene,
     started,
     wait_mark,
 )
@@ -262,3 +265,162 @@ def test_the_output_plan_refuses_two_outputs_on_one_path(tmp_path, monkeypatch):
             tmp.write_bytes(b"")
     assert files_in(out) == ["textbook-1d-positions.png"]
     assert (out / "textbook-1d-positions.png").read_bytes() == b"old"
+
+
+# --- 3. links planted in the output folder ---------------------------------------------------
+
+#: A 1D scene whose `run` writes its CSVs, a GIF and a figure: out-1d.csv, out-1d-impacts.csv,
+#: out-1d.gif, out-1d-positions.png.
+OUT_1D_EXTRA = ('[outputs]\nfigures = ["positions"]\ncsv = true\n'
+                'gif = { fps = 10, t_end = 0.02, size = "64x64" }\n')
+
+
+@pytest.fixture
+def planted(tmp_path):
+    """(the scene out-1d.toml, the output folder r, a folder outside it holding victim)."""
+    scene = short_scene(tmp_path, "out-1d.toml", OUT_1D_EXTRA)
+    out, outside = tmp_path / "r", tmp_path / "outside"
+    out.mkdir()
+    outside.mkdir()
+    (outside / "victim").write_text("victim\n")
+    return scene, out, outside
+
+
+def _untouched(outside: Path) -> None:
+    assert files_in(outside) == ["victim"], files_in(outside)
+    assert (outside / "victim").read_text() == "victim\n"
+
+
+@pytest.mark.parametrize("name", ["out-1d.csv", "out-1d-impacts.csv", "out-1d.gif",
+                                  "out-1d-positions.png"])
+@pytest.mark.parametrize("how", ["absolute", "relative", "chain", "dangling"])
+def test_a_link_out_of_the_folder_is_refused_before_the_work(planted, monkeypatch, name, how):
+    """`ln -s OUTSIDE/victim r/out-1d.csv; dumbbell run out-1d.toml --out r` overwrote the
+    file outside r; a link to nothing created its folders outside r. Refused before the run,
+    one line naming the link and where it leads; nothing outside is touched or created."""
+    from tests.test_hostile import _stepping_forbidden
+
+    scene, out, outside = planted
+    link = out / name
+    if how == "absolute":
+        link.symlink_to(outside / "victim")
+    elif how == "relative":
+        link.symlink_to(Path("..") / "outside" / "victim")
+    elif how == "chain":  # a link in the folder, to a link in the folder, to outside
+        (out / "step").symlink_to(outside / "victim")
+        link.symlink_to("step")
+    else:
+        link.symlink_to(outside / "new" / "deep" / "victim")
+    keep = tuple(files_in(out))
+    _stepping_forbidden(monkeypatch)
+    status, _, err = cli("run", scene, "--out", out, "-q")
+    line = refused(status, err, out, keep=keep)
+    assert name in line and "outside" in line and "link" in line, line
+    _untouched(outside)
+
+
+@pytest.mark.parametrize("argv", [["simulate", "SCENE", "-o", "OUT/x.csv"],
+                                  ["simulate", "SCENE", "-o", "-", "--events", "OUT/x.csv"],
+                                  ["render", "SCENE", "-o", "OUT/x.csv", "--t-end", "0.02"]])
+def test_a_file_flag_naming_a_link_out_of_its_folder_is_refused(planted, argv):
+    scene, out, outside = planted
+    (out / "x.csv").symlink_to(outside / "victim")
+    status, _, err = cli(*[str(scene) if a == "SCENE" else a.replace("OUT", str(out))
+                           for a in argv])
+    line = refused(status, err, out, keep=("x.csv",))
+    assert "x.csv" in line and "outside" in line, line
+    _untouched(outside)
+
+
+def test_run_all_refuses_a_link_out_of_the_folder_before_any_piece(tmp_path, monkeypatch):
+    """`run --all` made `.victim.XXXX.part` beside a link's target (and replaced it)."""
+    from tests.test_hostile import _stepping_forbidden
+
+    out, outside = tmp_path / "r", tmp_path / "outside"
+    out.mkdir()
+    outside.mkdir()
+    (outside / "victim").write_text("victim\n")
+    (out / "rigid-2d.gif").symlink_to(outside / "victim")
+    _stepping_forbidden(monkeypatch)
+    status, _, err = cli("run", "--all", "--out", out, "-q")
+    line = refused(status, err, out, keep=("rigid-2d.gif",))
+    assert "rigid-2d.gif" in line and "outside" in line, line
+    _untouched(outside)
+
+
+@pytest.mark.parametrize("where", ["plain", "sticky"])
+@pytest.mark.parametrize("how", ["real", "simulated"])
+def test_another_users_link_is_never_written_through(planted, monkeypatch, where, how):
+    """A link another user made (in a sticky folder, followed when root ran the command):
+    never written through, even to a file inside the folder. 'real': the link handed to
+    uid 12345 (root only); 'simulated': this user pretends to be another (os.geteuid)."""
+    scene, out, _ = planted
+    folder = out / "st" if where == "sticky" else out
+    folder.mkdir(exist_ok=True)
+    if where == "sticky":
+        os.chmod(folder, 0o1777)
+    (folder / "mine.csv").write_text("mine\n")
+    link = folder / "e.csv"
+    link.symlink_to(folder / "mine.csv")
+    if how == "real":
+        if os.geteuid() != 0:
+            pytest.skip("needs root to hand a link to another user")
+        os.lchown(link, 12345, 12345)
+    else:
+        me = os.geteuid()
+        monkeypatch.setattr(os, "geteuid", lambda: me + 4321)
+    keep = tuple(files_in(out))
+    status, _, err = cli("simulate", scene, "-o", out / "x.csv", "--events", link)
+    line = refused(status, err, out, keep=keep)
+    assert "--events" in line and "another user" in line and "e.csv" in line, line
+    assert (folder / "mine.csv").read_text() == "mine\n"
+
+
+def test_the_users_own_link_inside_the_folder_is_written_through(planted):
+    """The user's own link to a file inside the folder (a subfolder too): the file it names
+    gets the output, the link stays, and the temporary file sat in the folder."""
+    scene, out, outside = planted
+    (out / "archive").mkdir()
+    (out / "out-1d.csv").symlink_to(Path("archive") / "v2.csv")        # not there yet
+    (out / "archive" / "v1.gif").write_bytes(b"old")
+    (out / "out-1d.gif").symlink_to(out / "archive" / "v1.gif")
+    status, _, err = cli("run", scene, "--out", out, "-q")
+    assert status == 0, err
+    assert (out / "out-1d.csv").is_symlink() and (out / "out-1d.gif").is_symlink()
+    assert (out / "archive" / "v2.csv").read_text().startswith("t,xA,vA")
+    assert (out / "archive" / "v1.gif").read_bytes()[:6] == b"GIF89a"
+    _untouched(outside)
+
+
+def test_a_link_planted_after_the_check_is_refused_at_the_write(planted, monkeypatch):
+    """Between the check and the write (a run can take minutes) a link appears: the write
+    refuses it too; nothing outside is written and the command keeps nothing."""
+    from dumbbell.io import trajectory
+
+    scene, out, outside = planted
+    real = trajectory.write_events
+
+    def plant_then_write(traj, path):
+        Path(path).symlink_to(outside / "victim")
+        return real(traj, path)
+
+    monkeypatch.setattr(trajectory, "write_events", plant_then_write)
+    status, _, err = cli("simulate", scene, "-o", out / "x.csv", "--events", out / "e.csv")
+    line = refused(status, err, out, keep=("e.csv",))
+    assert "e.csv" in line and "outside" in line, line
+    _untouched(outside)
+
+
+def test_the_python_api_refuses_a_link_out_of_the_folder(planted):
+    import dumbbell
+    from dumbbell import DumbbellError
+    from dumbbell.io.trajectory import write_csv
+
+    scene, out, outside = planted
+    (out / "x.csv").symlink_to(outside / "victim")
+    traj = dumbbell.simulate(scene, t_end=0.01)
+    with pytest.raises(DumbbellError, match="outside") as info:
+        write_csv(traj, out / "x.csv")
+    assert len(str(info.value).splitlines()) == 1
+    _untouched(outside)
+    assert files_in(out) == ["x.csv"]

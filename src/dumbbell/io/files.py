@@ -82,6 +82,36 @@ def _under_system(path: Path) -> bool:
     return False
 
 
+def link_refusal(path: str | Path) -> str | None:
+    """Why the link at ``path`` (an output's name) may not be written through, or None when
+    it is no link or may be followed. Followed only: a link of the user's own (never
+    another user's, the rule the kernel's ``fs.protected_symlinks`` applies in sticky
+    folders, here everywhere) that names a file inside the folder holding it (a link to
+    nothing creates nothing outside it either), or names a device or a FIFO, which are
+    written, never created; and a system path the user named (``/dev/stdout``)."""
+    from ..model.args import show_path
+
+    path = Path(path)
+    if not os.path.islink(path) or os.path.abspath(path).startswith(("/dev/", "/proc/")):
+        return None
+    try:
+        owner = os.lstat(path).st_uid
+        target = os.readlink(path)
+    except OSError as exc:
+        return f"is a link that cannot be read ({exc.strerror})"
+    if owner != os.geteuid():
+        return (f"is a link of another user's (uid {owner}) to {show_path(target)}: never "
+                "written through; remove the link or write into another folder")
+    if is_special(path):
+        return None
+    folder = os.path.realpath(path.parent)
+    if os.path.commonpath([os.path.realpath(path), folder]) != folder:
+        return (f"is a link to {show_path(target)}, outside {show_path(path.parent)}: an "
+                "output is written only inside the folder it names; remove the link or write "
+                "elsewhere")
+    return None
+
+
 # --- temporary files: registered while they exist, removed at exit or on a stop signal ----
 
 #: Temporary file -> the process that made it (a forked child must not remove its parent's).
@@ -383,6 +413,9 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
         raise UsageError(f"path = {args.show(str(path))}: a path cannot hold a NUL character",
                          param="path")
     shown = path
+    refusal = link_refusal(path)
+    if refusal is not None:  # planted since the command checked its outputs, say
+        raise UsageError(f"{args.show_path(path)}: {refusal}", param="path")
     transaction = _active.get()
     if transaction is not None:
         transaction.claim(path)
@@ -448,6 +481,9 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
     if why:
         return why
     if not folder and os.path.islink(path):
+        why = link_refusal(path)
+        if why:
+            return why
         path = Path(os.path.realpath(path))  # the file the link names is written
     if not folder and is_special(path):
         return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
