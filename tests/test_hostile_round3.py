@@ -424,3 +424,142 @@ def test_the_python_api_refuses_a_link_out_of_the_folder(planted):
     assert len(str(info.value).splitlines()) == 1
     _untouched(outside)
     assert files_in(out) == ["x.csv"]
+
+
+# --- 4. exit 0 only when every output exists ------------------------------------------------
+
+#: Per command: its arguments (SCENE: a short 1D scene with every output of `run`; 2D: the
+#: short 2D scene; CASES: a catalogue of one short scene), writing into the folder OUT.
+STREAM_COMMANDS = {
+    "compare": ["compare", "SCENE", "--t-end", "0.05", "--out", "OUT"],
+    "restitution": ["restitution", "2D", "--theta", "30", "--stiffness", "2e4", "--out", "OUT"],
+    "run": ["run", "SCENE", "--out", "OUT"],
+    "render": ["render", "SCENE", "--t-end", "0.04", "-o", "OUT/x.gif"],
+    "simulate": ["simulate", "SCENE", "-o", "OUT/x.csv", "--events", "OUT/e.csv"],
+    "bench": ["bench", "SCENE", "--dts", "1e-3", "--t-end", "0.05", "--window", "0.05",
+              "--repeat", "1", "--out", "OUT"],
+    "sweep": ["sweep", "SCENE", "--grid", "k=100,200", "--workers", "1", "--out", "OUT"],
+    "stability": ["stability", "--cases", "CASES", "--solvers", "euler-cromer", "--workers",
+                  "1", "--out", "OUT"],
+}
+
+#: How standard output and error are lost: closed when the process starts (`>&-`, `2>&-`),
+#: or a pipe whose reader has gone before the first write.
+STREAM_LOSSES = ["stdout closed", "stderr closed", "stdout reader gone", "stderr reader gone",
+                 "both closed", "both readers gone"]
+
+
+def _stream_cases():
+    named = ("compare", "restitution", "run", "render")  # the issue's: each way alone
+    return [(c, how) for c in STREAM_COMMANDS for how in STREAM_LOSSES
+            if (c in named) != how.startswith("both")]
+
+
+#: command -> the files it writes on a terminal (the reference run, made once).
+_EXPECTED: dict[str, list[str]] = {}
+
+
+@pytest.fixture
+def stream_inputs(tmp_path):
+    from tests.test_fuzz_cli import SHORT_2D
+
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    scene = short_scene(inputs, "streams.toml", OUT_1D_EXTRA)
+    two = inputs / "short2d.toml"
+    two.write_text(SHORT_2D, encoding="utf-8")
+    (inputs / "cases").mkdir()
+    short_scene(inputs / "cases")
+    return {"SCENE": str(scene), "2D": str(two), "CASES": str(inputs / "cases")}
+
+
+def _argv(command: str, inputs: dict[str, str], out: Path) -> list[str]:
+    return [inputs.get(a, a).replace("OUT", str(out)) for a in STREAM_COMMANDS[command]]
+
+
+@pytest.mark.parametrize("command,how", _stream_cases())
+def test_losing_the_terminal_loses_no_file(tmp_path, stream_inputs, command, how):
+    """With stdout or stderr a closed descriptor or a pipe whose reader has gone, `compare`,
+    `restitution`, `run`, `render` (and the others) exited 0 and wrote nothing (`run ...
+    2>&-` exited 1). They write every file they write on a terminal, and exit 0."""
+    import subprocess
+
+    if command not in _EXPECTED:
+        reference = tmp_path / "reference"
+        status, _, err = cli(*_argv(command, stream_inputs, reference))
+        assert status == 0, err
+        _EXPECTED[command] = files_in(reference)
+    expected = _EXPECTED[command]
+    out = tmp_path / "out"
+    streams, pipes, closed = {}, [], []
+    for name, fd in (("stdout", 1), ("stderr", 2)):
+        if how.startswith((name, "both")):
+            if "closed" in how:
+                closed.append(fd)
+            else:
+                r, w = os.pipe()
+                os.close(r)  # the reader is gone before the first write
+                streams[name] = w
+                pipes.append(w)
+    closing = (lambda: [os.close(fd) for fd in closed]) if closed else None
+    with started(*_argv(command, stream_inputs, out), cwd=tmp_path,
+                 preexec_fn=closing, **{"stdout": subprocess.DEVNULL,
+                                        "stderr": subprocess.DEVNULL, **streams}) as proc:
+        for w in pipes:
+            os.close(w)
+        assert proc.wait(timeout=600) == 0, (command, how, proc.returncode)
+        assert not group_left(proc)
+    assert files_in(out) == expected
+
+
+def test_simulate_to_a_closed_stdout_is_refused(tmp_path, stream_inputs):
+    """`simulate` writes its CSV to standard output: closed when it starts, that is a
+    refusal before the run (exit 2), not a run into nothing."""
+    import subprocess
+
+    for argv in (["simulate", stream_inputs["SCENE"]],
+                 ["simulate", stream_inputs["SCENE"], "-o", "-", "--events", "e.csv"]):
+        with started(*argv, cwd=tmp_path, stdout=subprocess.DEVNULL,
+                     preexec_fn=lambda: os.close(1)) as proc:
+            _, err = finish(proc)
+        assert proc.returncode == 2 and "standard output is closed" in one_line(err), err
+        assert not (tmp_path / "e.csv").exists()
+
+
+def test_a_stream_that_fails_later_is_dropped_not_fatal(tmp_path, stream_inputs, monkeypatch):
+    """In-process: stdout that fails on the first write (EPIPE) and stderr that cannot
+    encode the title: the command still writes its files and exits 0."""
+    import io
+    import sys
+
+    from dumbbell.cli import main
+
+    class Gone(io.StringIO):
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+    ascii_err = io.TextIOWrapper(io.BytesIO(), encoding="ascii")
+    monkeypatch.setattr(sys, "stdout", Gone())
+    monkeypatch.setattr(sys, "stderr", ascii_err)
+    scene = Path(stream_inputs["SCENE"])
+    scene.write_text(scene.read_text().replace('title = "short"', 'title = "Ünïcode ☃"'))
+    assert main(["compare", str(scene), "--t-end", "0.05", "--out", str(tmp_path / "c")]) == 0
+    assert len(files_in(tmp_path / "c")) == 6
+
+
+@pytest.mark.slow
+def test_run_all_with_its_readers_gone_writes_the_showcase(tmp_path):
+    import subprocess
+
+    from dumbbell.cli.showcase import tracked
+
+    pipes = [os.pipe(), os.pipe()]
+    for r, _ in pipes:
+        os.close(r)
+    with started("run", "--all", "--out", "r", cwd=tmp_path, stdout=pipes[0][1],
+                 stderr=pipes[1][1], stdin=subprocess.DEVNULL) as proc:
+        for _, w in pipes:
+            os.close(w)
+        assert proc.wait(timeout=1800) == 0
+        assert not group_left(proc)
+    assert set(files_in(tmp_path / "r")) == tracked()

@@ -409,7 +409,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     state: dict[str, object] = {}
     # Without argv, this is the process's own command (the console script, python -m):
     # it ends with the command.
-    with _stop_signals(), _file_backend(process_ends=argv is None):
+    with _stop_signals(), _standard_streams(process_ends=argv is None), \
+            _file_backend(process_ends=argv is None):
         try:
             argv = sys.argv[1:] if argv is None else list(argv)
             parser = _parser_for(argv)
@@ -423,6 +424,88 @@ def main(argv: Sequence[str] | None = None) -> int:
                              + ("its outputs were already written\n" if kept
                                 else "no output was kept\n"))
             return 128 + signum
+
+
+class _Sturdy:
+    """A standard stream that cannot stop the command: a write or flush that fails because
+    the stream is gone (closed when the process started, ``>&-``, or a pipe whose reader
+    left) is dropped, and so is everything after it, so that the command still writes its
+    files and its exit status says how they went; text the stream's encoding cannot hold
+    (``PYTHONIOENCODING=ascii``) is written with backslash escapes instead of failing."""
+
+    def __init__(self, stream: Any):
+        self.stream = stream
+        #: The stream is gone: nothing more is written to it.
+        self.lost = stream is None
+
+    def write(self, text: str) -> int:
+        if not self.lost:
+            try:
+                return self.stream.write(text)
+            except UnicodeEncodeError:
+                encoding = getattr(self.stream, "encoding", None) or "ascii"
+                return self.write(text.encode(encoding, "backslashreplace").decode(encoding))
+            except (OSError, ValueError):  # EPIPE, EBADF; ValueError: a closed file
+                self._lose()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.lost:
+            try:
+                self.stream.flush()
+            except (OSError, ValueError):
+                self._lose()
+
+    def isatty(self) -> bool:
+        try:
+            return not self.lost and self.stream.isatty()
+        except (OSError, ValueError):
+            return False
+
+    def __getattr__(self, name: str) -> Any:  # encoding, errors, fileno, buffer, ...
+        if self.stream is None:
+            raise AttributeError(name)
+        return getattr(self.stream, name)
+
+    def _lose(self) -> None:
+        self.lost = True
+        # Python flushes the stream once more at exit: let that land in /dev/null rather
+        # than complain about the pipe (or end the process with status 120).
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, self.stream.fileno())
+            os.close(null)
+
+
+@contextlib.contextmanager
+def _standard_streams(process_ends: bool = False) -> Iterator[None]:
+    """Standard output and error as :class:`_Sturdy` streams for the command, given back
+    afterwards. ``process_ends`` (the process's own command): descriptors 0, 1 and 2 that
+    were closed when it started are opened on /dev/null first, so that no file the command
+    opens takes their number (a message to descriptor 2 would land in an output)."""
+    if process_ends:
+        for fd in (0, 1, 2):
+            try:
+                os.fstat(fd)
+            except OSError:
+                null = os.open(os.devnull, os.O_RDONLY if fd == 0 else os.O_WRONLY)
+                if null != fd:  # pragma: no cover - lower descriptors are open
+                    os.dup2(null, fd)
+                    os.close(null)
+    before = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Sturdy(before[0]), _Sturdy(before[1])
+    try:
+        yield
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            stream.flush()
+        sys.stdout, sys.stderr = before
+
+
+def stdout_closed() -> bool:
+    """Whether standard output was closed when the command started (``>&-``): a command
+    that writes its result there refuses before the work."""
+    return isinstance(sys.stdout, _Sturdy) and sys.stdout.stream is None
 
 
 @contextlib.contextmanager
@@ -469,12 +552,6 @@ def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> in
             return status
     except DumbbellError as exc:
         return error(as_flags(exc, args))
-    except BrokenPipeError:
-        # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep
-        # Python from complaining again when it flushes stdout at exit.
-        with contextlib.suppress(OSError, ValueError):
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
     except OSError as exc:
         # Backstop: a file that still cannot be written or read is one line, not a traceback.
         if exc.filename:
