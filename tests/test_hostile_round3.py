@@ -563,3 +563,162 @@ def test_run_all_with_its_readers_gone_writes_the_showcase(tmp_path):
         assert proc.wait(timeout=1800) == 0
         assert not group_left(proc)
     assert set(files_in(tmp_path / "r")) == tracked()
+
+
+# --- 5. tracebacks a CLI user saw ------------------------------------------------------------
+
+MATH_TITLES = ["price $\\frac{ and $ end", "$x^2$", "one $ alone", "$$", "a \\$ b $c$",
+               "$\\alpha$ and $"]
+
+
+def _unescaped_dollar(text: str) -> bool:
+    """Whether matplotlib would read mathtext in ``text`` (a '$' without a backslash)."""
+    import re
+
+    return re.search(r"(?<!\\)\$", text) is not None
+
+
+def _titled(tmp_path: Path, title: str, name: str = "math") -> Path:
+    """The short scene with every figure of `run`, titled ``title`` (TOML-escaped)."""
+    path = short_scene(tmp_path, f"{name}.toml",
+                       '[outputs]\nfigures = ["positions", "kinetic", "potential", "energy"]\n')
+    quoted = title.replace("\\", "\\\\").replace('"', '\\"')
+    path.write_text(path.read_text().replace('title = "short"', f'title = "{quoted}"'))
+    return path
+
+
+@pytest.mark.parametrize("title", MATH_TITLES)
+def test_a_title_with_dollars_is_text_in_run_and_compare(tmp_path, title):
+    """A scene titled `price $\\frac{ and $ end` broke `run` and `compare` (exit 1,
+    matplotlib's mathtext parser): a title is text, drawn as written."""
+    from dumbbell import load_scene
+
+    scene = _titled(tmp_path, title)
+    assert load_scene(scene).title == title
+    for argv in (["run", scene, "--out", tmp_path / "r", "-q"],
+                 ["compare", scene, "--t-end", "0.05", "--out", tmp_path / "c", "-q"]):
+        status, _, err = cli(*argv)
+        assert status == 0 and "Traceback" not in err, err
+    assert len(files_in(tmp_path / "r")) == 4 and len(files_in(tmp_path / "c")) == 6
+
+
+@pytest.mark.parametrize("title", MATH_TITLES[:3])
+def test_a_title_with_dollars_is_text_in_every_figure_of_the_api(tmp_path, title):
+    """`plot.positions(t).figure.savefig()` raised too: every figure that shows a user's
+    text (a title, a scene's file name, a solver name given to the figure) draws it as
+    text; the title on the figure is the title, with no '$' left for mathtext."""
+    import io
+
+    import dumbbell
+    from dumbbell import plot
+    from dumbbell.analysis.contact import about_contact
+    from dumbbell.analysis.topple import closed_form, measure
+
+    scene = dumbbell.load_scene(_titled(tmp_path, title, name="m$x$"))
+    traj = dumbbell.simulate(scene)
+    figures = [plot.positions(traj), plot.kinetic(traj), plot.potential(traj),
+               plot.energy(traj)]
+    result = dumbbell.compare(scene, t_end=0.05)
+    figures += [plot.compare(result), plot.compare_energy(result),
+                plot.compare_positions(result)]
+    figures.append(plot.sweep_map(dumbbell.sweep(scene, {"k": [100.0, 200.0]}, t_end=0.05,
+                                                 workers=1)))
+    bench = dumbbell.bench(scene, dts=[1e-3], t_end=0.05, window=0.05, repeat=1)
+    figures += [plot.work_precision(bench), plot.convergence(bench)]
+    topple = dumbbell.simulate(SCENES / "topple-2d.toml", t_end=0.5, every=100)
+    figures.append(plot.topple(closed_form(topple.scene), measure(topple), solver=title)[0])
+    rigid = dumbbell.simulate(SCENES / "rigid-2d.toml", "pymunk", every=10)
+    figures.append(plot.contact_momentum(about_contact(rigid), solver=title))
+    for ax in figures:
+        fig = ax.figure
+        fig.savefig(io.BytesIO(), format="png")
+        texts = [t.get_text() for t in fig.findobj(lambda a: hasattr(a, "get_text"))]
+        # matplotlib's own tick labels on log axes are mathtext ($\mathdefault{10^{-3}}$).
+        assert not any(_unescaped_dollar(t) for t in texts
+                       if t and "\\mathdefault" not in t), texts
+    drawn = " ".join(t.get_text() for t in figures[0].figure.texts)
+    assert title.replace("$", "\\$") in drawn
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+SOLVERS_NO_JIT = [("textbook-1d", "euler-cromer"), ("textbook-1d", "verlet"),
+                  ("textbook-1d", "exact"), ("tilted-2d", "euler-cromer-2d"),
+                  ("tilted-2d", "verlet"), ("tilted-2d", "reference"), ("rigid-2d", "exact")]
+
+
+@pytest.mark.parametrize("scene,solver", SOLVERS_NO_JIT)
+def test_numba_disabled_gives_the_same_numbers(tmp_path, scene, solver):
+    """`NUMBA_DISABLE_JIT=1 dumbbell simulate` (euler-cromer, verlet) raised
+    `NotImplementedError: <intrinsic to_fixed_tuple>`: the loops run as Python, the same
+    samples and impacts byte for byte as compiled."""
+    import subprocess
+    import sys
+
+    from tests.hostile import SRC
+
+    argv = ["simulate", SCENES / f"{scene}.toml", "--solver", solver, "--t-end", "0.3",
+            "--dt", "1e-4", "--every", "10", "-o", tmp_path / "jit.csv", "--events",
+            tmp_path / "jit-e.csv", "-q"]
+    status, _, err = cli(*argv)
+    assert status == 0, err
+    with started(*[str(a).replace("jit", "nojit") for a in argv], cwd=tmp_path,
+                 env={"NUMBA_DISABLE_JIT": "1"}) as proc:
+        _, err = finish(proc)
+    assert proc.returncode == 0 and err == "", err
+    for name in ("jit.csv", "jit-e.csv"):
+        assert (tmp_path / name).read_bytes() == (tmp_path / f"no{name}").read_bytes()
+    # The Python API too.
+    code = ("import dumbbell, sys; t = dumbbell.simulate(sys.argv[1], sys.argv[2], "
+            "t_end=0.3, dt=1e-4, every=10); sys.stdout.write(repr(t['E'].tolist()))")
+    api = subprocess.run([sys.executable, "-c", code, str(SCENES / f"{scene}.toml"), solver],
+                         env={**os.environ, "PYTHONPATH": SRC, "NUMBA_DISABLE_JIT": "1"},
+                         capture_output=True, text=True, timeout=600, check=False)
+    import dumbbell
+
+    jit = dumbbell.simulate(SCENES / f"{scene}.toml", solver, t_end=0.3, dt=1e-4, every=10)
+    assert api.returncode == 0 and api.stdout == repr(jit["E"].tolist()), api.stderr[-500:]
+
+
+@pytest.mark.parametrize("example", ["pendulum", "slope", "newtons_cradle"])
+def test_the_examples_run_without_docstrings(tmp_path, example):
+    """`PYTHONOPTIMIZE=2 python -m dumbbell.examples.pendulum --help`: AttributeError
+    (docstrings are None under -OO). --help works, and so does a short run."""
+    import subprocess
+    import sys
+
+    from tests.hostile import SRC
+
+    env = {**os.environ, "PYTHONPATH": SRC, "PYTHONOPTIMIZE": "2", "CI": "1"}
+    for argv in (["--help"], ["--seconds", "0.2", "--fps", "10", "--out",
+                              str(tmp_path / f"{example}.gif")]):
+        done = subprocess.run([sys.executable, "-m", f"dumbbell.examples.{example}", *argv],
+                              env=env, capture_output=True, text=True, timeout=600,
+                              check=False, cwd=tmp_path)
+        assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr[-800:]
+    assert (tmp_path / f"{example}.gif").read_bytes()[:6] == b"GIF89a"
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "latin-1"])
+@pytest.mark.parametrize("argv", [
+    ["compare", "SCENE", "--t-end", "0.05", "--out", "c"],
+    ["run", "SCENE", "--out", "r"],
+    ["simulate", "no-such-☃.toml"],
+])
+def test_a_unicode_title_on_a_narrow_terminal(tmp_path, encoding, argv):
+    """`PYTHONIOENCODING=ascii dumbbell compare` on a Unicode title: UnicodeEncodeError.
+    What the terminal cannot show is escaped; the files are written, the status is the
+    command's."""
+    scene = _titled(tmp_path, "Hantel ☃ – Ünïcödé", name="hantel-☃")
+    with started(*[str(scene) if a == "SCENE" else a for a in argv], cwd=tmp_path,
+                 env={"PYTHONIOENCODING": encoding}, encoding=encoding) as proc:
+        out, err = finish(proc)
+    assert "Traceback" not in err and "UnicodeEncodeError" not in err, err
+    if argv[0] == "simulate":
+        assert proc.returncode == 2 and "no such scene file" in one_line(err), err
+        return
+    assert proc.returncode == 0, err
+    folder = tmp_path / argv[-1]
+    assert len(files_in(folder)) == (6 if argv[0] == "compare" else 4)
+    assert "\\u2603" in out + err  # the snowman, escaped; the rest as the terminal shows it

@@ -13,7 +13,7 @@ import numpy as np
 from ..analysis.compare import DIVERGED, Comparison
 from ..analysis.metrics import energy_error
 from ..model import args
-from .style import ROW_COLOURS, ROW_DASHES, _subplots, legend_outside
+from .style import ROW_COLOURS, ROW_DASHES, _subplots, legend_outside, plain
 
 __all__ = ["compare", "compare_energy", "compare_positions"]
 
@@ -62,7 +62,7 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
         _heights_panel(panel, result, body)
     axes[-1].set_xlabel("t [s]")
     axes[-1].set_xlim(0, _shown(result))
-    fig.suptitle(f"{result.scene.title}: heights, each solver over the truth", fontsize=10)
+    fig.suptitle(f"{plain(result.scene.title)}: heights, each solver over the truth", fontsize=10)
     fig.tight_layout()
     return axes[-1]
 
@@ -95,7 +95,7 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, which="major", color="0.9", lw=0.6)
     legend_outside(ax)
-    ax.set_title(f"{scene.title}: position error against {truth.solver}", fontsize=9)
+    ax.set_title(f"{plain(scene.title)}: position error against {truth.solver}", fontsize=9)
     if own:
         fig.tight_layout()
     return ax
@@ -130,7 +130,7 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     ax.grid(True, color="0.9", lw=0.6)
     legend_outside(ax)
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    ax.set_title(f"{scene.title}: total energy per solver, relative to E(0) = {E0:.4g} J",
+    ax.set_title(f"{plain(scene.title)}: total energy per solver, relative to E(0) = {E0:.4g} J",
                  fontsize=9)
     if own:
         fig.tight_layout()

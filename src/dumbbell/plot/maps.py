@@ -13,7 +13,7 @@ from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
-from .style import FAIL_COLOURS, _subplots, legend_outside
+from .style import FAIL_COLOURS, _subplots, legend_outside, plain
 
 __all__ = ["stability_map", "sweep_map"]
 
@@ -66,7 +66,7 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     own = ax is None
     if own:
         fig, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
-    title = (f"Sweep of {result.scene.name}: {result.solver}, t_end = {result.t_end:g} s, "
+    title = (f"Sweep of {plain(result.scene.name)}: {result.solver}, t_end = {result.t_end:g} s, "
              f"{len(result.rows)} runs")
     if len(result.axes) == 2:
         draw_map(ax.figure, ax, result.axes[0], result.axes[1], result.rows, title)

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import _subplots, legend_outside
+from .style import _subplots, legend_outside, plain
 
 if TYPE_CHECKING:
     from ..analysis.contact import ContactMomentum
@@ -109,7 +109,7 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     args.instance(measured, "measured", ToppleMeasure,
                   "a ToppleMeasure (from dumbbell.analysis.topple.measure)")
     ax = args.axes(ax, count=3)
-    solver = args.text(solver, "solver", "a str (the name in the legend)")
+    solver = plain(args.text(solver, "solver", "a str (the name in the legend)"))
     a1, a2, a3 = _axes(ax, 3, figsize=(10.5, 8.0), sharex=True)
     t, theta = cf.angle_curve()
     step = max(1, len(measured.t) // 60)
@@ -167,7 +167,7 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
     args.instance(cm, "cm", ContactMomentum,
                   "a ContactMomentum (from dumbbell.analysis.contact.about_contact)")
     ax = args.axes(ax)
-    solver = args.text(solver, "solver", "a str (the name in the title)")
+    solver = plain(args.text(solver, "solver", "a str (the name in the title)"))
     ax = _axes(ax, 1, figsize=(10.5, 4.8))
     t = (cm.t - cm.impact.t) * 1e3
     ax.axvline(0, color="0.6", lw=0.8, ls=":")
