@@ -724,3 +724,90 @@ def test_a_unicode_title_on_a_narrow_terminal(tmp_path, encoding, argv):
     folder = tmp_path / argv[-1]
     assert len(files_in(folder)) == (6 if argv[0] == "compare" else 4)
     assert "\\u2603" in out + err  # the snowman, escaped; the rest as the terminal shows it
+
+
+# --- 7. the Python API's output paths --------------------------------------------------------
+
+
+def _api_writers(traj):
+    """Every way the Python API writes a file: name -> call(path)."""
+    import dumbbell
+    from dumbbell.io.figures import save_figure
+    from dumbbell.io.tables import write_text
+    from dumbbell.io.trajectory import write_csv, write_events
+
+    gif = dumbbell.render_gif(traj, size="64x64", t_end=0.04, fps=25)
+    return {"to_csv": traj.to_csv, "write_csv": lambda p: write_csv(traj, p),
+            "write_events": lambda p: write_events(traj, p),
+            "write_text": lambda p: write_text(p, "x\n"),
+            "render_gif": lambda p: dumbbell.render_gif(traj, p, size="64x64", t_end=0.04),
+            "Gif.save": gif.save,
+            "save_figure": lambda p: save_figure(dumbbell.plot.positions(traj).figure, p)}
+
+
+@pytest.fixture(scope="module")
+def short_traj(tmp_path_factory):
+    import dumbbell
+
+    return dumbbell.simulate(short_scene(tmp_path_factory.mktemp("traj")))
+
+
+BAD_OUTPUTS = {
+    "a folder": ("{d}/adir", "is a folder"),
+    "the working folder": (".", "names a folder"),
+    "the parent folder": ("..", "names a folder"),
+    "under a file": ("{d}/afile/x.{ext}", "is a file, not a folder"),
+    "under /proc": ("/proc/x.{ext}", "/proc"),
+    "under /proc/self": ("/proc/self/x.{ext}", "/proc"),
+    "under /dev": ("/dev/dumbbell-x.{ext}", "/dev"),
+    "under /sys": ("/sys/x.{ext}", "cannot write in /sys"),
+    "a new folder": ("{d}/newdir/", "ends in '/'"),
+    "a new folder, two slashes": ("{d}/newdir//", "ends in '/'"),
+    "an existing folder/": ("{d}/adir/", "ends in '/'"),
+}
+
+
+@pytest.mark.parametrize("writer", ["to_csv", "write_csv", "write_events", "write_text",
+                                    "render_gif", "Gif.save", "save_figure"])
+@pytest.mark.parametrize("case", list(BAD_OUTPUTS))
+def test_an_api_output_path_that_cannot_be_a_file_is_one_error(tmp_path, monkeypatch,
+                                                              short_traj, writer, case):
+    """`to_csv` on a folder, on ".", under a file, under /proc raised IsADirectoryError,
+    OSError, FileExistsError, FileNotFoundError; `render_gif(t, "/proc/x.gif")` failed only
+    after the work; `to_csv("newdir/")`, `render_gif(t, "newdir/")`, `Gif.save("g/")` wrote
+    a file named without the slash. One DumbbellError naming the argument, before the
+    work, and nothing written."""
+    from dumbbell import DumbbellError
+
+    if case == "under /sys" and not os.path.isdir("/sys"):
+        pytest.skip("no /sys here")
+    (tmp_path / "adir").mkdir()
+    (tmp_path / "afile").write_text("")
+    ext = {"render_gif": "gif", "Gif.save": "gif", "save_figure": "png"}.get(writer, "csv")
+    text, words = BAD_OUTPUTS[case]
+    path = text.format(d=tmp_path, ext=ext)
+    call = _api_writers(short_traj)[writer]
+    from dumbbell.animation import drawing
+
+    def no_drawing(*args, **kwargs):
+        raise AssertionError("the drawing started before the path was checked")
+
+    monkeypatch.setattr(drawing, "Painter", no_drawing)
+    before = files_in(tmp_path)
+    with pytest.raises(DumbbellError) as info:
+        call(path)
+    message = str(info.value)
+    assert message.startswith("path = ") and words in message, message
+    assert len(message.splitlines()) == 1 and len(message) < 400, message
+    assert files_in(tmp_path) == before
+    assert not os.path.exists(path.rstrip("/")) or os.path.isdir(path.rstrip("/")) \
+        or path.startswith(("/proc", "/sys"))
+
+
+@pytest.mark.parametrize("writer", ["to_csv", "render_gif", "Gif.save", "save_figure"])
+def test_an_api_output_in_a_new_folder_is_written(tmp_path, short_traj, writer):
+    """What is a file name still writes, folders made on the way (and nothing else)."""
+    ext = {"render_gif": "gif", "Gif.save": "gif", "save_figure": "png"}.get(writer, "csv")
+    path = tmp_path / "new" / "deeper" / f"x.{ext}"
+    assert _api_writers(short_traj)[writer](str(path)) == path
+    assert files_in(tmp_path) == ["new", "new/deeper", f"new/deeper/x.{ext}"]

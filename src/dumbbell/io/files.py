@@ -487,6 +487,9 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
         path = Path(os.path.realpath(path))  # the file the link names is written
     if not folder and is_special(path):
         return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
+    if not folder and _under_system(path):
+        return ("is no entry of the system's /dev or /proc, where no file can be created; "
+                "write elsewhere")
     if folder and path.exists() and not path.is_dir():
         return "exists and is not a folder"
     if not folder and path.is_dir():
@@ -536,8 +539,27 @@ def _unwritable(path: Path, folder: bool) -> str | None:
         return f"{here} is a file, not a folder"
     if not os.access(here, os.W_OK | os.X_OK):
         return f"cannot write in {here} (permission denied)"
+    probe = _probe(here)
+    if probe:
+        return f"cannot write in {here} ({probe})"
     if not folder and path.exists():
         return _sticky(path)
+    return None
+
+
+def _probe(folder: Path) -> str | None:
+    """Make and remove a file in ``folder``: the one sure test that a file can be created
+    there (a read-only file system, /sys, a folder only root may write pass ``os.access``
+    for root). None when it can; else why not."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".dumbbell-", suffix=".probe", dir=folder)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(fd)
+    try:
+        os.unlink(name)
+    except OSError:
+        pass
     return None
 
 
@@ -579,5 +601,22 @@ def check_writable(path: str | Path, flag: str, folder: bool = False, *,
         text = os.fsdecode(text)
     why = _why_not(Path(text.replace("\0", "")), text, folder, within)
     if why is not None:
-        shown = args.show(text) if "\0" in text else text
+        shown = args.show(text) if "\0" in text else args.show_path(text, 200)
         raise UsageError(f"{flag} {shown}: {why}")
+
+
+def writable_path(value: object, name: str = "path") -> Path:
+    """The output path ``value`` a function of the Python API was given, checked before any
+    work as the command line checks its outputs (:func:`check_writable`: as spelt, so that
+    ``"newdir/"`` is a folder, not a file called ``newdir``), else a UsageError naming
+    ``name``; returns it as a Path."""
+    from ..model import args
+
+    if not isinstance(value, str | os.PathLike) or not os.fspath(value):
+        raise UsageError(f"{name} = {args.show(value)}: must be a path (str or "
+                         "pathlib.Path)", param=name)
+    try:
+        check_writable(value, f"{name} =")
+    except UsageError as exc:
+        raise UsageError(str(exc), param=name) from None
+    return Path(os.fsdecode(value))

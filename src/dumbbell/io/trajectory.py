@@ -16,7 +16,7 @@ from typing import IO, Any
 
 from ..model import args
 from ..model.trajectory import Trajectory
-from .files import atomic_output
+from .files import atomic_output, writable_path
 from .tables import csv_text, write_text
 
 __all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
@@ -54,7 +54,7 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
     """Write the samples as CSV to ``path`` (see :func:`dump_csv`), whole or not at all (a
     device or a FIFO is written directly); returns the path."""
     traj = _checked(traj)
-    path = args.path(path, "path")
+    path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
     # One open of our own: given a name, numpy opens the file twice, and the first,
     # empty open would end a FIFO's reader.
     with atomic_output(path) as tmp, open(tmp, "w") as fh:
@@ -71,4 +71,5 @@ def events_csv(traj: Trajectory) -> str:
 def write_events(traj: Trajectory, path: str | Path) -> Path:
     """Write :func:`events_csv` to ``path``, whole or not at all; returns the path."""
     traj = _checked(traj)
-    return write_text(args.path(path, "path"), events_csv(traj))
+    path = writable_path(path)
+    return write_text(path, events_csv(traj))
