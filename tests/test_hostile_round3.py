@@ -811,3 +811,224 @@ def test_an_api_output_in_a_new_folder_is_written(tmp_path, short_traj, writer):
     path = tmp_path / "new" / "deeper" / f"x.{ext}"
     assert _api_writers(short_traj)[writer](str(path)) == path
     assert files_in(tmp_path) == ["new", "new/deeper", f"new/deeper/x.{ext}"]
+
+
+# --- 9. messages: every echo bounded ---------------------------------------------------------
+
+SPACED = " ".join(["word"] * 16_000)  # 80,000 characters, no word longer than 4
+
+
+@pytest.mark.parametrize("where", ["key", "table", "nested key", "body", "inline table key",
+                                   "array of tables"])
+def test_a_key_with_spaces_is_echoed_short(tmp_path, where):
+    """A scene key or table name with spaces gave an 80,000-character line (the clipping
+    shortened single words only). Every echo is bounded, in the library's error and on the
+    command line."""
+    from dumbbell import SceneError, load_scene
+
+    base = (SCENES / "textbook-1d.toml").read_text()
+    text = {"key": base + f'\n"{SPACED}" = 1\n',
+            "table": base + f'\n["{SPACED}"]\nx = 1\n',
+            "nested key": base.replace("[gravity]", f'[gravity]\n"{SPACED}" = 1'),
+            "body": base.replace("[bodies.A]", f'[bodies."{SPACED}"]\nmass = 1\n[bodies.A]'),
+            "inline table key": base.replace("[gravity]",
+                                             f'[gravity]\nx = {{ "{SPACED}" = 1 }}'),
+            "array of tables": base + f'\n[["{SPACED}"]]\nx = 1\n'}[where]
+    path = tmp_path / "spaced.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert len(str(info.value)) <= 600, len(str(info.value))
+    status, _, err = cli("simulate", path, "-o", tmp_path / "x.csv")
+    assert len(refused(status, err, tmp_path, keep=("spaced.toml",))) <= 1100
+
+
+@pytest.mark.parametrize("call", ["with_values", "with_values table", "with_values nested",
+                                  "load_scene_bytes", "scene_from_dict", "load_scene",
+                                  "sweep", "simulate"])
+def test_the_api_echoes_a_spaced_value_short(call):
+    import dumbbell
+    from dumbbell import DumbbellError
+    from dumbbell.model.scene import load_scene_bytes, scene_from_dict
+
+    scene = dumbbell.load_scene(SCENES / "textbook-1d.toml")
+    calls = {"with_values": lambda: scene.with_values({SPACED: 1}),
+             "with_values table": lambda: scene.with_values({SPACED + ".x": 1}),
+             "with_values nested": lambda: scene.with_values({"spring." + SPACED: 1}),
+             "load_scene_bytes": lambda: load_scene_bytes(b"x", SPACED),
+             "scene_from_dict": lambda: scene_from_dict({**scene.to_dict(), SPACED: 1}),
+             "load_scene": lambda: dumbbell.load_scene(SPACED),
+             "sweep": lambda: dumbbell.sweep(scene, {SPACED: [1.0, 2.0]}),
+             "simulate": lambda: dumbbell.simulate(scene, solver=SPACED)}
+    with pytest.raises(DumbbellError) as info:
+        calls[call]()
+    assert len(str(info.value)) <= 600 and len(str(info.value).splitlines()) == 1, \
+        len(str(info.value))
+
+
+def _text_flags():
+    from tests.test_fuzz_cli import COMMANDS, FLAGS
+
+    return [(c, f.names[0]) for c in COMMANDS for f in FLAGS[c] if f.metavar]
+
+
+@pytest.mark.parametrize("command,flag", _text_flags())
+def test_every_flag_echoes_a_spaced_value_short(tmp_path, monkeypatch, command, flag):
+    """Every flag of every command given 80,000 characters of short words (one value, or
+    50 of them for the flags that take several): one line of at most 1,000 characters."""
+    from dumbbell.cli.app import MAX_LINE
+    from tests.test_fuzz_cli import SHORT_2D
+
+    scene = short_scene(tmp_path)
+    if command == "restitution":
+        scene.write_text(SHORT_2D, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    many = 50 if flag in ("--solvers", "--dts", "--dt", "--stiffness", "--grid") else 1
+    positional = [] if command == "stability" else [scene]
+    extra = ["--grid", "k=1,2"] if command == "sweep" and flag != "--grid" else []
+    status, _, err = cli(command, *positional, *extra, flag, *[SPACED] * many)
+    assert status == 2, (command, flag, err[:300])
+    assert len(one_line(err)) <= MAX_LINE, len(err)
+
+
+@pytest.mark.parametrize("key,table,value", [
+    ("every", "run", "9" * 5000), ("every", "run", "1_0" * 2200), ("fps", "outputs.gif",
+                                                                    "9" * 4301),
+    ("stiffness", "spring", "-" + "9" * 5000), ("mass", "bodies.A", "+" + "9" * 100_000),
+    ("t_end", "run", "9" * 6000),
+])
+def test_a_5000_digit_integer_names_its_key(tmp_path, key, table, value):
+    """A 5,000-digit `every` gave `not valid TOML: Exceeds the limit ... use
+    sys.set_int_max_str_digits()`, naming no key. It names the key, and what it may be."""
+    from dumbbell import SceneError, load_scene
+
+    base = (SCENES / "textbook-1d.toml").read_text()
+    start = base.index(f"[{table}]\n") if table != "outputs.gif" else base.index("gif = {")
+    if table == "outputs.gif":
+        text = base.replace("fps = 25", f"fps = {value}")
+    else:
+        line_start = base.index(f"\n{key} = ", start) + 1
+        line_end = base.index("\n", line_start)
+        text = base[:line_start] + f"{key} = {value}" + base[line_end:]
+    path = tmp_path / "digits.toml"
+    path.write_text(text)
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    message = str(info.value)
+    digits = len(value.strip("+-").replace("_", ""))
+    assert f"{table}.{key} = a " in message and f"{digits:,} digits" in message, message
+    assert "set_int_max_str_digits" not in message and len(message) < 400, message
+    status, _, err = cli("simulate", path, "-o", tmp_path / "x.csv")
+    assert f"{table}.{key}" in refused(status, err, tmp_path, keep=("digits.toml",))
+
+
+def test_a_huge_integer_given_in_python_is_named_too():
+    import dumbbell
+    from dumbbell import DumbbellError
+
+    scene = dumbbell.load_scene(SCENES / "textbook-1d.toml")
+    with pytest.raises(DumbbellError, match=r"run\.every = a whole number of more than 4,300"):
+        scene.with_values({"run.every": 10**5000})
+    with pytest.raises(DumbbellError) as info:
+        dumbbell.simulate(scene.with_values({"run.every": 10**4299}))
+    assert len(str(info.value)) < 300
+
+
+# --- 10. a scene is read no further than its size limit --------------------------------------
+
+
+def _sparse(path: Path, size: int) -> Path:
+    with open(path, "wb") as fh:
+        fh.truncate(size)
+    return path
+
+
+def test_a_huge_packaged_scene_is_refused_from_its_size(tmp_path, monkeypatch):
+    """A packaged scene replaced by a 3 GB sparse file made `run --all` read it whole
+    (3.1 GB peak) before refusing it. Refused from its size, nothing read: in-process,
+    the Python allocations of the refusal stay under 2 MB."""
+    import tracemalloc
+
+    from dumbbell.model import scene as scene_module
+
+    sparse = _sparse(tmp_path / "rigid-2d.toml", 3 * 10**9)
+    real = scene_module.packaged_scene
+    monkeypatch.setattr(scene_module, "packaged_scene",
+                        lambda name="textbook-1d": sparse if name == "rigid-2d" else real(name))
+    out = tmp_path / "r"
+    tracemalloc.start()
+    try:
+        status, _, err = cli("run", "--all", "--out", out)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    line = refused(status, err)
+    assert "scenes/rigid-2d.toml" in line and "3,000,000,000 bytes" in line, line
+    assert str(tmp_path) not in line  # named as the repository names it
+    assert peak < 2 * 2**20, peak
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("how", ["packaged", "path", "stdin", "grown"])
+def test_a_scene_is_read_no_further_than_the_limit(tmp_path, monkeypatch, how):
+    """Everywhere a scene is read (the showcase's packaged scenes, a path, standard input,
+    a file that grows while it is read): at most the limit + 1 bytes are read."""
+    import io
+    import sys
+
+    from dumbbell.model import scene as scene_module
+    from dumbbell.model.scene import MAX_SCENE_BYTES
+
+    big = _sparse(tmp_path / "big.toml", 50 * MAX_SCENE_BYTES)
+    taken: list[int] = []
+    real_fdopen = os.fdopen
+
+    class Counting(io.BytesIO):
+        def read(self, n=-1):
+            data = super().read(n)
+            taken.append(len(data))
+            return data
+
+    if how == "stdin":
+        stream = Counting(b"#" * (50 * MAX_SCENE_BYTES))
+        monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(stream))
+        argv = ["simulate", "-", "-o", tmp_path / "x.csv"]
+    else:
+        class Reader:
+            """The file object the scene is read through, counting what it returns."""
+
+            def __init__(self, *args, **kwargs):
+                self.fh = real_fdopen(*args, **kwargs)
+
+            def read(self, n=-1):
+                data = self.fh.read(n)
+                taken.append(len(data))
+                return data
+
+            def __enter__(self):
+                return self
+
+            def __exit__(self, *exc):
+                self.fh.close()
+
+        monkeypatch.setattr(os, "fdopen", Reader)
+        if how == "grown":  # the size looked small, then the file grew
+            monkeypatch.setattr(scene_module.os, "fstat", lambda fd: os.stat_result(
+                (0o100644, 0, 0, 1, 0, 0, 10, 0, 0, 0)))
+        if how == "packaged":
+            monkeypatch.setattr(scene_module, "packaged_scene", lambda name="x": big)
+            argv = ["run", "--out", tmp_path / "r"]
+        else:
+            argv = ["simulate", big, "-o", tmp_path / "x.csv"]
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        status, _, err = cli(*argv)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    line = refused(status, err)
+    assert "1 MB" in line or "1,000,000 bytes" in line, line
+    assert sum(taken) <= MAX_SCENE_BYTES + 1, sum(taken)
+    assert peak < 8 * MAX_SCENE_BYTES, peak  # far below the 50 MB there are

@@ -37,12 +37,19 @@ EXIT_VERDICT = 3
 MAX_ECHO = 200
 
 
+#: Longest line a message may be: past it, its middle goes (an echo of many short words,
+#: a key of 80,000 characters with spaces in it).
+MAX_LINE = 1000
+
+
 def clip(text: str, limit: int = MAX_ECHO) -> str:
     """``text`` with every word (a run without spaces) longer than ``limit`` characters cut
     to its first ``limit - 23`` and last 20 around '...': a message echoing a huge value
-    (10,000 tilts, a 5,000-digit number, a 4,000-character path) stays short."""
-    return " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
+    (10,000 tilts, a 5,000-digit number, a 4,000-character path) stays short; and then at
+    most :data:`MAX_LINE` characters, its start and end kept around ' ... '."""
+    text = " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
                     for w in str(text).split(" "))
+    return text if len(text) <= MAX_LINE else f"{text[:MAX_LINE - 305]} ... {text[-300:]}"
 
 
 def one_line(text: str) -> str:
