@@ -92,6 +92,23 @@ def started(*argv: object, cwd: Path | None = None, prelude: str = "", **popen: 
         end_group(proc)
 
 
+def run_group(cmd: list[object], *, input: bytes | str | None = None,
+              timeout: float = HANG_S, **popen: object) -> subprocess.CompletedProcess:
+    """``subprocess.run(cmd, capture_output=True)`` in a session of its own, bounded by
+    ``timeout`` only against a hang, and its whole process group killed on the way out, pass
+    or fail (``subprocess.run`` kills only the process it started, not what that forked)."""
+    popen.setdefault("stdout", subprocess.PIPE)
+    popen.setdefault("stderr", subprocess.PIPE)
+    if input is not None:
+        popen["stdin"] = subprocess.PIPE
+    proc = subprocess.Popen([str(c) for c in cmd], start_new_session=True, **popen)
+    try:
+        out, err = proc.communicate(input, timeout=timeout)
+        return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+    finally:
+        end_group(proc)
+
+
 def group_left(proc: subprocess.Popen) -> list[int]:
     """Processes still running in ``proc``'s process group (its session: pool workers, the
     forked figure process) after it ended: none may be."""
@@ -185,8 +202,9 @@ def processes_naming(marker: str) -> list[psutil.Process]:
     return found
 
 
-def wait_gone(marker: str, timeout: float = 10.0) -> list[psutil.Process]:
-    """Wait up to ``timeout`` s for every process naming ``marker`` to end; the survivors."""
+def wait_gone(marker: str, timeout: float = HANG_S) -> list[psutil.Process]:
+    """Wait for every process naming ``marker`` to end (at most ``timeout`` s, against a
+    hang: it returns as soon as they are gone); the survivors, killed."""
     deadline = time.monotonic() + timeout
     while (left := processes_naming(marker)) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -208,14 +226,3 @@ def refused(status: int, err: str, folder: Path | None = None, keep: tuple[str, 
         assert files_in(folder) == sorted(keep), files_in(folder)
     assert not own_children()
     return line
-
-
-def send_when(proc: subprocess.Popen, ready, sig: signal.Signals, timeout: float = HANG_S
-              ) -> None:
-    """Send ``sig`` to ``proc`` as soon as ``ready()`` is true (polled)."""
-    deadline = time.monotonic() + timeout
-    while not ready():
-        assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() < deadline, "the run never reached the state to signal"
-        time.sleep(0.02)
-    proc.send_signal(sig)
