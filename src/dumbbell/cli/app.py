@@ -431,6 +431,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                              + ("its outputs were already written\n" if kept
                                 else "no output was kept\n"))
             return 128 + signum
+        finally:
+            # The command is over: a signal from now on (a second Ctrl-C) changes nothing.
+            if threading.current_thread() is threading.main_thread():
+                _stopping.closing = True
 
 
 class _Sturdy:

@@ -487,7 +487,7 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
         path = Path(os.path.realpath(path))  # the file the link names is written
     if not folder and is_special(path):
         return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
-    if not folder and _under_system(path):
+    if not folder and _under_system(path) and not os.path.abspath(path).startswith("/dev/shm/"):
         return ("is no entry of the system's /dev or /proc, where no file can be created; "
                 "write elsewhere")
     if folder and path.exists() and not path.is_dir():
