@@ -1034,3 +1034,33 @@ def test_a_scene_is_read_no_further_than_the_limit(tmp_path, monkeypatch, how):
     assert "1 MB" in line or "1,000,000 bytes" in line, line
     assert sum(taken) <= MAX_SCENE_BYTES + 1, sum(taken)
     assert peak < 8 * MAX_SCENE_BYTES, peak  # far below the 50 MB there are
+
+
+@pytest.mark.parametrize("target", ["fifo", "/dev/stdout"])
+def test_a_pipe_output_whose_reader_leaves_keeps_the_other_outputs(tmp_path, stream_inputs,
+                                                                  target):
+    """`-o FIFO` or `-o /dev/stdout` (a pipe) whose reader leaves early: as for standard
+    output (`| head`), what it did not read is dropped, `--events` is written, exit 0; and
+    `/dev/stdout` through a pipe is a pipe, not a name under /dev to refuse."""
+    import subprocess
+
+    r, w = os.pipe()
+    if target == "fifo":
+        fifo = tmp_path / "fifo"
+        os.mkfifo(fifo)
+        output, stdout = str(fifo), subprocess.DEVNULL
+    else:
+        output, stdout = "/dev/stdout", w
+    argv = ["simulate", stream_inputs["SCENE"], "--t-end", "0.05", "--every", "1", "-o",
+            output, "--events", tmp_path / "e.csv"]
+    with started(*argv, cwd=tmp_path, stdout=stdout) as proc:
+        os.close(w)
+        if target == "fifo":
+            with open(fifo, "rb") as reader:  # opens once the command opens it to write
+                assert reader.read(10) == b"t,xA,vA,xB"
+        else:
+            assert os.read(r, 10) == b"t,xA,vA,xB"
+        os.close(r)  # the reader leaves after 10 bytes
+        _, err = finish(proc)
+    assert proc.returncode == 0, err
+    assert (tmp_path / "e.csv").read_text().startswith("t,body")

@@ -422,6 +422,10 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     if is_special(path) or _under_system(path):
         try:
             yield path
+        except BrokenPipeError:
+            # A FIFO or a pipe (/dev/stdout) whose reader left: what it did not read is
+            # dropped, as for standard output (`| head`); the other outputs are written.
+            pass
         except OSError as exc:
             raise _user_error(exc, path, None) from None
         return
@@ -484,10 +488,12 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
         why = link_refusal(path)
         if why:
             return why
-        path = Path(os.path.realpath(path))  # the file the link names is written
+        if not is_special(path):  # a device or a pipe (/dev/stdout) is written through
+            path = Path(os.path.realpath(path))  # the file the link names is written
     if not folder and is_special(path):
         return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
-    if not folder and _under_system(path) and not os.path.abspath(path).startswith("/dev/shm/"):
+    if not folder and _under_system(path) and not os.path.exists(path) \
+            and not os.path.abspath(path).startswith("/dev/shm/"):
         return ("is no entry of the system's /dev or /proc, where no file can be created; "
                 "write elsewhere")
     if folder and path.exists() and not path.is_dir():
