@@ -54,8 +54,23 @@ def spawn(*argv: object, cwd: Path | None = None, prelude: str = "",
     env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", **popen.pop("env", {})}
     code = f"{prelude}\nimport sys; from dumbbell.cli import main; sys.exit(main())"
     popen = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE, "text": True, **popen}
+    popen["preexec_fn"] = interruptible(popen.get("preexec_fn"))
     return subprocess.Popen([sys.executable, "-c", code, *map(str, argv)], cwd=cwd, env=env,
                             start_new_session=True, **popen)
+
+
+def interruptible(then=None):
+    """A ``preexec_fn`` giving the child SIGINT's default action, then calling ``then``: a
+    test run in the background by a shell without job control (``pytest ... &`` in a
+    script) has SIGINT ignored, which its children inherit, and the command keeps an
+    ignored signal ignored, as it must under ``nohup``; the tests that send SIGINT mean a
+    process that has it."""
+    def child() -> None:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        if then is not None:
+            then()
+
+    return child
 
 
 #: Generous bound on one subprocess of a test (s): only a hang reaches it; the tests wait
@@ -109,17 +124,20 @@ def run_group(cmd: list[object], *, input: bytes | str | None = None,
         end_group(proc)
 
 
-def group_left(proc: subprocess.Popen) -> list[int]:
-    """Processes still running in ``proc``'s process group (its session: pool workers, the
-    forked figure process) after it ended: none may be."""
-    left = []
+def group_left(proc: subprocess.Popen, timeout: float = HANG_S) -> list[int]:
+    """Processes of ``proc``'s process group (its session: pool workers, the forked figure
+    process) still running after it ended, once those that end by themselves have: the
+    multiprocessing resource tracker, say, which ends when it sees its parent gone. Waits
+    for them (the event), at most ``timeout`` s against a hang; none may be left."""
+    members = []
     for p in psutil.process_iter(["pid"]):
         try:
             if os.getpgid(p.pid) == proc.pid and p.status() != psutil.STATUS_ZOMBIE:
-                left.append(p.pid)
+                members.append(p)
         except (ProcessLookupError, psutil.NoSuchProcess):
             pass
-    return left
+    _, alive = psutil.wait_procs(members, timeout=timeout)
+    return [p.pid for p in alive]
 
 
 def finish(proc: subprocess.Popen, timeout: float = HANG_S) -> tuple[str, str]:

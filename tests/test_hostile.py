@@ -31,6 +31,7 @@ from tests.hostile import (
     files_in,
     finish,
     group_left,
+    interruptible,
     marker_pipe,
     own_children,
     refused,
@@ -1242,7 +1243,8 @@ def test_no_temporary_file_survives_a_signal_in_a_users_script(tmp_path, how, si
     out.mkdir()
     proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, how, str(out)],
                             env={**os.environ, "PYTHONPATH": SRC}, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=interruptible())  # noqa: PLW1509 - no thread forks here
     try:
         # Waits for the line (an event); the script then sleeps until the signal comes.
         assert proc.stdout.readline().strip() == "ready", proc.stderr.read()
