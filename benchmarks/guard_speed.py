@@ -2,11 +2,15 @@
 
     python benchmarks/guard_speed.py [--sizes 100 400 1600 10000] [--repeat 3]
     python benchmarks/guard_speed.py --src OTHER/src --sizes 100 400   # another checkout
+    python benchmarks/guard_speed.py --pin          # also with a pendulum on a pin joint
 
 The scene: N square boxes (1 kg, 20 px) in columns of a stack on a ground segment between two
 walls, y up, g = 900 px/s^2, pymunk's pixel defaults, resting on each other (0.05 px of overlap,
 under the slop, so every contact is there from the first step); plus pymunk's own box2d_pyramid
-(325 boxes) built as the example builds it. For each size, side by side in one process: ten ``space.step(1/150)`` (the reference),
+(325 boxes) built as the example builds it; with ``--pin``, each size again with a pendulum on
+a PinJoint beside the stack (the guard then measures the joint on a copy of the whole space,
+its steps bounded by the probe's budget). For each size, side by side in one process: ten
+``space.step(1/150)`` (the reference),
 ``spaces.report``, ``spaces.check``, ``spaces.suggest_dt`` and ``Driver(space, 1/150)`` (the time
 it takes to choose its sub-steps), each the minimum over ``--repeat`` runs on a fresh space.
 Printed: seconds and each as a multiple of one ``space.step``. ``--src`` runs the same
@@ -78,6 +82,20 @@ def pyramid():
     return space
 
 
+def with_pin(n: int):
+    """:func:`boxes` and a 1 kg bob on a 200 px PinJoint beside the stack, released level:
+    the guard's probe then runs (a copy of the whole space, bounded in steps)."""
+    import pymunk
+
+    space = boxes(n)
+    top = max(b.position.y for b in space.bodies) + 300.0
+    bob = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0.0, 10.0))
+    bob.position = (-400.0, top)
+    space.add(bob, pymunk.Circle(bob, 10.0),
+              pymunk.PinJoint(space.static_body, bob, (-200.0, top), (0.0, 0.0)))
+    return space
+
+
 def timed(make, use, repeat: int) -> float:
     best = math.inf
     for _ in range(repeat):
@@ -88,12 +106,14 @@ def timed(make, use, repeat: int) -> float:
     return best
 
 
-def measure(sizes: list[int], repeat: int) -> list[dict]:
+def measure(sizes: list[int], repeat: int, pins: bool = False) -> list[dict]:
     from dumbbell import spaces
 
     rows = []
     cases = [(f"{n} boxes", (lambda n=n: boxes(n))) for n in sizes]
     cases.insert(min(2, len(cases)), ("box2d_pyramid (325)", pyramid))
+    if pins:
+        cases += [(f"{n} boxes + a pin", (lambda n=n: with_pin(n))) for n in sizes]
     for name, make in cases:
         def ten_steps(space):
             for _ in range(10):
@@ -124,10 +144,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", type=int, nargs="+", default=[100, 400, 1600, 10000])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--src", help="run on this checkout's src folder instead")
+    parser.add_argument("--pin", action="store_true",
+                        help="also each size with a pendulum on a PinJoint (the joint probe)")
     a = parser.parse_args(argv)
     if a.src:
         return subprocess.call([sys.executable, __file__, "--sizes", *map(str, a.sizes),
-                                "--repeat", str(a.repeat)],
+                                "--repeat", str(a.repeat), *(["--pin"] if a.pin else [])],
                                env={"PYTHONPATH": str(Path(a.src).resolve()),
                                     "PATH": "/usr/bin:/bin"})
     import dumbbell
@@ -135,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"guard from {Path(dumbbell.__file__).parent}; minimum of {a.repeat} runs each, "
           "2 shared cores: compare the columns of one run, not runs")
     print(HEAD, flush=True)
-    measure(a.sizes, a.repeat)
+    measure(a.sizes, a.repeat, a.pin)
     return 0
 
 

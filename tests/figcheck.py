@@ -1,8 +1,9 @@
 """Is a matplotlib figure fit for a lecture? :func:`findings` lists what collides on it.
 
-    from tests.figcheck import findings, problems
+    from tests.figcheck import findings, outside_axes, problems
     assert findings(fig) == []          # or print them: each finding is one line
     assert problems(fig) == []          # findings and missing units, as lines of text
+    assert outside_axes(ax) == []       # a figure drawn on the user's axes stays inside them
 
 It draws the figure once (``fig.canvas.draw()``) and reads every artist's window extent (px):
 
@@ -12,7 +13,17 @@ It draws the figure once (``fig.canvas.draw()``) and reads every artist's window
 - **text on a legend**: a text, or another legend, overlaps a legend's frame;
 - **a line through text**: a ``Line2D`` (data curves, markers, ``axhline``/``axvline``) crosses
   a text's box or a legend's frame; lines are clipped to their axes, as drawn;
-- **cut off**: a text or legend reaches past the figure's edge.
+- **data under text**: the other data an axes draws (filled areas such as ``fill_between``,
+  bars, colour meshes, scatter markers, line collections such as ``hlines`` or a contour)
+  lies under a text's box or a legend's frame; a span that marks a stretch of an axis
+  (``axvspan``, ``axhspan``: drawn over the whole height or width whatever the data) is a
+  background, not data;
+- **cut off**: a text or legend reaches past the figure's edge;
+- **squeezed**: an axes' data area takes less than ``share`` (half) of the width, or of the
+  height, of its whole box (its frame with its tick labels, axis labels, titles and legend):
+  a legend or a text beside it has taken the room its data should have (a legend outside
+  each axes of a row squeezes each plot to a third of its width). A colour bar is not
+  checked (it is a thin strip by design).
 
 :func:`missing_units` lists the axes whose tick labels show numbers but whose label names no
 unit in brackets (``t [s]``; a ratio is ``[1]``).
@@ -34,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Finding", "findings", "missing_units", "problems"]
+__all__ = ["Finding", "findings", "missing_units", "outside_axes", "problems"]
 
 
 @dataclass(frozen=True)
@@ -210,11 +221,12 @@ def problems(fig: Any) -> list[str]:
 
 
 def findings(fig: Any, gap: float = 2.0, tolerance: float = 1.0, lines: bool = True,
-             draw: bool = True) -> list[Finding]:
+             draw: bool = True, share: float = 0.5) -> list[Finding]:
     """Everything that collides on ``fig`` (see the module docstring): [] when nothing does.
     Texts and legends side by side must stand ``gap`` points apart; a line may come within
-    ``tolerance`` px of a box; ``lines`` False skips the lines; ``draw`` False trusts that the
-    figure was laid out since it last changed."""
+    ``tolerance`` px of a box; ``lines`` False skips the lines and the other data; an axes'
+    data area must take at least ``share`` of its box's width and height; ``draw`` False
+    trusts that the figure was laid out since it last changed."""
     from matplotlib.lines import Line2D
     from matplotlib.transforms import Bbox
 
@@ -241,9 +253,11 @@ def findings(fig: Any, gap: float = 2.0, tolerance: float = 1.0, lines: bool = T
     for a, b in itertools.combinations(legends, 2):
         if _overlap(wide[id(a)], wide[id(b)]):
             out.append(Finding("text/legend", a.name, b.name))
+    out += _squeezed(fig, renderer, share)
     if not lines:
         return out
     small = {id(box): _grown(box.bbox, -tolerance) for box in texts + legends}
+    out += _data_under_text(fig, texts + legends, small)
     for ax in fig.axes:
         if not ax.get_visible():
             continue
@@ -265,6 +279,142 @@ def findings(fig: Any, gap: float = 2.0, tolerance: float = 1.0, lines: bool = T
                 if _crosses(pieces, marks, half, target):
                     kind = "line/legend" if box.owner is not None else "line/text"
                     out.append(Finding(kind, name.rstrip(), box.name))
+    return out
+
+
+def _squeezed(fig: Any, renderer: Any, share: float) -> list[Finding]:
+    """The axes whose data area (frame) takes less than ``share`` of the width or the height
+    of its whole box (``Axes.get_tightbbox``: frame, tick labels, axis labels, titles, legend),
+    colour bars left out."""
+    out = []
+    for ax in fig.axes:
+        if not ax.get_visible() or ax.get_label() == "<colorbar>":
+            continue
+        frame, box = ax.get_window_extent(renderer), ax.get_tightbbox(renderer)
+        if box is None or box.width <= 0 or box.height <= 0:
+            continue
+        for what, part, whole in (("width", frame.width, box.width),
+                                  ("height", frame.height, box.height)):
+            if part < share * whole:
+                out.append(Finding("squeezed", f"{_axes_name(fig, ax)}: its data area is "
+                                   f"{part / whole:.0%} of its box's {what} ({part:.0f} of "
+                                   f"{whole:.0f} px)"))
+    return out
+
+
+def _is_span(artist: Any, ax: Any) -> bool:
+    """Whether ``artist`` spans the axes' whole height or width whatever the data (axvspan,
+    axhspan: one of its coordinates is in axes fractions)."""
+    x, y = artist.get_transform().contains_branch_seperately(ax.transData)
+    return x != y
+
+
+def _data_shapes(ax: Any) -> list[tuple[str, Any]]:
+    """What ``ax`` draws as data besides its lines, as (name, hit) where ``hit(box)`` says
+    whether it lies under the display box ``box``."""
+    from matplotlib.collections import Collection, LineCollection, QuadMesh
+    from matplotlib.image import AxesImage
+    from matplotlib.patches import Patch
+    from matplotlib.path import Path
+    from matplotlib.transforms import Bbox
+
+    def paths_hit(paths: list[Any], filled: bool) -> Any:
+        pieces = [(pa, pa.get_extents()) for pa in paths if len(pa.vertices)]
+
+        def hit(box: Any) -> bool:
+            return any(e.overlaps(box) and pa.intersects_bbox(box, filled=filled)
+                       for pa, e in pieces)
+        return hit
+
+    shapes: list[tuple[str, Any]] = []
+    where = _axes_name(ax.figure, ax)
+    for child in ax.get_children():
+        if (not isinstance(child, Collection | Patch | AxesImage) or not _drawn(child)
+                or child is ax.patch):
+            continue
+        label = str(child.get_label() or "")
+        shown = _short(label) if label and not label.startswith("_") else ""
+        name = f"{where}: {type(child).__name__} {shown}".rstrip()
+        if isinstance(child, QuadMesh):
+            xy = child.get_transform().transform(child.get_coordinates().reshape(-1, 2))
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            if len(xy):
+                extent = Bbox.from_extents(*xy.min(axis=0), *xy.max(axis=0))
+                shapes.append((name, extent.overlaps))
+        elif isinstance(child, Collection):
+            offsets = np.asarray(child.get_offsets(), dtype=float)
+            if len(offsets) and np.any(offsets) and not isinstance(child, LineCollection):
+                # Markers (scatter): each a square of its size (points²) round its offset.
+                xy = child.get_offset_transform().transform(offsets)
+                sizes = np.asarray(child.get_sizes(), dtype=float)
+                half = (np.sqrt(sizes.max()) if sizes.size else 6.0) * ax.figure.dpi / 72 / 2
+
+                def hit(box: Any, xy: Any = xy, half: float = half) -> bool:
+                    return bool(((xy[:, 0] >= box.x0 - half) & (xy[:, 0] <= box.x1 + half)
+                                 & (xy[:, 1] >= box.y0 - half)
+                                 & (xy[:, 1] <= box.y1 + half)).any())
+                shapes.append((name, hit))
+            elif not _is_span(child, ax):
+                t = child.get_transform()
+                paths = [t.transform_path(pa) for pa in child.get_paths()]
+                shapes.append((name, paths_hit(paths, not isinstance(child, LineCollection))))
+        elif isinstance(child, Patch) and not _is_span(child, ax):
+            path = child.get_transform().transform_path(child.get_path())
+            shapes.append((name, paths_hit([Path(path.vertices, path.codes)], True)))
+        elif isinstance(child, AxesImage):
+            shapes.append((name, child.get_window_extent().overlaps))
+    return shapes
+
+
+def _data_under_text(fig: Any, boxes: list[_Box], small: dict[int, Any]) -> list[Finding]:
+    """Data other than lines (:func:`_data_shapes`) under a text's box or a legend's frame,
+    each clipped to its axes as drawn."""
+    from matplotlib.transforms import Bbox
+
+    out = []
+    for ax in fig.axes:
+        if not ax.get_visible() or ax.get_label() == "<colorbar>":
+            continue
+        clip = ax.get_window_extent()
+        shapes = _data_shapes(ax)
+        for box in boxes:
+            target = Bbox.intersection(small[id(box)], clip)
+            if target is None or target.width <= 0 or target.height <= 0:
+                continue
+            for name, hit in shapes:
+                if hit(target):
+                    kind = "data/legend" if box.owner is not None else "data/text"
+                    out.append(Finding(kind, name, box.name))
+    return out
+
+
+def outside_axes(ax: Any, draw: bool = True, tolerance: float = 1.0) -> list[Finding]:
+    """What ``ax`` holds that reaches outside it, for a figure drawn on the user's axes (the
+    package's own figures put legends outside on purpose): its legend or a text of its own
+    (``ax.text``, an annotation's words) past its frame on any side, or a title past the
+    frame's left or right edge (into the neighbouring axes). ``draw`` as for
+    :func:`findings`; ``tolerance`` px are allowed."""
+    from matplotlib.text import Text
+
+    if draw:
+        _draw(ax.figure)
+    renderer = ax.figure.canvas.get_renderer()
+    frame = _grown(ax.get_window_extent(renderer), tolerance)
+    where = _axes_name(ax.figure, ax)
+    out = []
+    legend = ax.get_legend()
+    boxes = []
+    if legend is not None and _drawn(legend):
+        boxes.append((f"legend of {where}", legend.get_window_extent(renderer), True))
+    for child in ax.get_children():
+        if isinstance(child, Text):
+            box = _text_box(child, renderer, f"{where}: text")
+            if box is not None:
+                boxes.append((box.name, box.bbox, child in ax.texts))
+    for name, b, whole in boxes:
+        sideways = b.x0 < frame.x0 or b.x1 > frame.x1
+        if sideways or (whole and (b.y0 < frame.y0 or b.y1 > frame.y1)):
+            out.append(Finding("outside its axes", name))
     return out
 
 

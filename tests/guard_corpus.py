@@ -25,6 +25,9 @@ other programs), run headless by :mod:`pymunk_corpus`:
     space (pass-through begins near 1);
   - ``bias``: the largest energy gain over the start, ``max (E(t) - E(0)) / E_scale``, with
     ``space.collision_bias = 1`` (the fix) against the program's;
+  - ``joint``: the largest drift per second of a failing joint, ``spaces.Ledger``'s term of
+    that joint over the run divided by its time and by the ledger's energy scale (the
+    guard's tolerance is 0.01 a second);
   - a program the guard calls fine: that overlap at its own step (it must stay under 1).
 
 ``python tests/guard_corpus.py`` prints the table (Markdown) that docs/spaces.md holds.
@@ -267,6 +270,27 @@ def _series(case: str, steps: int, substeps: int = 1, setting: dict | None = Non
     return series, scale
 
 
+def _joint_drift(case: str, steps: int, substeps: int, subjects: set[str]) -> float:
+    """The largest drift per second of the joints ``subjects`` over ``steps`` program steps
+    of ``substeps`` each: ``spaces.Ledger``'s term of each over the run, divided by the time
+    and by the ledger's scale."""
+    from dumbbell import spaces
+
+    name, kind = CASES[case]
+    held: dict[str, Any] = {}
+
+    def first(space: Any, dt: float) -> None:
+        held["ledger"], held["dt"] = spaces.Ledger(space), dt
+
+    run_example(name, steps, isolate=_isolate(kind), on_first=first, substeps=substeps)
+    balance = held["ledger"].balance()
+    held["ledger"].detach()
+    seconds = steps * held["dt"]
+    worst = max((abs(t.energy) for t in balance.terms
+                 if t.kind == "constraint" and t.source in subjects), default=0.0)
+    return worst / seconds / balance.scale if balance.scale > 0 else 0.0
+
+
 @dataclass
 class Advice:
     """The guard's advice on a case at the program's step (``substeps``, the kinds that fail,
@@ -330,6 +354,11 @@ def advice(case: str, steps: int = ADVICE_STEPS) -> Advice:
             depth.append(max(d, default=0.0))
         return Advice(case, dt, n, kinds, settings, "first-contact overlap / limit", depth[0],
                       depth[1])
+    if "joint" in kinds:
+        subjects = {f.subject for f in failing if f.kind == "joint"}
+        drift = [_joint_drift(case, steps, m, subjects) for m, _ in runs]
+        return Advice(case, dt, n, kinds, settings, "joint drift / scale a second", drift[0],
+                      drift[1])
     gained = []
     for m, setting in runs:
         b, scale = _series(case, steps, m, setting, "balance")

@@ -22,6 +22,7 @@ Run ``python tests/pymunk_corpus.py`` to list the corpus with its size and orien
 from __future__ import annotations
 
 import contextlib
+import importlib.abc
 import importlib.util
 import io
 import math
@@ -147,6 +148,25 @@ def _pyglet_stand_in(run: Run, budget: Callable[[], bool]) -> dict[str, types.Mo
     return mods
 
 
+class _StandInFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Imports the given stand-in modules by their names (``import pyglet`` gives pyglet's
+    stand-in), and nothing else."""
+
+    def __init__(self, modules: dict[str, types.ModuleType]) -> None:
+        self.modules = modules
+
+    def find_spec(self, name: str, path: Any, target: Any = None) -> Any:
+        if name not in self.modules:
+            return None
+        return importlib.util.spec_from_loader(name, self, is_package=True)
+
+    def create_module(self, spec: Any) -> types.ModuleType:
+        return self.modules[spec.name]
+
+    def exec_module(self, module: types.ModuleType) -> None:
+        pass  # made whole by _pyglet_stand_in
+
+
 @contextlib.contextmanager
 def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
               on_step: Callable[[Any, float], Any] | None,
@@ -214,8 +234,12 @@ def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
     saved = {name: sys.modules.get(name) for name in [*stand_in, "pymunk.pyglet_util"]}
     saved_argv = sys.argv
     sys.argv = [f"{run.name}.py", *ARGV.get(run.name, [])]
-    sys.modules.update(stand_in)
-    sys.modules.pop("pymunk.pyglet_util", None)
+    for name in saved:
+        sys.modules.pop(name, None)
+    # pyglet's stand-in is imported only by a program that imports pyglet, as pyglet would
+    # be: which window libraries a program has imported is what a recorder reads.
+    finder = _StandInFinder(stand_in)
+    sys.meta_path.insert(0, finder)
     pymunk.Space.step, pymunk.Space.debug_draw = step, debug_draw
     pygame.time.Clock, pygame.event.get = Clock, get
     state = random.getstate()
@@ -232,6 +256,7 @@ def _headless(run: Run, steps: int, on_start: Callable[[Any], Any] | None,
         pymunk.Space.step, pymunk.Space.debug_draw = real_step, real_draw
         pygame.time.Clock, pygame.event.get = real_clock, real_get
         pymunk.pygame_util.positive_y_is_up = real_y
+        sys.meta_path.remove(finder)
         for name, mod in saved.items():
             if mod is None:
                 sys.modules.pop(name, None)

@@ -391,6 +391,11 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "strip": True, "t_end": 0.2, "timing": {}, "max_frames": 100},
     "dumbbell.animation.render.Gif": lambda f: {"data": b"GIF89a"},
     "dumbbell.animation.render.Gif.save": lambda f: {"path": f.tmp / "g.gif"},
+    "dumbbell.animation.player.player": lambda f: {
+        "source": f.traj, "fps": 10, "size": "64x64", "strip": True, "t_end": 0.2,
+        "labels": ["x"], "max_samples": 1000},
+    "dumbbell.animation.player.Player": lambda f: {"html_text": "<p>x</p>", "size": (64, 64)},
+    "dumbbell.animation.player.Player.save": lambda f: {"path": f.tmp / "p.html"},
     "dumbbell.analysis.api.compare": lambda f: {
         "scene": f.scene, "solvers": ["euler-cromer"], "dts": [1e-3], "window": 0.02,
         "t_end": 0.02, "quiet": True},
@@ -508,24 +513,24 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.estimates.reach": lambda f: {"space": f.space(), "dt": 1e-3, "units": "m"},
     "dumbbell.spaces.estimates.Reach": lambda f: fields(
         importlib.import_module("dumbbell.spaces").reach(f.space(), 1e-3)[0]),
-    "dumbbell.spaces.guard.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
+    "dumbbell.spaces.stepping.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
     "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
     "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
     "dumbbell.spaces.guard.Finding": lambda f: fields(f.finding),
-    "dumbbell.spaces.guard.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
+    "dumbbell.spaces.stepping.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
                                                "speeds": "both", "tolerance": math.inf},
-    "dumbbell.spaces.guard.Driver.step": lambda f: {"frames": 2},
+    "dumbbell.spaces.stepping.Driver.step": lambda f: {"frames": 2},
     # dumbbell.spaces.heat, recorder
     "dumbbell.spaces.heat.HeatCounter": lambda f: {"space": f.space()},
-    # dumbbell.spaces.ledger
+    # dumbbell.spaces.ledger, balance
     "dumbbell.spaces.ledger.Ledger": lambda f: {"space": f.space(), "tolerance": 1e-6},
     "dumbbell.spaces.ledger.Ledger.declare_potential": lambda f: {
         "target": list(f.space().bodies), "potential": lambda x, y, m: 0.0 * x,
         "name": "field"},
-    "dumbbell.spaces.ledger.Balance": lambda f: fields(f.balance),
-    "dumbbell.spaces.ledger.Balance.sources": lambda f: {"kind": "contact", "at_least": 0.0},
-    "dumbbell.spaces.ledger.Balance.table": lambda f: {"top": 4},
-    "dumbbell.spaces.ledger.Term": lambda f: fields(f.balance.terms[0]),
+    "dumbbell.spaces.balance.Balance": lambda f: fields(f.balance),
+    "dumbbell.spaces.balance.Balance.sources": lambda f: {"kind": "contact", "at_least": 0.0},
+    "dumbbell.spaces.balance.Balance.table": lambda f: {"top": 4},
+    "dumbbell.spaces.balance.Term": lambda f: fields(f.balance.terms[0]),
     "dumbbell.spaces.recorder.Recorder": lambda f: {
         "space": f.space(), "path": f.tmp / "r.gif", "fps": 10, "energy": True,
         "size": "64x64", "strip": False, "heat": f.heat(), "world": (-1.0, 1.0, -0.2, 1.0),
@@ -572,12 +577,12 @@ VALID.update(_solver_rows())
 
 #: Method case -> f -> the object whose method it is (fresh at each call).
 OWNER: dict[str, Callable[[Fixtures], Any]] = {
-    "dumbbell.spaces.guard.Driver.step": lambda f: importlib.import_module("dumbbell.spaces").Driver(
+    "dumbbell.spaces.stepping.Driver.step": lambda f: importlib.import_module("dumbbell.spaces").Driver(
         f.space(), 1e-2, 1),
     "dumbbell.spaces.ledger.Ledger.declare_potential": lambda f: importlib.import_module(
         "dumbbell.spaces").Ledger(f.space()),
-    "dumbbell.spaces.ledger.Balance.sources": lambda f: f.balance,
-    "dumbbell.spaces.ledger.Balance.table": lambda f: f.balance,
+    "dumbbell.spaces.balance.Balance.sources": lambda f: f.balance,
+    "dumbbell.spaces.balance.Balance.table": lambda f: f.balance,
     "dumbbell.model.scene.Scene.with_values": lambda f: f.scene,
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
@@ -590,6 +595,7 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
+    "dumbbell.animation.player.Player.save": lambda f: __import__("dumbbell").Player("<p></p>"),
     "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,
     "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: f.topple_cf,

@@ -111,17 +111,20 @@ def test_failed_runs_are_kept_and_slow_steps_skipped(tmp_path):
                                            window=0.5, repeat=1, budget=1e-9))
     rows = {p.dt: p for p in result.points if p.dt is not None}
     assert rows[4e-3].verdict == "unstable" and math.isinf(rows[4e-3].error)
-    assert rows[1e-3].verdict == "ok"  # the first point that ran sets the cost per step
+    # The first point that ran sets the cost per step: stable (w*dt = 0.63) but its energy
+    # swings past 0.1, so it is inaccurate, its errors measured like an ok point's.
+    assert rows[1e-3].verdict == "inaccurate" and rows[1e-3].complete
+    assert math.isfinite(rows[1e-3].error)
     # A skipped step has no verdict (it did not run); the tables print "skipped" for it.
     assert rows[1e-4].verdict is None and not rows[1e-4].ran and "budget" in rows[1e-4].reason
-    assert rows[1e-4].status == "skipped" and rows[1e-3].status == "ok"
+    assert rows[1e-4].status == "skipped" and rows[1e-3].status == "inaccurate"
     assert fit_order(result.points) is None
     write_all(result, tmp_path)
     table = markdown(result)
     assert "**unstable**" in table and "**skipped**" in table
     data = json.loads((tmp_path / "bench-test.json").read_text())
     assert data["points"][0]["error"] == "inf"
-    stepped = ["unstable", "ok", "skipped"]  # the three dt, in order; then the truth's point
+    stepped = ["unstable", "inaccurate", "skipped"]  # the three dt, in order; then the truth's
     assert [p["verdict"] for p in data["points"] if p["dt"] is not None] == stepped
     csv_rows = list(csv.DictReader((tmp_path / "bench-test.csv").read_text().splitlines()))
     assert [r["verdict"] for r in csv_rows if r["dt"]] == stepped
@@ -192,3 +195,17 @@ def test_every_csv_column_has_a_unit():
     from dumbbell.analysis.bench import CSV_UNITS
 
     assert set(CSV_UNITS) == set(CSV_COLUMNS)
+
+
+def test_the_table_counts_its_runs_and_times_share_one_precision(one_second):
+    """Issue 29: "at least 1 runs", and a JIT line that mixed precisions ("0.03 s; verlet
+    0.0192 s"). The table and every line after it write times alike: three significant
+    digits, trailing zeros kept, in the unit that suits them."""
+    euler, verlet = (next(p for p in one_second.points if p.solver == name)
+                     for name in ("euler-cromer", "verlet"))
+    points = [replace(euler, compile_seconds=0.03), replace(verlet, compile_seconds=0.0192)]
+    once = replace(one_second, points=points, repeat=1)
+    table = markdown(once)
+    assert "at least 1 run after a warm-up" in table and "1 runs" not in table
+    assert "euler-cromer 30.0 ms; verlet 19.2 ms (the first numba solver" in table
+    assert "at least 3 runs" in markdown(replace(once, repeat=3))

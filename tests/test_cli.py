@@ -84,3 +84,22 @@ def test_a_closed_pipe_ends_quietly():
     err = proc.stderr.read()
     assert proc.wait(timeout=600) == 0  # a guard against a hang, not a clock
     assert err == b""
+
+
+def test_clip_bounds_each_echoed_word_and_the_whole_message():
+    # A message echoing a huge value stays short: each word (run without spaces) keeps its
+    # first and last characters; the whole keeps its start and its end (what is allowed),
+    # for an echo of many words too (a key with spaces, 'a b a b ...' as a path).
+    from dumbbell.cli.app import MAX_ECHO, clip, one_line
+
+    assert clip("fps = 0: must be from 1 to 50") == "fps = 0: must be from 1 to 50"
+    word = clip("path " + "a" * 100_000 + ": must end in .gif")
+    assert len(word) == len("path ") + MAX_ECHO + len(" must end in .gif")
+    assert word.endswith("a" * 19 + ": must end in .gif")
+    for echo in ("a b " * 25_000, "key " * 30_000 + "x" * 100_000):
+        whole = clip(f"scene.toml: {echo}: unknown key; allowed: spring, bodies")
+        assert len(whole) == 5 * MAX_ECHO
+        assert whole.startswith("scene.toml: ") and whole.endswith("allowed: spring, bodies")
+    long_but_fine = "word " * (MAX_ECHO - 1)  # 995 characters: left whole
+    assert clip(long_but_fine) == long_but_fine
+    assert len(one_line("line\n" * 100_000)) <= 5 * MAX_ECHO

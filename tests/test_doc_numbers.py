@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import dumbbell
-from tests.conftest import ROOT, SCENES, rigid_pymunk_drops
+from tests.conftest import ROOT, SCENES
 
 G = 9.8
 
@@ -52,21 +52,6 @@ def energy_error(solver: str, dt: float) -> float:
 
     every = max(1, round(1e-3 / dt))
     return energy_error(run("textbook-1d", solver, dt=dt, every=every), truth())
-
-
-@cache
-def rigid_bounces(e: float) -> dict[float, float]:
-    """The rigid dumbbell's first-impact e_eff in pymunk at dt = 1e-5 s, by tilt (degrees),
-    from the drops ``dumbbell restitution`` makes."""
-    from dumbbell.analysis.restitution import bounce
-
-    return {theta: bounce(traj).e_first for theta, traj in rigid_pymunk_drops(e).items()}
-
-
-def formula(theta: float, e: float) -> float:
-    from dumbbell.analysis.restitution import e_eff_rigid
-
-    return float(e_eff_rigid(theta, e))
 
 
 def truth_e_eff(theta: float, e: float) -> float:
@@ -151,35 +136,7 @@ CLAIMS = [
     Claim("README.md", "its top particle at 1.97528 m/s", "1.97528", lambda: topple()[1].v_top),
     Claim("README.md", "against 1.97613 m/s", "1.97613", lambda: topple()[0].landing_speeds()[1]),
     Claim("README.md", "(√(2gL) = 1.980 m/s", "1.980", lambda: math.sqrt(2 * G * 0.2)),
-    *[Claim("README.md", f"| {cell}", cell.split(" |")[0], fn) for cell, fn in [
-        ("0.6 | 0.3333 | 0.1429 | 0.01531 |", lambda: formula(30, 1)),
-        ("0.3333 | 0.1429 | 0.01531 |", lambda: formula(45, 1)),
-        ("0.1429 | 0.01531 |", lambda: formula(60, 1)),
-        ("0.01531 |", lambda: formula(80, 1)),
-        ("0.99998 | 0.59998 |", lambda: rigid_bounces(1.0)[0.0]),
-        ("0.59998 | 0.33332 |", lambda: rigid_bounces(1.0)[30.0]),
-        ("0.33332 | 0.14284 |", lambda: rigid_bounces(1.0)[45.0]),
-        ("0.14284 | 0.01530 |", lambda: rigid_bounces(1.0)[60.0]),
-        ("0.01530 |", lambda: rigid_bounces(1.0)[80.0]),
-        ("0.2 | 0 | −0.1429 | −0.2385 |", lambda: formula(30, 0.5)),
-        ("−0.2385 |", lambda: formula(80, 0.5)),
-        ("0.49999 | 0.19999 |", lambda: rigid_bounces(0.5)[0.0]),
-        ("0.19999 | −7e-6 |", lambda: rigid_bounces(0.5)[30.0]),
-        ("−7e-6 | −0.14286 |", lambda: rigid_bounces(0.5)[45.0]),
-        ("−0.14286 | −0.23852 |", lambda: rigid_bounces(0.5)[60.0]),
-        ("−0.23852 |", lambda: rigid_bounces(0.5)[80.0])]],
     # docs/rotation.md
-    *[Claim("docs/rotation.md", f"| {th}° | {f} | {t} | {p} |", p, fn) for th, f, t, p, fn in [
-        (0, "1", "1", "0.999978", lambda: rigid_bounces(1.0)[0.0]),
-        (30, "0.6", "0.6", "0.599982", lambda: rigid_bounces(1.0)[30.0]),
-        (45, "0.333333", "0.333333", "0.333319", lambda: rigid_bounces(1.0)[45.0]),
-        (60, "0.142857", "0.142857", "0.142844", lambda: rigid_bounces(1.0)[60.0]),
-        (80, "0.0153076", "0.0153076", "0.0152964", lambda: rigid_bounces(1.0)[80.0]),
-        (0, "0.5", "0.5", "0.499989", lambda: rigid_bounces(0.5)[0.0]),
-        (30, "0.2", "0.2", "0.199991", lambda: rigid_bounces(0.5)[30.0]),
-        (45, "0", "−5e-18", "−7.4e-6", lambda: rigid_bounces(0.5)[45.0]),
-        (60, "−0.142857", "−0.142857", "−0.142863", lambda: rigid_bounces(0.5)[60.0]),
-        (80, "−0.238519", "−0.238519", "−0.238525", lambda: rigid_bounces(0.5)[80.0])]],
     Claim("docs/rotation.md", "| 80° | 0.0153076 | 0.0153076 |", "0.0153076",
           lambda: truth_e_eff(80.0, 1.0)),
     Claim("docs/rotation.md", "| 80° | −0.238519 | −0.238519 |", "−0.238519",
@@ -254,21 +211,112 @@ CLAIMS = [
 
 def _printed(value: float, quoted: str) -> str:
     """``value`` written the way ``quoted`` is: the same decimals, or the same mantissa
-    digits in e-notation, with the page's minus sign."""
+    digits in e-notation, with the page's minus sign. A value that is not zero never prints
+    as zero: rounded to nothing, it is written in e-notation (7.4e-17 as 7e-17, not 0), as
+    the commands print it, so a page cannot say 0 where a command prints 7.40149e-17."""
     minus = "−" if quoted.startswith("−") else "-"
     plain = quoted.replace("−", "-")
     if "e" in plain:
         mantissa = plain.split("e")[0]
         digits = len(mantissa.split(".")[1]) if "." in mantissa else 0
-        text = f"{value:.{digits}e}"
-        m, exp = text.split("e")
-        text = f"{m}e{int(exp)}"
+        text = _e_notation(value, digits)
     else:
         decimals = len(plain.split(".")[1]) if "." in plain else 0
         text = f"{value:.{decimals}f}"
+        if float(text) == 0 and value != 0:
+            text = _e_notation(value, 0)
     if text.startswith("-") and float(text.replace("e", "E")) == 0:
         text = text[1:]  # -0.00 prints as 0.00
     return text.replace("-", minus, 1) if text.startswith("-") else text
+
+
+def _e_notation(value: float, digits: int) -> str:
+    """``value`` as 7.4e-17 (``digits`` after the point; no '+', no leading zeros)."""
+    m, exp = f"{value:.{digits}e}".split("e")
+    return f"{m}e{int(exp)}"
+
+
+@cache
+def restitution_result(e: float):
+    """What ``dumbbell restitution scenes/tilted-2d.toml --theta 0,30,45,60,80 --elasticity
+    E`` computes, for E = ``e`` (the analysis the command runs)."""
+    from dumbbell.analysis.restitution import restitution
+
+    return restitution(scene("tilted-2d").with_values({"floor.elasticity": e}),
+                       [0.0, 30.0, 45.0, 60.0, 80.0])
+
+
+def _table(page: str, first_line: str) -> list[list[str]]:
+    """The cells of the Markdown table of ``page`` whose header row starts with
+    ``first_line``, header included, separator left out."""
+    lines = (ROOT / page).read_text(encoding="utf-8").splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(first_line))
+    rows = []
+    for line in lines[start:]:
+        if not line.startswith("|"):
+            break
+        if not line.startswith("|---"):
+            rows.append([c.strip() for c in line.strip().strip("|").split("|")])
+    return rows
+
+
+def _cell_matches(cell: str, value: float) -> bool:
+    return _printed(value, cell) == cell
+
+
+def test_the_readme_restitution_table_is_the_command_s_every_cell():
+    """Every number of the README's table, row by row, from the command's own result:
+    the formula (and the truth within what the row claims, '(to 3e-16)'), pymunk, and the three
+    spring dumbbells' e_eff (a cell 'a / b / c')."""
+    rows = _table("README.md", "| θ | 0° |")
+    thetas = [float(c.rstrip("°")) for c in rows[0][1:]]
+    assert thetas == [0.0, 30.0, 45.0, 60.0, 80.0]
+    checked = 0
+    for label, *cells in rows[1:]:
+        e = 1.0 if label.startswith("e = 1:") else 0.5
+        result = restitution_result(e)
+        if "formula" in label:
+            columns = [result.formula]
+            within = float(label.split("(to ")[1].rstrip(")"))  # the row's own claim
+            assert np.max(np.abs(result.truth - result.formula)) <= within, label
+        elif "pymunk" in label:
+            columns = [result.pymunk]
+        else:
+            columns = [result.springs[k]["e_eff"] for k in (200.0, 2e3, 2e4)]
+        for i, cell in enumerate(cells):
+            parts = [p.strip() for p in cell.split("/")]
+            assert len(parts) == len(columns), (label, cell)
+            for part, column in zip(parts, columns, strict=True):
+                assert _cell_matches(part, float(column[i])), (label, thetas[i], part,
+                                                               float(column[i]))
+                checked += 1
+    assert checked == 5 * (1 + 1 + 3 + 1 + 1)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_the_rotation_page_s_tables_are_the_command_s_every_cell(e):
+    """docs/rotation.md's tables, every cell: formula, truth, pymunk, and each spring's
+    e_eff with the impacts of its first cluster ('0.988 (2)')."""
+    text = (ROOT / "docs/rotation.md").read_text(encoding="utf-8")
+    marker = f"e = {e:g}:\n\n"
+    assert marker in text
+    # The table after this e's marker (both tables share their header row).
+    start = text.index(marker) + len(marker)
+    rows = [[c.strip() for c in line.strip().strip("|").split("|")]
+            for line in text[start:].splitlines()
+            if line.startswith("|") and not line.startswith("|---")][:6]
+    assert rows[0][:4] == ["θ", "formula", "truth", "pymunk"]
+    result = restitution_result(e)
+    springs = [result.springs[k] for k in (200.0, 2e3, 2e4)]
+    for i, (theta, formula, truth, pymunk, *spring_cells) in enumerate(rows[1:]):
+        assert float(theta.rstrip("°")) == result.theta[i]
+        for cell, value in ((formula, result.formula[i]), (truth, result.truth[i]),
+                            (pymunk, result.pymunk[i])):
+            assert _cell_matches(cell, float(value)), (theta, cell, float(value))
+        for cell, spring in zip(spring_cells, springs, strict=True):
+            value, impacts = cell.split()
+            assert _cell_matches(value, float(spring["e_eff"][i])), (theta, cell)
+            assert impacts == f"({int(spring['impacts'][i])})", (theta, cell)
 
 
 @pytest.mark.parametrize("claim", CLAIMS, ids=[f"{c.page}:{c.number}" for c in CLAIMS])

@@ -69,3 +69,24 @@ def test_the_runner_fails_what_does_not_run(tmp_path):
                       (30, "a fence without a known language (''): l"), (34, "")]
     assert left == ["renders/stray.png: not a showcase file, and git would see it"]
     assert written == {"stray.png", "ok.csv"}
+
+
+def test_a_repr_a_page_shows_is_the_code_s(tmp_path):
+    """A comment showing a repr (a name and a parenthesis) is checked against the value; a
+    number cut with '...' stands for its digits only, so it cannot hide a field the page
+    left out (the README's Impact without heat=None was such a case)."""
+    (tmp_path / "scenes").mkdir()
+    doc = tmp_path / "README.md"
+    doc.write_text(
+        "```python\nfrom fractions import Fraction\n"
+        "Fraction(1, 3)  # Fraction(1, 3)\n"
+        "Fraction(2, 3)  # Fraction(2, ...)\n```\n\n"
+        "```python\nFraction(1, 3)  # Fraction(1, 4)\n```\n\n"
+        "```python\nclass P:\n    def __init__(self, x):\n        self.x = x\n\n"
+        "    def __repr__(self):\n        return f'P(x={self.x}, y=None)'\n\n\n"
+        "P(1.23456)  # P(x=1.23..., y=None)\nP(1.23456)  # P(x=1.23...)\n```\n")
+    results, _, _ = docblocks.run_file(doc, tmp_path)
+    errors = [(r.block.line, (r.error or "")[:60]) for r in results]
+    assert errors[0] == (1, "")
+    assert errors[1][0] == 7 and "shows 'Fraction(1, 4)'" in errors[1][1]
+    assert errors[2][0] == 11 and "line 10: the page shows 'P(x=1.23...)'" in results[2].error

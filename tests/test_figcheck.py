@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.figcheck import findings, missing_units
+from tests.figcheck import findings, missing_units, outside_axes
 
 plt = pytest.importorskip("matplotlib.pyplot")
 
@@ -163,3 +163,107 @@ def test_problems_lists_findings_and_missing_units_as_lines():
     found = problems(fig)
     assert len(found) == 3 and found[0].startswith("line/text")
     assert all("has no [unit]" in line for line in found[1:])
+
+
+def test_a_legend_beside_each_axes_of_a_row_squeezes_it():
+    """Issue 29: kinetic beside potential on a 1x2 grid, each legend outside its axes on the
+    right: laid out, each plot keeps about a third of its width. Nothing overlaps, nothing is
+    cut: only the share of the box the data keep tells."""
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
+    t = np.linspace(0, 2, 100)
+    for ax in axes:
+        for name in ("K_cm, centre of mass", "K_int, relative to the centre of mass"):
+            ax.plot(t, np.sin(3 * t), label=name)
+        ax.set(xlabel="t [s]", ylabel="E [J]")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.tight_layout()
+    found = findings(fig)
+    assert {f.kind for f in found} == {"squeezed"} and len(found) == 2
+    assert all("of its box's width" in f.first for f in found)
+    for ax in axes:
+        ax.get_legend().remove()
+        ax.legend(loc="upper left", fontsize=8)
+    ax.set_ylim(-1, 3)
+    axes[0].set_ylim(-1, 3)
+    fig.tight_layout()
+    assert findings(fig) == []
+
+
+def test_a_short_axes_under_a_tall_title_is_squeezed_too():
+    fig, ax = plt.subplots(figsize=(6, 3))
+    ax.plot([0, 1], [0, 1])
+    ax.set_title("\n".join(["a title of many lines"] * 9), fontsize=8)
+    ax.set(xlabel="t [s]", ylabel="x [m]")
+    fig.tight_layout()
+    assert [f.kind for f in findings(fig)] == ["squeezed"]
+    assert "height" in findings(fig)[0].first
+
+
+def test_data_other_than_lines_under_text():
+    """A filled area, bars, a colour mesh and scatter markers are data as much as a curve:
+    a text or a legend on them is found; a span marking a stretch of the axis is not data."""
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    x = np.linspace(0, 1, 50)
+    ax.fill_between(x, 0, 0.8, alpha=0.3, label="filled")
+    ax.set(xlim=(0, 1), ylim=(0, 1), xlabel="t [s]", ylabel="E [J]")
+    ax.text(0.5, 0.5, "on the fill", ha="center")
+    fig.tight_layout()
+    found = findings(fig)
+    assert [f.kind for f in found] == ["data/text"] and "FillBetween" in found[0].first
+    ax.texts[0].set_position((0.5, 0.9))          # above the fill
+    assert findings(fig) == []
+    ax.axvspan(0.4, 0.6, color="0.9", zorder=0)  # a marked stretch under the text: fine
+    assert findings(fig) == []
+    ax.bar([0.5], [0.95], width=0.2)
+    assert [f.kind for f in findings(fig)] == ["data/text"]
+    ax.patches[-1].remove()
+    ax.scatter([0.5], [0.91], s=30)
+    assert [f.kind for f in findings(fig)] == ["data/text"]
+
+
+def test_a_legend_on_a_colour_map():
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.pcolormesh(np.arange(6), np.arange(5), np.random.default_rng(1).random((4, 5)))
+    ax.plot([], [], "r--", label="w*dt = 2")
+    ax.set(xlabel="k [N/m]", ylabel="dt [s]")
+    ax.legend(loc="upper right")
+    found = findings(fig)
+    assert [f.kind for f in found] == ["data/legend"] and "QuadMesh" in found[0].first
+    ax.set_ylim(0, 6)                             # a band above the map
+    assert findings(fig) == []
+
+
+def test_what_a_figure_on_the_users_axes_puts_outside_them():
+    _, (a, b) = plt.subplots(1, 2, figsize=(8, 3))
+    for ax in (a, b):
+        ax.plot([0, 1], [0, 1], label="a line")
+        ax.set(xlabel="t [s]", ylabel="x [m]", ylim=(0, 2))
+    a.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    a.set_title("a title much wider than the axes it stands on, into its neighbour's")
+    a.annotate("a note", xy=(0.5, 1.02), xycoords="axes fraction")
+    kinds = [(f.kind, f.first.split(": ")[-1][:6]) for f in outside_axes(a)]
+    assert kinds == [("outside its axes", "legend"), ("outside its axes", "text '"),
+                     ("outside its axes", "text '")]
+    assert outside_axes(b) == []
+    b.legend(loc="upper left")
+    assert outside_axes(b) == []
+
+
+def test_the_one_solver_stability_map_as_it_was():
+    """Issue 29: ``dumbbell stability --solvers euler-cromer`` drew one panel on 5.8 x 4.6 in
+    with the margins set by hand for any number of panels (left 5.5 %): the y tick labels
+    lost their first digit (10^4 read "0^4") and the figure's title ran off both ends. The
+    checker finds each (the suite drew the map with two solvers only, where those margins
+    happen to hold)."""
+    fig, axes = plt.subplots(1, 1, figsize=(5.8, 4.6), squeeze=False)
+    ax = axes[0, 0]
+    ax.pcolormesh([0, 1, 2], [0.5, 20, 2e4], [[1, 2], [3, 4]])
+    ax.set_yscale("log")
+    ax.set(xlabel="w*dt [1]", ylabel="mass ratio mB/mA [1]")
+    fig.subplots_adjust(left=0.055, right=0.9, bottom=0.25, top=0.86)
+    fig.suptitle("Stability of the explicit spring step: 2000 steps per run, no floor, no "
+                 "gravity; 'unstable' = non-finite or energy error > 1000", fontsize=10)
+    cut = [f.first for f in findings(fig) if f.kind == "cut off"]
+    assert any("figure text 'Stability" in c for c in cut)
+    assert any("y tick '$\\\\mathdefault{10^{4}}$'" in c for c in cut), cut
+    assert any("y label" in c for c in cut)

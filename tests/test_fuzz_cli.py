@@ -136,6 +136,7 @@ PLAUSIBLE = {
     "FILE": ["x.csv", "y.csv", "short.toml", "-", "/dev/null", "sub/x.csv", "x.csv/",
              "dangling/x.csv", "newdir/"],
     "FILE.gif": ["a.gif", "b.GIF", "x.csv", "short.toml", "/dev/null"],
+    "FILE.html": ["a.html", "b.HTM", "x.csv", "short.toml", "/dev/null", "a.gif"],
     "WxH": ["64x36", "640x360", "9x9", "0x0", "64X36", "1x99999"],
     "ADDRESS": ["tcp://127.0.0.1:{closed}", "tcp://10.255.255.1:8786", "tcp://127.0.0.1:0",
                 "tcp://[::1]:{closed}", "http://127.0.0.1:{closed}", "tcp://", "127.0.0.1:1",
@@ -307,8 +308,8 @@ def test_random_flags_never_give_a_traceback(tiny_budgets, args):
 def test_the_fuzz_reaches_every_command_and_flag():
     """The help texts are read right: every subcommand, and on each the flags its usage line
     names; every metavar has plausible values."""
-    assert set(COMMANDS) == {"run", "simulate", "compare", "render", "bench", "stability",
-                             "sweep", "restitution"}
+    assert set(COMMANDS) == {"run", "simulate", "compare", "render", "play", "bench",
+                             "stability", "sweep", "restitution"}
     for command in COMMANDS:
         usage = _usage(_help(command))
         used = set(re.findall(r"(?<![\w-])(--?[a-z][a-z-]*)", usage)) - {"-h"}

@@ -1514,7 +1514,7 @@ def test_the_strip_is_drawn_in_pieces_that_match_the_whole_tape():
 
     traj = dumbbell.simulate(SCENES / "textbook-1d.toml", t_end=6.0, every=20)
     frames = frames_of(traj, 10, 6.0)
-    painter = Painter(traj.scene, frames, (640, 360), True)
+    painter = Painter.of(traj.scene, frames, (640, 360), True)
     tape, strip = painter.tape, painter.strip
     whole = Image.new("P", (tape.width, tape.height))
     for c0 in range(0, tape.width, TAPE_CHUNK):

@@ -61,7 +61,8 @@ def test_delays_keep_real_time_when_fps_does_not_divide_100():
 
 
 def test_particle_height_follows_the_trajectory(frames, short):
-    """B's drawn centre moves linearly with its height, and height 0 is the floor line."""
+    """B's drawn centre moves linearly with its height, and the floor's surface is one
+    particle radius below height 0 (issue 29: the balls were drawn half inside the floor)."""
     _, _, arrays = frames
     t = np.arange(len(arrays)) / 25
     xB = np.interp(t, short.t, short["xB"])
@@ -73,11 +74,20 @@ def test_particle_height_follows_the_trajectory(frames, short):
     slope, intercept = np.polyfit(xB, ys, 1)
     assert slope < -100                             # up in metres is up on screen
     assert np.max(np.abs(np.polyval([slope, intercept], xB) - ys)) < 1.0   # px
-    # The floor line (dark grey across the scene panel, clear of the dumbbell) is at height 0.
+    # The floor line (dark grey across the scene panel, clear of the dumbbell): the model's
+    # floor is where the particle centres meet it (height 0), so its surface, the line's top
+    # edge, is drawn one particle radius below: a particle that touches it sits on it.
+    from dumbbell.animation.world import FLOOR_LINE
+
     darkness = 255.0 - arrays[0][:, left - 50:left - 10, 0].mean(axis=1)
     line = darkness > 60
     floor_y = (np.flatnonzero(line) * darkness[line]).sum() / darkness[line].sum()
-    assert abs(floor_y - intercept) < 1.0
+    radius = short.scene.system.B.radius * -slope
+    surface = intercept + radius
+    assert abs(floor_y - (surface + FLOOR_LINE / 2)) < 1.0
+    # No frame draws B inside the floor (its lowest drawn row at most the surface's).
+    lowest = max(np.nonzero(_mask(f[:, :left], TERM_RGB["B"]))[0].max() for f in arrays)
+    assert lowest <= surface + 0.5
     # Falling then bouncing: lowest drawn position right at the first impact (t = 0.4518 s).
     assert abs(t[int(np.argmax(ys))] - math.sqrt(2 / 9.8)) <= 0.04
 
@@ -221,7 +231,7 @@ def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     from dumbbell.animation.render import frames_of
 
     frames = frames_of(short, 25, 1.0)
-    painter = Painter(short.scene, frames, (320, 180), True)
+    painter = Painter.of(short.scene, frames, (320, 180), True)
     clear = palette()[1]
     assert all(clear not in np.asarray(painter.frame(k)) for k in range(len(frames.t)))
 
@@ -235,7 +245,7 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
     frames = frames_of(traj, 25, 2.0)
-    painter = Painter(textbook, frames, (640, 360), True)
+    painter = Painter.of(textbook, frames, (640, 360), True)
     strip = painter.strip
     assert strip.window == WINDOW < 2.0
     sx0, sy0, sx1, sy1 = strip.box
@@ -289,9 +299,10 @@ def test_strip_marks_a_lasting_contact_along_its_foot_and_impacts_across_it(shor
 
     traj = dataclasses.replace(short, contacts=(Contact(0.2, 0.6, "B"), Contact(0.7, 1.0, "A")))
     frames = frames_of(traj, 25, 1.0)
-    painter = Painter(traj.scene, frames, (640, 360), True)
+    painter = Painter.of(traj.scene, frames, (640, 360), True)
     strip = painter.strip
-    rgb = np.asarray(painter.frame(0).convert("RGB"))     # the cursor at t = 0
+    last = len(frames.t) - 1
+    rgb = np.asarray(painter.frame(last).convert("RGB"))  # the cursor at t = 0.96 s
     sx0, _, sx1, sy1 = strip.box
     cols = np.arange(sx0 + 2, sx1 - 1)
     t = (cols - strip.inner_x) / strip.px_per_s         # the window shows [0, 1] s
@@ -301,10 +312,35 @@ def test_strip_marks_a_lasting_contact_along_its_foot_and_impacts_across_it(shor
 
     red, blue = where(sy1 - 1, TERM_RGB["B"]), where(sy1 - 2, TERM_RGB["A"])
     assert red[(t > 0.21) & (t < 0.59)].all() and not red[(t < 0.19) | (t > 0.61)].any()
-    assert blue[(t > 0.71) & (t < 0.99)].all() and not blue[t < 0.69].any()
+    assert blue[(t > 0.71) & (t < 0.95)].all() and not blue[t < 0.69].any()
     # The impacts (the textbook's first two, before 0.6 s) cross the strip; B's bar does not.
     lines = t[where(strip.box[1] + 2, IMPACT)]           # above the curves (PAD)
     assert len(lines) and all(min(abs(x - e.t) for e in short.events) < 0.01 for x in lines)
+
+
+def test_the_strip_draws_what_has_not_happened_yet_faded(short):
+    """Issue 29: at t = 0 the strip showed the impact spike of 0.45 s in full colour. What
+    lies after the cursor is drawn at opacity strip.FUTURE over white: at each frame no
+    column after the cursor holds a term's full colour, every column before it is as drawn,
+    and the curves ahead are still there, faded."""
+    from dumbbell.animation.palette import blend
+    from dumbbell.animation.render import frames_of
+    from dumbbell.animation.strip import FUTURE
+
+    frames = frames_of(short, 25, 1.0)
+    painter = Painter.of(short.scene, frames, (640, 360), True)
+    strip = painter.strip
+    sx0, sy0, sx1, sy1 = strip.box
+    full = [np.array(TERM_RGB[n]) for n in ("K_cm", "K_int", "U_g", "U_spring")]
+    faded = [np.array(blend(TERM_RGB[n], FUTURE)) for n in ("K_cm", "U_g")]
+    for k in (0, 5, 11, 20):
+        rgb = np.asarray(painter.frame(k).convert("RGB"))[sy0 + 1:sy1, sx0 + 1:sx1]
+        cursor = round(float(frames.t[k]) * strip.px_per_s)     # the window starts at 0 s
+        ahead, behind = rgb[:, cursor + 3:], rgb[:, :max(0, cursor - 2)]
+        assert not any(np.all(ahead == c, axis=2).any() for c in full), k
+        assert all(np.all(ahead == c, axis=2).any() for c in faded), k
+        if k >= 11:  # past 0.44 s: K_cm's and U_g's curves drawn in full behind the cursor
+            assert all(np.all(behind == c, axis=2).any() for c in full[::2]), k
 
 
 def test_contact_checks_its_fields():

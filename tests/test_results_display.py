@@ -99,7 +99,7 @@ def test_reprs_say_what_was_measured(results):
     comparison = results["Comparison"]
     assert f"euler-cromer {comparison.rows[0].window_error:.3g} m" in repr(comparison)
     stability = results["StabilityResult"]
-    assert repr(stability).startswith("<StabilityResult: 1 runs of 1 cases, 1 agree")
+    assert repr(stability).startswith("<StabilityResult: 1 run of 1 case, 1 agree")
     sweep = results["SweepResult"]
     assert "2 points over spring.stiffness (2) x run.dt (1)" in repr(sweep)
     assert "1 ok, 1 unstable" in repr(sweep)  # w*dt = 0.45 and 4.5 at k = 1e2, 1e6
@@ -170,7 +170,7 @@ def test_the_spaces_objects_say_what_they_hold_in_a_line(tmp_path):
     # but for the step's error (pymunk's symplectic Euler: g dt^2 terms).
     e0 = 0.5 * 2.0 * 9.0 + 2.0 * 9.81 * 1.0
     assert f"E0={e0:.6g}" in shown[ledger] and "steps=10" in shown[ledger]
-    assert shown[heat] == "HeatCounter(attached, total=0)"
+    assert shown[heat] == "HeatCounter(attached, total=0 energy units)"
     assert "frames=2" in shown[rec] and "..." in shown[rec]
     heat.detach()
     assert repr(heat).startswith("HeatCounter(detached")

@@ -119,7 +119,7 @@ def test_topple_in_pymunk(topple_scene):
     assert len(traj.contacts) == 2 and set(spans) == {"A", "B"}
     assert spans["B"][0] <= topple_scene.run.dt and spans["B"][1] == t_end
     assert spans["A"] == (landing.t, t_end)
-    assert "1 impacts, 2 contacts" in repr(traj)
+    assert "1 impact, 2 contacts" in repr(traj)
 
 
 def test_topple_refuses_what_it_cannot_describe(topple_scene):

@@ -90,20 +90,36 @@ def test_what_the_commands_write_beside_the_showcase_is_ignored_by_git():
         assert name.endswith(UNTRACKED) and not any(re.fullmatch(k, name) for k in kept)
 
 
+#: Rows whose errors are rounding: the truths against the exact solution. scipy's DOP853 (the
+#: reference) adds its stages with BLAS, whose kernels OpenBLAS picks by CPU, so these errors
+#: differ in their leading digits from one machine to another (1.68e-11 and 2.95e-11 m here);
+#: they are compared to within a factor of 10, the other rows digit for digit.
+ROUNDING_ROWS = ("| reference |", "| exact |")
+
+
 def _untimed(markdown: str) -> str:
-    """The benchmark's table without what depends on the clock: the run-time column, the
-    count of timed runs, the interpolated times and the compile times."""
+    """The benchmark's table without what depends on the clock (the run-time column, the
+    count of timed runs, the interpolated times and the compile times) or on the CPU (the
+    error cells of :data:`ROUNDING_ROWS`, checked by :func:`_rounding_errors`)."""
     lines = []
     for line in markdown.splitlines():
         if line.startswith(("Run time to reach", "JIT compile")):
             continue
-        line = re.sub(r"at least \d+ runs", "at least N runs", line)
+        line = re.sub(r"at least \d+ runs?\b", "at least N runs", line)
         line = re.sub(r"until [\d.]+ s are timed", "until T s are timed", line)
         cells = line.split(" | ")
         if line.startswith("| ") and len(cells) == 8:
             cells[3] = "-"
+            if line.startswith(ROUNDING_ROWS):
+                cells[4:7] = [re.sub(r"\d\.\d+e[-+]\d+", "E", c) for c in cells[4:7]]
         lines.append(" | ".join(cells))
     return "\n".join(lines)
+
+
+def _rounding_errors(markdown: str) -> list[float]:
+    """The error cells of :data:`ROUNDING_ROWS`, as numbers."""
+    return [float(x) for line in markdown.splitlines() if line.startswith(ROUNDING_ROWS)
+            for x in re.findall(r"\d\.\d+e[-+]\d+", " | ".join(line.split(" | ")[4:7]))]
 
 
 class _Once:
@@ -157,6 +173,9 @@ def test_each_piece_writes_the_tracked_bytes_again(tmp_path, piece, monkeypatch)
         if name in piece.measured:
             if name.endswith(".md"):
                 assert _untimed(new.decode()) == _untimed(old.decode())
+                pairs = list(zip(_rounding_errors(new.decode()),
+                                 _rounding_errors(old.decode()), strict=True))
+                assert pairs and all(0.1 < a / b < 10 for a, b in pairs), pairs
             else:
                 assert new[:8] == b"\x89PNG\r\n\x1a\n"
         else:
@@ -169,3 +188,10 @@ def test_the_untimed_bench_table_still_sees_a_changed_error():
     assert changed != table and _untimed(changed) != _untimed(table)
     retimed = re.sub(r"\| [\d.]+ (µs|ms|s) \([\d.]+ (µs|ms|s)\) \|", "| 1 s (2 s) |", table)
     assert retimed != table and _untimed(retimed) == _untimed(table)
+    # The reference row's error, whatever this machine's BLAS made of it, as another CPU's.
+    tracked = re.search(r"^\| reference \|(?:[^|]*\|){3} ([\d.]+e-\d+) \|", table, re.M)
+    assert tracked, "the reference row lost its error column"
+    other = "9.99e-12" if tracked.group(1) != "9.99e-12" else "1.11e-11"
+    other_cpu = table.replace(f"| {tracked.group(1)} |", f"| {other} |", 1)
+    assert other_cpu != table and _untimed(other_cpu) == _untimed(table)
+    assert _rounding_errors(other_cpu) != _rounding_errors(table)

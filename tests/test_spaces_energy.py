@@ -175,3 +175,35 @@ def test_what_moves_energy_over_time_is_named_in_the_snapshot():
     e = spaces.energy(space)
     assert not e.complete and [u.subject for u in e.unknown] == ["body 0"]
     assert "velocity_func" in e.unknown[0].reason
+
+
+def test_printed_values_claim_a_unit_only_when_the_program_names_one():
+    # Issue 29 item 14: a value of a space carries its unit when known, and pymunk has none:
+    # a pixel space's energies are not joules unless the program says they are.
+    import pymunk
+
+    def space_now():
+        space = pymunk.Space()
+        space.gravity = (0, 900)
+        ball = pymunk.Body(2, 100)
+        ball.position, ball.velocity = (10, -500), (30, 0)
+        space.add(ball, pymunk.Circle(ball, 5))
+        return space
+
+    # By hand: K = m v^2 / 2 = 900; U_g = -m g . r = -2 (900 * -500) = 900000.
+    E = 0.5 * 2 * 30**2 - 2 * (900 * -500)
+    for units, energy, momentum in [(None, "energy units", "momentum units"),
+                                    ("px", "kg px²/s²", "kg px/s"), ("m", "J", "kg m/s"),
+                                    (("cm", "g", "ms"), "g cm²/ms²", "g cm/ms")]:
+        space = space_now()
+        shown = repr(spaces.energy(space, units=units))
+        assert f"E = {E:.9g} {energy}:" in shown and f"momentum = (60, 0) {momentum}" in shown
+        assert (" J" in shown) == (units == "m")
+        ledger = spaces.Ledger(space, units=units)
+        heat = spaces.HeatCounter(space, units=units)
+        space.step(1 / 60)
+        table = ledger.balance().table()
+        assert energy in repr(ledger.balance()) and energy in table and energy in repr(heat)
+        assert ("J" in table.replace(",", " ").split()) == (units == "m")
+        ledger.detach()
+        heat.detach()

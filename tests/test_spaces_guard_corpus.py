@@ -54,6 +54,10 @@ def test_the_guard_on_a_pymunk_example(case):
     if not a.failing:
         # Called fine: the step brings no shapes together deeper than the pass-through limit.
         assert a.substeps == 1 and a.before == a.after < 1
+    elif a.measure.startswith("joint drift"):
+        # A joint past the tolerance (1 % of the energy scale a second) comes under it with
+        # the sub-steps the guard works out from its drift at dt/2.
+        assert a.before > 0.01 > a.after and a.substeps > 1
     elif a.substeps > 1 or a.settings:
         # What it names shrinks when its advice is applied (or there was nothing to shrink:
         # a spring at rest in this run).

@@ -422,14 +422,43 @@ def test_non_finite_states_are_refused_naming_the_body():
         ledger.balance()
 
 
-def test_a_pymunk_build_it_cannot_read_is_refused(monkeypatch):
-    from dumbbell.spaces import _memory as mem
+def test_a_pymunk_build_it_cannot_read_falls_back_to_the_public_api(monkeypatch):
+    # An unknown layout (forced here) gives one warning naming the pymunk version, and a
+    # ledger that reads pymunk's getters only: it closes, E is spaces.energy's, and what
+    # it cannot split is one lumped term, named.
+    import warnings
+    from importlib import metadata
 
-    monkeypatch.setattr(mem, "readable", lambda: False)
-    space = pymunk.Space()
-    _ball(space)
-    with pytest.raises(DumbbellError, match="cannot read this pymunk build"):
-        spaces.Ledger(space)
+    from dumbbell import spaces as sp
+    from dumbbell.spaces import _layout as layout
+    from dumbbell.spaces import ledger as ledger_module
+
+    monkeypatch.setattr(layout, "problem", lambda: "a layout forced for this test")
+    monkeypatch.setattr(ledger_module, "_FALLBACK_SAID", [])
+    spaces_made = []
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        for _ in range(2):
+            space, _ = _slope()
+            space.add(pymunk.PinJoint(space.static_body, next(iter(space.bodies)), (0.0, 3.0)))
+            spaces_made.append((space, sp.Ledger(space)))
+    assert [str(w.message) for w in said] == [
+        (f"dumbbell.spaces.Ledger: pymunk {metadata.version('pymunk')}'s structs are not laid "
+        "out as the ledger reads them (a layout forced for this test); it counts with "
+        "pymunk's public API only: the joints' and contacts' work as one lumped term")]
+    space, ledger = spaces_made[0]
+    assert type(ledger).__name__ == "PublicLedger" and isinstance(ledger, sp.Ledger)
+    for _ in range(1000):
+        space.step(1e-3)
+    bal = ledger.balance()
+    assert bal.E == pytest.approx(spaces.energy(space).E, rel=1e-14, abs=1e-14 * bal.scale)
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+    lumped = [t for t in bal.terms if t.kind == "contacts and joints"]
+    assert len(lumped) == 1 and "lumped" in lumped[0].source and lumped[0].energy < 0
+    with pytest.raises(UsageError, match="declared potentials need"):
+        ledger.declare_potential(space.bodies, lambda x, y, m: x)
+    ledger.detach()
+    space.step(1e-3)
 
 
 def test_arguments_are_checked():

@@ -92,11 +92,93 @@ def test_bad_arguments_are_one_clear_error(tmp_path):
 
     with pytest.raises(UsageError, match="fps = 0"):
         spaces.Recorder(_space(), tmp_path / "a.gif", fps=0)
-    with pytest.raises(UsageError, match=r"\.gif or \.mp4"):
+    with pytest.raises(UsageError, match=r"\.gif, \.mp4 or \.html"):
         spaces.Recorder(_space(), tmp_path / "a.png")
     with pytest.raises(DumbbellError, match="no frames"), spaces.Recorder(_space(),
                                                                          tmp_path / "a.gif"):
         pass
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("kw, param", [
+    ({"fps": 10**5000}, "fps"),
+    ({"fps": "9" * 100_000}, "fps"),
+    ({"fps": 51}, "fps"),
+    ({"size": (10**5000, 360)}, "size"),
+    ({"size": (640, -10**5000)}, "size"),
+    ({"size": ("9" * 100_000, 360)}, "size"),
+    ({"size": "9" * 100_000}, "size"),
+    ({"size": (640.0, 360.0)}, "size"),
+    ({"t0": 1e308}, "t0"),
+    ({"t0": -2e9}, "t0"),
+    ({"t0": 10**5000}, "t0"),
+    ({"t0": "9" * 100_000}, "t0"),
+])
+def test_huge_arguments_are_one_short_line_before_any_work(tmp_path, kw, param):
+    # Issue 30: fps=10**5000 and size=(10**5000, 360) raised ValueError from int -> str,
+    # fps='9' * 100000 gave a 100,000-character message.
+    with pytest.raises(UsageError) as info:
+        spaces.Recorder(_space(), tmp_path / "a.gif", **kw)
+    message = str(info.value)
+    assert message.startswith(param) and info.value.param == param
+    assert "\n" not in message and len(message) <= 250
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("t", [1e308, -1e308, 2e9, 10**5000, float("nan"), "1"],
+                         ids=["1e308", "-1e308", "2e9", "10**5000", "nan", "str"])
+def test_a_frame_time_beyond_what_a_label_shows_is_refused_and_the_recording_goes_on(
+        tmp_path, t):
+    # Issue 30: capture(t=1e308) raised OverflowError when the file was written.
+    space, _ = _ball()
+    with spaces.Recorder(space, tmp_path / "a.gif", energy=True) as rec:
+        space.step(0.04)
+        with pytest.raises(UsageError, match=r"^t = .{1,60}: must be a finite number from "
+                                             r"-1e\+09 to 1e\+09 \(s\)$"):
+            rec.capture(t=t)
+        rec.capture(t=1e9)  # the largest: its label fits
+        space.step(0.04)
+        rec.capture()
+    assert rec.times == (0.0, 1e9, 1e9 + 0.04)
+
+
+def test_a_long_time_label_is_drawn_whole_over_the_one_before(tmp_path, monkeypatch):
+    # Labels wider than the usual box (t near 1e9 with 5 decimals, a 12-character unit):
+    # the file is the one made of every frame drawn whole and compared whole.
+    from dumbbell.animation import recording
+
+    space, _ = _ball()
+    kw = {"energy": False, "units": ("m", "kg", "fortnights__"), "t0": 999_999_999.8}
+    with spaces.Recorder(space, tmp_path / "a.gif", **kw) as rec:
+        for k in range(1, 4):
+            space.step(0.04)
+            rec.capture(t=999_999_999.8 + k * 1e-5)  # "t = 999999999.80003 fortnights__"
+    whole = recording.Painter.frame
+
+    def from_nothing(self, k):
+        self._canvas = None
+        return whole(self, k)
+
+    monkeypatch.setattr(recording.Painter, "frame", from_nothing)
+    monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
+    recording.write(tmp_path / "b.gif", rec.recording())
+    assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+
+
+@pytest.mark.parametrize("name", ["a.gif/", "a.gif/.", "sub/a.gif/"])
+def test_a_path_naming_a_folder_is_refused(tmp_path, name):
+    # Issue 30: Recorder(s, "a.gif/") wrote a file named without the slash.
+    message = _refused(f"{tmp_path}/{name}", "names a folder")
+    assert name.rstrip("/.") in message
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name", ["a" * 100_000 + ".gif", "a b " * 25_000 + ".gif",
+                                  "d/" * 30_000 + "a.gif"])
+def test_a_huge_path_is_echoed_clipped(tmp_path, name):
+    # Issue 30: a 100,000-character path gave a 100,000-character message.
+    message = _refused(f"{tmp_path}/{name}", ".")
+    assert len(message) <= 1000
     assert list(tmp_path.iterdir()) == []
 
 
@@ -246,18 +328,87 @@ def test_the_ground_is_at_the_bottom_in_y_up_and_y_down_worlds(tmp_path, g, floo
     assert floor.min() > ball.max()
 
 
-def test_y_down_follows_pygame_util_without_gravity(tmp_path, monkeypatch):
-    import pymunk.pygame_util
+def _window(monkeypatch, imported: tuple[str, ...], flag: bool | None = None) -> None:
+    """Make sys.modules hold exactly these window libraries (stand-ins: the recorder only
+    looks at which are imported), and pymunk.pygame_util with ``flag`` when it is given."""
+    import sys
+    import types
 
-    space = _ball_and_floor(0.0, 500.0, 100.0)
-    for flag, ball_above in ((False, True), (True, False)):
-        monkeypatch.setattr(pymunk.pygame_util, "positive_y_is_up", flag)
-        path = tmp_path / f"{flag}.gif"
-        with spaces.Recorder(space, path, energy=False, camera="all") as rec:
+    for name in ("pygame", "pymunk.pygame_util", "pyglet", "arcade", "kivy"):
+        monkeypatch.delitem(sys.modules, name, raising=False)
+    for name in imported:
+        name, _, blocked = name.partition("=")
+        monkeypatch.setitem(sys.modules, name, None if blocked else types.ModuleType(name))
+    if flag is not None:
+        util = types.ModuleType("pymunk.pygame_util")
+        util.positive_y_is_up = flag
+        monkeypatch.setitem(sys.modules, "pygame", types.ModuleType("pygame"))
+        monkeypatch.setitem(sys.modules, "pymunk.pygame_util", util)
+
+
+def _ball_above_floor(path) -> bool:
+    """Whether the ball is drawn above the floor (rows from the top) in a one-frame GIF."""
+    frame = _frames(path)[0]
+    ball, floor = np.nonzero(_coloured(frame))[0], np.nonzero(_grey(frame))[0]
+    assert len(ball) and len(floor)
+    assert ball.max() < floor.min() or floor.max() < ball.min()
+    return bool(ball.max() < floor.min())
+
+
+#: The window rule: (window libraries imported, pygame_util's flag or None when it is not
+#: imported, gravity's y, whether y is up in the picture). The ball is at y = 100, the floor
+#: at y = 500: y down puts the ball above the floor.
+WINDOWS = [
+    (("pygame",), None, 0.0, False),         # pygame drawn by hand, no gravity: y down
+    (("pygame",), None, 900.0, False),
+    (("pygame",), None, -900.0, True),       # its own flipy: gravity -y says so
+    ((), False, 0.0, False),                 # pygame_util, y down
+    ((), False, 900.0, False),
+    ((), True, 0.0, True),                   # pygame_util told y is up ...
+    ((), True, 900.0, True),                 # ... whatever the gravity
+    (("pyglet",), None, 0.0, True),          # pyglet, arcade, kivy: y up, whatever the gravity
+    (("pyglet",), None, 900.0, True),
+    (("arcade",), None, 0.0, True),
+    (("kivy",), None, 900.0, True),
+    ((), None, 0.0, True),                   # no window library: up against gravity, else up
+    ((), None, 900.0, False),
+    ((), None, -900.0, True),
+    (("pygame", "pyglet"), None, 0.0, True),     # both kinds: as with none
+    (("pygame", "pyglet"), None, 900.0, False),
+    (("pyglet", "pygame=None"), None, 0.0, True),  # an import blocked is no import
+]
+
+
+@pytest.mark.parametrize("imported, flag, g, up", WINDOWS)
+def test_y_points_the_way_the_programs_window_shows_it(tmp_path, monkeypatch, imported, flag,
+                                                       g, up):
+    _window(monkeypatch, imported, flag)
+    space = _ball_and_floor(g, 500.0, 100.0)
+    with spaces.Recorder(space, tmp_path / "a.gif", energy=False, camera="all") as rec:
+        rec.capture()
+    assert _ball_above_floor(tmp_path / "a.gif") is not up
+    assert rec.orientation.startswith(f"y {'up' if up else 'down'}: ")
+    assert rec.note.splitlines()[0] == rec.orientation
+    _, _, bottom, top = rec.view
+    assert (top > bottom) is up
+
+
+@pytest.mark.parametrize("imported, flag, g, up", WINDOWS[::3])
+def test_y_up_given_wins_and_the_rule_is_read_when_the_recorder_is_made(
+        tmp_path, monkeypatch, imported, flag, g, up):
+    _window(monkeypatch, imported, flag)
+    space = _ball_and_floor(g, 500.0, 100.0)
+    for given in (True, False):
+        with spaces.Recorder(space, tmp_path / "a.gif", energy=False, camera="all",
+                             y_up=given) as rec:
             rec.capture()
-        frame = _frames(path)[0]
-        ball, floor = np.nonzero(_coloured(frame))[0], np.nonzero(_grey(frame))[0]
-        assert bool(ball.max() < floor.min()) is ball_above
+        assert _ball_above_floor(tmp_path / "a.gif") is not given
+    rec = spaces.Recorder(space, tmp_path / "b.gif", energy=False, camera="all")
+    _window(monkeypatch, () if imported or flag is not None else ("pygame",))  # changes after
+    space.gravity = (0.0, -g)
+    rec.capture()
+    rec.write()
+    assert _ball_above_floor(tmp_path / "b.gif") is not up
 
 
 def test_a_world_box_that_contradicts_y_up_is_refused(tmp_path):
@@ -367,6 +518,121 @@ def test_static_shapes_added_later_are_drawn_from_then_on(tmp_path):
     assert drawn[:4] == [0] * 4 and min(drawn[4:]) > 100
 
 
+def _small_parts(far: bool = False, angle: float = 0.0) -> pymunk.Space:
+    """A pixel space (y down, no gravity) of bodies spread over 2,000 px: a 60 x 30 px
+    chassis, and small parts of each kind (a 3 x 2 px box, a 5 px rod of radius 0, a circle
+    of radius 1 px, a body of two 2 px boxes), turned by ``angle``; a floor under them,
+    and (``far``) a static segment 100,000 px away."""
+    space = pymunk.Space()
+    space.add(pymunk.Segment(space.static_body, (-100, 40), (2100, 40), 2))
+    if far:
+        space.add(pymunk.Segment(space.static_body, (1e5, -5e4), (1.2e5, -5e4), 3))
+    parts = [
+        (0.0, [pymunk.Poly.create_box(None, (60, 30))]),
+        (500.0, [pymunk.Poly.create_box(None, (3, 2))]),
+        (1000.0, [pymunk.Segment(None, (-2.5, 0), (2.5, 0), 0)]),
+        (1500.0, [pymunk.Circle(None, 1.0)]),
+        (2000.0, [pymunk.Poly(None, [(0, 0), (2, 0), (2, 2), (0, 2)]),
+                  pymunk.Poly(None, [(3, 0), (5, 0), (5, 2), (3, 2)])]),
+    ]
+    for x, shapes in parts:
+        body = pymunk.Body(1.0, 10.0)
+        body.position, body.angle = (x, 0.0), angle
+        for shape in shapes:
+            shape.body = body
+        space.add(body, *shapes)
+    return space
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.4, math.pi / 4])
+def test_every_body_is_drawn_at_least_4_px_and_far_static_shapes_change_nothing(
+        tmp_path, angle):
+    from .recorder_corpus import extent, picture
+
+    views, notes = [], []
+    for far in (False, True):
+        space = _small_parts(far, angle)
+        with spaces.Recorder(space, tmp_path / f"{far}.gif", y_up=False) as rec:
+            rec.capture()
+        views.append(rec.view)
+        notes.append(rec.note)
+    # The far segment neither widens nor moves the view: the frames are the same.
+    assert views[0] == views[1] and notes[0] == notes[1]
+    assert (tmp_path / "False.gif").read_bytes() == (tmp_path / "True.gif").read_bytes()
+    # At this view (~0.16 px per px of the space) the parts would be 0.3 to 1 px; each is
+    # drawn at least 4 px across (measured on its pixels, drawn alone), the chassis to scale.
+    s = 0.56 * 640 - 16
+    scale = s / (rec.view[1] - rec.view[0])
+    drawn = [extent(picture(space, rec, bodies=[i])) for i in range(5)]
+    assert all(d >= 4 for d in drawn), drawn
+    c, si = abs(math.cos(angle)), abs(math.sin(angle))
+    assert drawn[0] == pytest.approx(scale * max(60 * c + 30 * si, 60 * si + 30 * c), abs=2.5)
+    # The note names the parts drawn larger than to scale, and not the chassis.
+    grown = rec.note.splitlines()[1]
+    assert grown.startswith("drawn larger than to scale, to be 4 px across: ")
+    assert "body 1, body 2, body 3, body 4 (4 of 5 moving bodies; " in grown
+    assert len(rec.note.splitlines()) == 2  # nothing outside the picture
+
+
+def _pair_and_walls(size: float, walls: float | None) -> pymunk.Space:
+    """Two boxes ``size`` px across, 1,000 px apart (y down, no gravity), and static walls
+    at ``walls`` px outside them on each side."""
+    space = pymunk.Space()
+    for x in (0.0, 1000.0):
+        body = pymunk.Body(1.0, 10.0)
+        body.position = (x, 0.0)
+        space.add(body, pymunk.Poly.create_box(body, (size, size)))
+    if walls is not None:
+        for x in (-walls, 1000.0 + walls):
+            space.add(pymunk.Segment(space.static_body, (x, -10), (x, 10), 1))
+    return space
+
+
+@pytest.mark.parametrize("size", [10.0, 40.0])
+def test_static_shapes_near_the_bodies_never_make_one_smaller_than_4_px(tmp_path, size):
+    from .recorder_corpus import extent, picture
+
+    def record(walls):
+        with spaces.Recorder(_pair_and_walls(size, walls), tmp_path / "a.gif", energy=False,
+                             y_up=False) as rec:
+            rec.capture()
+        return rec, rec.view[1] - rec.view[0]
+
+    rec, bodies_only = record(None)
+    # Walls 250 px outside the bodies are near them (within a quarter of their box's width):
+    # shown, as long as the bodies stay at least 4 px across to scale.
+    rec, with_walls = record(250.0)
+    area = 640 - 16  # the scene's width without the energy panel (px)
+    to_scale = size * math.cos(math.pi / 64)  # (the least side as measured, 16 turns)
+    if size * area / (1502 * 1.1) >= 4:
+        # Large bodies: the view holds the walls, as it always did.
+        assert with_walls == pytest.approx(1502 * 1.1, rel=1e-9)
+    else:
+        # Small ones: the view widens only until they are 4 px across, to scale.
+        assert with_walls == pytest.approx(to_scale * area / 4, rel=1e-9)
+        assert bodies_only < with_walls < 1502 * 1.1
+    assert len(rec.note.splitlines()) == 1  # none drawn larger than to scale
+    drawn = [extent(picture(rec.space, rec, bodies=[i])) for i in range(2)]
+    assert min(drawn) >= 4
+    assert extent(picture(rec.space, rec, statics=[0])) > 0  # the walls are in the picture
+    # Walls beyond the near zone change nothing.
+    assert record(2000.0)[1] == bodies_only
+
+
+def test_a_body_that_leaves_the_picture_is_named(tmp_path):
+    space, _ = _row_of_balls(runaway=40.0)
+    with spaces.Recorder(space, tmp_path / "a.gif", energy=False) as rec:
+        for _ in range(50):
+            spaces.step(space, 1 / 25, substeps=2)
+            rec.capture()
+    lines = rec.note.splitlines()
+    assert lines[-1].startswith("outside the picture (or not drawable) in some frames: body 4 ")
+    out = int(lines[-1].split(" in ")[-1].split(" of ")[0])
+    # The runaway flies 1.6 m per frame: the view (about 1 m wide) loses it within a frame
+    # or two.
+    assert 45 <= out <= 50 and lines[-1].endswith(" of 51")
+
+
 def test_far_and_tiny_things_do_not_break_the_drawing(tmp_path):
     space, _ = _ball()
     far = pymunk.Body(1.0, 1.0)
@@ -385,6 +651,24 @@ def test_bad_worlds_are_refused_when_the_recorder_is_made(tmp_path, world):
     with pytest.raises(UsageError, match=r"^world"):
         spaces.Recorder(_space(), tmp_path / "a.gif", world=world)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_refusals_name_the_spaces_units(tmp_path):
+    # Issue 29: a value of a space carries the space's unit wherever it is printed.
+    space = _space()
+    body = next(b for b in space.bodies if b.body_type == pymunk.Body.DYNAMIC)
+    for kw, unit in [({"world": (0, "a", 0, 1)}, "(px)"), ({"world": (0, 1e40, 0, 1)}, " px,"),
+                     ({"camera": body, "span": -1.0}, "(px)"),
+                     ({"reference": {"U_g": math.nan}}, "(kg px²/s²)"),
+                     ({"t0": math.inf}, "(s)")]:
+        with pytest.raises(UsageError) as info:
+            spaces.Recorder(space, tmp_path / "a.gif", units="px", **kw)
+        assert unit in str(info.value)
+    with pytest.raises(UsageError, match=r"\(J\)$"):
+        spaces.Recorder(space, tmp_path / "a.gif", units="m", reference={"U_g": math.nan})
+    # Units not named: no unit is claimed (a pixel space's energy is not in J).
+    with pytest.raises(UsageError, match=r"\(energy units\)$"):
+        spaces.Recorder(space, tmp_path / "a.gif", reference={"U_g": math.nan})
 
 
 # --- energy bars --------------------------------------------------------------------------------

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from .pymunk_corpus import EXAMPLES
 from .recorder_corpus import (
     NAMES,
     body_size,
@@ -16,6 +17,7 @@ from .recorder_corpus import (
     frame,
     ground,
     in_view,
+    orientation,
     picture,
     record,
     rows,
@@ -94,6 +96,17 @@ def test_ground_at_the_bottom_and_bodies_readable(name, which, recorded):
         floor = picture(space, rec, statics=[g])
         assert floor.any()
         assert below(floor, alone) > 0
+
+
+@pytest.mark.parametrize("name", list(EXAMPLES))
+def test_y_points_the_way_each_programs_window_shows_it(name, tmp_path):
+    # Every program of the corpus, pygame (pygame_util's flag either way, or its own flipy),
+    # pyglet, with and without gravity: the recorder made inside the running program draws
+    # y as the program's own window does (breakout, pygame_util told y is up and no gravity,
+    # was drawn y down before issue 28).
+    r = record(name, 0.2, tmp_path / f"{name}.gif", energy=False)
+    assert orientation(r.rec) == ("up" if r.run.y_up else "down")
+    assert r.rec.orientation.startswith(f"y {orientation(r.rec)}: ")
 
 
 def below(floor, bodies):

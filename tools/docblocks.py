@@ -10,7 +10,11 @@ a fresh temporary folder holding a copy of the
 repository's ``scenes/`` (what a reader who cloned the repository has beside them), run
 against the installed ``dumbbell``:
 
-- ```` ```python ```` blocks run in order in one namespace per file, as in a notebook;
+- ```` ```python ```` blocks run in order in one namespace per file, as in a notebook; a
+  line that is an expression followed by a comment showing a result's repr
+  (``traj.events[0]  # Impact(t=0.45..., body='B', ...)``: a name and an opening
+  parenthesis) must have that repr, by doctest's rules (``...`` stands for any text): the
+  page shows what the reader will see;
 - ```` ```sh ```` and ```` ```bash ```` blocks run line by line (``\\`` continues a line,
   ``#`` starts a comment, ``&&`` and ``;`` join commands); ``dumbbell ARGS`` runs in this
   process (``dumbbell.cli.main``, exit status 0 expected), ``python ...`` with this Python,
@@ -31,9 +35,11 @@ ignores: the docs' commands write outside ``renders/`` unless they are the showc
 
 from __future__ import annotations
 
+import ast
 import contextlib
 import doctest
 import io
+import itertools
 import os
 import re
 import shlex
@@ -42,6 +48,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import tokenize
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -132,12 +139,25 @@ class Session:
     # -- Python ---------------------------------------------------------------------------
 
     def python(self, block: Block) -> None:
-        code = compile(block.code, f"{block.path}:{block.line}", "exec")
+        name = f"{block.path}:{block.line}"
+        tree = ast.parse(block.code, name)
+        shown = _shown_reprs(block.code)
         printed = io.StringIO()
         with _in(self.folder), contextlib.redirect_stdout(printed), \
                 contextlib.redirect_stderr(printed):
             try:
-                exec(code, self.namespace)  # noqa: S102 - running the docs is the point
+                # One statement at a time, as the module would run, so that an expression
+                # whose repr the page shows is checked where it stands.
+                for node in tree.body:
+                    want = shown.get(node.end_lineno) if isinstance(node, ast.Expr) else None
+                    if want is None:
+                        exec(compile(ast.Module([node], []), name, "exec"), self.namespace)  # noqa: S102
+                        continue
+                    value = eval(compile(ast.Expression(node.value), name, "eval"),
+                                 self.namespace)
+                    _check_repr(value, want, f"{name}, line {node.end_lineno}")
+            except Failed:
+                raise
             except Exception as exc:
                 raise Failed(f"{type(exc).__name__}: {exc}\n(it printed: "
                              f"{printed.getvalue()[-2000:]})") from exc
@@ -212,6 +232,45 @@ class Session:
     def run(self, block: Block) -> None:
         {"python": self.python, "sh": self.shell, "bash": self.shell,
          "console": self.console}[block.lang](block)
+
+
+#: A comment that shows a repr: a name and an opening parenthesis (``# Impact(t=...``).
+_REPR_COMMENT = re.compile(r"#\s*(?P<repr>[A-Z]\w*\(.*)$")
+
+
+def _shown_reprs(code: str) -> dict[int, str]:
+    """The reprs the comments of a Python block show, by line (1-based): the comment's text
+    from the name to the parenthesis that closes the one after it."""
+    out = {}
+    for tok in _tokens(code):
+        m = _REPR_COMMENT.match(tok.string) if tok.type == tokenize.COMMENT else None
+        if m is None:
+            continue
+        text, depth = m.group("repr"), 0
+        for i, ch in enumerate(text):
+            depth += {"(": 1, ")": -1}.get(ch, 0)
+            if depth == 0 and ch == ")":
+                out[tok.start[0]] = text[: i + 1]
+                break
+    return out
+
+
+def _tokens(code: str) -> list[tokenize.TokenInfo]:
+    return list(tokenize.generate_tokens(io.StringIO(code).readline))
+
+
+def _check_repr(value: object, want: str, where: str) -> None:
+    """Failed unless ``repr(value)`` is what the page shows (``want``): ``...`` after a
+    digit stands for a number's further digits (``-4.427...``), anywhere else for any text
+    (``Verdict(status='ok', ...)``), so a cut number cannot hide a field the page left out."""
+    got = repr(value)
+    pieces = want.split("...")
+    pattern = re.escape(pieces[0])
+    for before, piece in itertools.pairwise(pieces):
+        pattern += (r"[0-9]*(?:e[-+]?[0-9]+)?" if before[-1:].isdigit() else ".*")
+        pattern += re.escape(piece)
+    if not re.fullmatch(pattern, got, re.DOTALL):
+        raise Failed(f"{where}: the page shows {want!r}, the code gives {got!r}")
 
 
 @contextlib.contextmanager

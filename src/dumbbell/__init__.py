@@ -22,8 +22,9 @@ _NAMES = {
     "bench": "analysis.api", "compare": "analysis.api", "stability": "analysis.api",
     "sweep": "analysis.api",
     "Gif": "animation.render", "render_gif": "animation.render",
+    "Player": "animation.player", "player": "animation.player",
     "ColumnError": "errors", "DumbbellError": "errors", "MissingExtraError": "errors",
-    "SceneError": "errors", "UsageError": "errors",
+    "PymunkVersionError": "errors", "SceneError": "errors", "UsageError": "errors",
     "Scene": "model.scene", "load_scene": "model.scene",
     "Impact": "model.trajectory", "Trajectory": "model.trajectory", "Verdict": "model.trajectory",
     "simulate": "solvers",
@@ -35,9 +36,10 @@ SUBMODULES = ("analysis", "animation", "cli", "errors", "examples", "io", "model
 _getattr, _, _ = _attach(__name__, SUBMODULES, _NAMES)
 
 __all__ = [
-    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Scene", "SceneError",
-    "Trajectory", "UsageError", "Verdict", "available_solvers", "bench", "compare", "load_scene",
-    "render_gif", "simulate", "stability", "sweep",
+    "ColumnError", "DumbbellError", "Gif", "Impact", "MissingExtraError", "Player",
+    "PymunkVersionError", "Scene", "SceneError", "Trajectory", "UsageError", "Verdict",
+    "available_solvers", "bench", "compare", "load_scene", "player", "render_gif", "simulate",
+    "stability", "sweep",
 ]
 
 
@@ -68,6 +70,7 @@ def __dir__() -> list[str]:
 TYPE_CHECKING = False
 if TYPE_CHECKING:
     from .analysis.api import bench, compare, stability, sweep
+    from .animation.player import Player, player
     from .animation.render import Gif, render_gif
     from .errors import ColumnError, DumbbellError, MissingExtraError, SceneError, UsageError
     from .model.scene import Scene, load_scene

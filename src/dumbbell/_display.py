@@ -25,6 +25,24 @@ def one_line(text: str) -> str:
     return text[: MAX_REPR - 3 - len(tail)] + "..." + tail
 
 
+def counted(n: int, noun: str, plural: str | None = None, grouped: bool = False) -> str:
+    """``n`` things, the noun agreeing with the count: '1 run', '3 runs' (``plural`` where
+    adding 's' is wrong); ``grouped`` writes thousands apart: '12,000 points'."""
+    word = noun if n == 1 else (plural or noun + "s")
+    return f"{n:,} {word}" if grouped else f"{n} {word}"
+
+
+def significant(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant digits, trailing zeros kept so that numbers side
+    by side show their precision alike: 0.0300 beside 0.0192, not 0.03; 154 and 1.30e+03
+    without a trailing point."""
+    if not math.isfinite(value):
+        return str(value)
+    text = f"{value:#.{digits}g}"
+    mantissa, e, exponent = text.partition("e")
+    return mantissa.rstrip(".") + e + exponent
+
+
 def number(value: Any, digits: int = 3) -> str:
     """A table cell: "-" for None or NaN, ``digits`` significant digits for a float."""
     if value is None or (isinstance(value, float) and math.isnan(value)):

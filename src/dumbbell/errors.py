@@ -76,3 +76,16 @@ class ColumnError(UsageError, KeyError):
 class MissingExtraError(DumbbellError, ImportError):
     """An optional dependency is not installed; the message names the extra that brings it,
     e.g. ``to_pandas() needs pandas: pip install 'dumbbell[pandas]'``."""
+
+
+class PymunkVersionError(DumbbellError, ImportError):
+    """The installed pymunk is a release dumbbell does not run on. Raised at the first use of
+    pymunk (the pymunk solver, the first name read from ``dumbbell.spaces``); the message
+    names the installed version and the supported range, e.g. ``pymunk 6.11.1 is installed;
+    dumbbell needs pymunk>=7.0,<8: pip install 'pymunk>=7.0,<8'``. ``version`` and
+    ``supported`` hold the two."""
+
+    def __init__(self, message: str, version: str, supported: str):
+        self.version = version
+        self.supported = supported
+        super().__init__(message)

@@ -47,10 +47,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene
-from ..model.trajectory import Trajectory
+from ..model.trajectory import COMPLETE, Trajectory
 from ..solvers import (
     MAX_SAMPLES,
     RunOptions,
@@ -135,7 +136,13 @@ class Point:
 
     @property
     def ok(self) -> bool:
+        """The run ended ``ok``: stable, and within its scene's ``run.inaccurate_energy``."""
         return self.verdict == "ok"
+
+    @property
+    def complete(self) -> bool:
+        """The run reached its end (``ok`` or ``inaccurate``): its errors are measured."""
+        return self.verdict in COMPLETE
 
     @property
     def status(self) -> str:
@@ -188,8 +195,8 @@ class BenchResult:
         solvers = list(dict.fromkeys(p.solver for p in self.points))
         speed = self.speedups().get("speedup", {})
         fast = ", ".join(f"{n} {v:.3g}x" for n, v in speed.items() if n != self.baseline)
-        return one_line(f"<BenchResult {self.scene}: {len(self.points)} points of "
-                        f"{len(solvers)} solvers ({ok} ok), truth {self.truth or '-'}, error "
+        return one_line(f"<BenchResult {self.scene}: {counted(len(self.points), 'point')} of "
+                        f"{counted(len(solvers), 'solver')} ({ok} ok), truth {self.truth or '-'}, error "
                         f"over [0, {self.window:g}] s"
                         + (f"; speed-up at {self.baseline}'s error: {fast}" if fast else "")
                         + ">")
@@ -211,7 +218,7 @@ class BenchResult:
         speed-up against Euler-Cromer (2D: euler-cromer-2d) there."""
         target = None if target is None else args.real(target, "target", "m")
         base_name = self.baseline
-        ref = next((p for p in self.points if p.solver == base_name and p.ok
+        ref = next((p for p in self.points if p.solver == base_name and p.complete
                     and p.dt is not None and math.isclose(p.dt, TEXTBOOK_DT)), None)
         if target is None:
             if ref is None:
@@ -220,7 +227,7 @@ class BenchResult:
         times = {}
         for name in dict.fromkeys(p.solver for p in self.points):
             line = sorted(((p.seconds, p.error) for p in self.points
-                           if p.solver == name and p.ok and p.dt is not None
+                           if p.solver == name and p.complete and p.dt is not None
                            and math.isfinite(p.error) and p.error > 0),
                           key=lambda se: se[0])
             t = time_for_error(line, target)
@@ -474,7 +481,7 @@ def _stepper_points(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any,
         estimate = None if cost_per_step is None else cost_per_step * options.n_steps
         if estimate is not None and estimate * (o.repeat + 1) > o.budget:
             base.verdict, base.seconds = None, estimate
-            base.reason = (f"estimated {estimate:.3g} s per run x {o.repeat + 1} runs > "
+            base.reason = (f"estimated {estimate:.3g} s per run x {counted(o.repeat + 1, 'run')} > "
                            f"budget {o.budget:g} s")
             points.append(base)
             pb.update(1)
@@ -482,7 +489,7 @@ def _stepper_points(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any,
         traj, point = _measure(cls, scene, options, o.repeat, base)
         _score(point, traj, truth_at(options), o.window)
         points.append(point)
-        if point.ok and point.steps:
+        if point.complete and point.steps:
             cost_per_step = point.seconds_call / point.steps
         pb.update(1)
     return points
@@ -524,7 +531,7 @@ def _score(point: Point, traj: Trajectory, truth: Trajectory | None, window: flo
     point.energy_error = _energy_error(traj, truth)
     if truth is None:
         return
-    if not point.ok:
+    if not point.complete:
         point.error = math.inf
     else:
         point.error = _position_error(traj, truth, window)
@@ -567,12 +574,13 @@ def _single_point(scene: Scene, cls: type[Solver], plan: _Plan, truth_at: Any) -
 
 
 def fit_order(points: list[Point]) -> Fit | None:
-    """Least-squares slope of log10(error) against log10(dt) over the ok points with an error
-    between FIT_MIN_ERROR and FIT_MAX_ERROR (m); None with fewer than 3 such points."""
+    """Least-squares slope of log10(error) against log10(dt) over the points that reached
+    their end (ok or inaccurate) with an error between FIT_MIN_ERROR and FIT_MAX_ERROR (m);
+    None with fewer than 3 such points."""
     if not isinstance(points, list | tuple) or not all(isinstance(p, Point) for p in points):
         raise UsageError(f"points = {args.show(points)}: must be a list of bench Points "
                          "(BenchResult.points)", param="points")
-    use = [p for p in points if p.ok and p.dt is not None and math.isfinite(p.error)
+    use = [p for p in points if p.complete and p.dt is not None and math.isfinite(p.error)
            and FIT_MIN_ERROR < p.error < FIT_MAX_ERROR]
     if len(use) < 3:
         return None

@@ -7,11 +7,16 @@ report says so). Each other run is measured against it:
 
 - impact times side by side, matched in order, with their differences;
 - the position error (the distance of either particle from its true place) at each sample,
-  its largest value over a window (default 2 s): the motion is chaotic, so later errors say
-  nothing about the method (docs/physics.md, on chaos), and the time at which it first passes
-  1 mm;
-- the energy error over the whole run (drift from E(0) relative to the energy scale; for a
-  dissipative scene the distance from the truth's E);
+  its largest value over a window (default 2 s), or up to where the runs part when that comes
+  sooner, and the time at which it first passes 1 mm;
+- where the runs part by chaos (:func:`parting`): each impact turns a small difference in when
+  it happens into a larger one, so once the position error has grown past
+  :data:`PART_FRACTION` of the dumbbell's length it measures the chaos, not the method. The
+  runs part at the truth's last impact before that (the impact that amplified the difference);
+  the position error is reported up to there. An error that passes that distance before any
+  impact is the method's own, not a parting;
+- the energy error and the impacts over the whole run (drift from E(0) relative to the
+  energy scale; for a dissipative scene the distance from the truth's E);
 - the run time, warm: a first run also pays numba's start-up and compile (or its load from
   numba's cache), so a run shorter than :data:`TIME_AGAIN_BELOW` s, or of a step-free solver,
   is timed again and the fastest later run is the run time; what the first run paid on top
@@ -32,6 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene
@@ -51,6 +57,9 @@ __all__ = ["Comparison", "Row", "Timing"]
 
 #: Position error (m) whose first passing is reported as the divergence time.
 DIVERGED = 1e-3
+#: The runs have parted once the position error passes this fraction of the dumbbell's
+#: length (2 mm for the textbook's 0.2 m): a difference the motion figures show.
+PART_FRACTION = 0.01
 
 #: A run shorter than this (s) is timed again, until :data:`TIMED` s are timed in all (at most
 #: :data:`MAX_TIMED_RUNS` runs): the fastest later run is its warm run time.
@@ -61,8 +70,71 @@ MAX_TIMED_RUNS = 5
 
 #: Columns of :meth:`Comparison.summary` and their units.
 SUMMARY_UNITS = {"solver": "", "dt": "s", "wall_time": "s", "steps_per_s": "1/s",
-                 "window_error": "m", "diverged_at": "s", "energy_error": "1", "impacts": "",
+                 "window_error": "m", "error_until": "s", "parted_at": "s",
+                 "diverged_at": "s", "energy_error": "1", "impacts": "", "run_until": "s",
                  "verdict": "", "warm_up": "s"}
+
+
+@dataclass(frozen=True)
+class Parting:
+    """Where a run and the truth part by chaos: at the truth's impact number ``impact``
+    (1-based) at ``t`` (s), after which the position error passed ``distance`` (m) at
+    ``passed`` (s); ``differences`` the impact-time differences (s, run minus truth) of the
+    impacts matched in order up to the first after the parting (or the last there is)."""
+
+    t: float
+    impact: int
+    distance: float
+    passed: float
+    differences: tuple[float, ...]
+
+    @property
+    def growth(self) -> float:
+        """How much an impact-time difference grows per impact (the geometric mean of
+        |diff[i+1] / diff[i]| over ``differences``; NaN with fewer than two non-zero ones)."""
+        d = [abs(x) for x in self.differences if x != 0]
+        if len(d) < 2:
+            return math.nan
+        return (d[-1] / d[0]) ** (1.0 / (len(d) - 1))
+
+    def why(self, label: str, truth: str) -> str:
+        """One line: when and why the run(s) ``label`` and the truth ``truth`` part."""
+        shown = ", ".join(f"{abs(x) * 1e3:.3g}" for x in self.differences)
+        growth = (f", about {self.growth:.2g}x per impact" if math.isfinite(self.growth)
+                  else "")
+        return (f"{label} part{'' if ' and ' in label else 's'} from the truth ({truth}) at "
+                f"{self.t:.4g} s (the truth's impact "
+                f"{self.impact}), by chaos: each impact turns a small difference in when it "
+                f"happens into a larger one (|impact time - truth's|: {shown} ms at impacts "
+                f"1-{len(self.differences)}{growth}), and the position error then passed "
+                f"{self.distance:.3g} m ({PART_FRACTION:.0%} of the dumbbell's length) at "
+                f"{self.passed:.4g} s; errors after the parting measure the chaos, not the "
+                "method, so the position error is reported up to it")
+
+
+def parting(traj: Trajectory, truth: Trajectory, error: np.ndarray) -> Parting | None:
+    """Where ``traj`` and ``truth`` (sharing their sample times; ``error`` the position error
+    series, m) part by chaos: the truth's last impact before the error first passes
+    :data:`PART_FRACTION` of the dumbbell's length. None if it never passes it, or passes it
+    before any impact (the method's own error, not chaos)."""
+    from ..solvers.advice import length
+
+    distance = PART_FRACTION * length(truth.scene.system)
+    over = np.flatnonzero(error > distance)
+    if not distance > 0 or not over.size:
+        return None
+    passed = float(truth.t[over[0]])
+    before = [i for i, e in enumerate(truth.events) if e.t < passed]
+    if not before:
+        return None
+    k = before[-1]
+    pairs = list(zip(traj.events, truth.events, strict=False))[: k + 2]
+    differences = []
+    for mine, true in pairs:
+        if mine.body != true.body:
+            break
+        differences.append(mine.t - true.t)
+    return Parting(truth.events[k].t, k + 1, distance, passed, tuple(differences))
 
 
 @dataclass(frozen=True)
@@ -81,9 +153,10 @@ class Timing:
 @dataclass(frozen=True)
 class Row:
     """One compared run: its trajectory and the measures against the truth: the position
-    error series (m, at the samples both have), its largest value over the window (m; inf if
-    the run stopped before the window ended), when it first passed 1 mm (s) and the energy
-    error (dimensionless)."""
+    error series (m, at the samples both have), its largest value over [0, ``error_until``]
+    s (m; inf if the run stopped before then), ``error_until`` the window's end or where the
+    runs part by chaos (:class:`Parting`, ``parted``) when that comes sooner, when the error
+    first passed 1 mm (s) and the energy error (dimensionless, over the whole run)."""
 
     label: str
     traj: Trajectory
@@ -92,21 +165,29 @@ class Row:
     diverged_at: float | None
     energy_error: float
     timing: Timing | None = None
+    error_until: float = math.nan
+    parted: Parting | None = None
 
     def __repr__(self) -> str:
         from .._display import one_line
 
+        part = f" (the runs part at {self.parted.t:.4g} s)" if self.parted else ""
         return one_line(f"<Row {self.label}: largest position error {self.window_error:.3g} m "
-                        f"over the window, energy error {self.energy_error:.3g}, "
-                        f"{len(self.traj.events)} impacts, verdict {self.traj.verdict.status}>")
+                        f"over [0, {self.error_until:.4g}] s{part}, energy error "
+                        f"{self.energy_error:.3g} and {counted(len(self.traj.events), 'impact')}"
+                        f" over the whole run, verdict {self.traj.verdict.status}>")
 
     def _repr_html_(self) -> str:
         from .._display import html_table
 
-        return html_table(repr(self), ["run", "largest position error (m)", "passes 1 mm at (s)",
-                                       "energy error", "impacts", "verdict"],
-                          [(self.label, self.window_error, self.diverged_at, self.energy_error,
-                            len(self.traj.events), self.traj.verdict.status)])
+        end = f"{self.traj.t[-1]:.4g}" if len(self.traj.t) else "0"
+        return html_table(repr(self), [
+            "run", f"largest position error over [0, {self.error_until:.4g}] s (m)",
+            "runs part at (s)", "passes 1 mm at (s)", f"energy error over [0, {end}] s",
+            f"impacts in [0, {end}] s", "verdict"],
+            [(self.label, self.window_error, self.parted.t if self.parted else None,
+              self.diverged_at, self.energy_error, len(self.traj.events),
+              self.traj.verdict.status)])
 
 
 @dataclass(frozen=True)
@@ -125,7 +206,9 @@ class Comparison:
         """One line: the scene, the truth, and each run's largest position error."""
         from .._display import one_line
 
-        runs = ", ".join(f"{r.label} {r.window_error:.3g} m" for r in self.rows)
+        runs = ", ".join(f"{r.label} {r.window_error:.3g} m"
+                         + (f" (to {r.error_until:.3g} s, where the runs part)"
+                            if r.error_until < self.window else "") for r in self.rows)
         return one_line(f"<Comparison {self.scene.name}: truth {self.truth.solver}; largest "
                         f"position error over [0, {self.window:g}] s: {runs or 'no runs'}>")
 
@@ -135,21 +218,25 @@ class Comparison:
         from .._display import html_table
 
         head = ["run", "dt (s)", "run time (s)", "warm-up (s)", "steps/s",
-                f"max |dr| over [0, {self.window:g}] s (m)", "|dr| > 1 mm at (s)",
-                "energy error", "impacts", "verdict"]
+                "max |dr| (m)", "... over [0, T] s: T", "runs part at (s)",
+                "|dr| > 1 mm at (s)", "energy error", "impacts", "... over [0, T] s: T",
+                "verdict"]
         rows = [(r["label"], r["dt"], r["wall_time"], r["warm_up"], r["steps_per_s"],
-                 "(truth)" if i == 0 else r["window_error"], r["diverged_at"],
-                 r["energy_error"], r["impacts"], r["verdict"].status)
+                 "(truth)" if i == 0 else r["window_error"], r["error_until"], r["parted_at"],
+                 r["diverged_at"], r["energy_error"], r["impacts"], r["run_until"],
+                 r["verdict"].status)
                 for i, r in enumerate(self.summary())]
         return html_table(repr(self), head, rows, [f"truth: {self.truth_note}", *self.notes])
 
     def summary(self) -> list[dict[str, object]]:
         """One record per run, the truth first, keyed by label: solver, dt (s; None for the
-        step-free truths), warm run time (s), steps/s, the largest position error over the
-        window (m; NaN for the truth), when it first passed 1 mm (s; None if never), energy
-        error (the truth's own drift; NaN for a dissipative truth, which has nothing to be
-        measured against), impacts, verdict and the first run's warm-up (s, :class:`Timing`;
-        see :data:`SUMMARY_UNITS`)."""
+        step-free truths), warm run time (s), steps/s, the largest position error (m; NaN for
+        the truth) over [0, ``error_until``] s (the window, or up to where the runs part by
+        chaos, ``parted_at`` s, when sooner; None if they do not), when it first passed 1 mm
+        (s; None if never), energy error (the truth's own drift; NaN for a dissipative truth,
+        which has nothing to be measured against) and impacts, both over the whole run,
+        [0, ``run_until``] s, verdict and the first run's warm-up (s, :class:`Timing`; see
+        :data:`SUMMARY_UNITS`)."""
         out = []
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
@@ -163,9 +250,12 @@ class Comparison:
                 "wall_time": seconds,
                 "steps_per_s": steps / seconds if steps and seconds > 0 else None,
                 "window_error": math.nan if row is None else row.window_error,
+                "error_until": math.nan if row is None else row.error_until,
+                "parted_at": None if row is None or row.parted is None else row.parted.t,
                 "diverged_at": None if row is None else row.diverged_at,
                 "energy_error": _energy_error(r, None) if row is None else row.energy_error,
                 "impacts": len(r.events),
+                "run_until": float(r.t[-1]) if len(r.t) else 0.0,
                 "verdict": r.verdict, "warm_up": timing.warm_up})
         return out
 
@@ -264,12 +354,22 @@ def compare(scene: Scene | str | Path, options: CompareOptions) -> Comparison:
             err = _position_error_series(run, truth)
             over = np.flatnonzero(err > DIVERGED)
             label = cls.name if len(dts) == 1 else f"{cls.name} dt={dt:g}"
-            rows.append(Row(label, run, err, _position_error(run, truth, window),
+            parted = parting(run, truth, err)
+            until = min(window, t_end) if parted is None else min(window, t_end, parted.t)
+            rows.append(Row(label, run, err, _position_error(run, truth, until),
                             float(run.t[over[0]]) if over.size else None,
-                            _energy_error(run, truth), timing))
+                            _energy_error(run, truth), timing, until, parted))
     notes = []
     if t_end < window:
         notes.append(f"note: the run ends at {t_end:g} s, inside the {window:g} s window")
+    # One line per parting: runs that part alike (same impact, same differences) share it.
+    alike: dict[Parting, list[str]] = {}
+    for row in rows:
+        if row.parted is not None and row.parted.t < min(window, t_end):
+            alike.setdefault(row.parted, []).append(row.label)
+    for part, labels in alike.items():
+        names = ", ".join(labels[:-1]) + " and " + labels[-1] if len(labels) > 1 else labels[0]
+        notes.append(part.why(names, truth.solver))
     return Comparison(scene, truth, truth_note, rows, min(window, t_end), notes, truth_timing)
 
 

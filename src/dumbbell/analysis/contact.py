@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import angular_momentum
@@ -74,7 +75,7 @@ def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> Con
     if s.system.dimensions != 2:
         raise UsageError(f"{s.source}: angular momentum about a contact point needs a 2D scene")
     if not 0 <= index < len(traj.events):
-        raise UsageError(f"index = {index}: the run has {len(traj.events)} impacts",
+        raise UsageError(f"index = {index}: the run has {counted(len(traj.events), 'impact')}",
                          param="index")
     imp = traj.events[index]
     t = traj.t

@@ -113,9 +113,9 @@ def _energy_error(traj: Trajectory, truth: Trajectory | None) -> float:
     if len(traj.t) == 0:
         return math.nan
     if not traj.scene.system.dissipative:
-        return float(np.max(_relative_energy_error(traj.energy)))
+        return float(np.max(_relative_energy_error(traj.energy, traj.scene.system)))
     if truth is None:
         return math.nan
     n = min(len(traj.t), len(truth.t))
     E, E_true = traj["E"][:n], truth["E"][:n]
-    return float(np.max(np.abs(E - E_true)) / _start_scale(truth.energy))
+    return float(np.max(np.abs(E - E_true)) / _start_scale(truth.energy, truth.scene.system))

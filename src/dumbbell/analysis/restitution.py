@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import rigid_moment
@@ -93,7 +94,7 @@ class Bounce:
         from .._display import one_line
 
         return one_line(f"<Bounce e_first={self.e_first:.6g}, e_cluster={self.e_cluster:.6g} "
-                        f"after {self.impacts} impacts, K_rot share {self.share_first:.3g} "
+                        f"after {counted(self.impacts, 'impact')}, K_rot share {self.share_first:.3g} "
                         f"after the first, {self.share_cluster:.3g} after the cluster>")
 
     def _repr_html_(self) -> str:
@@ -101,7 +102,7 @@ class Bounce:
 
         return html_table(repr(self), ["", "e_eff", "K_rot / K before"],
                           [("first impact", self.e_first, self.share_first),
-                           (f"first cluster ({self.impacts} impacts)", self.e_cluster,
+                           (f"first cluster ({counted(self.impacts, 'impact')})", self.e_cluster,
                             self.share_cluster)])
 
 
@@ -270,7 +271,8 @@ class RestitutionResult:
         from .._display import one_line
 
         n = len(self.theta)
-        tilts = f"{n} tilts {self.theta[0]:g}..{self.theta[-1]:g} deg" if n else "no tilts"
+        tilts = (f"{counted(n, 'tilt')} {self.theta[0]:g}..{self.theta[-1]:g} deg" if n
+                 else "no tilts")
         gap = float(np.max(np.abs(self.truth - self.formula))) if n else math.nan
         springs = ", ".join(f"{k:g}" for k in self.springs)
         return one_line(f"<RestitutionResult e={self.e:g}, q={self.q:.4g}: {tilts}; "

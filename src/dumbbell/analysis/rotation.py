@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.scene import Scene, scene_from_dict
@@ -99,7 +100,7 @@ class Series:
     def __repr__(self) -> str:
         from .._display import one_line
 
-        return one_line(f"<Series {self.scene.name}: {len(self.runs)} runs "
+        return one_line(f"<Series {self.scene.name}: {counted(len(self.runs), 'run')} "
                         f"({', '.join(self.runs)}), {self.solver} at dt = {self.dt:g} s>")
 
     def _repr_html_(self) -> str:

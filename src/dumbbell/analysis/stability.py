@@ -60,14 +60,17 @@ MAP_UNSTABLE_ENERGY = 1e3
 
 #: Units of :data:`COLUMNS` ("1": dimensionless; "" for names and text).
 UNITS = {"case": "", "title": "", "solver": "", "dt": "s", "w_dt": "1", "verdict": "",
-         "t_fail": "s", "max_rel_energy_error": "1", "dissipative": "", "predicted": "",
-         "agreement": "", "reason": "", "theory": "", "wall_s": "s"}
+         "t_fail": "s", "max_rel_energy_error": "1", "inaccurate_energy": "1",
+         "dissipative": "", "predicted": "", "agreement": "", "reason": "", "theory": "",
+         "wall_s": "s"}
 
 
 @dataclass(frozen=True)
 class StabilityRow:
     """One (case, solver) run beside the theory: one line of stability.csv, the fields in
-    column order (units in :data:`UNITS`)."""
+    column order (units in :data:`UNITS`). ``inaccurate_energy`` is the case's threshold
+    (``run.inaccurate_energy``): a run that stays stable is ``ok`` within it and
+    ``inaccurate`` past it, dated (``t_fail``) where its energy error first passed it."""
 
     case: str
     title: str
@@ -77,6 +80,7 @@ class StabilityRow:
     verdict: str
     t_fail: float | None
     max_rel_energy_error: float
+    inaccurate_energy: float
     dissipative: bool
     predicted: str
     agreement: str
@@ -105,12 +109,12 @@ class StabilityResult:
 
     def __repr__(self) -> str:
         """One line: runs, cases, and which runs disagree with the theory."""
-        from .._display import one_line
+        from .._display import counted, one_line
 
         bad = self.disagreements
         which = "; ".join(f"{r.case} {r.solver}" for r in bad)
-        return one_line(f"<StabilityResult: {len(self.rows)} runs of "
-                        f"{len({r.case for r in self.rows})} cases, "
+        return one_line(f"<StabilityResult: {counted(len(self.rows), 'run')} of "
+                        f"{counted(len({r.case for r in self.rows}), 'case')}, "
                         f"{len(self.rows) - len(bad)} agree with the theory, {len(bad)} "
                         f"disagree{' (' + which + ')' if bad else ''}>")
 
@@ -220,8 +224,48 @@ def _predict(scene: Scene, cls: type[Solver], dt: float, t_end: float) -> Predic
         return Prediction("failed", f"a point mass comes to rest at {t_rest:.2f} s "
                                     f"< t_end = {t_end:g} s")
     if limit is not None:
+        swing = _swing_share(scene, cls, w_dt)
+        if swing is not None and swing > scene.run.unstable_energy:
+            return Prediction("unstable", (
+                f"w*dt = {w_dt:.2g} < {limit:.3g}: stable, but the step moves the energy by "
+                f"up to {swing:.3g} of its scale > run.unstable_energy = "
+                f"{scene.run.unstable_energy:g}"))
+        if swing is not None and swing > scene.run.inaccurate_energy:
+            return Prediction("inaccurate", (
+                f"w*dt = {w_dt:.2g} < {limit:.3g}: stable, but the step moves the energy by "
+                f"up to {swing:.3g} of its scale > run.inaccurate_energy = "
+                f"{scene.run.inaccurate_energy:g}"))
         return Prediction("ok", f"w*dt = {w_dt:.2g} < {limit:.3g}")
     return Prediction("ok", "no step limit applies")
+
+
+def _swing_share(scene: Scene, cls: type[Solver], w_dt: float) -> float | None:
+    """How far (relative to the energy scale) a stable run of ``cls`` at ``w_dt`` moves the
+    energy of a scene where only the spring acts (no floor, no gravity), whose vibration
+    energy then stays what it was at the start: the solver's swing or drift over the run
+    (:func:`dumbbell.solvers.advice.step_error`) times the vibration's share of the scale.
+    None where the theory says nothing of the accuracy (a floor or gravity feeds energy into
+    and out of the vibration) or the solver states neither."""
+    from ..solvers.advice import step_error
+
+    if scene.system.floor is not None or scene.system.g != 0 or not w_dt > 0:
+        return None
+    swing = step_error(cls, w_dt, scene.system.omega * scene.run.t_end)
+    if swing is None:
+        return None
+    import numpy as np
+
+    from ..model.energy import _partition, _start_scale, state_columns
+    from ..solvers.stepping import initial_state
+
+    state = {c: np.array([v]) for c, v in zip(state_columns(scene), initial_state(scene),
+                                               strict=True)}
+    if scene.system.discs:
+        state |= {"omegaA": np.array([scene.system.A.spin]),
+                  "omegaB": np.array([scene.system.B.spin])}
+    energy = _partition(scene, np.zeros(1), state)
+    vibration = sum(float(energy[c][0]) for c in ("K_int", "K_vib", "U_spring") if c in energy)
+    return swing * vibration / _start_scale(energy, scene.system)
 
 
 def run_case(path: str, cls: type[Solver]) -> StabilityRow:
@@ -242,6 +286,7 @@ def run_case(path: str, cls: type[Solver]) -> StabilityRow:
                         w_dt=result.w_dt, verdict=result.verdict,
                         t_fail=result.t_fail,
                         max_rel_energy_error=result.max_rel_energy_error,
+                        inaccurate_energy=scene.run.inaccurate_energy,
                         dissipative=scene.system.dissipative, predicted=expected.status,
                         agreement=agreement, reason=result.reason, theory=expected.why,
                         wall_s=wall)

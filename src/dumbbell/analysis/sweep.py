@@ -28,9 +28,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._display import counted
 from ..errors import DumbbellError, UsageError
 from ..model import args
 from ..model.scene import Scene
+from ..model.trajectory import COMPLETE
 from ..parallel import Backend, ordered_map
 from ..solvers import Solver, scene_class, solver_class
 from ._fields import check
@@ -283,7 +285,7 @@ def _evaluate(scene: Scene, values: dict[str, Any], cls: type[Solver]) -> PointR
     try:
         runnable(cls, point)
         traj = cls._solve(point, run_options(point, every=every))
-        err = _relative_energy_error(traj.energy)
+        err = _relative_energy_error(traj.energy, point.system)
         finite = err[np.isfinite(err)]
         max_err = float(finite.max()) if finite.size else math.nan
         verdict = traj.verdict
@@ -326,7 +328,8 @@ class SweepResult:
         grid = " x ".join(f"{a.key} ({len(a.values)})" for a in self.axes)
         counts = ", ".join(f"{n:,} {v}" for v, n in sorted(self.counts().items()))
         took = f"; {self.wall_time:.3g} s on {self.backend}" if self.backend else ""
-        return one_line(f"<SweepResult {self.scene.name}: {len(self.rows):,} points over "
+        points = counted(len(self.rows), "point", grouped=True)
+        return one_line(f"<SweepResult {self.scene.name}: {points} over "
                         f"{grid}, solver {self.solver}, t_end {self.t_end:g} s: "
                         f"{counts or 'none'}{took}>")
 
@@ -337,7 +340,8 @@ class SweepResult:
 
         bad = [r for r in self.rows if r.verdict != "ok"]
         shown = bad or self.rows
-        note = (f"the {len(bad):,} points that did not end ok" if bad else "every point ended ok")
+        note = (f"the {counted(len(bad), 'point', grouped=True)} that did not end ok" if bad
+                else "every point ended ok")
         return html_table(repr(self), self.columns, (r.cells for r in shown), [note])
 
     def to_pandas(self) -> pandas.DataFrame:
@@ -359,9 +363,10 @@ class SweepResult:
         return out
 
     def boundary(self) -> list[dict[str, float]]:
-        """Where a (something, run.dt) sweep stops being ok: for each value of the other axis,
-        the largest dt below which every point is ok, its w*dt and the theory's 2/w (s).
-        Empty unless one of two axes is run.dt."""
+        """Where a (something, run.dt) sweep stops being stable: for each value of the other
+        axis, the largest dt below which every point reached its end (``ok`` or
+        ``inaccurate``: the stability boundary, not the accuracy's), its w*dt and the
+        theory's 2/w (s). Empty unless one of two axes is run.dt."""
         if len(self.axes) != 2 or "run.dt" not in (a.key for a in self.axes):
             return []
         di = [a.key for a in self.axes].index("run.dt")
@@ -375,10 +380,11 @@ class SweepResult:
         for value, line in zip(other.values, table, strict=True):
             ok_dt, w_dt = math.nan, math.nan
             for j in order:
-                if line[j].verdict != "ok":
+                if line[j].verdict not in COMPLETE:
                     break
                 ok_dt, w_dt = dts[j], line[j].w_dt
-            first_bad = next((dts[j] for j in order if line[j].verdict != "ok"), math.nan)
+            first_bad = next((dts[j] for j in order if line[j].verdict not in COMPLETE),
+                             math.nan)
             w = line[order[0]].w_dt / dts[order[0]]
             out.append({other.key: value, "largest_ok_dt": ok_dt, "w_dt": w_dt,
                         "first_failing_dt": first_bad,

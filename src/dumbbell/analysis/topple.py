@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import rigid_moment
@@ -202,7 +203,7 @@ class ToppleMeasure:
 
         return one_line(f"<ToppleMeasure lands at {self.fall_time:.6g} s: top particle "
                         f"{self.v_top:.6g} m/s, centre of mass {self.v_cm:.6g} m/s, "
-                        f"horizontal drift {self.cm_drift:.2g} m; {len(self.t)} samples>")
+                        f"horizontal drift {self.cm_drift:.2g} m; {counted(len(self.t), 'sample')}>")
 
     def _repr_html_(self) -> str:
         from .._display import html_table

@@ -12,7 +12,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from ..model.energy import BOOKKEEPING
-from .backdrop import Patch
+from .backdrop import SS, Patch
 from .frames import Frames
 from .glyphs import SMALL_PX, TEXT_PX, TITLE_PX, Stamps, font, nice_step
 from .palette import GREY, INK, TERM_RGB, term_inks, term_tints
@@ -40,6 +40,11 @@ MOMENTUM_HALF = 8   # ... its crop reaches this far above and below its middle
 #: The note beside the title, longest first: the first that fits is drawn.
 NOTES = ("fixed scale; pale: largest value since the last frame",
          "pale: largest since last frame", "pale: since last frame")
+#: The panel's title.
+TITLE = "Energy (J)"
+#: L_cm's line under the bars: before its value, after it, and the note that follows when
+#: it fits.
+MOMENTUM_TEXT = ("L_cm = ", " kg m²/s", " (about the centre of mass)")
 
 
 @dataclass(frozen=True)
@@ -97,7 +102,7 @@ def bar_rows(names: Sequence[str], box: tuple[int, int, int, int], u: float,
 
 def draw_legend(d: ImageDraw.ImageDraw, S: int, u: float, box: tuple[int, int, int, int],
                 rows: Sequence[Row], colour: Callable[[str], tuple[int, int, int]],
-                zero_x: float, title: str = "Energy (J)",
+                zero_x: float, title: str = TITLE,
                 label: Callable[[str], str] | None = None) -> None:
     """The panel's static parts on a background ``S`` times the size: its ``title``, a swatch
     and the name of each row (``label(name)`` if given), and the zero line at ``zero_x``
@@ -132,7 +137,8 @@ def draw_values(patch: Patch, rows: Sequence[Row], text: Callable[[str], str], r
 class Bars:
     """The energy panel of one animation: its box (px), the unit ``u``, the terms shown
     (``names``; E's own terms in ``terms``), the fixed ``scale``, where the bars run (``left``
-    to ``right``, 0 J at ``zero``, px; ``px_per_j``) and the rows."""
+    to ``right``, 0 J at ``zero``, px; ``px_per_j``), the rows, and the note beside the title
+    (the longest of :data:`NOTES` that fits; None when none does)."""
 
     box: tuple[int, int, int, int]
     u: float
@@ -144,6 +150,7 @@ class Bars:
     zero: int
     px_per_j: float
     rows: tuple[Row, ...]
+    note: str | None = None
 
     @classmethod
     def build(cls, box: tuple[int, int, int, int], u: float, names: Sequence[str],
@@ -156,8 +163,11 @@ class Bars:
         right = bx1 - round(values.width(f"-{span:.{scale.decimals}f}") + VALUE_PAD * u)
         zero = left + round((right - left) * (-scale.lo) / span)
         terms = tuple(n for n in names if n not in BOOKKEEPING)
+        note_font = font(round(SMALL_PX * u) * SS)
+        room = (bx1 - bx0 - NOTE_X * u) * SS
+        note = next((n for n in NOTES if note_font.getlength(n) <= room), None)
         return cls(box, u, tuple(names), terms, scale, left, right, zero,
-                   (right - left) / span, bar_rows(names, box, u))
+                   (right - left) / span, bar_rows(names, box, u), note)
 
     def px(self, value: float) -> float:
         """Pixel x of energy ``value`` (J) on the fixed scale."""
@@ -169,14 +179,10 @@ class Bars:
         u = self.u
         draw_legend(d, S, u, self.box, self.rows, lambda name: TERM_RGB.get(name, GREY),
                     self.zero)
-        bx0, by0, bx1, _ = self.box
-        note_font = font(round(SMALL_PX * u) * S)
-        room = (bx1 - bx0 - NOTE_X * u) * S
-        for note in NOTES:
-            if note_font.getlength(note) <= room:
-                d.text(((bx0 + NOTE_X * u) * S, (by0 + 1 * u) * S), note, font=note_font,
-                       fill=GREY, anchor="lt")
-                break
+        bx0, by0, _, _ = self.box
+        if self.note is not None:
+            d.text(((bx0 + NOTE_X * u) * S, (by0 + 1 * u) * S), self.note,
+                   font=font(round(SMALL_PX * u) * S), fill=GREY, anchor="lt")
 
     def draw(self, img: Image.Image, frames: Frames, k: int,
              patch: Callable[[tuple[int, int, int, int]], Patch], values: Stamps) -> None:
@@ -241,9 +247,10 @@ class Bars:
         y = (below + limit) / 2
         box = (self.box[0], round(y - MOMENTUM_HALF * u), self.box[2],
                round(y + MOMENTUM_HALF * u))
-        text = f"L_cm = {fixed(value, 4, '+')} kg m²/s (about the centre of mass)"
+        before, after, note = MOMENTUM_TEXT
+        text = f"{before}{fixed(value, 4, '+')}{after}{note}"
         if stamps.width(text) > box[2] - box[0]:
-            text = f"L_cm = {fixed(value, 4, '+')} kg m²/s"
+            text = f"{before}{fixed(value, 4, '+')}{after}"
         crop, (cx, cy), done = patch(box)
         stamps.draw(crop, (box[2] - cx, y - cy), text, INK, "rm")
         done()

@@ -2,10 +2,10 @@
 
 A frame is the scene panel (:mod:`.world`: floor, height ruler, the dumbbell, the time), the
 energy panel (:mod:`.bars`: one bar per energy column on one fixed scale) and optionally the
-strip of the energy time series (:mod:`.strip`). :class:`Painter` puts them together on a
-:class:`~.layout.Layout` computed once: it draws the background once (:mod:`.backdrop`) and
-per frame only what changes, on crops of it, in the palette of :mod:`.palette`, with text from
-the glyph cache of :mod:`.glyphs`.
+strip of the energy time series (:mod:`.strip`), as one :class:`~.picture.Picture` describes
+them (the description the player page is given too). :class:`Painter` draws it: the
+background once (:mod:`.backdrop`) and per frame only what changes, on crops of it, in the
+palette of :mod:`.palette`, with text from the glyph cache of :mod:`.glyphs`.
 """
 
 from __future__ import annotations
@@ -15,45 +15,39 @@ import math
 import numpy as np
 from PIL import Image, ImageDraw
 
-from ..model.energy import energy_columns
 from ..model.scene import Scene
 from .backdrop import SS, Backdrop
-from .bars import MOMENTUM_EDGE, MOMENTUM_GAP, Bars, EnergyScale
+from .bars import MOMENTUM_EDGE, MOMENTUM_GAP
 from .frames import Frames
 from .glyphs import NOTE_PX, TEXT_PX, TIME_PX, Stamps, font
-from .layout import EDGE, Layout, layout
+from .layout import EDGE
 from .palette import LIGHT, WHITE, to_palette
-from .strip import Strip
-from .world import World
+from .picture import Picture, describe
 
 #: No public names: this is the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []
 
-#: Columns the bars leave out: E_lost's split (E_heat, E_err) is in the CSV.
-SPLIT_OF_LOST = ("E_heat", "E_err")
-
 
 class Painter(Backdrop):
-    """Draws the frames of one animation of ``scene`` at ``size`` (px) into the palette:
-    the scene panel (``world``), the energy bars (``bars``) and, with ``strip``, the energy
-    time series (``strip``, None without), all on one ``layout``."""
+    """Draws the frames of run ``run`` of a ``picture`` into the palette: the scene panel
+    (``world``), the energy bars (``bars``) and the energy time series (``strip``, None
+    without), all on the picture's ``layout``."""
 
-    def __init__(self, scene: Scene, frames: Frames, size: tuple[int, int], strip: bool):
-        self.frames = frames
-        self.W, self.H = size
-        self.layout: Layout = layout(scene, frames, size, strip)
+    def __init__(self, picture: Picture, run: int = 0):
+        self.picture = picture
+        self.frames = frames = picture.runs[run]
+        self.layout = picture.layout
+        self.W, self.H = self.layout.W, self.layout.H
         u = self.layout.u
-        self.world = World(scene.system, self.layout)
-        names = [n for n in energy_columns(scene) if n not in SPLIT_OF_LOST]
+        self.world = picture.world
         self.values = Stamps(font(max(8, round(TEXT_PX * u))))
         self.time = Stamps(font(max(9, round(TIME_PX * u)), bold=True))
         self.letters = Stamps(font(max(8, round(NOTE_PX * u)) * SS, bold=True))
         self.small = Stamps(font(max(8, round(NOTE_PX * u)) * SS))
         self.note = Stamps(font(max(8, round(NOTE_PX * u))))
-        scale = EnergyScale.of(self._scaled(names))
-        self.bars = Bars.build(self.layout.bars_box, u, names, scale, self.values)
-        self.strip = Strip.build(self.layout.strip_box, u, scale, frames.t_end) if strip else None
-        self.tape = self.strip.tape(frames, names) if self.strip else None
+        self.bars = picture.bars
+        self.strip = picture.strip
+        self.tape = self.strip.tape(frames, picture.names) if self.strip else None
         self.bg = self._background()
         self.bg_rgb = self.bg.convert("RGB")
         self.bg_ss = self.bg_rgb.resize((self.W * SS, self.H * SS), Image.Resampling.NEAREST)
@@ -62,15 +56,10 @@ class Painter(Backdrop):
         self.impact_frames = {int(k) for k in np.searchsorted(t, impacts, side="left")
                               if 0 < k < len(t)}
 
-    def _scaled(self, names: list[str]) -> list[np.ndarray]:
-        """Every value the bars and the strip show (J): the series, the extremes between
-        frames, and E + E_lost (the stacked bar's end)."""
-        fr = self.frames
-        values = [fr.series[n] for n in names if n != "E_lost"]
-        values += [fr.hi[n] for n in names] + [fr.lo[n] for n in names]
-        if "E_lost" in names:
-            values.append(fr.series["E"] + fr.series["E_lost"])
-        return values
+    @classmethod
+    def of(cls, scene: Scene, frames: Frames, size: tuple[int, int], strip: bool) -> Painter:
+        """The painter of ``frames`` of ``scene`` alone on frames of ``size`` (px)."""
+        return cls(describe(scene, (frames,), size, strip))
 
     def _background(self) -> Image.Image:
         """Everything static, drawn once at :data:`SS` times the size, then halved."""

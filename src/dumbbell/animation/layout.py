@@ -7,6 +7,7 @@ mapping keeps the aspect ratio: 1 m is as long in x as in y.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -74,14 +75,16 @@ class Layout:
         return self.ox + x * self.s, self.oy - y * self.s
 
 
-def layout(scene: Scene, frames: Frames, size: tuple[int, int], strip: bool) -> Layout:
-    """The layout of ``frames`` of ``scene`` on a frame of ``size`` (px): the world window
-    holds every position the particles reach (and the floor), at one scale in x and y."""
+def layout(scene: Scene, runs: Sequence[Frames], size: tuple[int, int], strip: bool
+           ) -> Layout:
+    """The layout of the frames of ``runs`` of ``scene`` (one run, or runs shown together)
+    on a frame of ``size`` (px): the world window holds every position the particles reach
+    in any of them (and the floor), at one scale in x and y."""
     W, H = size
     u = unit(W, H)
     r = max(scene.system.A.radius, scene.system.B.radius)
-    xs = np.concatenate([frames.A[:, 0], frames.B[:, 0]])
-    ys = np.concatenate([frames.A[:, 1], frames.B[:, 1]])
+    xs = np.concatenate([p[:, 0] for fr in runs for p in (fr.A, fr.B)])
+    ys = np.concatenate([p[:, 1] for fr in runs for p in (fr.A, fr.B)])
     finite = np.isfinite(xs) & np.isfinite(ys)
     xs, ys = (xs[finite], ys[finite]) if finite.any() else (np.zeros(1), np.zeros(1))
     x0, x1 = float(xs.min()) - r, float(xs.max()) + r

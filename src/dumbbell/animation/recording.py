@@ -23,14 +23,22 @@ the positions of every moving element (each moving body's shapes, and each const
 holds one, static anchors included) at every frame, and keeps those whose centre lies within
 :data:`FENCE` interquartile ranges of the middle half of all centres along x and along y
 (Tukey's far-out fences; the range is the larger of x's and y's, and at least the median
-element's size), and every element of the first frame. The view holds the kept elements: a body that flies away (or strays for a small
-share of the time) leaves the picture instead of shrinking everything else. Static shapes
-within :data:`NEAR` of that box (a share of its size along each axis) are added, a floor under
-the bodies say; one that runs past the near zone on both sides along an axis (a long floor, a
-tall wall) does not widen the view along it. The box is at least :data:`MIN_SIZE` times the
-median element's size, padded by :data:`PAD` and fitted to the scene panel. ``"all"`` shows
-everything ever captured, static shapes included; a fixed box is the user's; ``"follow"``
-keeps one body at the centre of a view of fixed size.
+element's size), and every element of the first frame. The box of the kept elements, at
+least :data:`MIN_SIZE` times the median element's size, is where the bodies move: a body
+that flies away (or strays for a small share of the time) leaves the picture instead of
+shrinking everything else. Static shapes within :data:`NEAR` of that box (a share of its
+size along each axis) are shown too, a floor under the bodies say (one that runs past the
+near zone on both sides along an axis, a long floor or a tall wall, does not widen the view
+along it), as long as that leaves every moving body at least :data:`BODY_PX` across to
+scale; else the view widens only that far (not at all if the bodies' box alone is too
+large), placed to hold as much of them as it can: static shapes never shrink a body below
+:data:`BODY_PX`, and those farther away never count. The box is padded by :data:`PAD` and
+fitted to the scene panel. ``"all"`` shows everything ever captured, static shapes included;
+a fixed box is the user's; ``"follow"`` keeps one body at the centre of a view of fixed size.
+
+**Sizes.** Whatever the view, every moving body is drawn at least :data:`BODY_PX` across
+whichever way it turns (:meth:`Shapes.at_least`): a smaller one is drawn larger than to
+scale, and the painter says which (``Painter.grown``, named in the recorder's note).
 """
 
 from __future__ import annotations
@@ -54,9 +62,9 @@ from PIL import Image, ImageDraw
 from ..errors import DumbbellError
 from ..io.files import atomic_output
 from .backdrop import SS, Backdrop
-from .bars import EnergyScale, bar_rows, draw_legend, draw_values
+from .bars import SWATCH, SWATCH_GAP, EnergyScale, bar_rows, draw_legend, draw_values
 from .gif import write_frames
-from .glyphs import Stamps, fmt_tick, font, nice_step
+from .glyphs import TEXT_PX, Stamps, fmt_tick, font, nice_step
 from .layout import unit
 from .palette import (
     GREY,
@@ -88,15 +96,26 @@ STATIC_FILL = (232, 232, 232)
 SHAPE_COLOURS = (*((rgb, blend(rgb, 0.33)) for rgb in BODY_INKS), (GREY, STATIC_FILL))
 #: Height of an energy bar's row at most (px at 640x360).
 ROW_MAX = 26
+#: The bars start at least this far right of the panel's left edge (px at 640x360) ...
+LABEL_ROOM = 70
+#: ... and this far right of the end of the longest row name.
+NAME_GAP = 4
 #: The camera: a moving body's position counts unless it lies more than this many
 #: interquartile ranges beyond the middle half of all positions (Tukey's far-out fences) ...
 FENCE = 3.0
-#: ... static shapes this near the bodies' box (a share of its size along each axis) count ...
+#: ... static shapes this near the bodies' box (a share of its size along each axis) are
+#: shown where the view has room for them, never by widening it ...
 NEAR = 0.25
 #: ... the view is at least this many times the median body's size ...
 MIN_SIZE = 4.0
 #: ... with this margin (a share of its span) on each side.
 PAD = 0.05
+#: Every moving body is drawn at least this many px across (its larger side, whichever
+#: way it turns; times the frame's size unit when larger than 640x360), larger than to scale
+#: if need be (the recorder's note names those), ...
+BODY_PX = 4.0
+#: ... measured on its box turned this many times in a quarter turn.
+TURNS = 16
 #: A spring's zig-zag: its coils, and its half-width at most (px at 640x360).
 COILS, SPRING_WIDTH = 9, 5.0
 #: Pixel coordinates are clipped to this far outside the frame (px) before drawing.
@@ -189,6 +208,65 @@ class Shapes:
             out[..., g.at, 2] = pts[..., 1].min(axis=-1) - r
             out[..., g.at, 3] = pts[..., 1].max(axis=-1) + r
         return out
+
+    @functools.cached_property
+    def least(self) -> tuple[np.ndarray, np.ndarray]:
+        """Per body row: how small the body can look, the least over its turns of the larger
+        side of its shapes' box (world units; nan for a row without shapes), and the middle
+        of that box in the body's coordinates (rows x 2)."""
+        rows = int(self.body.max()) + 1 if self.n else 0
+        a = np.arange(TURNS) * (math.pi / 2 / TURNS)  # the box repeats every quarter turn
+        c, s = np.cos(a), np.sin(a)
+        # Each shape's extent along x and y turned by each angle (n x 2 x turns) ...
+        lo = np.full((self.n, 2, TURNS), math.inf)
+        hi = np.full((self.n, 2, TURNS), -math.inf)
+        for g in self.groups:
+            if not g.local.shape[1]:
+                continue
+            x, y = g.local[..., 0, None], g.local[..., 1, None]  # m x p x 1
+            r = g.r[:, None, None]
+            along = np.stack([x * c + y * s, y * c - x * s], axis=2)  # m x p x 2 x turns
+            lo[g.at], hi[g.at] = along.min(axis=1) - r, along.max(axis=1) + r
+        # ... then each body's (its shapes together).
+        order = np.argsort(self.body, kind="stable")
+        starts = np.flatnonzero(np.r_[True, np.diff(self.body[order]) != 0]) if self.n else order
+        body_lo, body_hi = np.full((rows, 2, TURNS), math.inf), np.full((rows, 2, TURNS), -math.inf)
+        if self.n:
+            at = self.body[order][starts]
+            body_lo[at] = np.minimum.reduceat(lo[order], starts, axis=0)
+            body_hi[at] = np.maximum.reduceat(hi[order], starts, axis=0)
+        with np.errstate(invalid="ignore"):
+            # (Between two of the turns measured the side can be at most this much smaller.)
+            side = (body_hi - body_lo).max(axis=1).min(axis=1) * math.cos(math.pi / 4 / TURNS)
+            middle = (body_lo[:, :, 0] + body_hi[:, :, 0]) / 2
+        side[~(side >= 0)] = math.nan
+        return side, middle
+
+    def at_least(self, s: float, px: float) -> tuple[Shapes, np.ndarray]:
+        """The shapes drawn at ``s`` px per unit with every body at least ``px`` px across
+        whichever way it turns (its larger side): a body that would be drawn smaller is
+        drawn larger than to scale, its shapes grown about the middle of their box. Returns
+        the shapes to draw (these, when none is grown) and the numbers of the moving bodies
+        grown."""
+        side, middle = self.least
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            # (A body exactly px across, as a view made for it draws it, is not grown.)
+            grow = np.where(side * s < px * (1 - 1e-9), px / (side * s), 1.0)
+        grow[~np.isfinite(grow) | (side <= 0)] = 1.0  # nothing to grow (no size, no shapes)
+        if not (grow > 1).any():
+            return self, np.zeros(0, dtype=int)
+        groups = []
+        for g in self.groups:
+            f = grow[g.rows]
+            if not (f > 1).any():
+                groups.append(g)
+                continue
+            m = middle[g.rows][:, None, :]
+            local = m + f[:, None, None] * (g.local - m)
+            groups.append(Group(g.kind, g.at, local, g.r * f, g.rows,
+                                bool(local.shape[1]) and not local.any()))
+        grown = np.unique(self.number[(grow[self.body] > 1) & (self.number >= 0)])
+        return Shapes(self.body, self.ink, self.number, tuple(groups)), grown
 
     def items(self, pose: np.ndarray) -> list[tuple]:
         """The shapes at ``pose`` as primitives (see the module docstring), in order."""
@@ -333,12 +411,16 @@ def static_boxes(statics: tuple[tuple[tuple, ...], ...]) -> np.ndarray:
     return _finite(np.array(boxes, dtype=float).reshape(-1, 4))
 
 
-def auto_box(rec: Recording) -> Box:
-    """The automatic camera's world box (see the module's docstring for the rule)."""
+def auto_boxes(rec: Recording) -> tuple[Box, Box]:
+    """The automatic camera's boxes (see the module's docstring for the rule): where the
+    bodies move (dynamic and kinematic, with their constraints), which the view holds at
+    its scale; and that box with the static shapes near it, which the view holds where it
+    has room."""
     moving, where = element_boxes(rec)
     fixed = static_boxes(rec.statics)
     if not len(moving):
-        return _union(fixed) or (-1.0, 1.0, -1.0, 1.0)
+        box = _union(fixed) or (-1.0, 1.0, -1.0, 1.0)
+        return box, box
     size = np.maximum(moving[:, 1] - moving[:, 0], moving[:, 3] - moving[:, 2])
     size = size[size > 0]
     # The median (as np.median, which would import numpy.ma).
@@ -357,7 +439,8 @@ def auto_box(rec: Recording) -> Box:
     if not max(x1 - x0, y1 - y0) > 0:
         # Only points move (pivots of bodies without shapes): show the static shapes, or
         # one unit around them.
-        return _union(fixed) or (x0 - 0.5, x1 + 0.5, y0 - 0.5, y1 + 0.5)
+        box = _union(fixed) or (x0 - 0.5, x1 + 0.5, y0 - 0.5, y1 + 0.5)
+        return box, box
     nx, ny = NEAR * (x1 - x0), NEAR * (y1 - y0)
     ex0, ex1, ey0, ey1 = x0 - nx, x1 + nx, y0 - ny, y1 + ny
     bx0, bx1, by0, by1 = x0, x1, y0, y1
@@ -365,12 +448,44 @@ def auto_box(rec: Recording) -> Box:
         if sx1 < ex0 or sx0 > ex1 or sy1 < ey0 or sy0 > ey1:
             continue
         # Along an axis where the shape runs past the near zone on both sides, it does not
-        # widen the view (a long floor, a tall wall); else the part of it near the bodies does.
+        # move the view (a long floor, a tall wall); else the part of it near the bodies does.
         if not (sx0 <= ex0 and sx1 >= ex1):
             bx0, bx1 = min(bx0, max(sx0, ex0)), max(bx1, min(sx1, ex1))
         if not (sy0 <= ey0 and sy1 >= ey1):
             by0, by1 = min(by0, max(sy0, ey0)), max(by1, min(sy1, ey1))
-    return bx0, bx1, by0, by1
+    return (x0, x1, y0, y1), (bx0, bx1, by0, by1)
+
+
+def auto_view(rec: Recording, width: float, height: float, body_px: float = 0.0) -> Box:
+    """The automatic camera's view, of the aspect ratio ``width`` : ``height`` (px): the box
+    where the bodies move with the static shapes near them (:func:`auto_boxes`), fitted
+    (:func:`fit`), as long as that leaves every moving body at least ``body_px`` across; else
+    the view is only as large as keeps them so (the box where the bodies move, if even that
+    is too large), placed to hold as much of the static shapes near them as it can: static
+    shapes never make a body smaller than ``body_px``."""
+    core, near = auto_boxes(rec)
+    wide = fit(near, width, height)
+    if near == core:
+        return wide
+    tight = fit(core, width, height)
+    least = [float(np.nanmin(sh.least[0])) for sh in rec.shapes
+             if sh.n and np.isfinite(sh.least[0]).any()]
+    # The largest view (world units across) that draws the smallest body body_px across.
+    most = min(least, default=math.inf) * width / body_px if body_px > 0 else math.inf
+    if wide[1] - wide[0] <= most:
+        return wide
+    span = max(tight[1] - tight[0], most)
+    spans = (span, span * height / width)
+    out: list[float] = []
+    for size, (c0, c1), (n0, n1) in zip(spans, (core[:2], core[2:]), (near[:2], near[2:]),
+                                        strict=True):
+        # The view holds the bodies' box, padded as fit pads it, and is centred on the
+        # shapes near them as far as that allows.
+        half, mid = (c1 / 2 - c0 / 2) * (1 + 2 * PAD), c0 / 2 + c1 / 2
+        lo = min(max(n0 / 2 + n1 / 2 - size / 2, mid + half - size), mid - half)
+        out += [lo, lo + size]
+    box = (out[0], out[1], out[2], out[3])
+    return box if all(math.isfinite(v) for v in box) else tight
 
 
 def _quartiles(values: np.ndarray) -> tuple[float, float]:
@@ -889,9 +1004,10 @@ class Layer:
     there is drawn as it was)."""
 
     def __init__(self, rec: Recording, k: int, view: View, u: float,
-                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None
-                 ) -> None:
-        self.px = Pixels(rec.shapes[rec.shape_of[k]], rec.poses[k], rec.extras[k], view, u)
+                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None,
+                 shapes: Shapes | None = None) -> None:
+        shapes = rec.shapes[rec.shape_of[k]] if shapes is None else shapes
+        self.px = Pixels(shapes, rec.poses[k], rec.extras[k], view, u)
         self.panel = panel
         box = self.px.box
         self.box = self._clipped(box) if box is not None else None
@@ -987,15 +1103,29 @@ class Painter(Backdrop):
         if self.energy:
             self._energy_scale()
         self.base = self._base()
+        self.body_px = BODY_PX * max(1.0, u)
         self._views()
         self.tx_time, self.tx_text = _Text(self.st_time), _Text(self.st_text)
-        self.label_box = (4 * u, 2 * u, 150 * u, 24 * u)
+        # The time label's box: wider when the longest label needs it (a large t0, a long
+        # time unit), so that each label is drawn over the whole of the one before.
+        longest = max((self._time_label(k) for k in range(self.n)), key=len, default="")
+        self.label_box = (4 * u, 2 * u, max(150 * u, self.st_time.width(longest) + 12 * u),
+                          24 * u)
         self._bg_key: tuple[int, int] | None = None
         self._layer: Layer | None = None
         self._canvas: Image.Image | None = None
         self._shown: dict[str, Any] = {}
         self._flat: dict[tuple[int, int], bool] = {}
         self.changed: tuple[float, float, float, float] | None = None
+        # The shapes drawn, each body at least BODY_PX across, per set of shapes and scale.
+        self._drawn: dict[tuple[int, float], Shapes] = {}
+        #: Numbers of the moving bodies drawn larger than to scale (to be body_px across).
+        self.grown: set[int] = set()
+        # Per moving body's number: in how many frames it is, and is in the picture.
+        bodies = max((int(sh.number.max()) + 1 for sh in rec.shapes if sh.n), default=0)
+        self.frames_in = np.zeros(bodies, dtype=np.int64)
+        self.frames_shown = np.zeros(bodies, dtype=np.int64)
+        self._present: dict[int, tuple] = {}
 
     # --- geometry -----------------------------------------------------------------------
 
@@ -1028,7 +1158,7 @@ class Painter(Backdrop):
         elif rec.camera == "all":
             box = fit(all_box(rec), aw, ah)
         else:
-            box = fit(auto_box(rec), aw, ah)
+            box = auto_view(rec, aw, ah, self.body_px)
         self.views = [View.of(box, self.area, rec.y_up)] * self.n
 
     @property
@@ -1047,7 +1177,14 @@ class Painter(Backdrop):
         bx0, _, bx1, _ = self.bars_box
         widest = max(abs(scale.lo), scale.hi)
         self.value_w = round(self.st_text.width(f"-{widest:.{scale.decimals}f}") + 8 * self.u)
-        self.bar_left = bx0 + round(70 * self.u)
+        # The bars start right of the longest name (a negative bar reaching the scale's
+        # low end must not paint over it: issue 29), and at least LABEL_ROOM from the left.
+        labels = self.rec.labels or {}
+        name_font = font(round(TEXT_PX * self.u))
+        names_end = (round(SWATCH * self.u) + SWATCH_GAP * self.u
+                     + max(name_font.getlength(labels.get(n, n)) for n in self.names))
+        self.bar_left = bx0 + max(round(LABEL_ROOM * self.u),
+                                  math.ceil(names_end + NAME_GAP * self.u))
         self.bar_right = bx1 - self.value_w
         self.bar_scale = (self.bar_right - self.bar_left) / scale.span
         self.bar_zero = self.bar_left - scale.lo * self.bar_scale
@@ -1153,7 +1290,9 @@ class Painter(Backdrop):
         when theirs changed."""
         fresh = self.background(k)
         view = self.views[k]
-        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat)
+        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat,
+                      self._shapes(self.rec.shape_of[k], view))
+        self._count(layer)
         touched: list[tuple[float, float, float, float]] | None = []
         if fresh or self._canvas is None or self._layer is None:
             self._canvas, self._shown, touched = self.bg.copy(), {}, None
@@ -1195,6 +1334,41 @@ class Painter(Backdrop):
             self.changed = _union_px(touched) if touched else (0.0, 0.0, 0.0, 0.0)
         return img
 
+    def _shapes(self, i: int, view: View) -> Shapes:
+        """Set ``i`` of moving shapes as drawn through ``view``: each body at least
+        :attr:`body_px` across (:meth:`Shapes.at_least`); the same object for the same set
+        and scale, so that frames compare their pixels."""
+        key = (i, view.s)
+        got = self._drawn.get(key)
+        if got is None:
+            got, grown = self.rec.shapes[i].at_least(view.s, self.body_px)
+            self._drawn[key] = got
+            self.grown.update(grown.tolist())
+        return got
+
+    def _count(self, layer: Layer) -> None:
+        """Count the moving bodies of a frame, and those it shows (a shape of theirs drawn
+        on the scene panel)."""
+        px, n = layer.px, layer.px.n_shapes
+        if not n or not len(self.frames_in):
+            return
+        shapes = px.shapes
+        got = self._present.get(id(shapes))
+        if got is None or got[0] is not shapes:
+            number = shapes.number  # type: ignore[union-attr]
+            mine = number >= 0
+            present = np.bincount(number[mine], minlength=len(self.frames_in)) > 0
+            got = self._present[id(shapes)] = (shapes, number, mine, present)
+        _, number, mine, present = got
+        self.frames_in += present
+        box = px.box
+        if box is not None and px.ok[:n].all() and box[0] >= 0 and box[1] >= 0 and (
+                box[2] <= self.scene_w and box[3] <= self.H):
+            self.frames_shown += present  # everything drawn is on the panel
+            return
+        shown = px.within((0.0, 0.0, float(self.scene_w), float(self.H)))[:n] & mine
+        self.frames_shown += np.bincount(number[shown], minlength=len(self.frames_in)) > 0
+
     def _restore(self, box: tuple[float, float, float, float]) -> tuple[int, int, int, int]:
         """Put the background back over the whole pixels that cover ``box`` (px); returns
         them (left, top, right, bottom)."""
@@ -1210,7 +1384,7 @@ class Painter(Backdrop):
         """Draw the time label if it changed or the scene was drawn over it; the box
         touched."""
         u, box = self.u, self.label_box
-        label = f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
+        label = self._time_label(k)
         if self._shown.get("label") == label and not any(_meets(r, box) for r in scene):
             return []
         self._shown["label"] = label
@@ -1222,6 +1396,9 @@ class Painter(Backdrop):
             self.st_time.draw(crop, (6 * u - cx, 6 * u - cy), label, INK, "lt")
             done()
         return [box]
+
+    def _time_label(self, k: int) -> str:
+        return f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
 
     def _values_box(self) -> tuple[float, float, float, float]:
         """Where the bars' values are written (px)."""
@@ -1427,6 +1604,7 @@ def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) ->
     with _signals_end_cleanly():
         if path.suffix.lower() == ".mp4":
             _write_mp4(path, painter, rec.fps)
+
         else:
             with atomic_output(path) as tmp, open(tmp, "wb") as fh:
                 stats["draw"], stats["encode"] = write_frames(

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Self, overload
 
 import numpy as np
 
+from .._display import counted
 from ..errors import UsageError
 from ..io.files import atomic_output
 from ..model.scene import GifSettings
@@ -76,7 +77,7 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
         n = frame_count(t_end, fps)
         if n <= max_frames:
             return n
-        count = f"{n:,} frames"
+        count = counted(n, "frame", grouped=True)
     else:
         count = (f"{math.ceil(t_end * fps):,} frames" if math.isfinite(t_end * fps)
                  else "more than 1e308 frames")
@@ -254,6 +255,7 @@ def render_gif(
     from ..model import args
     from .drawing import Painter
     from .gif import write_frames
+    from .picture import describe
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
@@ -274,7 +276,7 @@ def render_gif(
     check_frames(t_end, fps, max_frames)
     t0 = time.perf_counter()
     frames = frames_of(traj, fps, t_end)
-    painter = Painter(traj.scene, frames, (width, height), strip)
+    painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
     delays = delays_cs(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"

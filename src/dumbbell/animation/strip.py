@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from PIL import Image, ImageDraw
@@ -21,7 +22,7 @@ from .backdrop import Patch
 from .bars import EnergyScale
 from .frames import Frames
 from .glyphs import Stamps, fmt_tick, nice_step
-from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, term_inks, to_palette
+from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, palette, term_inks, to_palette
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []
@@ -32,6 +33,9 @@ __all__: list[str] = []
 WINDOW = 1.0
 #: Fraction of the strip's window after the cursor (what comes next).
 AHEAD = 0.25
+#: Opacity of what lies after the cursor (over white): it has not happened yet at the
+#: frame's time, so it is drawn faded.
+FUTURE = 0.25
 #: Width (px) of the pieces the strip's tape is drawn in.
 TAPE_CHUNK = 1024
 #: Time ticks per window (about).
@@ -43,6 +47,8 @@ BAND_PX = 3
 BAND_ALPHA = 0.45
 GRID = (238, 238, 238)     # the energy grid lines
 IMPACT = (216, 216, 216)   # the impacts' faint lines
+#: The names of the strip's axes: energy (left) and time (under it).
+ENERGY_AXIS, TIME_AXIS = "J", "t (s)"
 #: The strip, in units of u (px on the 640 x 360 reference frame).
 PAD = 4          # between the strip's frame and the highest and lowest energy
 TICK = 3         # length of a time tick under the strip (at least 2 px)
@@ -118,10 +124,34 @@ class Strip:
             y = self.y(v)
             d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(v), font=fs, fill=GREY,
                    anchor="rm")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), "J", font=fs, fill=GREY,
-               anchor="rs")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), "t (s)", font=fs,
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS, font=fs,
+               fill=GREY, anchor="rs")
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), TIME_AXIS, font=fs,
                fill=GREY, anchor="rt")
+
+    def curves(self, frames: Frames, names: Sequence[str]
+               ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], dict[str, bool]]:
+        """The series ``names`` of ``frames`` as the strip draws them, E last (on top): for
+        each term with at least two finite samples, its sample times (s), tape columns and
+        rows (px from the tape's top), and whether it is drawn as a pale band (its range
+        within one pixel column mostly wider than :data:`BAND_PX`: it changes faster than a
+        column shows) or as a line."""
+        order = [n for n in names if n != "E"] + ["E"]
+        t = frames.series_t
+        cols_all = np.floor(t * self.px_per_s).astype(np.int64)
+        series: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        band: dict[str, bool] = {}
+        for name in order:
+            ys = self.y(frames.series[name]) - self.tape_y
+            ok = np.isfinite(ys)
+            if ok.sum() < 2:
+                continue
+            c, y = cols_all[ok], ys[ok]
+            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
+            series[name] = (t[ok], c, y)
+            band[name] = bool(np.median(np.maximum.reduceat(y, starts)
+                                        - np.minimum.reduceat(y, starts)) > BAND_PX)
+        return series, band
 
     def tape(self, frames: Frames, names: Sequence[str]) -> Tape:
         """The energy time series ``names`` of the whole animation as a :class:`Tape` at the
@@ -133,8 +163,12 @@ class Strip:
         """The window of ``tape`` a frame at ``t`` (s) shows, its time labels (on a crop from
         ``patch``, reaching to the frame's right edge) and the cursor."""
         left, x = self.offset(t)
-        img.paste(tape.crop((left, 0, left + self.inner_w, self.tape_h)),
-                  (self.inner_x, self.tape_y))
+        window = tape.crop((left, 0, left + self.inner_w, self.tape_h))
+        # What lies after the cursor has not happened yet: faded, down to the strip's foot.
+        future = (x - left + 1, 0, self.inner_w, tape.edge)
+        if future[2] > future[0]:
+            window.paste(window.crop(future).point(fade_table()), future[:2])
+        img.paste(window, (self.inner_x, self.tape_y))
         sx0, _, _, sy1 = self.box
         u, W = self.u, img.width
         y = sy1 + self.tick_len + 1
@@ -155,6 +189,19 @@ class Strip:
                                  width=max(1, round(CURSOR * u)))
 
 
+@lru_cache(maxsize=1)
+def fade_table() -> list[int]:
+    """For each palette index, the index of its colour at opacity :data:`FUTURE` over white
+    (the nearest in the palette); the index kept for 'unchanged' stays itself."""
+    pal, clear = palette()
+    rgb = np.frombuffer(pal, dtype=np.uint8).reshape(256, 3).astype(float)
+    faded = 255.0 + (rgb - 255.0) * FUTURE
+    nearest = ((faded[:, None, :] - rgb[None, :clear, :]) ** 2).sum(axis=2).argmin(axis=1)
+    table = nearest.tolist()
+    table[clear] = clear
+    return table
+
+
 class Tape:
     """The energy time series ``names`` of the whole animation on one long palette strip at
     the ``strip``'s time scale (grid, bottom edge, time and impact ticks included), drawn
@@ -169,7 +216,6 @@ class Tape:
     def __init__(self, strip: Strip, frames: Frames, names: Sequence[str]):
         fr, S = frames, 1
         self.strip, self.width, self.height = strip, strip.tape_w, strip.tape_h
-        p = strip.px_per_s
         self.grid_y = [(strip.y(v) - strip.tape_y) * S for v in strip.scale.ticks()]
         self.edge = (strip.box[3] - strip.tape_y) * S
         self.ticks = [k * strip.t_step
@@ -179,21 +225,7 @@ class Tape:
         self.contacts = [(self.edge - (1 if body == "B" else 2) * self.bar, TERM_RGB[body], t0,
                           min(t1, fr.t_end)) for body, t0, t1 in fr.contacts if t0 <= fr.t_end]
         # Fast terms as pale bands, the others as lines; E on top.
-        order = [n for n in names if n != "E"] + ["E"]
-        t = fr.series_t
-        cols_all = np.floor(t * p * S).astype(np.int64)
-        self.series: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self.band: dict[str, bool] = {}
-        for name in order:
-            ys = (strip.y(fr.series[name]) - strip.tape_y) * S
-            ok = np.isfinite(ys)
-            if ok.sum() < 2:
-                continue
-            c, y = cols_all[ok], ys[ok]
-            starts = np.flatnonzero(np.r_[True, c[1:] != c[:-1]])
-            self.series[name] = (t[ok], c, y)
-            self.band[name] = bool(np.median(np.maximum.reduceat(y, starts)
-                                             - np.minimum.reduceat(y, starts)) > BAND_PX * S)
+        self.series, self.band = strip.curves(fr, names)
         self.pieces: dict[int, Image.Image] = {}
 
     def piece(self, c0: int) -> Image.Image:

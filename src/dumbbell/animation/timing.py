@@ -26,7 +26,7 @@ def check_fps(fps: Any, where: str = "fps") -> int:
     """``fps`` as an int in 1..50, else a UsageError naming ``where`` and why."""
     if isinstance(fps, bool) or not isinstance(fps, int | np.integer) or not 1 <= fps <= MAX_FPS:
         raise UsageError(
-            f"{where} = {fps}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
+            f"{where} = {args.show(fps)}: must be a whole number from 1 to {MAX_FPS} (GIF delays are "
             "stored in 10 ms units; browsers show delays of 10 ms or less as 100 ms)",
             param=where.lstrip("-") if isinstance(where, str) else None)
     return int(fps)
@@ -34,9 +34,12 @@ def check_fps(fps: Any, where: str = "fps") -> int:
 
 def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, int]:
     """``'640x360'`` or (640, 360) as (width, height) px, else a UsageError."""
-    if isinstance(size, tuple | list) and len(size) == 2:
-        size = f"{size[0]}x{size[1]}"
-    found = pixel_size(size)
+    text = size
+    if isinstance(size, tuple | list) and len(size) == 2 and all(
+            isinstance(v, int | np.integer) and not isinstance(v, bool) and 0 <= v < 10**6
+            for v in size):  # (huge numbers are not spelt out: int -> str is quadratic)
+        text = f"{size[0]}x{size[1]}"
+    found = pixel_size(text)
     if found is None:
         raise UsageError(f"{where}: {args.show(size)}: {SIZE_RULE}",
                          param=where.lstrip("-") if isinstance(where, str) else None)

@@ -63,6 +63,12 @@ TIME_BOX = (4, 2)     # the time label's crop: from the left and top edges ...
 TIME_BOTTOM_1D, TIME_BOTTOM_2D = 22, 34  # ... down to here (2D: the angle's line too)
 TIME_AT = 6           # the time label, this far from the left and top edges
 ANGLE_AT = 24         # the angle's line, this far from the top edge
+#: The ruler's title, the word under an impact's mark, and the time and angle labels (the
+#: time's format: its decimals; the angle's: the text around its value in degrees).
+RULER_NAME = "height (m)"
+IMPACT_WORD_TEXT = "impact"
+TIME_DECIMALS = 2
+ANGLE_TEXT = ("axis ", "° from vertical")
 
 
 def axis_angle(pa: tuple[float, float], pb: tuple[float, float]) -> float:
@@ -121,31 +127,60 @@ def zigzag(p0: tuple[float, float], p1: tuple[float, float], amp: float, coils: 
 
 @dataclass(frozen=True)
 class World:
-    """The scene panel of one animation: the dumbbell ``system`` on the ``layout``."""
+    """The scene panel of one animation, as drawn: the ``layout``, the scene's
+    ``dimensions``, each particle's drawn radius (px, at least :data:`MIN_RADIUS_PX` u:
+    ``radius_px`` of A and B), A's share of the mass (``weight_a``: where the centre of mass
+    sits between them), what joins them (``link``: "spring", "rod" or "none") and the
+    spring's zig-zag half-width (``amp``, px), the floor (``floor_y``: the pixel row of its
+    surface, a particle's drawn radius below the row where particle centres meet it, since
+    the model's floor is where the centres touch it; None without a floor) and the height
+    ruler's ticks ((pixel row, label), ...)."""
 
-    system: System
     layout: Layout
+    dimensions: int
+    radius_px: tuple[float, float]
+    weight_a: float
+    link: str
+    amp: float
+    floor_y: float | None
+    ruler: tuple[tuple[float, str], ...]
+
+    @classmethod
+    def build(cls, system: System, layout: Layout) -> World:
+        """The scene panel of the dumbbell ``system`` on ``layout``."""
+        L, u = layout, layout.u
+        ra = max(system.A.radius * L.s, MIN_RADIUS_PX * u)
+        rb = max(system.B.radius * L.s, MIN_RADIUS_PX * u)
+        rest = (system.spring.rest_length if system.spring else
+                system.rigid.length if system.rigid else 0.0)
+        amp = max((CM_RADIUS + 1.5) * u, min(ZIGZAG_SHARE * rest * L.s, ZIGZAG_MAX * u))
+        link = "rod" if system.rigid is not None else "spring" if system.spring else "none"
+        # Where the particle centres meet the floor is height 0; a disc of the drawn radius
+        # resting there reaches that far below it (the larger disc, when the two differ:
+        # no particle is ever drawn inside the floor).
+        floor_y = L.px(0.0, 0.0)[1] + max(ra, rb) if system.floor is not None else None
+        _, _, y0, y1 = L.world
+        step = nice_step((y1 - y0) / 5)
+        lo, hi = math.ceil(y0 / step - 1e-9), math.floor(y1 / step + 1e-9)
+        ruler = tuple((L.px(0, k * step)[1], fmt_tick(k * step)) for k in range(lo, hi + 1))
+        return cls(layout, system.dimensions, (ra, rb), system.A.mass / system.M, link, amp,
+                   floor_y, ruler)
 
     def draw_static(self, d: ImageDraw.ImageDraw, S: int, fs) -> None:
         """The floor and the height ruler on a background ``S`` times the size."""
         L, u, H = self.layout, self.layout.u, self.layout.H
-        if self.system.floor is not None:
-            _, fy = L.px(0.0, 0.0)
+        if self.floor_y is not None:
+            # The surface is the line's top edge: a particle resting on the floor touches it.
+            fy, line = self.floor_y, round(FLOOR_LINE * u * S)
             d.rectangle([0, fy * S, L.scene_w * S, H * S], fill=FLOOR)
-            d.line([(0, fy * S), (L.scene_w * S, fy * S)], fill=GREY,
-                   width=round(FLOOR_LINE * u * S))
-        _, _, y0, y1 = L.world
-        step = nice_step((y1 - y0) / 5)
+            d.line([(0, fy * S + line / 2), (L.scene_w * S, fy * S + line / 2)], fill=GREY,
+                   width=line)
         rx = L.ruler_x * S
-        lo, hi = math.ceil(y0 / step - 1e-9), math.floor(y1 / step + 1e-9)
-        ya, yb = L.px(0, lo * step)[1], L.px(0, hi * step)[1]
-        d.line([(rx, ya * S), (rx, yb * S)], fill=GREY, width=S)
-        for k in range(lo, hi + 1):
-            y = L.px(0, k * step)[1] * S
-            d.line([(rx - RULER_TICK * u * S, y), (rx, y)], fill=GREY, width=S)
-            d.text((rx - RULER_LABEL * u * S, y), fmt_tick(k * step), font=fs, fill=GREY,
-                   anchor="rm")
-        d.text((RULER_TITLE[0] * u * S, (H - RULER_TITLE[1] * u) * S), "height (m)", font=fs,
+        d.line([(rx, self.ruler[0][0] * S), (rx, self.ruler[-1][0] * S)], fill=GREY, width=S)
+        for y, label in self.ruler:
+            d.line([(rx - RULER_TICK * u * S, y * S), (rx, y * S)], fill=GREY, width=S)
+            d.text((rx - RULER_LABEL * u * S, y * S), label, font=fs, fill=GREY, anchor="rm")
+        d.text((RULER_TITLE[0] * u * S, (H - RULER_TITLE[1] * u) * S), RULER_NAME, font=fs,
                fill=GREY, anchor="ls")
 
     def draw_dumbbell(self, frames: Frames, k: int, impact: bool,
@@ -154,46 +189,42 @@ class World:
         """Frame ``k``'s dumbbell (``impact``: with the mark of an impact since the previous
         frame) on a crop from ``patch`` at :data:`SS` times the size; ``letters`` and
         ``small`` are fonts at that size."""
-        sc, L, u, S = self.system, self.layout, self.layout.u, SS
+        L, u, S = self.layout, self.layout.u, SS
         (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
         if not all(math.isfinite(v) for v in (ax, ay, bx, by)):
             return
         pa, pb = L.px(ax, ay), L.px(bx, by)
-        ra = max(sc.A.radius * L.s, MIN_RADIUS_PX * u)
-        rb = max(sc.B.radius * L.s, MIN_RADIUS_PX * u)
-        rest = sc.spring.rest_length if sc.spring else sc.rigid.length if sc.rigid else 0.0
-        amp = max((CM_RADIUS + 1.5) * u, min(ZIGZAG_SHARE * rest * L.s, ZIGZAG_MAX * u))
-        two_d = sc.dimensions == 2
+        (ra, rb), amp = self.radius_px, self.amp
+        two_d = self.dimensions == 2
         m = max(ra, rb, amp) + (CROP_2D if two_d else CROP_1D) * u
-        impact = impact and sc.floor is not None
+        floor_y = self.floor_y
+        impact = impact and floor_y is not None
         mx = m + (LABELS_2D * u if two_d else 0)
         x0, x1 = min(pa[0], pb[0]) - mx, max(pa[0], pb[0]) + mx + LABELS_RIGHT * u
         y0, y1 = min(pa[1], pb[1]) - mx, max(pa[1], pb[1]) + (mx if two_d else m)
         if impact:  # the mark on the floor and the word under it
-            fy = L.px(0.0, 0.0)[1]
             low = pa if pa[1] > pb[1] else pb
             x0, x1 = min(x0, low[0] - IMPACT_CROP * u), max(x1, low[0] + IMPACT_CROP * u)
-            y1 = max(y1, fy + IMPACT_WORD * u)
+            y1 = max(y1, floor_y + IMPACT_WORD * u)
         crop, (cx, cy), done = patch((x0, y0, x1, y1))
         d = ImageDraw.Draw(crop)
 
         def P(p: tuple[float, float]) -> tuple[float, float]:
             return ((p[0] - cx) * S, (p[1] - cy) * S)
 
-        w = sc.A.mass / sc.M
+        w = self.weight_a
         pc = (w * pa[0] + (1 - w) * pb[0], w * pa[1] + (1 - w) * pb[1])
         if two_d:
             self._angle(d, P, pa, pb, pc)
         if impact:
-            fy = L.px(0.0, 0.0)[1]
             low = pa if pa[1] > pb[1] else pb
-            x, y = P((low[0], fy))
+            x, y = P((low[0], floor_y))
             d.line([(x - IMPACT_MARK * u * S, y), (x + IMPACT_MARK * u * S, y)], fill=BLACK,
                    width=round(IMPACT_LINE * u * S))
-            small.draw(crop, (x, y + IMPACT_GAP * u * S), "impact", INK, "mt")
-        if sc.rigid is not None:
+            small.draw(crop, (x, y + IMPACT_GAP * u * S), IMPACT_WORD_TEXT, INK, "mt")
+        if self.link == "rod":
             d.line([P(pa), P(pb)], fill=SPRING, width=round(ROD_LINE * u * S))
-        elif sc.spring is not None:
+        elif self.link == "spring":
             d.line([P(p) for p in zigzag(pb, pa, amp, COILS)], fill=SPRING,
                    width=max(2, round(ZIGZAG_LINE * u * S)), joint="curve")
         else:
@@ -205,7 +236,7 @@ class World:
         dx, dy = pa[0] - pb[0], pa[1] - pb[1]
         dist = math.hypot(dx, dy)
         ex, ey = (dx / dist, dy / dist) if two_d and dist > 0 else (0.0, 0.0)
-        floor_y = L.px(0.0, 0.0)[1] if sc.floor is not None else math.inf
+        floor_y = math.inf if floor_y is None else floor_y
         outline = max(1, round(OUTLINE * u * S))
         for p, r, name, sign in ((pa, ra, "A", 1), (pb, rb, "B", -1)):
             x, y = P(p)
@@ -252,16 +283,16 @@ class World:
                   time: Stamps, note: Stamps) -> None:
         """Frame ``k``'s time and, in 2D, its axis angle from vertical, top left."""
         L, u = self.layout, self.layout.u
-        two_d = self.system.dimensions == 2
+        two_d = self.dimensions == 2
         box = (round(TIME_BOX[0] * u), round(TIME_BOX[1] * u), L.scene_w - round(TIME_BOX[0] * u),
                round((TIME_BOTTOM_2D if two_d else TIME_BOTTOM_1D) * u))
         crop, (cx, cy), done = patch(box)
-        time.draw(crop, (TIME_AT * u - cx, TIME_AT * u - cy), f"t = {frames.t[k]:.2f} s", INK,
+        time.draw(crop, (TIME_AT * u - cx, TIME_AT * u - cy), f"t = {frames.t[k]:.{TIME_DECIMALS}f} s", INK,
                   "lt")
         if two_d:
             (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
             if all(math.isfinite(v) for v in (ax, ay, bx, by)) and (ax, ay) != (bx, by):
                 theta = axis_angle(L.px(ax, ay), L.px(bx, by))
                 note.draw(crop, (TIME_AT * u - cx, ANGLE_AT * u - cy),
-                          f"axis {theta:+.0f}° from vertical", GREY, "lt")
+                          f"{ANGLE_TEXT[0]}{theta:+.0f}{ANGLE_TEXT[1]}", GREY, "lt")
         done()

@@ -2,8 +2,10 @@
 :mod:`dumbbell.cli` and provides ``register(subparsers)``.
 
 Exit status: 0 done; 2 bad input (one line naming the file, key or flag and what is allowed;
-nothing written); 3 a run ended with a verdict other than ``ok``; 128+N stopped by signal N
-(SIGINT, SIGTERM, SIGHUP; nothing written, pool workers stopped).
+nothing written); 3 a run ended early (a verdict unstable, tunnelled or failed); 4 a run
+reached its end but is ``inaccurate`` (its energy error passed ``run.inaccurate_energy``;
+every output written); 128+N stopped by signal N (SIGINT, SIGTERM, SIGHUP; nothing
+written, pool workers stopped).
 """
 
 from __future__ import annotations
@@ -25,11 +27,30 @@ from ..errors import DumbbellError, UsageError
 from ..parallel import STOP_SIGNALS
 
 #: Subcommand modules, in the order ``--help`` lists them.
-COMMANDS = ("run", "simulate", "compare", "render", "bench", "stability", "sweep",
+COMMANDS = ("run", "simulate", "compare", "render", "play", "bench", "stability", "sweep",
             "restitution")
 
 EXIT_USAGE = 2
 EXIT_VERDICT = 3
+EXIT_INACCURATE = 4
+#: The exit statuses of runs, from best to worst: a command that makes several runs exits
+#: with the worst (an early end is worse than an inaccurate run).
+RUN_STATUSES = (0, EXIT_INACCURATE, EXIT_VERDICT)
+
+
+def verdict_status(verdict: Any) -> int:
+    """The exit status of a run's verdict: 0 ``ok``, :data:`EXIT_INACCURATE` for a run that
+    reached its end but is ``inaccurate``, :data:`EXIT_VERDICT` for one that ended early."""
+    if verdict.ok:
+        return 0
+    return EXIT_INACCURATE if verdict.complete else EXIT_VERDICT
+
+
+def worst_status(*statuses: int) -> int:
+    """The worst of exit statuses: a status outside :data:`RUN_STATUSES` (a usage error,
+    a signal) first, then by that order."""
+    return max(statuses, key=lambda s: RUN_STATUSES.index(s) if s in RUN_STATUSES
+               else len(RUN_STATUSES) + s, default=0)
 
 
 #: Longest run of characters without a space a message may echo (a value, a path): longer
@@ -37,25 +58,22 @@ EXIT_VERDICT = 3
 MAX_ECHO = 200
 
 
-#: Longest line a message may be: past it, its middle goes (an echo of many short words,
-#: a key of 80,000 characters with spaces in it).
-MAX_LINE = 1000
-
-
 def clip(text: str, limit: int = MAX_ECHO) -> str:
     """``text`` with every word (a run without spaces) longer than ``limit`` characters cut
-    to its first ``limit - 23`` and last 20 around '...': a message echoing a huge value
-    (10,000 tilts, a 5,000-digit number, a 4,000-character path) stays short; and then at
-    most :data:`MAX_LINE` characters, its start and end kept around ' ... '."""
-    text = " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
-                    for w in str(text).split(" "))
-    return text if len(text) <= MAX_LINE else f"{text[:MAX_LINE - 305]} ... {text[-300:]}"
+    to its first ``limit - 23`` and last 20 around '...', and the whole at most ``5 *
+    limit`` characters (its first ``3 * limit - 3`` and last ``2 * limit`` around '...'): a
+    message echoing a huge value (10,000 tilts, a 5,000-digit number, a 4,000-character
+    path, a key of many words) stays short, and keeps its end, which says what is allowed."""
+    out = " ".join(w if len(w) <= limit else f"{w[:limit - 23]}...{w[-20:]}"
+                   for w in str(text).split(" "))
+    return out if len(out) <= 5 * limit else f"{out[:3 * limit - 3]}...{out[-2 * limit:]}"
 
 
 def one_line(text: str) -> str:
     """``text`` with every character that is not printable (newlines, control characters,
     line and record separators) escaped, so that a message echoing user input stays one line,
-    and no word longer than :data:`MAX_ECHO` characters (:func:`clip`)."""
+    and no word longer than :data:`MAX_ECHO` characters, nor the whole longer than five
+    times that (:func:`clip`)."""
     return clip("".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text)))
 
 
@@ -165,7 +183,9 @@ def build_parser(commands: Sequence[str] = COMMANDS) -> Parser:
         prog="dumbbell",
         description="How a body's mechanical energy is shared between centre-of-mass and "
                     "internal motion: the bouncing dumbbell of textbook section 13.5.1.",
-        epilog="Exit status: 0 done, 2 bad input, 3 a run ended with a verdict other than ok.",
+        epilog="Exit status: 0 done, 2 bad input, 3 a run ended early (unstable, tunnelled or "
+               "failed), 4 a run reached its end but is inaccurate (its energy error passed "
+               "run.inaccurate_energy; every output written).",
     )
     parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
@@ -410,8 +430,8 @@ def as_flags(exc: DumbbellError, args: argparse.Namespace | None = None) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``dumbbell`` console script; returns the exit status: 0 done, 2 bad
-    input, 3 a verdict other than ok, 128+N stopped by signal N (SIGINT 130, SIGTERM 143,
-    SIGHUP 129)."""
+    input, 3 a run ended early, 4 a run is inaccurate, 128+N stopped by signal N (SIGINT 130,
+    SIGTERM 143, SIGHUP 129)."""
     command = "dumbbell"
     state: dict[str, object] = {}
     # Without argv, this is the process's own command (the console script, python -m):

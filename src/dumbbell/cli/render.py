@@ -9,13 +9,13 @@ from pathlib import Path
 from ..animation.render import MAX_FRAMES
 from .app import (
     DEFAULT_OUT,
-    EXIT_VERDICT,
     _shown,
     add_quiet,
     add_scene,
     positive_float,
     positive_int,
     read_scene,
+    verdict_status,
 )
 
 #: What ``dumbbell render --help`` says the command does.
@@ -96,8 +96,7 @@ def run(args: argparse.Namespace) -> int:
         sys.stderr.write(f"wrote {out}\n")
     if not traj.verdict.ok:
         sys.stderr.write(f"dumbbell render: {scene.name}: {traj.solver}: {traj.verdict}\n")
-        return EXIT_VERDICT
-    return 0
+    return verdict_status(traj.verdict)
 
 
 def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, quiet: bool = True,
@@ -115,7 +114,7 @@ def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, qui
     every = sample_every(options.dt, fps, options.t_end, scene.run.every)
     if (traj is not None and traj.every == every and traj.dt == options.dt
             and (solver is None or traj.solver == solver)
-            and (not traj.verdict.ok  # ended early: a new run would end there too
+            and (not traj.verdict.complete  # ended early: a new run would end there too
                  or traj.t[-1] >= options.t_end - options.dt * every / 2)):
         return traj
     return simulate(scene, solver, t_end=options.t_end, every=every, quiet=quiet)

@@ -111,9 +111,7 @@ def run(args: argparse.Namespace) -> int:
         result = restitution(scene, args.theta, tuple(args.stiffness), args.dt,
                              progress=progress.update)
     write_csv(result, csv)
-    fig = draw(result)[0].figure
-    fig.tight_layout()
-    save_figure(fig, png)
+    save_figure(draw(result)[0].figure, png)
     print(markdown(result))
     if not args.quiet:
         for path in (csv, png):

@@ -125,12 +125,12 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
               max_frames: int = MAX_FRAMES) -> int:
     """Make every output ``scene`` asks for in ``out``, refusing a run that would keep more
     than ``max_samples`` samples or a GIF of more than ``max_frames`` frames; returns the
-    exit status (0 or 3). The figures are drawn beside the CSVs and the GIF, in a forked
+    exit status (0, 3 or 4: :func:`~.app.verdict_status`). The figures are drawn beside the CSVs and the GIF, in a forked
     process, where there is a CPU for it (:mod:`.beside`); the bytes are the same either
     way."""
     from ..io.files import atomic_output
     from ..solvers import simulate
-    from .app import EXIT_VERDICT
+    from .app import verdict_status
     from .beside import beside
 
     names = dict(outputs(scene, out))
@@ -160,8 +160,7 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
             sys.stderr.write(f"wrote {path}\n")
     if not traj.verdict.ok:
         sys.stderr.write(f"dumbbell run: {scene.name}: {traj.solver}: {traj.verdict}\n")
-        return EXIT_VERDICT
-    return 0
+    return verdict_status(traj.verdict)
 
 
 def _write_rest(scene, traj: Any, names: dict[str, Path], quiet: bool, max_frames: int
@@ -218,13 +217,9 @@ def _figure(name: str, traj: Any) -> Any:
     if name == "contact":
         from ..analysis.contact import about_contact
 
-        ax = plot.contact_momentum(about_contact(traj), solver=traj.solver)
-        ax.figure.tight_layout()
-        return ax
+        return plot.contact_momentum(about_contact(traj), solver=traj.solver)
     if name == "topple":
         from ..analysis.topple import closed_form, measure
 
-        axes = plot.topple(closed_form(traj.scene), measure(traj), solver=traj.solver)
-        axes[0].figure.tight_layout()
-        return axes[0]
+        return plot.topple(closed_form(traj.scene), measure(traj), solver=traj.solver)[0]
     return getattr(plot, name)(traj)

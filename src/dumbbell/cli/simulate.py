@@ -9,13 +9,13 @@ from pathlib import Path
 from ..errors import UsageError
 from ..solvers.base import MAX_SAMPLES, MAX_STEPS
 from .app import (
-    EXIT_VERDICT,
     add_quiet,
     add_scene,
     positive_float,
     positive_int,
     read_scene,
     stdout_closed,
+    verdict_status,
 )
 
 #: What ``dumbbell simulate --help`` says the command does.
@@ -74,5 +74,4 @@ def run(args: argparse.Namespace) -> int:
         write_events(traj, Path(args.events))
     if not traj.verdict.ok:
         sys.stderr.write(f"dumbbell simulate: {traj.solver}: {traj.verdict}\n")
-        return EXIT_VERDICT
-    return 0
+    return verdict_status(traj.verdict)

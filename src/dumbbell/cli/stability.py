@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .._display import counted
 from .app import add_out, add_quiet, options, positive_int
 
 if TYPE_CHECKING:
@@ -105,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.quiet:
         rows = result["rows"]
         bad = sum(not r.agrees for r in rows)
-        sys.stderr.write(f"{len(rows)} runs, {len(rows) - bad} agree with the theory, "
+        sys.stderr.write(f"{counted(len(rows), 'run')}, {len(rows) - bad} agree with the theory, "
                          f"{bad} disagree\n")
         for path in result["written"]:
             sys.stderr.write(f"wrote {path}\n")

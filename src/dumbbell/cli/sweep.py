@@ -6,6 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from .._display import counted
 from .app import add_out, add_quiet, positive_float, positive_int, read_scene
 
 #: What ``dumbbell sweep --help`` says the command does.
@@ -97,6 +98,6 @@ def run(args: argparse.Namespace) -> int:
     save_figure(sweep_map(result).figure, png_path, dpi=100)
     if not args.quiet:
         counts = ", ".join(f"{n} {v}" for v, n in sorted(result.counts().items()))
-        sys.stderr.write(f"{len(result.rows)} runs ({counts}) in {result.wall_time:.2f} s on "
+        sys.stderr.write(f"{counted(len(result.rows), 'run')} ({counts}) in {result.wall_time:.2f} s on "
                          f"{result.backend}\nwrote {csv_path}\nwrote {png_path}\n")
     return 0

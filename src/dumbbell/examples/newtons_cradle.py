@@ -16,6 +16,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.newtons_cradle``.
@@ -99,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("newtons_cradle", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle") as rec:
+    with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle", units="m") as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec)
     results = [(args.dt, first), (args.dt / 10, measure(args.dt / 10, args.seconds, args.fps))]
@@ -107,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"dt = {dt:.3g} s over {args.seconds:g} s: energy drift max "
               f"{m['energy_drift_max']:.2e}, at the end {m['energy_drift_end']:.2e}; momentum "
               f"change across an impact max {m['momentum_change_max']:.2e}")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

@@ -20,6 +20,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.pendulum``.
@@ -103,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("pendulum", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring",
+    with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring", units="m",
                          world=(-0.45, 0.45, -0.55, 0.55)) as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec)
@@ -114,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{(m['period'] - T0) / T0:+.3%} from the small-angle formula, "
               f"{(m['period'] - T1) / T1:+.1e} from the corrected one; energy drift max "
               f"{m['energy_drift_max']:.2e}")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

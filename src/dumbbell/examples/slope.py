@@ -16,6 +16,7 @@ import math
 import sys
 from typing import Any
 
+from .._display import counted
 from . import arguments, check_run, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.slope``.
@@ -60,7 +61,7 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
 
     dt, seconds, fps = check_run(dt, seconds, fps, space, recorder, heat)
     space = build() if space is None else space
-    heat = spaces.HeatCounter(space) if heat is None else heat
+    heat = spaces.HeatCounter(space, units="m") if heat is None else heat
     box = next(iter(space.bodies))
     start = box.position
     e0 = spaces.energy(space).E
@@ -80,9 +81,9 @@ def main(argv: list[str] | None = None) -> int:
     args = arguments("slope", __doc__, 2.0, argv)
     space = build()
     print_guard(space, args)
-    heat = spaces.HeatCounter(space)
+    heat = spaces.HeatCounter(space, units="m")
     c, s = math.cos(ANGLE), math.sin(ANGLE)
-    with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope",
+    with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope", units="m",
                          world=(-0.1, RAMP * c + 0.05, -0.15, RAMP * s + 0.45)) as rec:
         rec.capture()
         first = measure(args.dt, args.seconds, args.fps, space, rec, heat)
@@ -91,7 +92,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"dt = {dt:.3g} s: E(0) = {m['E0']:.5f} J, E(t) = {m['E']:.5f} J, heat "
               f"{m['heat']:.5f} J over {m['distance']:.3f} m; E(0) - E(t) - heat = {left:+.2e} J "
               f"({left / m['heat']:+.2e} of the heat)")
-    print(f"wrote {args.out} ({rec.frames} frames)")
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0
 
 

@@ -10,6 +10,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from .._display import counted, significant
 from ..analysis.bench import (
     CSV_COLUMNS,
     FIT_MAX_ERROR,
@@ -88,7 +89,7 @@ def markdown(result: BenchResult) -> str:
     lines = [
         (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
         f"truth: `{result.truth}`; position error over [0, {result.window:g}] s; time: min "
-        f"(median) of at least {result.repeat} runs after a warm-up; short runs are "
+        f"(median) of at least {counted(result.repeat, 'run')} after a warm-up; short runs are "
         f"repeated until {MIN_TIMED:g} s are timed."),
         "",
         ("| solver | dt (s) | steps | run time min (median) | position error (m) "
@@ -101,7 +102,7 @@ def markdown(result: BenchResult) -> str:
             time_s = f"{_ms(p.seconds)} ({_ms(p.seconds_median)})"
         else:
             time_s = f"~{_ms(p.seconds)} (estimate)"
-        verdict = p.status if p.ok else f"**{p.status}**" + (
+        verdict = p.status if p.complete else f"**{p.status}**" + (
             f" at {p.verdict_t:.3g} s" if p.verdict_t is not None else "")
         imp = _sci(p.impact_time_error)
         if p.impacts_truth:
@@ -113,10 +114,11 @@ def markdown(result: BenchResult) -> str:
     if result.fits:
         fit_text = "; ".join(
             f"{n} {f.order:.2f} (dt {dt_label(min(f.dts))}..{dt_label(max(f.dts))} s, "
-            f"{len(f.dts)} points{'' if f.expected is None else f'; its order {f.expected}'})"
+            f"{counted(len(f.dts), 'point')}{'' if f.expected is None else f'; its order {f.expected}'})"
             for n, f in result.fits.items())
         lines.append(f"Fitted order of the position error over [0, {result.window:g}] s "
-                     f"(least squares in log-log over the ok points with error between "
+                     f"(least squares in log-log over the points that reached their end with "
+                     f"error between "
                      f"{FIT_MIN_ERROR:g} and {FIT_MAX_ERROR:g} m): {fit_text}.")
     sp = result.speedups()
     if sp and sp.get("seconds"):
@@ -130,7 +132,7 @@ def markdown(result: BenchResult) -> str:
     if compile_parts:
         lines.append("JIT compile (or load from numba's cache) before the runs, not in the "
                      "times above: "
-                     + "; ".join(f"{n} {v:.3g} s" for n, v in compile_parts.items())
+                     + "; ".join(f"{n} {_ms(v)}" for n, v in compile_parts.items())
                      + " (the first numba solver also pays numba's one-time start-up).")
     for p in result.points:
         if p.ran and p.window != result.window:
@@ -140,13 +142,15 @@ def markdown(result: BenchResult) -> str:
 
 
 def _ms(seconds: float) -> str:
+    """A time in the unit that suits it (s, ms, µs), three significant digits with their
+    trailing zeros, so that times side by side show one precision: '30.0 ms; 19.2 ms'."""
     if not math.isfinite(seconds):
         return "-"
     if seconds >= 1:
-        return f"{seconds:.3g} s"
+        return f"{significant(seconds)} s"
     if seconds >= 1e-3:
-        return f"{seconds * 1e3:.3g} ms"
-    return f"{seconds * 1e6:.3g} µs"
+        return f"{significant(seconds * 1e3)} ms"
+    return f"{significant(seconds * 1e6)} µs"
 
 
 def write_markdown(result: BenchResult, path: Path) -> Path:

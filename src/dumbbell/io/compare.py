@@ -25,8 +25,12 @@ def _checked(result: Any) -> Comparison:
 #: Columns of SCENE-compare.csv (times in s, position errors in m, the energy error
 #: dimensionless; the measures of :mod:`dumbbell.analysis.metrics`). ``run_time_s`` is warm;
 #: ``warm_up_s`` what the first run paid on top (numba start-up, compile or cache load).
-SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m", "window_s",
-                   "error_passes_1mm_at_s", "energy_error", "impacts", "verdict", "warm_up_s")
+#: Each measure says its span: ``max_position_error_m`` covers [0, ``error_until_s``] (the
+#: window, ``window_s``, or up to ``parted_at_s``, where the runs part by chaos, when
+#: sooner); ``energy_error`` and ``impacts`` cover the whole run, [0, ``run_until_s``].
+SUMMARY_COLUMNS = ("solver", "dt", "run_time_s", "steps", "max_position_error_m",
+                   "error_until_s", "window_s", "parted_at_s", "error_passes_1mm_at_s",
+                   "energy_error", "impacts", "run_until_s", "verdict", "warm_up_s")
 
 
 def summary_csv(result: Comparison) -> str:
@@ -37,9 +41,10 @@ def summary_csv(result: Comparison) -> str:
         r = result.truth if row is None else row.traj
         rows.append((r.solver if row is None else row.label, r.dt if r.dt else "",
                      f"{rec['wall_time']:.6g}", r.info.get("steps", ""),
-                     None if row is None else row.window_error, result.window,
-                     None if row is None else row.diverged_at,
-                     rec["energy_error"], len(r.events), r.verdict.status,
+                     None if row is None else row.window_error,
+                     None if row is None else row.error_until, result.window,
+                     rec["parted_at"], None if row is None else row.diverged_at,
+                     rec["energy_error"], len(r.events), rec["run_until"], r.verdict.status,
                      "" if math.isnan(rec["warm_up"]) else f"{rec['warm_up']:.3g}"))
     return csv_text(SUMMARY_COLUMNS, rows)
 
@@ -82,25 +87,29 @@ def text(result: Comparison) -> str:
     then the impacts inside the window and the notes: what ``dumbbell compare`` prints."""
     result = _checked(result)
     head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'warm-up [s]':>13}"
-            f"{'steps/s':>10}{'max |dr| [m]':>14}{'|dr|>1mm at':>13}{'E error':>11}"
-            f"{'impacts':>9}  verdict")
+            f"{'steps/s':>10}{'max |dr| [m]':>14}{'over [s]':>11}{'parts at':>10}"
+            f"{'|dr|>1mm at':>13}{'E error':>11}{'impacts':>9}{'over [s]':>10}  verdict")
     lines = [f"{result.scene.title}  ({result.scene.source})",
              f"truth: {result.truth_note}",
-             (f"position error: largest distance of either particle from its true place over "
-              f"[0, {result.window:g}] s "
-              "(chaotic motion: later errors do not measure the method)"),
+             (f"position error (max |dr|): largest distance of either particle from its true "
+              f"place over [0, {result.window:g}] s, or up to where the runs part by chaos "
+              "when that comes sooner (later errors do not measure the method); "
+              "E error and impacts: over the whole run"),
              "", head, "-" * len(head)]
     for i, rec in enumerate(result.summary()):
         rate = "-" if rec["steps_per_s"] is None else f"{rec['steps_per_s']:.3g}"
         dt = "-" if rec["dt"] is None else f"{rec['dt']:g}"
         err = "(truth)" if i == 0 else f"{rec['window_error']:.3g}"
+        span = "-" if i == 0 else f"0-{rec['error_until']:.3g}"
+        part = "-" if rec["parted_at"] is None else f"{rec['parted_at']:.3g} s"
         div = "-" if rec["diverged_at"] is None else f"{rec['diverged_at']:.3g} s"
         energy = "-" if math.isnan(rec["energy_error"]) else f"{rec['energy_error']:.2e}"
         warm = "-" if math.isnan(rec["warm_up"]) else f"{rec['warm_up']:.3g}"
         lines.append(
             f"{rec['label']:<26}{dt:>9}{rec['wall_time']:>14.3g}{warm:>13}"
-            f"{rate:>10}{err:>14}{div:>13}{energy:>11}"
-            f"{rec['impacts']:>9}  {rec['verdict']}")
+            f"{rate:>10}{err:>14}{span:>11}{part:>10}{div:>13}{energy:>11}"
+            f"{rec['impacts']:>9}{'0-' + format(rec['run_until'], '.3g'):>10}"
+            f"  {rec['verdict']}")
     lines += [("run time: warm, on the solver's own clock (a run under "
               f"{TIME_AGAIN_BELOW:g} s, or of exact or reference, is timed again: the fastest "
               f"of up to {MAX_TIMED_RUNS} later runs); warm-up: what the first run paid on top "

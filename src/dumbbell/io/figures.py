@@ -42,11 +42,16 @@ def write_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> None:
     """Write the checked figure ``fig`` to the file ``path`` itself (format from its suffix),
     then close it: :func:`save_figure` past its checks, for a caller that already holds the
     file to write (a temporary file of :func:`~.files.atomic_output`)."""
-    from matplotlib.layout_engine import PlaceHolderLayoutEngine
+    from matplotlib.layout_engine import ConstrainedLayoutEngine, PlaceHolderLayoutEngine
 
-    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine):
-        # What tight_layout() leaves behind: it lays nothing out, but savefig would draw the
-        # whole figure once more for it, without rendering, before drawing it for real.
+    engine = fig.get_layout_engine()
+    if isinstance(engine, PlaceHolderLayoutEngine) or (
+            isinstance(engine, ConstrainedLayoutEngine) and not fig.stale):
+        # What tight_layout() leaves behind lays nothing out, and a constrained layout done
+        # since the figure last changed (dumbbell.plot's figures are laid out when drawn) is
+        # done: its places are fractions of the figure, the same at the dpi written. Either
+        # way savefig would draw the whole figure once more for it, without rendering (and
+        # lay it out again), before drawing it for real.
         fig.set_layout_engine(None)
     fig.savefig(path, dpi=dpi)
     # Only pyplot keeps figures open (a bare Figure is freed with its last reference); its

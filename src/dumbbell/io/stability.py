@@ -58,6 +58,13 @@ def markdown(result: StabilityResult) -> str:
     if any(r.dissipative for r in rows):
         out += ["", ("(a) The floor takes energy on purpose in this scene (elasticity below 1 "
                      "or friction), so this is the energy lost, not an error.")]
+    thresholds = sorted({r.inaccurate_energy for r in rows})
+    if thresholds:
+        out += ["", ("`ok`: stable to the end, and the relative energy error (on a dissipative "
+                     "scene, what the heat counted leaves unexplained) within the case's "
+                     "`run.inaccurate_energy` "
+                     f"({' or '.join(f'{v:g}' for v in thresholds)}); `inaccurate`: stable "
+                     "to the end, but past it, dated where it first passed it.")]
     notes = [r for r in rows if r.verdict != "ok" or not r.agrees]
     if notes:
         out += ["", "Runs that did not end ok, or disagree with the theory:", ""]

@@ -16,6 +16,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from .._display import counted
+from .._pymunk import require as require_pymunk
 from ..errors import UsageError
 
 #: None: these are the checks the public functions call, not functions a user calls.
@@ -243,7 +245,7 @@ def columns(value: Any, n: int, name: str) -> dict[str, Any]:
            for key, col in mapping(value, name, "a dict of columns by name").items()}
     for key, col in out.items():
         if len(col) != n:
-            raise UsageError(f"{name}[{key!r}] has {len(col)} samples: must have as many as "
+            raise UsageError(f"{name}[{key!r}] has {counted(len(col), 'sample')}: must have as many as "
                              f"t ({n})", param=name)
     return out
 
@@ -311,12 +313,18 @@ def _pymunk(name: str) -> Any:
 
 
 def space(value: Any, name: str = "space") -> Any:
-    """``value`` as a ``pymunk.Space`` (pymunk is not imported here)."""
-    return instance(value, name, _pymunk("Space"), "a pymunk.Space")
+    """``value`` as a ``pymunk.Space`` (pymunk is not imported here), on a pymunk release
+    dumbbell runs on (else a PymunkVersionError: this is the spaces API's first use of it)."""
+    instance(value, name, _pymunk("Space"), "a pymunk.Space")
+    require_pymunk()
+    return value
 
 
 def pymunk_object(value: Any, name: str, kinds: tuple[str, ...]) -> Any:
-    """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle')."""
+    """``value`` if it is one of the pymunk classes ``kinds`` (by name, e.g. 'Circle'), on a
+    pymunk release dumbbell runs on."""
     classes = tuple(c for c in (_pymunk(k) for k in kinds) if c != ())
-    return instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))
+    instance(value, name, classes, " or ".join(f"a pymunk.{k}" for k in kinds))
+    require_pymunk()
+    return value
 

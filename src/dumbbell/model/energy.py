@@ -409,44 +409,71 @@ def partition_from_terms(
     return _with_losses(scene, t, state, events, parts)
 
 
-def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None) -> float:
-    """The scale (J) that relative energy errors are taken against: |E(0)|, or where that is
-    near zero (zero gravity, say) the largest single term at the start, or 1 J if all vanish."""
+#: Energies below this fraction of a scene's own energy (:func:`scene_energy`) are rounding,
+#: not motion: the floor of the energy scale. A dumbbell at rest carries a spring energy of
+#: the rounding of its stretch, about (2.2e-16 H / l)^2 of 1/2 k l^2 at a height H at most
+#: (the textbook's at rest: 3e-31 J, 8e-32 of it); 1e-12 lies far above that and far below
+#: any motion simulated on purpose (a stretch of 1.4e-6 l carries 1e-12 of 1/2 k l^2).
+ROUNDING_FLOOR = 1e-12
+
+
+def scene_energy(system: System) -> float:
+    """The energy the scene's own numbers give, whatever its start (J): the larger of the
+    spring's 1/2 k l^2 and the weight's M g l, with l the dumbbell's length (the largest of
+    the spring's rest length, the rod and the particles' starting distance); 0 for a
+    dumbbell with neither spring nor gravity, or of no length."""
+    A, B = system.A, system.B
+    length = max(system.b, system.rigid.length if system.rigid is not None else 0.0,
+                 float(np.hypot(A.x - B.x, A.height - B.height)))
+    return max(0.5 * system.k * length**2, system.M * abs(system.g) * length)
+
+
+def energy_scale(E0: float, terms_at_start: dict[str, float] | None = None,
+                 scene: Any = None) -> float:
+    """The scale (J) that relative energy errors are taken against: the largest of |E(0)|
+    and the single terms at the start (|K_cm|, |U_g|, ...), and, given the ``scene`` (a Scene
+    or a path), :data:`ROUNDING_FLOOR` times its :func:`scene_energy`, so that a state at rest
+    up to rounding is not its own scale; 1 J if all of them vanish (then nothing moves)."""
     E0 = args.real(E0, "E0", "J", positive=False)
     if terms_at_start is not None:
         args.mapping(terms_at_start, "terms_at_start", "a dict of energy terms (J) or None")
         terms_at_start = {key: args.real(v, "terms_at_start", "J", positive=False)
                           for key, v in terms_at_start.items()}
-    return _energy_scale(E0, terms_at_start)
+    system = None if scene is None else _scene(scene).system
+    return _energy_scale(E0, terms_at_start, system)
 
 
-def _energy_scale(E0: float, terms_at_start: Mapping[str, float] | None) -> float:
+def _energy_scale(E0: float, terms_at_start: Mapping[str, float] | None,
+                  system: System | None = None) -> float:
     scale = abs(E0)
     if terms_at_start:
-        largest = max(abs(v) for v in terms_at_start.values())
-        if scale < 1e-3 * largest:
-            scale = largest
+        scale = max(scale, max(abs(v) for v in terms_at_start.values()))
+    if system is not None:
+        scale = max(scale, ROUNDING_FLOOR * scene_energy(system))
     return scale if scale > 0 else 1.0
 
 
-def relative_energy_error(energy: Columns) -> np.ndarray:
+def relative_energy_error(energy: Columns, scene: Any = None) -> np.ndarray:
     """|E(t) - E(0)| / scale for every sample (dimensionless) of the energy columns ``energy``
-    (J, as :func:`partition` gives them), scale from :func:`energy_scale`."""
+    (J, as :func:`partition` gives them), scale from :func:`energy_scale` (with the floor of
+    the ``scene`` it was run from, when given)."""
     args.mapping(energy, "energy", "a dict of energy columns (J) by name")
     if "E" not in energy:
         raise UsageError("energy has no column 'E': must hold the total energy E (J)",
                          param="energy")
-    return _relative_energy_error(args.columns(energy, _length(energy["E"]), "energy"))
+    system = None if scene is None else _scene(scene).system
+    return _relative_energy_error(args.columns(energy, _length(energy["E"]), "energy"), system)
 
 
-def _relative_energy_error(energy: Columns) -> np.ndarray:
+def _relative_energy_error(energy: Columns, system: System | None = None) -> np.ndarray:
     E = energy["E"]
     if len(E) == 0:
         return E
-    return np.abs(E - E[0]) / _start_scale(energy)
+    return np.abs(E - E[0]) / _start_scale(energy, system)
 
 
-def _start_scale(energy: Columns) -> float:
-    """The :func:`energy_scale` of energy columns (J) at their first sample."""
+def _start_scale(energy: Columns, system: System | None = None) -> float:
+    """The :func:`energy_scale` of energy columns (J) at their first sample, with the floor
+    of ``system`` when given."""
     terms = {name: float(v[0]) for name, v in energy.items() if name not in BOOKKEEPING}
-    return _energy_scale(float(energy["E"][0]), terms)
+    return _energy_scale(float(energy["E"][0]), terms, system)

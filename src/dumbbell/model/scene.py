@@ -46,6 +46,9 @@ MIN_MASS = 1e-75
 MAX_SCENE_BYTES = 1_000_000
 #: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
 DEFAULT_UNSTABLE_ENERGY = 10.0
+#: Default ``run.inaccurate_energy``: past a relative energy error of 0.1 a run that stays
+#: stable is ``inaccurate`` (docs/stability.md says why 0.1).
+DEFAULT_INACCURATE_ENERGY = 0.1
 
 
 @dataclass(frozen=True)
@@ -89,13 +92,15 @@ class Floor:
 @dataclass(frozen=True)
 class RunSettings:
     """Default run options: ``t_end`` and ``dt`` in s, ``every`` in steps (keep every N-th),
-    ``unstable_energy`` the relative energy error that makes a run ``unstable``."""
+    ``unstable_energy`` the relative energy error that makes a run ``unstable``, and
+    ``inaccurate_energy`` the one past which a run that stays stable is ``inaccurate``."""
 
     t_end: float
     dt: float
     solver: str
     every: int
     unstable_energy: float
+    inaccurate_energy: float = DEFAULT_INACCURATE_ENERGY
 
 
 #: The scene tables a solver owns, by table name: where the owner's settings class lives
@@ -250,7 +255,8 @@ class Scene:
             doc["floor"] = {"elasticity": s.floor.elasticity, "friction": s.floor.friction}
         doc["gravity"] = {"g": s.g}
         doc["run"] = {"t_end": run.t_end, "dt": run.dt, "solver": run.solver,
-                      "every": run.every, "unstable_energy": run.unstable_energy}
+                      "every": run.every, "unstable_energy": run.unstable_energy,
+                      "inaccurate_energy": run.inaccurate_energy}
         doc["outputs"] = {"figures": list(out.figures), "csv": out.csv}
         if out.gif is not None:
             gif = {"fps": out.gif.fps, "size": out.gif.size, "strip": out.gif.strip}
@@ -667,7 +673,7 @@ def _gravity(top: _Checker) -> float:
 
 
 def _run(top: _Checker, source: str) -> RunSettings:
-    """[run]: t_end and dt (s), solver, every, unstable_energy."""
+    """[run]: t_end and dt (s), solver, every, unstable_energy, inaccurate_energy."""
     crun = top.sub("run")
     if crun is None:
         raise SceneError(f"{_printable(source)}: [run] is missing: needs t_end and dt (s)")
@@ -682,8 +688,12 @@ def _run(top: _Checker, source: str) -> RunSettings:
         "unstable_energy", DEFAULT_UNSTABLE_ENERGY, lo=0.0, lo_open=True,
         unit="relative energy error that makes a run unstable",
     )
+    inaccurate = crun.number(
+        "inaccurate_energy", DEFAULT_INACCURATE_ENERGY, lo=0.0, lo_open=True,
+        unit="relative energy error past which a stable run is inaccurate",
+    )
     crun.done()
-    return RunSettings(t_end, dt, solver, every, unstable)
+    return RunSettings(t_end, dt, solver, every, unstable, inaccurate)
 
 
 def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: float

@@ -35,7 +35,10 @@ if TYPE_CHECKING:
 FIRST_IMPACTS = 5
 
 #: Verdict statuses, from good to bad.
-VERDICTS = ("ok", "unstable", "tunnelled", "failed")
+VERDICTS = ("ok", "inaccurate", "unstable", "tunnelled", "failed")
+#: The statuses of a run that reached its end with every sample kept (stable): ``ok``, and
+#: ``inaccurate`` (its energy error passed ``run.inaccurate_energy``).
+COMPLETE = ("ok", "inaccurate")
 
 _FINITE = math.isfinite
 
@@ -115,8 +118,10 @@ class Contact:
 
 @dataclass(frozen=True)
 class Verdict:
-    """How a run ended. ``status`` is one of ok, unstable, tunnelled, failed; ``t`` is the
-    time of failure (s, None when ok); ``reason`` says why in words."""
+    """How a run ended. ``status`` is one of ok, inaccurate, unstable, tunnelled, failed
+    (:data:`VERDICTS`); ``t`` is the time of failure (s, None when ok; for ``inaccurate`` the
+    step where the energy error first passed ``run.inaccurate_energy``, the run going on to
+    its end); ``reason`` says why in words and what to change."""
 
     status: str = "ok"
     t: float | None = None
@@ -132,7 +137,13 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
+        """Stable, and within the scene's ``run.inaccurate_energy`` to the end."""
         return self.status == "ok"
+
+    @property
+    def complete(self) -> bool:
+        """The run reached its end with every sample kept: ``ok`` or ``inaccurate``."""
+        return self.status in COMPLETE
 
     def __str__(self) -> str:
         if self.ok:
@@ -287,12 +298,12 @@ class Trajectory:
         any), verdict."""
         dt = "-" if self.dt is None else f"{self.dt:g} s"
         span = f"{self.t[0]:g}..{self.t[-1]:g} s" if len(self.t) else "empty"
-        from .._display import one_line
+        from .._display import counted, one_line
 
         verdict = " ".join(str(self.verdict).split())     # one line even if a reason is not
-        contacts = f", {len(self.contacts)} contacts" if self.contacts else ""
+        contacts = f", {counted(len(self.contacts), 'contact')}" if self.contacts else ""
         return one_line(f"<Trajectory {self.scene.name}: solver={self.solver}, dt={dt}, "
-                        f"t={span}, {len(self.t)} samples, {len(self.events)} impacts"
+                        f"t={span}, {counted(len(self.t), 'sample')}, {counted(len(self.events), 'impact')}"
                         f"{contacts}, verdict: {verdict}>")
 
     def _repr_html_(self) -> str:

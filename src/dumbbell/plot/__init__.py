@@ -2,7 +2,10 @@
 
 Every function draws on the axes ``ax`` it is given, or makes its own figure when given none,
 and returns the axes (``ax.figure`` is the figure). None chooses a matplotlib backend and none
-saves: :func:`dumbbell.io.figures.save_figure` does. Colours are in :mod:`.style`.
+saves: :func:`dumbbell.io.figures.save_figure` does. Colours are in :mod:`.style`. A figure of
+its own fits its canvas whatever the number of panels and the length of its texts (legends
+outside the axes); on the user's axes a figure stays inside them (its legend in a band above
+the data), so that several share a grid without squeezing each other.
 
 >>> ax = dumbbell.plot.kinetic(traj)                                    # doctest: +SKIP
 >>> dumbbell.plot.compare(dumbbell.analysis.compare.compare(scene), ax=my_axes)  # doctest: +SKIP

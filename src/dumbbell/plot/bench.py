@@ -1,6 +1,9 @@
 """Figures of a benchmark (:class:`dumbbell.analysis.bench.BenchResult`): work-precision
 (error against run time) and convergence (error against dt, with the fitted orders). Each
-draws on the axes it is given or makes its own figure, and returns the axes; none saves."""
+draws on the axes it is given or makes its own figure, and returns the axes; none saves. The
+legend of a figure of their own sits outside the axes (below the work-precision plot, whose
+labels take the room beside its points; right of the convergence plot); on the user's axes,
+inside them, above the data."""
 
 from __future__ import annotations
 
@@ -9,10 +12,20 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
 from ..model import args
 from ..solvers import solver_class
-from .style import _subplots, legend_outside, plain, solver_style
+from .style import (
+    _subplots,
+    finish,
+    legend,
+    legend_below,
+    legend_inside,
+    plain,
+    solver_style,
+    wrap_texts,
+)
 
 __all__ = ["convergence", "work_precision"]
 
@@ -67,15 +80,17 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.margins(x=0.07, y=0.06)  # room for the labels of the outermost points
-    ax.set_xlabel(f"run time [s], fastest of at least {result.repeat} runs")
+    ax.set_xlabel(f"run time [s], fastest of at least {counted(result.repeat, 'run')}")
     ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
     ax.set_title(f"Work-precision: {plain(result.scene)}, {result.t_end:g} s simulated; "
                  f"labels: dt (s)", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
-              frameon=False)
     if own:
-        fig.tight_layout()
+        legend_below(ax)
+        finish(fig)             # laid out before the labels are placed by their pixels
+    else:
+        legend_inside(ax)
+        wrap_texts(ax)
     _place_labels(ax, labels)
     return ax
 
@@ -104,30 +119,42 @@ def _crossed(ax: Any, box: tuple[float, float, float, float]) -> bool:
 
 def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
                   size: float = 7.5) -> None:
-    """Write each (text, x, y, colour) beside its point, at the first spot whose box stays
-    inside the axes and overlaps neither a marker, a label already placed nor a line (else at
-    the first spot)."""
+    """Write each (text, x, y, colour) beside its point, at the first spot whose box (as the
+    text is drawn: measured) stays inside the axes and overlaps neither a marker, a label
+    already placed, the legend nor a line: near the point first, then farther out; where no
+    spot is free, at the one with the fewest of those."""
     px = ax.figure.dpi / 72.0
     xy = ax.transData.transform([(x, y) for _, x, y, _ in labels]) if labels else []
     taken = [(u - 6, v - 6, u + 6, v + 6) for u, v in xy]  # the markers
+    key = ax.get_legend()
+    if key is not None:
+        box = key.get_window_extent()
+        taken.append((box.x0, box.y0, box.x1, box.y1))
     frame = ax.get_window_extent()
+    gap = 2 * px
+    spots = [(dx * f, dy * f, ha) for f in (1.0, 1.8, 2.6) for dx, dy, ha in _LABEL_SPOTS]
     for (text, x, y, colour), (u, v) in zip(labels, xy, strict=True):
-        w, h = 0.55 * size * px * len(text), 1.15 * size * px
-        chosen = _LABEL_SPOTS[0]
-        for spot in _LABEL_SPOTS:
+        note = ax.annotate(text, (x, y), textcoords="offset points", xytext=spots[0][:2],
+                           ha=spots[0][2], fontsize=size, color=colour)
+        best: tuple[int, Any, Any] | None = None
+        for spot in spots:
             dx, dy, ha = spot
-            left = u + dx * px - (w if ha == "right" else 0.0)
-            box = (left, v + dy * px, left + w, v + dy * px + h)
-            inside = (frame.x0 <= box[0] and box[2] <= frame.x1 and frame.y0 <= box[1]
-                      and box[3] <= frame.y1)
-            if inside and not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3]
-                                  and b[1] < box[3] for b in taken) and not _crossed(ax, box):
-                chosen = spot
-                taken.append(box)
+            note.set_position((dx, dy))
+            note.set_ha(ha)
+            b = note.get_window_extent()
+            box = (b.x0 - gap, b.y0, b.x1 + gap, b.y1)
+            inside = (frame.x0 <= b.x0 and b.x1 <= frame.x1 and frame.y0 <= b.y0
+                      and b.y1 <= frame.y1)
+            clashes = (sum(box[0] < t[2] and t[0] < box[2] and box[1] < t[3] and t[1] < box[3]
+                           for t in taken) + (not inside) + _crossed(ax, box))
+            if best is None or clashes < best[0]:
+                best = (clashes, spot, box)
+            if clashes == 0:
                 break
-        dx, dy, ha = chosen
-        ax.annotate(text, (x, y), textcoords="offset points", xytext=(dx, dy), ha=ha,
-                    fontsize=size, color=colour)
+        _, (dx, dy, ha), box = best
+        note.set_position((dx, dy))
+        note.set_ha(ha)
+        taken.append(box)
 
 
 def convergence(result: BenchResult, ax: Any = None) -> Any:
@@ -149,7 +176,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
         label = name + (f":\nfitted order {fit.order:.2f} (dt {dt_label(min(fit.dts))} to "
                         f"{dt_label(max(fit.dts))} s)" if fit else ": no fit (< 3 points)")
         if fit and fit.expected is not None:
-            label += f"; its own order {fit.expected}: dashed"
+            label += f"\nits own order {fit.expected}: dashed"
         ax.plot([p.dt for p in good], [p.error for p in good], marker=marker, color=colour,
                 lw=0, label=label)
         if fit:
@@ -173,7 +200,9 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     ax.set_title(f"Convergence: {plain(result.scene)}, error over [0, {result.window:g} s]; "
                  "lines: least-squares fits", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
-    legend_outside(ax)
+    legend(ax, own)
     if own:
-        fig.tight_layout()
+        finish(fig)
+    else:
+        wrap_texts(ax)
     return ax

@@ -9,11 +9,22 @@ from typing import Any
 
 import numpy as np
 
+from .._display import counted
 from ..analysis.stability import MAP_RATIOS, MAP_STEPS, MAP_UNSTABLE_ENERGY, MAP_WDT
 from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
-from .style import FAIL_COLOURS, _subplots, legend_outside, plain
+from ..model.trajectory import COMPLETE
+from .style import (
+    FAIL_COLOURS,
+    _subplots,
+    finish,
+    legend,
+    legend_below,
+    legend_inside,
+    plain,
+    wrap_texts,
+)
 
 __all__ = ["stability_map", "sweep_map"]
 
@@ -60,32 +71,46 @@ def _check_maps(maps: Any) -> None:
 
 def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     """The sweep's map: log10 of the largest relative energy error over the grid (two axes),
-    or along its one axis, failures painted by verdict, and the line w*dt = 2."""
+    or along its one axis, failures painted by verdict, and the line w*dt = 2.
+
+    A map's colour bar takes its room from ``ax`` (as ``Figure.colorbar(ax=)`` does); its
+    legend hangs below the x label on a figure of its own, and on the user's axes sits inside
+    them, in a band above the map (:func:`~.style.legend_inside`)."""
     result = args.instance(result, "result", SweepResult, "a SweepResult (from dumbbell.sweep)")
     ax = args.axes(ax)
     own = ax is None
     if own:
-        fig, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
+        _, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
+    fig = ax.figure
     title = (f"Sweep of {plain(result.scene.name)}: {result.solver}, t_end = {result.t_end:g} s, "
-             f"{len(result.rows)} runs")
+             f"{counted(len(result.rows), 'run')}")
     if len(result.axes) == 2:
-        draw_map(ax.figure, ax, result.axes[0], result.axes[1], result.rows, title)
+        mesh, handles = draw_map(ax, result.axes[0], result.axes[1], result.rows, title)
+        cbar = fig.colorbar(mesh, ax=ax, pad=0.02)
+        cbar.set_label("log10 of the largest |E - E0| / |E0| [1]")
+        if own:
+            legend_below(ax, handles=handles)   # its columns fitted again once laid out
+        else:
+            wrap_texts(cbar.ax)
+            legend_inside(ax, handles=handles)
     else:
-        draw_line(ax, result.axes[0], result.rows, title)
+        draw_line(ax, result.axes[0], result.rows, title, own)
     if own:
-        fig.tight_layout()
+        finish(fig)
+    else:
+        wrap_texts(ax)
     return ax
 
 
-def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResult],
+def draw_map(ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResult],
              title: str, x_label: str | None = None, y_label: str | None = None,
-             wdt: np.ndarray | None = None, limits: tuple[int, int] | None = None,
-             colorbar: bool = True, legend_drop: float = 0.13) -> Any:
+             wdt: np.ndarray | None = None, limits: tuple[int, int] | None = None
+             ) -> tuple[Any, list[Any]]:
     """Paint a 2D grid of sweep rows (x outer, y inner, as in grid order) on ``ax``:
     colour by log10 of the largest relative energy error (between ``limits``, else fitted),
-    failures by verdict, and the contour w*dt = 2 (from the rows' w_dt, or ``wdt`` given on
-    the same grid); the legend hangs ``legend_drop`` axes heights below the axes, under the
-    x label. Returns the colour mesh."""
+    failures by verdict, and the line w*dt = 2 (from the rows' w_dt, or ``wdt`` given on the
+    same grid: :func:`limit_line`). Returns the colour mesh and the legend's entries (for
+    :func:`~.style.legend_below`, once the figure is laid out)."""
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -105,15 +130,13 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
     xe, ye = _edges(xs, xlog), _edges(ys, ylog)
     with np.errstate(divide="ignore", invalid="ignore"):
         level = np.log10(np.maximum(err, 1e-17))
-    level = np.ma.masked_where((verdict != "ok") | ~np.isfinite(level), level)
+    # Runs that reached their end (ok or inaccurate) are coloured by their error.
+    level = np.ma.masked_where(~np.isin(verdict, COMPLETE) | ~np.isfinite(level), level)
     if limits is None:
         lo = math.floor(float(level.min())) if level.count() else -16
         limits = (lo, max(lo + 1, math.ceil(float(level.max()))) if level.count() else 2)
     mesh = ax.pcolormesh(xe, ye, level, cmap="viridis", vmin=limits[0], vmax=limits[1],
                          shading="flat")
-    if colorbar:
-        cbar = fig.colorbar(mesh, ax=ax, pad=0.02)
-        cbar.set_label("log10 of the largest relative energy error |E - E0| / |E0| [1]")
     handles = []
     for code, (name, colour) in enumerate(FAIL_COLOURS.items()):
         mask = verdict == name
@@ -121,15 +144,13 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
             ax.pcolormesh(xe, ye, np.ma.masked_where(~mask, np.full(mask.shape, code)),
                           cmap=ListedColormap([colour]), shading="flat")
             handles.append(Patch(facecolor=colour, edgecolor="0.3",
-                                 label=f"{name} ({int(mask.sum())} runs)"))
+                                 label=f"{name} ({counted(int(mask.sum()), 'run')})"))
     if x_axis.key == "w_dt":
         ax.axvline(2.0, color="red", lw=2.2, ls="--")
         handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
     elif np.nanmax(w_dt) > 2.0 > np.nanmin(w_dt):
-        # log10(w*dt) is linear in log k and log dt, so its interpolated contour is straight.
-        with np.errstate(divide="ignore"):
-            ax.contour(xs, ys, np.log10(w_dt), levels=[math.log10(2.0)], colors="red",
-                       linewidths=2.2, linestyles="--")
+        for x, y in limit_line(xs, ys, w_dt, xlog, ylog):
+            ax.plot(x, y, color="red", lw=2.2, ls="--")
         handles.append(_legend_line("red", "--", "w*dt = 2: stability limit from theory"))
     else:
         handles.append(Patch(facecolor="none", edgecolor="none",
@@ -142,9 +163,49 @@ def draw_map(fig: Any, ax: Any, x_axis: Axis, y_axis: Axis, rows: list[PointResu
     ax.set_xlabel(x_label or axis_label(x_axis.key))
     ax.set_ylabel(y_label or axis_label(y_axis.key))
     ax.set_title(title, fontsize=10)
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -legend_drop), ncol=2,
-              fontsize=8, frameon=False)
-    return mesh
+    return mesh, handles
+
+
+def limit_line(xs: np.ndarray, ys: np.ndarray, w_dt: np.ndarray, xlog: bool, ylog: bool
+               ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The line w*dt = 2 over a map whose cells are centred on the sorted ``xs`` and ``ys``
+    (``w_dt[iy, ix]`` at each centre), out to the map's edges: its pieces, as (x, y) arrays.
+
+    Traced in the axes' own scale (log10 of a log axis), where log10(w*dt) is linear in
+    log k and log dt: the level crossings interpolated there lie on the exact line, and the
+    pieces between them are straight on the drawn axes. (Interpolated in the values
+    themselves, the crossings fall off the line and the contour kinks at each decade.) The
+    grid is carried to the cells' outer edges linearly in the same scale."""
+    import contourpy
+
+    def scaled(values: np.ndarray, log: bool) -> np.ndarray:
+        return np.log10(values) if log else values.astype(float)
+
+    u, v = scaled(xs, xlog), scaled(ys, ylog)
+    ue, ve = scaled(_edges(xs, xlog), xlog), scaled(_edges(ys, ylog), ylog)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.log10(w_dt) - math.log10(2.0)
+    u, z = _to_edges(u, ue[[0, -1]], z, axis=1)
+    v, z = _to_edges(v, ve[[0, -1]], z, axis=0)
+    pieces = contourpy.contour_generator(u, v, np.ma.masked_invalid(z)).lines(0.0)
+    back = [(10**p[:, 0] if xlog else p[:, 0], 10**p[:, 1] if ylog else p[:, 1])
+            for p in pieces if len(p) >= 2]
+    return back
+
+
+def _to_edges(centres: np.ndarray, ends: np.ndarray, z: np.ndarray, axis: int
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Cell centres ``centres`` and ``z`` along ``axis`` extended to the two outer edges
+    ``ends``, z linearly from its two outermost values on each side (held where the axis has
+    one value)."""
+    z = np.moveaxis(z, axis, 0)
+    if len(centres) < 2:
+        first, last = z[0], z[-1]
+    else:
+        first = z[0] + (z[0] - z[1]) * (ends[0] - centres[0]) / (centres[0] - centres[1])
+        last = z[-1] + (z[-1] - z[-2]) * (ends[1] - centres[-1]) / (centres[-1] - centres[-2])
+    out = np.concatenate([first[None], z, last[None]])
+    return np.concatenate([[ends[0]], centres, [ends[1]]]), np.moveaxis(out, 0, axis)
 
 
 def _legend_line(colour: str, style: str, label: str) -> Any:
@@ -153,9 +214,10 @@ def _legend_line(colour: str, style: str, label: str) -> Any:
     return Line2D([], [], color=colour, ls=style, lw=2.2, label=label)
 
 
-def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
+def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str, own: bool) -> None:
     """A one-axis sweep: log10 of the largest relative energy error against the value, the
-    failures marked by verdict and the value where w*dt = 2."""
+    failures marked by verdict and the value where w*dt = 2; the legend outside on the right
+    of the package's own figure (``own``), else inside the axes."""
     if not axis.numeric:
         raise UsageError("grid: a plot needs a numeric axis; use a list of numbers", param="grid")
     xs = np.array(axis.values, float)
@@ -164,8 +226,10 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     rows = [rows[i] for i in order]
     err = np.array([r.max_rel_energy_error for r in rows], float)
     verdicts = [r.verdict for r in rows]
-    ok = np.array([v == "ok" for v in verdicts])
-    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label="ok")
+    ok = np.array([v in COMPLETE for v in verdicts])
+    label = ("ok" if all(v == "ok" for v in verdicts if v in COMPLETE)
+             else "stable: ok or inaccurate")
+    ax.plot(xs[ok], err[ok], "o-", color="#31688e", ms=4, lw=1.2, label=label)
     top = np.nanmax(err[np.isfinite(err)]) if np.isfinite(err).any() else 1.0
     for name, colour in FAIL_COLOURS.items():
         mask = np.array([v == name for v in verdicts])
@@ -173,7 +237,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
             # At the error reached before the run stopped; off the top if none was finite.
             ys = np.where(np.isfinite(err[mask]), err[mask], max(top, 1.0) * 3)
             ax.plot(xs[mask], ys, "X", color=colour, mec="0.2", ms=9, ls="none",
-                    label=f"{name} ({int(mask.sum())} runs, error when it stopped)")
+                    label=f"{name} ({counted(int(mask.sum()), 'run')}, error when it stopped)")
     w_dt = np.array([r.w_dt for r in rows], float)
     cross = np.flatnonzero(np.diff(np.sign(w_dt - 2.0)) != 0)
     if cross.size:
@@ -190,7 +254,7 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str) -> None:
     ax.set_ylabel("largest relative energy error [1]")
     ax.set_title(title, fontsize=10)
     ax.grid(True, color="0.9")
-    legend_outside(ax)
+    legend(ax, own)
 
 
 def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
@@ -203,21 +267,21 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     x_axis = Axis("w_dt", "w*dt", MAP_WDT, "lin")
     y_axis = Axis("mass_ratio", "mB/mA", MAP_RATIOS, "log")
     errs = [r.max_rel_energy_error for rows in maps.values() for r in rows
-            if r.verdict == "ok" and r.max_rel_energy_error > 0]
+            if r.verdict in COMPLETE and r.max_rel_energy_error > 0]
     lo = math.floor(math.log10(min(errs))) if errs else -16
     hi = max(lo + 1, math.ceil(math.log10(max(errs)))) if errs else 3
     mesh = None
     for ax, (solver, rows) in zip(axes[0], maps.items(), strict=True):
         wdt = np.array([[r.w_dt for r in rows[i::len(MAP_RATIOS)]]
                         for i in range(len(MAP_RATIOS))], float)
-        mesh = draw_map(fig, ax, x_axis, y_axis, rows, solver,
-                        x_label="w*dt, w = sqrt(k/mu) [1]", y_label="mass ratio mB/mA [1]",
-                        wdt=wdt, limits=(lo, hi), colorbar=False, legend_drop=0.2)
-    fig.subplots_adjust(left=0.055, right=0.9, bottom=0.25, top=0.86, wspace=0.25)
-    cax = fig.add_axes((0.92, 0.25, 0.013, 0.61))
-    cbar = fig.colorbar(mesh, cax=cax)
+        mesh, handles = draw_map(ax, x_axis, y_axis, rows, solver,
+                                 x_label="w*dt, w = sqrt(k/mu) [1]",
+                                 y_label="mass ratio mB/mA [1]", wdt=wdt, limits=(lo, hi))
+        legend_below(ax, handles=handles)   # its columns fitted again once laid out
+    cbar = fig.colorbar(mesh, ax=list(axes[0]), pad=0.02, aspect=30)
     cbar.set_label("log10 of the largest relative energy error [1]")
     fig.suptitle(f"Stability of the explicit spring step: {MAP_STEPS} steps per run, no floor, "
-                 f"no gravity; 'unstable' = non-finite or energy error > {MAP_UNSTABLE_ENERGY:g}",
-                 fontsize=10)
+                 f"no gravity;\n'unstable' = non-finite or energy error > "
+                 f"{MAP_UNSTABLE_ENERGY:g}", fontsize=10)
+    finish(fig)
     return list(axes[0])

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.rotation import Series, mean_after_first_cluster
-from .style import COLOURS, _subplots, legend_outside, plain
+from .style import COLOURS, _subplots, finish, legend_inside, legend_outside, plain
 
 __all__ = ["rotation"]
 
@@ -24,7 +24,8 @@ def _colour(label: str, i: int) -> str:
 
 
 def _overlay(ax: Any, s: Series) -> None:
-    """Every run's K_rot on one axes, the rigid dumbbell's dashed."""
+    """Every run's K_rot on the user's axes, the rigid dumbbell's dashed; the legend inside
+    them, above the data."""
     for i, (label, r) in enumerate(s.runs.items()):
         if label == "rigid":
             ax.plot(r.t, r["K_rot"], color="black", lw=1.0, ls="--",
@@ -34,7 +35,7 @@ def _overlay(ax: Any, s: Series) -> None:
     ax.set_xlabel("t [s]")
     ax.set_ylabel("E [J]")
     ax.grid(True, color="0.9", lw=0.6)
-    legend_outside(ax)
+    legend_inside(ax)
 
 
 def _spring_panel(panel: Any, r: Any, rigid: Any, label: str, rigid_mean: float) -> str:
@@ -117,5 +118,5 @@ def rotation(s: Series, ax: Any = None) -> Any:
         f"{plain(s.scene.title)}: rotation preview ({s.runs[labels[0]].solver}, dt = {s.dt:g} s)\n"
         "Between impacts a stiffer spring turns more like the rigid body; the floor's push on "
         "one particle leaves it far less rotation", fontsize=9.5)
-    fig.tight_layout()
+    finish(fig)
     return axes[0]

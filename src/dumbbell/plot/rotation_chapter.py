@@ -1,6 +1,7 @@
 """Figures of the rotation chapter's preview: apparent restitution against tilt, and the topple
 against its closed form. Each draws on the axes it is given (or a new figure) and returns them;
-none saves or switches matplotlib's backend. Legends sit outside the axes, on the right."""
+none saves or switches matplotlib's backend. Legends sit outside the axes, on the right, on a
+figure of their own; inside the user's axes, above the data."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import _subplots, legend_outside, plain
+from .style import _subplots, finish, legend, plain, wrap_texts
 
 if TYPE_CHECKING:
     from ..analysis.contact import ContactMomentum
@@ -30,6 +31,16 @@ def _axes(ax: Any, nrows: int = 1, **fig_kw: Any) -> Any:
     return axes
 
 
+def _end(axes: list[Any], own: bool) -> None:
+    """Lay out what was drawn: the package's own figure finished, the user's axes' titles
+    wrapped to their widths."""
+    if own:
+        finish(axes[0].figure)
+    else:
+        for a in axes:
+            wrap_texts(a)
+
+
 def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     """e_eff against tilt (degrees), then the impacts in the first cluster and the share of
     kinetic energy that went into rotation. ``ax``: three axes, or None for a new figure.
@@ -39,7 +50,7 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     args.instance(result, "result", RestitutionResult,
                   "a RestitutionResult (from dumbbell.analysis.restitution.restitution)")
     ax = args.axes(ax, count=3)
-
+    own = ax is None
     top, mid, bottom = _axes(ax, 3, figsize=(11.0, 9.0), sharex=True,
                              gridspec_kw={"height_ratios": [2.4, 1, 1.2]})
     th = np.linspace(float(result.theta.min()), float(result.theta.max()), 400)
@@ -66,7 +77,7 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     top.set_ylabel("e_eff = -V_after / V_before [1]")
     top.set_title(f"Apparent restitution of a dumbbell dropped at tilt θ on a floor with "
                   f"e = {result.e:g}\n" + "\n".join(textwrap.wrap(note, 100)), fontsize=10)
-    legend_outside(top, fontsize=7.5)
+    legend(top, own, fontsize=7.5)
 
     series = [("rigid (pymunk)", result.rigid_impacts, "#2ca02c")]
     series += [(f"k = {k:g} N/m", cols["impacts"], c) for (k, cols), c in
@@ -79,7 +90,7 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     mid.set_ylabel("impacts in the\nfirst cluster [1]")
     mid.set_ylim(0, 1.15 * max(float(np.max(s[1])) for s in series))
     mid.yaxis.get_major_locator().set_params(integer=True)    # counts
-    legend_outside(mid, fontsize=7.5)
+    legend(mid, own, fontsize=7.5)
 
     bottom.plot(th, k_rot_share_rigid(th, result.e, result.q), color="black", lw=1.6,
                 label="rigid, formula (1+e)² q sin²θ / (1 + q sin²θ)²,\nafter the first impact")
@@ -91,9 +102,10 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     bottom.set_ylabel("K_rot / K before [1]")
     bottom.set_ylim(0, 1.05)
     bottom.set_xlabel("tilt θ of the axis from vertical [degrees]")
-    legend_outside(bottom, fontsize=7.5)
     for a in (top, mid, bottom):
         a.grid(True, color="0.9")
+    legend(bottom, own, fontsize=7.5)
+    _end([top, mid, bottom], own)
     return top, mid, bottom
 
 
@@ -110,6 +122,7 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
                   "a ToppleMeasure (from dumbbell.analysis.topple.measure)")
     ax = args.axes(ax, count=3)
     solver = plain(args.text(solver, "solver", "a str (the name in the legend)"))
+    own = ax is None
     a1, a2, a3 = _axes(ax, 3, figsize=(10.5, 8.0), sharex=True)
     t, theta = cf.angle_curve()
     step = max(1, len(measured.t) // 60)
@@ -126,7 +139,7 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
                 (T, 90), xytext=(0.03, 0.83), textcoords="axes fraction", va="top",
                 fontsize=8.5, arrowprops={"arrowstyle": "->", "color": "0.4",
                                           "shrinkA": 4, "shrinkB": 2})
-    legend_outside(a1)
+    legend(a1, own)
 
     a2.axhline(0, color="black", lw=1.6,
                label="closed form: no\nhorizontal force,\nx_cm stays put")
@@ -136,7 +149,7 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     a2.set_ylim(-lim, lim)
     a2.text(0.01, 0.08, f"largest drift: {measured.cm_drift:.2g} m", transform=a2.transAxes,
             fontsize=8.5)
-    legend_outside(a2)
+    legend(a2, own)
 
     w = cf.omega(theta)
     vA = w * np.sqrt((cf.L - cf.a) ** 2 * np.cos(theta) ** 2 + cf.L**2 * np.sin(theta) ** 2)
@@ -150,11 +163,12 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     a3.set_xlabel("t [s]")
     a3.text(0.01, 0.55, f"at the landing: closed form {v_cf:.5f} m/s,\n{solver} "
             f"{measured.v_top:.5f} m/s", transform=a3.transAxes, fontsize=8.5)
-    legend_outside(a3)
+    legend(a3, own)
     for a in (a1, a2, a3):
         a.grid(True, color="0.9")
     a1.set_title(f"Toppling rigid dumbbell: L = {cf.L:g} m, released at "
                  f"{math.degrees(cf.theta0):g}° on a frictionless floor", fontsize=10.5)
+    _end([a1, a2, a3], own)
     return a1, a2, a3
 
 
@@ -168,6 +182,7 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
                   "a ContactMomentum (from dumbbell.analysis.contact.about_contact)")
     ax = args.axes(ax)
     solver = plain(args.text(solver, "solver", "a str (the name in the title)"))
+    own = ax is None
     ax = _axes(ax, 1, figsize=(10.5, 4.8))
     t = (cm.t - cm.impact.t) * 1e3
     ax.axvline(0, color="0.6", lw=0.8, ls=":")
@@ -175,14 +190,20 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
     ax.plot(t, cm.L_orbit, color="#1f77b4", lw=1.4, ls="--",
             label="M (R - P) x V, the centre\nof mass's orbit about P")
     ax.plot(t, cm.L_P, color="black", lw=2.0, label="L_P, their sum: about\nthe contact point")
-    ax.set_xlabel(f"t - t_impact [ms]   (impact of {cm.impact.body} at {cm.impact.t:.6f} s, "
-                  f"P = ({cm.px:.4f} m, 0))")
+    impact = f"impact of {cm.impact.body} at {cm.impact.t:.6f} s, P = ({cm.px:.4f} m, 0)"
     ax.set_ylabel("angular momentum [kg m²/s]")
     ax.grid(True, color="0.9")
-    legend_outside(ax)
+    legend(ax, own)
     who = f" ({solver})" if solver else ""
-    ax.set_title(f"Through a frictionless impact{who}: L_cm jumps {cm.L_cm_before:+.5f} → "
-                 f"{cm.L_cm_after:+.5f}, L_P stays {cm.before:+.6f} → {cm.after:+.6f} "
-                 "kg m²/s\n(the floor's push acts at P: no torque about it; gravity turns L_P "
-                 "slowly and evenly)", fontsize=9)
+    numbers = (f"L_cm jumps {cm.L_cm_before:+.5f} → {cm.L_cm_after:+.5f}, L_P stays "
+               f"{cm.before:+.6f} → {cm.after:+.6f} kg m²/s")
+    if own:
+        ax.set_xlabel(f"t - t_impact [ms]   ({impact})")
+        ax.set_title(f"Through a frictionless impact{who}: {numbers}\n(the floor's push acts "
+                     "at P: no torque about it; gravity turns L_P slowly and evenly)",
+                     fontsize=9)
+    else:   # the user's axes: the numbers only, in a smaller title
+        ax.set_xlabel("t - t_impact [ms]")
+        ax.set_title(f"{impact[0].upper()}{impact[1:]}{who}: {numbers}", fontsize=8)
+    _end([ax], own)
     return ax

@@ -9,8 +9,10 @@
 All show the textbook's window, 0 to 2 s, and mark the first impact. Each draws on the axes
 it is given, or makes its own figure when given none, and returns the axes; none saves (see
 :func:`dumbbell.io.figures.save_figure`). Matplotlib is imported only when a figure is drawn.
-Legends sit outside the axes, on the right, and the first impact's time above the top axes,
-so that no curve runs through text whatever the data.
+On a figure of their own, legends sit outside the axes, on the right, and the first impact's
+time above the top axes, so that no curve runs through text whatever the data; on the user's
+axes, the legend (with the first impact's time in it) sits inside them, in a band above the
+data (:func:`dumbbell.plot.style.legend_inside`).
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ from .style import (
     MOMENTUM_COLOUR,
     _figure,
     _subplots,
-    legend_outside,
+    finish,
+    legend,
     plain,
 )
 
@@ -67,17 +70,18 @@ def _positions_panel(ax: Any, traj: Trajectory, window: float) -> None:
     ax.set_ylabel(f"{name} [m]")
     top = float(np.nanmax(a)) if len(a) else 1.0
     ax.set_ylim(min(-0.05, float(np.nanmin(b)) - 0.05) if len(b) else -0.05, top * 1.08 + 0.02)
-    legend_outside(ax)
 
 
 def _mark_first_impact(axes: list[Any], traj: Trajectory, window: float, text: bool) -> None:
     """A dashed line at the first impact through every panel, and its time written above the
-    top panel (outside it: no curve can cross the words), on the side with more room."""
+    top panel (outside it: no curve can cross the words), on the side with more room; without
+    ``text`` (the user's axes) its time is the line's legend entry instead."""
     first = traj.first_impact()
     if first is None or first.t > window:
         return
     for ax in axes:
-        ax.axvline(first.t, color="0.5", lw=0.8, ls="--", zorder=1)
+        ax.axvline(first.t, color="0.5", lw=0.8, ls="--", zorder=1,
+                   label=None if text else f"first impact, t = {first.t:.4f} s")
     if text:
         left = first.t <= 0.6 * window
         axes[0].annotate(f"first impact, t = {first.t:.4f} s", xy=(first.t, 1.0),
@@ -98,16 +102,18 @@ def _energy_panel(ax: Any, traj: Trajectory, names: list[str], window: float) ->
     lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
     span = hi - min(lo, 0.0)
     ax.set_ylim(min(lo, 0.0) - 0.04 * span, hi + 0.08 * span)
-    legend_outside(ax)
 
 
-def _frame(axes: list[Any], traj: Trajectory, window: float) -> None:
-    """Time axis, grid and first-impact mark shared by every panel."""
+def _frame(axes: list[Any], traj: Trajectory, window: float, own: bool = True) -> None:
+    """Time axis, grid and first-impact mark shared by every panel, then each panel's legend
+    (outside on the package's own figure, ``own``; inside on the user's axes)."""
     axes[-1].set_xlabel("t [s]")
     for ax in axes:
         ax.set_xlim(0, window)
         ax.grid(True, color="0.9", lw=0.6)
-    _mark_first_impact(axes, traj, window, text=True)
+    _mark_first_impact(axes, traj, window, text=own)
+    for ax in axes:
+        legend(ax, own)
 
 
 def _checked(traj: Any, ax: Any, window: Any) -> tuple[Trajectory, Any, float]:
@@ -122,8 +128,7 @@ def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle:
     # stepping solver counts its steps in info).
     dt = f", dt = {traj.dt:g} s" if traj.dt and "steps" in traj.info else ""
     fig.suptitle(f"{plain(traj.scene.title)}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
-    if fig.get_layout_engine() is None:
-        fig.tight_layout()
+    finish(fig)
 
 
 def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
@@ -131,7 +136,7 @@ def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     traj, ax, window = _checked(traj, ax, window)
     if ax is not None:
         _positions_panel(ax, traj, window)
-        _frame([ax], traj, window)
+        _frame([ax], traj, window, own=False)
         return ax
     fig, ax = _subplots(figsize=(9.5, 4.2))
     _positions_panel(ax, traj, window)
@@ -146,7 +151,7 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
     them (the textbook's layout). Returns the energy axes."""
     if ax is not None:
         _energy_panel(ax, traj, names, window)
-        _frame([ax], traj, window)
+        _frame([ax], traj, window, own=False)
         return ax
     fig, (top, bottom) = _subplots(2, 1, figsize=(9.5, 6.4), sharex=True)
     _positions_panel(top, traj, window)
@@ -208,7 +213,8 @@ def _plane_panel(ax: Any, traj: Trajectory, window: float) -> None:
 
 def momentum_panel(ax: Any, traj: Trajectory, window: float = WINDOW) -> Any:
     """L_cm, the angular momentum about the centre of mass (kg m^2/s, 2D), against time on
-    ``ax``: flat in flight, a step at each impact. Returns the axes."""
+    ``ax``: flat in flight, a step at each impact; its legend entry is placed with the
+    figure's others. Returns the axes."""
     traj, ax, window = _checked(traj, ax, window)
     if ax is None:
         raise UsageError("ax = None: must be a matplotlib Axes (the panel to draw on)",
@@ -223,7 +229,6 @@ def momentum_panel(ax: Any, traj: Trajectory, window: float = WINDOW) -> Any:
     pad = 0.1 * max(hi - lo, abs(hi), abs(lo), 1e-12)
     ax.set_ylim(lo - pad, hi + pad)
     ax.set_ylabel("L_cm [kg m²/s]")
-    legend_outside(ax)
     return ax
 
 
@@ -239,14 +244,14 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     inner = [n for n in ("K_int", "K_rot", "K_vib", "U_spring", "K_spin") if n in cols]
     if ax is not None:
         _energy_panel(ax, traj, outer + inner, window)
-        _frame([ax], traj, window)
+        _frame([ax], traj, window, own=False)
         return ax
     wide = traj.scene.system.dimensions == 2
     spin = wide and "L_cm" in cols and bool(inner)
-    # Constrained layout: the time panels stay aligned in one column whatever their legends
-    # (outside, on the right) need; in 2D the motion in the plane sits right of the legends.
-    fig = _figure(figsize=(11.5 if wide else 10.0, 10.8 if spin else 8.8),
-                          layout="constrained")
+    # Constrained layout (every figure's): the time panels stay aligned in one column
+    # whatever their legends (outside, on the right) need; in 2D the motion in the plane sits
+    # right of the legends.
+    fig = _figure(figsize=(11.5 if wide else 10.0, 10.8 if spin else 8.8))
     rows = 4 if spin else 3
     grid = fig.add_gridspec(rows, 2 if wide else 1, width_ratios=[3.2, 1] if wide else None,
                             height_ratios=[1.15, 1, 1, 0.55][:rows])

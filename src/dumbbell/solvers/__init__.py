@@ -23,6 +23,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Trajectory
 from .base import (
     MAX_SAMPLES,
+    REGISTRY,
     RunOptions,
     Solver,
     contract_problems,
@@ -37,10 +38,12 @@ from .reference import Reference
 from .stepping import Stepper
 from .verlet import Verlet
 
-#: Solver name -> class, in the order listings show them.
-METHODS: dict[str, type[Solver]] = {
+#: Solver name -> class, in the order listings show them (the one dict, ``base.REGISTRY``,
+#: that the solvers' own modules read).
+METHODS: dict[str, type[Solver]] = REGISTRY
+METHODS.update({
     cls.name: cls for cls in (EulerCromer, Exact, Verlet, Pymunk, Reference, EulerCromer2D)
-}
+})
 
 __all__ = ["METHODS", "Kernel", "RunOptions", "Solver", "Stepper", "available", "simulate"]
 

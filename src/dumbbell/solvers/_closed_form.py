@@ -26,9 +26,9 @@ def at_rest(body: str, t: float, v: float) -> Verdict:
     """The verdict of ``body`` meeting the floor at ``t`` (s) at a speed ``v`` (m/s) below
     :data:`REST_SPEED`: ``failed``, since an inelastic floor has infinitely many impacts in
     finite time there."""
-    return Verdict("failed", t,
-                   f"{body} came to rest on the floor (impact speed {abs(v):.1e} m/s): an "
-                   "inelastic floor has infinitely many impacts in finite time here")
+    from .verdicts import rest_reason
+
+    return Verdict("failed", t, rest_reason(body, v))
 
 
 def search_failed(t: float) -> RuntimeError:

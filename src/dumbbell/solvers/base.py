@@ -190,6 +190,14 @@ class Solver:
         return None
 
     @classmethod
+    def drift(cls, ratio: float, steps: float) -> float | None:
+        """How far (relative) the vibration energy has moved after ``steps`` stable steps
+        at w*dt = ``ratio``, for a step that loses or gains energy steadily rather than
+        swinging about it (classic Runge-Kutta loses it: 1 - |R(i h)|^(2 steps)); None for a
+        step that keeps it (the default). The accuracy theory reads it beside :meth:`swing`."""
+        return None
+
+    @classmethod
     def warm_up(cls) -> float:
         """Compile or load what the first run would; returns the seconds it took, NaN when
         there is nothing to compile (the default)."""
@@ -211,6 +219,12 @@ class ExplicitSpring:
 
             ratio = args.real(ratio, "ratio", "1", lo=0.0)
         return ratio / (2.0 - ratio) if ratio < 2.0 else math.inf
+
+
+#: The registered solvers by name: :data:`dumbbell.solvers.METHODS` is this dict, filled
+#: there; kept here so that the solvers' own modules can read it without importing the
+#: package that imports them.
+REGISTRY: dict[str, type[Solver]] = {}
 
 
 def contract_problems(cls: Any) -> list[str]:

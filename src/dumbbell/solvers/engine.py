@@ -105,8 +105,9 @@ class World:
 
 def build(scene: Scene) -> World:
     """Build the pymunk space of ``scene`` (see the module docstring)."""
-    import pymunk
+    from .._pymunk import require
 
+    pymunk = require()
     cfg = settings(scene)
     space = pymunk.Space()
     space.gravity = (0.0, -scene.system.g)

@@ -55,9 +55,9 @@ from ..model.energy import (
 )
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from .base import RunOptions, Solver
+from .base import RunOptions, Solver, impact_budget_reason
 from .kernels import REST_SPEED
-from .verdicts import RawRun, head, judge
+from .verdicts import RawRun, head, judge, rest_reason
 
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
 __all__: list[str] = []
@@ -262,7 +262,7 @@ def _integrate_dop853(scene: Scene, times: np.ndarray, t_end: float, tight: bool
         impacts.append(impact)
         t = impact.t
         if len(impacts) >= MAX_IMPACTS:
-            verdict = Verdict("failed", t, f"more than {MAX_IMPACTS} impacts")
+            verdict = Verdict("failed", t, impact_budget_reason(MAX_IMPACTS))
             break
         if t >= t_end:
             break
@@ -292,8 +292,7 @@ def _bounce(scene: Scene, model: _Model, sol: Any, bodies: list[str]
     y = np.asarray(sol.y_events[bodies.index(body)][0], dtype=float)
     v_before = float(model.vertical_velocity(y, body))
     if abs(v_before) < REST_SPEED:
-        return y, Verdict("failed", t_hit, f"{body} came to rest on the floor (impact speed "
-                          f"{abs(v_before):.1e} m/s): infinitely many impacts ahead")
+        return y, Verdict("failed", t_hit, rest_reason(body, v_before))
     mass = (model.effective_mass(y, body) if model.effective_mass is not None
             else (scene.system.A.mass if body == "A" else scene.system.B.mass))
     y = model.jump(y, body, e)
@@ -360,7 +359,7 @@ def _estimate_error(
         "position_m_window": float(diff[window].max()),
         "window_s": float(min(ERROR_WINDOW, t[n - 1])),
         "position_m_whole_run": float(diff.max()),
-        "energy_relative": float(_relative_energy_error(energy).max()),
+        "energy_relative": float(_relative_energy_error(energy, scene.system).max()),
     }
     early = [(a, b) for a, b in zip(impacts, events, strict=False)
              if max(a.t, b.t) <= ERROR_WINDOW and a.body == b.body]

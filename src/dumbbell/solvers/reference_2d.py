@@ -31,6 +31,8 @@ from ..model.energy import spins
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Verdict
 from ._closed_form import REST_SPEED, HeightPoint
+from .base import impact_budget_reason
+from .verdicts import rest_reason
 
 #: Nothing public: the machinery the solver classes share.
 __all__: list[str] = []
@@ -199,9 +201,7 @@ class _Integration:
         for body in hit:
             v_before = float(vel[body][1])
             if abs(v_before) < REST_SPEED:
-                self.verdict = Verdict("failed", hit_t, f"{body} came to rest on the floor "
-                                       f"(impact speed {abs(v_before):.1e} m/s): infinitely "
-                                       "many impacts ahead")
+                self.verdict = Verdict("failed", hit_t, rest_reason(body, v_before))
                 self.t = hit_t
                 return False
             vel[body][1] = -self.e * v_before
@@ -215,7 +215,7 @@ class _Integration:
             C = self.CA if body == "A" else self.CB
             self.quiet[body] = hit_t + (vel[body][1] / C if C > 0 else math.inf)
         if len(self.impacts) >= MAX_IMPACTS:
-            self.verdict = Verdict("failed", self.t, f"more than {MAX_IMPACTS} impacts")
+            self.verdict = Verdict("failed", self.t, impact_budget_reason(MAX_IMPACTS))
             return False
         return True
 

@@ -27,7 +27,14 @@ from ..model.trajectory import Impact, Trajectory, Verdict
 from ..progress import bar
 from .base import RunOptions, Solver, kernel_params, point_particle_limits
 from .kernels import BLOWUP, EVENT_BUFFER, OK, REST, TUNNEL_A, TUNNEL_B, Kernel, Params
-from .verdicts import RawRun, Sinking, below_floor_verdict, conclude, nonfinite_reason
+from .verdicts import (
+    RawRun,
+    Sinking,
+    below_floor_verdict,
+    conclude,
+    nonfinite_reason,
+    rest_reason,
+)
 
 #: Nothing public: the machinery the solver classes share.
 __all__: list[str] = []
@@ -91,8 +98,11 @@ class Stepper(Solver):
         def replay(last: int) -> Iterator[tuple[np.ndarray, dict[str, np.ndarray]]]:
             return _Steps.of(cls, scene, options.dt).replay(columns, last)
 
+        # A particle held below the floor is the step's doing (it flipped too late).
+        held = status in (TUNNEL_A, TUNNEL_B)
         return conclude(cls, scene, options, RawRun(t, state, run.events, verdict, wall,
-                                                    {"steps": steps}, replay=replay))
+                                                    {"steps": steps}, replay=replay,
+                                                    step_fixes=held))
 
     @classmethod
     def warm_up(cls) -> float:
@@ -207,11 +217,9 @@ def kernel_verdict(cls: type[Solver], scene: Scene, run: _Steps, end: tuple[int,
         return below_floor_verdict(scene, steps * dt, dt, sinking(scene, run.st, status), E=E)
     if status == REST:
         last = run.events[-1] if run.events else None
-        return Verdict(
-            "failed", last.t if last else steps * dt,
-            f"{last.body if last else 'a particle'} came to rest on the floor (impact speed "
-            f"{abs(last.v_before) if last else 0.0:.1e} m/s): an inelastic floor has infinitely "
-            "many impacts in finite time here")
+        return Verdict("failed", last.t if last else steps * dt,
+                       rest_reason(last.body if last else "a particle",
+                                   last.v_before if last else 0.0))
     return Verdict()
 
 

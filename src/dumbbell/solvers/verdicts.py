@@ -8,10 +8,16 @@ the step where it happens, whatever the sampling: a stepping solver can replay i
 between the samples (``RawRun.replay``), and the energy is then judged step by step. The verdict's ``str`` is the line ``dumbbell
 simulate`` prints:
 
+- ``inaccurate``: the run stayed stable to its end, but its energy error passed
+  ``run.inaccurate_energy`` (dated at the step where it first did; every sample kept);
 - ``unstable``: the state stopped being finite or the energy grew past ``run.unstable_energy``
-  ("unstable at t = 0.031 s: w*dt = 2.10 > 2 (w = sqrt(k/mu) = 1000 rad/s); use dt < 2e-3 s");
+  ("unstable at t = 0.031 s: w*dt = 2.10 > 2 (w = sqrt(k/mu) = 1000 rad/s): stable only for
+  dt < 2e-3 s; try dt = 4e-5 s (...)");
 - ``tunnelled``: a particle went through the floor (:func:`tunnel_reason`);
 - ``failed``: anything else, with the reason.
+
+Every message but ``ok``'s ends with what to change: where the step is the cause, a value
+(:mod:`.advice` computes it).
 
 The theory behind the messages (a solver's spring step is stable iff w*dt is below its
 ``step_limit``, 2 for an explicit step, with w = sqrt(k/mu)) is in docs/physics.md.
@@ -29,6 +35,8 @@ import numpy as np
 from ..model.energy import _partition, _start_scale
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
+from . import advice
+from .advice import seconds
 from .kernels import BIG
 
 if TYPE_CHECKING:
@@ -41,15 +49,6 @@ __all__: list[str] = []
 def step_ratio(scene: Scene, dt: float | None) -> float:
     """w*dt (dimensionless) for step ``dt`` (s); 0 without a spring or without a step."""
     return scene.system.omega * dt if dt else 0.0
-
-
-def seconds(value: float) -> str:
-    """A time as people write it: '0.031', '3.16e-3' (s, without the unit)."""
-    if value == 0 or 1e-2 <= abs(value) < 1e4:
-        return f"{value:.3g}"
-    mantissa, exponent = f"{value:.2e}".split("e")
-    mantissa = mantissa.rstrip("0").rstrip(".")
-    return f"{mantissa}e{int(exponent)}"
 
 
 def ratio_text(ratio: float, limit: float) -> str:
@@ -68,7 +67,7 @@ def nonfinite_reason(scene: Scene, dt: float, limit: float | None) -> str:
         return "the state grew without bound"
     if w * dt >= limit:
         return (f"w*dt = {ratio_text(w * dt, limit)} > {limit:.3g} (w = sqrt(k/mu) = {w:.4g} "
-                f"rad/s); use dt < {seconds(limit / w)} s")
+                f"rad/s): the step is stable only for dt < {seconds(limit / w)} s")
     return (f"the state grew without bound although w*dt = {ratio_text(w * dt, limit)} < "
             f"{limit:.3g} (w = {w:.4g} rad/s)")
 
@@ -97,13 +96,30 @@ def tunnel_reason(scene: Scene, sinking: Sinking, dt: float | None) -> str:
     if dt is None:
         return text
     travel = speed * dt
-    if depth is not None and depth > 0:
+    if depth is not None and depth > 0 and travel > depth:
         text += (f": it moves {travel:.3g} m per step, more than the {depth:.3g} m in which "
-                 f"a contact is caught; use dt < {seconds(depth / speed)} s or a larger "
-                 "radius")
+                 f"a contact is caught (at dt < {seconds(depth / speed)} s, or with a larger "
+                 "radius, it would be)")
+    elif depth is not None and depth > 0:
+        text += f", past the {depth:.3g} m in which a contact is caught"
     else:
         text += f" ({travel:.3g} m per step): the velocity flip came too late to stop it"
     return text
+
+
+#: What every verdict of a particle come to rest on an inelastic floor says (:func:`rest_reason`);
+#: :func:`judge` then adds what to change.
+RESTED = "came to rest on the floor"
+#: What the verdict of a run stopped by its budget of impacts or work says; :func:`judge` then
+#: adds the end time to use.
+SHORTER = "a shorter t_end fits"
+
+
+def rest_reason(body: str, v: float) -> str:
+    """Why a run ends where ``body`` meets an inelastic floor at a speed ``v`` (m/s) too small
+    to go on: the bounces ahead are infinitely many and come in a finite time."""
+    return (f"{body} {RESTED} (impact speed {abs(v):.1e} m/s): an inelastic floor has "
+            "infinitely many impacts in finite time here")
 
 
 def below_floor_verdict(scene: Scene, t: float, dt: float, sinking: Sinking,
@@ -128,12 +144,12 @@ def below_floor_verdict(scene: Scene, t: float, dt: float, sinking: Sinking,
             left = float(E[-1] / E[0]) if E[0] else math.nan
             if left < 0.5:
                 reason += (f"; the floor is elastic, so the step's impact errors drained the "
-                           f"energy to {left:.0%} of its start: use a smaller dt")
+                           f"energy to {left:.0%} of its start")
         return Verdict("failed", t, reason)
     reason = tunnel_reason(scene, sinking, dt)
     if push > scene.system.g:
         reason += (f"; the spring pushed it back down (at {push:.3g} m/s^2) before it climbed "
-                   f"out, with w*dt = {step_ratio(scene, dt):.2f}: use a smaller dt")
+                   f"out, with w*dt = {step_ratio(scene, dt):.2f}")
     return Verdict("tunnelled", t, reason)
 
 
@@ -172,7 +188,8 @@ def _energy_errors(scene: Scene, E: np.ndarray, E0: float, scale: float) -> np.n
     energy by design, only a gain counts."""
     err = np.subtract(E, E0)  # |E - E0| / scale, in one array
     np.abs(err, out=err)
-    err /= scale
+    with np.errstate(over="ignore"):  # a blown-up state's 1e300 J over a small scale: inf
+        err /= scale
     return np.where(E > E0, err, 0.0) if scene.system.dissipative else err
 
 
@@ -194,6 +211,51 @@ def _unstable(cls: type[Solver], scene: Scene, t: float, err: float, dt: float |
     return Verdict("unstable", t, reason)
 
 
+def _accuracy_errors(scene: Scene, energy: Mapping[str, np.ndarray], E0: float, scale: float
+                     ) -> np.ndarray:
+    """The method's own relative energy error at every sample of the energy columns
+    ``energy`` (J): |E - E0| / scale, or on a dissipative scene, whose floor takes energy by
+    design, what the heat counted does not explain, |E0 - E - E_heat| / scale."""
+    E = energy["E"]
+    if scene.system.dissipative and "E_heat" in energy:
+        err = np.subtract(E0, E)
+        err -= energy["E_heat"]
+    else:
+        err = np.subtract(E, E0)
+    np.abs(err, out=err)
+    with np.errstate(over="ignore"):
+        err /= scale
+    return err
+
+
+def _inaccurate(scene: Scene, t: float, err: float, worst: tuple[float, float]) -> Verdict:
+    """``inaccurate`` at ``t`` (s), where the energy error ``err`` passed the scene's
+    ``run.inaccurate_energy``; ``worst`` the largest error and its time (s)."""
+    top, when = worst
+    return Verdict("inaccurate", t, (
+        f"energy error {err:.3g} passed run.inaccurate_energy = "
+        f"{scene.run.inaccurate_energy:g} and reached {top:.3g} at t = {when:.4g} s; the run "
+        "stayed stable to its end"))
+
+
+def accuracy_verdict(scene: Scene, t: np.ndarray, energy: Mapping[str, np.ndarray]
+                     ) -> tuple[Verdict, tuple[float, float]]:
+    """For a run that stayed stable (every sample kept): ``inaccurate`` at the first sample
+    whose energy error (:func:`_accuracy_errors`, at the sample times ``t`` in s) passes the
+    scene's ``run.inaccurate_energy``, else ``ok``; and the largest error (dimensionless)
+    with its time (s)."""
+    if len(t) == 0:
+        return Verdict(), (0.0, 0.0)
+    err = _accuracy_errors(scene, energy, float(energy["E"][0]),
+                           _start_scale(energy, scene.system))
+    i = int(np.argmax(err))
+    worst = (float(err[i]), float(t[i]))
+    if not err[i] > scene.run.inaccurate_energy:
+        return Verdict(), worst
+    j = int(np.flatnonzero(err > scene.run.inaccurate_energy)[0])
+    return _inaccurate(scene, float(t[j]), float(err[j]), worst), worst
+
+
 def energy_verdict(
     cls: type[Solver], scene: Scene, t: np.ndarray, energy: Mapping[str, np.ndarray],
     dt: float | None,
@@ -204,7 +266,8 @@ def energy_verdict(
     the step (s; None for a truth solver, whose dt only sets the sample times)."""
     if len(t) == 0:
         return Verdict(), 0
-    err = _energy_errors(scene, energy["E"], float(energy["E"][0]), _start_scale(energy))
+    err = _energy_errors(scene, energy["E"], float(energy["E"][0]),
+                         _start_scale(energy, scene.system))
     if err.max() <= scene.run.unstable_energy:  # every error within (a NaN fails this)
         return Verdict(), len(t)
     bad = np.flatnonzero(~(err <= scene.run.unstable_energy))
@@ -239,7 +302,9 @@ class RawRun:
     the impacts, its own verdict (from how it stopped), its clock (s), its notes (``info``),
     its energy columns (J) if it counted them itself, and, for a stepping solver whose samples
     skip steps, how to replay its steps (:data:`Replay`), so that a verdict is dated at the step
-    where it happens."""
+    where it happens. ``step_fixes``: its own ``failed`` verdict is one a smaller step cures
+    (a particle held below a velocity-flip floor), so the message ends with a step to try;
+    ``unstable`` and ``tunnelled`` always do."""
 
     t: np.ndarray
     state: Mapping[str, np.ndarray]
@@ -249,6 +314,7 @@ class RawRun:
     info: Mapping[str, Any] = field(default_factory=dict)
     energy: Mapping[str, np.ndarray] | None = None
     replay: Replay | None = None
+    step_fixes: bool = False
 
 
 def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
@@ -261,10 +327,12 @@ def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
     - ``unstable`` (the state blew up): the samples before the explosion, then the energy
       verdict if it finds the failure earlier, else the solver's;
     - ``tunnelled``, ``failed``: the solver's, all samples kept;
-    - ``ok``: :func:`energy_verdict` (a truth solver's with no step).
+    - ``ok``: :func:`energy_verdict` (a truth solver's with no step), then, if the run stayed
+      stable, :func:`accuracy_verdict` (``inaccurate``, all samples kept).
 
-    An ``unstable`` verdict of a run that can replay its steps is dated at the first step
-    whose energy error passes the scene's threshold, not at the first such sample.
+    An ``unstable`` or ``inaccurate`` verdict of a run that can replay its steps is dated at
+    the first step whose energy error passes the scene's threshold, not at the first such
+    sample. Every verdict but ``ok`` then ends with what to change (:mod:`.advice`).
 
     Returns the verdict, how many samples the run keeps, and the energy columns of those
     samples (from :func:`dumbbell.model.energy.partition` unless given). Changes nothing."""
@@ -281,6 +349,10 @@ def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
     t, state = t[:keep], head(state, keep)
     energy = (_partition(scene, t, state, tuple(raw.events)) if raw.energy is None
               else head(raw.energy, keep))
+    # A state that blew up, or a step past its limit, measured no error worth scaling.
+    limit = cls.step_limit
+    blown = verdict.status == "unstable" or (
+        dt is not None and limit is not None and step_ratio(scene, dt) >= limit)
     if verdict.ok or verdict.status == "unstable":
         judged, keep = energy_verdict(cls, scene, t, energy, dt)
         if raw.replay is not None and dt is not None and len(t) and not (
@@ -290,7 +362,101 @@ def judge(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun
             judged = _first_bad_step(cls, scene, dt, energy, raw.replay(last)) or judged
         if not (judged.ok and verdict.status == "unstable"):
             verdict = judged
+    if verdict.ok:
+        verdict = _accuracy(scene, dt, (t, energy), raw)
+    if not verdict.ok:
+        cured = verdict.status != "failed" or raw.step_fixes
+        verdict = _advised(cls, scene, options, verdict, (t, state, energy),
+                           (cured, blown))
+    if verdict.status == "failed" and verdict.t is not None and (
+            not raw.step_fixes or verdict is raw.verdict or scene.system.elasticity < 1.0):
+        # No step cures it, none was found, or a step may not: a particle held on an
+        # inelastic floor may be at rest there for good.
+        verdict = _ended_early(scene, verdict, held=raw.step_fixes)
     return verdict, keep, head(energy, keep)
+
+
+def _accuracy(scene: Scene, dt: float | None,
+              samples: tuple[np.ndarray, Mapping[str, np.ndarray]], raw: RawRun) -> Verdict:
+    """The verdict of a run that stayed stable: ``ok``, or ``inaccurate`` dated at the first
+    step (replayed, where the run can) whose energy error passes ``run.inaccurate_energy``."""
+    t, energy = samples
+    judged, worst = accuracy_verdict(scene, t, energy)
+    if judged.ok or raw.replay is None or dt is None:
+        return judged
+    E0, scale = float(energy["E"][0]), _start_scale(energy, scene.system)
+    events = tuple(raw.events) if scene.system.dissipative else ()
+
+    def errors(steps: np.ndarray, state: Mapping[str, np.ndarray]) -> np.ndarray:
+        return _accuracy_errors(scene, _partition(scene, steps * dt, state, events), E0, scale)
+
+    found = _first_step_past(raw.replay(round(judged.t / dt)), errors,  # type: ignore[operator]
+                             scene.run.inaccurate_energy)
+    if found is None:
+        return judged
+    step, err = found
+    return _inaccurate(scene, step * dt, err, worst)
+
+
+def _advised(cls: type[Solver], scene: Scene, options: RunOptions, verdict: Verdict,
+             samples: tuple[np.ndarray, Mapping[str, np.ndarray], Mapping[str, np.ndarray]],
+             how: tuple[bool, bool]) -> Verdict:
+    """``verdict`` with the step to try at the end of its reason (:func:`advice.step_text`)
+    when a smaller step cures it (``how`` = (cured, blown)): from the energy error the run
+    measured up to its verdict (the samples: times in s, state, energy columns in J), unless
+    it blew up."""
+    cured, blown = how
+    if not cls.has_step or not cured:
+        return verdict
+    t, state, energy = samples
+    measured = None
+    if len(t) > 1 and not blown:
+        err = _accuracy_errors(scene, energy, float(energy["E"][0]),
+                               _start_scale(energy, scene.system))
+        end = np.searchsorted(t, verdict.t, side="right") if verdict.t is not None else len(t)
+        if verdict.status == "inaccurate":
+            end = len(t)  # the run went on: all of it was measured
+        if end > 1:
+            until = float(t[end - 1])
+            measured = (options.dt, float(np.nanmax(err[:end])), until)
+    bounds = advice.step_bounds(cls, scene, measured)
+    if verdict.status == "tunnelled":
+        columns = ("vA", "vB") if scene.system.dimensions == 1 else ("vyA", "vyB")
+        speed = max(float(np.max(np.abs(state[c]))) for c in columns) if len(t) else 0.0
+        bounds.append(advice.catch_bound(cls._catch_depth(scene), speed))
+    text = advice.step_text(scene, options.dt, bounds)
+    if not text:
+        return verdict
+    return Verdict(verdict.status, verdict.t, f"{verdict.reason}; {text}")
+
+
+def _ended_early(scene: Scene, verdict: Verdict, held: bool = False) -> Verdict:
+    """A ``failed`` verdict that no step cures, with what to change: a run that came to rest
+    on an inelastic floor (or, ``held``, is held on it) ends before it or uses a solver that
+    holds contact; one stopped by a budget or by its integrator ends before that time."""
+    if RESTED in verdict.reason or held:
+        fix = advice.rest_text(scene, verdict.t)  # type: ignore[arg-type]
+    elif SHORTER in verdict.reason:
+        return Verdict("failed", verdict.t, verdict.reason.replace(
+            SHORTER, f"{SHORTER} (run.t_end = {advice.seconds_below(verdict.t)} s)", 1))  # type: ignore[arg-type]
+    else:
+        fix = (f"end the run before it (run.t_end = {advice.seconds_below(verdict.t)} s)"  # type: ignore[arg-type]
+               if verdict.t > 0 else "")  # type: ignore[operator]
+    return Verdict("failed", verdict.t, f"{verdict.reason}; {fix}") if fix else verdict
+
+
+def _first_step_past(blocks: Iterator[tuple[np.ndarray, Mapping[str, np.ndarray]]],
+                     errors: Callable[[np.ndarray, Mapping[str, np.ndarray]], np.ndarray],
+                     threshold: float) -> tuple[int, float] | None:
+    """The first of the replayed steps (``blocks`` of step indices and states) whose error
+    (``errors`` of the block) passes ``threshold``, and that error; None if none does."""
+    for steps, state in blocks:
+        err = errors(steps, state)
+        bad = np.flatnonzero(~(err <= threshold))
+        if bad.size:
+            j = int(bad[0])
+            return int(steps[j]), float(err[j])
+    return None
 
 
 def _first_bad_step(cls: type[Solver], scene: Scene, dt: float,
@@ -300,15 +466,16 @@ def _first_bad_step(cls: type[Solver], scene: Scene, dt: float,
     """``unstable`` at the first of the replayed steps (``blocks`` of step indices and states;
     step ``dt`` in s) whose energy error (against the run's first sample, ``energy``) passes
     the scene's threshold; None if none does."""
-    E0, scale = float(energy["E"][0]), _start_scale(energy)
-    for steps, state in blocks:
-        E = _partition(scene, steps * dt, state)["E"]
-        err = _energy_errors(scene, E, E0, scale)
-        bad = np.flatnonzero(~(err <= scene.run.unstable_energy))
-        if bad.size:
-            j = int(bad[0])
-            return _unstable(cls, scene, float(steps[j]) * dt, float(err[j]), dt)
-    return None
+    E0, scale = float(energy["E"][0]), _start_scale(energy, scene.system)
+
+    def errors(steps: np.ndarray, state: Mapping[str, np.ndarray]) -> np.ndarray:
+        return _energy_errors(scene, _partition(scene, steps * dt, state)["E"], E0, scale)
+
+    found = _first_step_past(blocks, errors, scene.run.unstable_energy)
+    if found is None:
+        return None
+    step, err = found
+    return _unstable(cls, scene, float(step) * dt, err, dt)
 
 
 def conclude(cls: type[Solver], scene: Scene, options: RunOptions, raw: RawRun) -> Trajectory:

@@ -26,11 +26,11 @@ _WHERE = {
     "energy": "accounting", "SpaceEnergy": "accounting", "BodyEnergy": "accounting",
     "SpringEnergy": "accounting", "Skipped": "accounting",
     "check": "guard", "survey": "guard", "suggest_dt": "guard", "substeps": "guard",
-    "report": "guard", "Finding": "guard", "step": "guard", "Driver": "guard",
+    "report": "guard", "Finding": "guard", "step": "stepping", "Driver": "stepping",
     "spring_omega": "guard", "shape_size": "guard", "energy_swing": "guard",
     "reach": "estimates", "Reach": "estimates",
     "HeatCounter": "heat",
-    "Ledger": "ledger", "Balance": "ledger", "Term": "ledger",
+    "Ledger": "ledger", "Balance": "balance", "Term": "balance",
     "Recorder": "recorder", "PaletteDrawOptions": "recorder", "draw_options": "recorder",
 }
 

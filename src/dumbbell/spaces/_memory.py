@@ -1,18 +1,32 @@
 """Read pymunk's C structs in bulk: what the energy ledger needs and pymunk's Python API does
-not give (signed constraint impulses, contact impulses, the solver's bias velocities, the
-list of contacts the solver used in a step), for many bodies at once with numpy.
+not give (signed constraint impulses, the solver's bias velocities, the list of contacts the
+solver used in a step), for many bodies at once with numpy.
 
-pymunk 7 runs on Munk2D (a Chipmunk2D fork). Its struct layouts are declared here in cffi's
-ABI mode (no compiler): cffi lays them out by the platform's C rules. Nothing is trusted
-blindly: :func:`check` compares what the declarations read against pymunk's own getters
-(masses, positions, velocities, every constraint setting, the space's settings and time
-stamp) on live objects, and the ledger refuses to attach when they differ (another pymunk
-build), rather than read the wrong bytes. Reads happen only at addresses of live objects of
-the space and at the solver's own arrays.
+pymunk 7 runs on Munk2D (a Chipmunk2D fork). pymunk's compiled module declares the arbiters,
+contacts and ``cpArray`` in full (their layout is checked by the C compiler when pymunk is
+built: read through it, they are right by construction), but keeps ``cpSpace``, ``cpBody``
+and the constraints opaque. Those are declared here in cffi's ABI mode (no compiler), with
+pymunk's own sizes of ``cpFloat``, ``cpBool``, ``cpTimestamp``, ``cpHashValue`` and pointers,
+and cffi lays them out by the platform's C rules. Nothing is trusted blindly:
 
-:func:`gather` reads fields of many structs of one type at once: it views the memory from the
-lowest to the highest address as one numpy array (creating the view reads nothing) and picks
-the fields by index, so only the structs' own bytes are read.
+- :func:`platform_problem`: the gathers index memory in 8-byte words, so every float field
+  must sit at a multiple of 8 and every pointer at a multiple of the pointer width;
+- :func:`check_space`: the settings up to ``dt`` against pymunk's getters (with a
+  tolerance), then, before any pointer past ``dt`` is followed, the fields past it that
+  Chipmunk's public C getters return (the shape id counter, the static body); then each
+  array's header, and its contents against the objects the space is known to hold;
+- :func:`check_body` and :func:`check_constraint`: every field read against pymunk's getters
+  and Chipmunk's C getters (bodies, space, user data), floats with a tolerance;
+- :func:`readable`: all of it once per process on a small space of every constraint kind,
+  stepped with contacts and a sleeping body.
+
+When any check fails, the ledger says so once and counts with pymunk's public API only
+(:mod:`._public`). Reads happen only at addresses of live objects of the space and at the
+solver's own arrays.
+
+:class:`Reader` reads fields of many structs of one type at once: it views the memory from
+the lowest to the highest address as one numpy array (creating the view reads nothing) and
+picks the fields by index, so only the structs' own bytes are read.
 """
 
 from __future__ import annotations
@@ -22,60 +36,71 @@ from typing import Any
 
 import numpy as np
 
-#: The structs, in Munk2D's field order (cpFloat = double, cpBool = unsigned char,
-#: cpTimestamp = unsigned int, pointers and cpHashValue 8 bytes on 64-bit platforms).
+#: The structs, in Munk2D's field order (its include/chipmunk/chipmunk_structs.h, the same in
+#: every pymunk 7.x). The typedefs come from pymunk's compiled module (:func:`_typedefs`);
+#: ``handler`` stands for the space's global collision handler, ``handler_words`` pointer-
+#: sized words long.
 _DECLARATIONS = """
-typedef struct { double x, y; } vec;
+typedef struct { cpFloat x, y; } vec;
 typedef struct { int num, max; void **arr; } array;
 typedef struct {
     void *velocity_func, *position_func;
-    double m, m_inv, i, i_inv;
+    cpFloat m, m_inv, i, i_inv;
     vec cog, p, v, f;
-    double a, w, t;
-    double transform[6];
+    cpFloat a, w, t;
+    cpFloat transform[6];
     void *user_data;
     vec v_bias;
-    double w_bias;
+    cpFloat w_bias;
     void *space, *shapes, *arbiters, *constraints;
     void *root, *next;
-    double idle_time;
+    cpFloat idle_time;
 } body;
 typedef struct {
     void *klass, *space, *a, *b, *next_a, *next_b;
-    double max_force, error_bias, max_bias;
-    unsigned char collide_bodies;
+    cpFloat max_force, error_bias, max_bias;
+    cpBool collide_bodies;
     void *pre_solve, *post_solve, *user_data;
 } constraint;
-typedef struct { constraint c; vec anchor_a, anchor_b; double dist; vec r1, r2, n;
-                 double n_mass, j, bias; } pin;
-typedef struct { constraint c; vec anchor_a, anchor_b; double min, max; vec r1, r2, n;
-                 double n_mass, j, bias; } slide;
-typedef struct { constraint c; vec anchor_a, anchor_b; vec r1, r2; double k[4];
+typedef struct { constraint c; vec anchor_a, anchor_b; cpFloat dist; vec r1, r2, n;
+                 cpFloat n_mass, j, bias; } pin;
+typedef struct { constraint c; vec anchor_a, anchor_b; cpFloat min, max; vec r1, r2, n;
+                 cpFloat n_mass, j, bias; } slide;
+typedef struct { constraint c; vec anchor_a, anchor_b; vec r1, r2; cpFloat k[4];
                  vec j, bias; } pivot;
 typedef struct { constraint c; vec groove_n, groove_a, groove_b, anchor_b, groove_tn;
-                 double clamp; vec r1, r2; double k[4]; vec j, bias; } groove;
-typedef struct { constraint c; vec anchor_a, anchor_b; double rest, stiffness, damping;
-                 void *force_func; double target_vrn, v_coef; vec r1, r2; double n_mass;
-                 vec n; double j; } spring;
-typedef struct { constraint c; double rest, stiffness, damping; void *torque_func;
-                 double target_wrn, w_coef, i_sum, j; } rotary_spring;
-typedef struct { constraint c; double min, max, i_sum, bias, j; } rotary_limit;
-typedef struct { constraint c; double angle, phase, ratchet, i_sum, bias, j; } ratchet;
-typedef struct { constraint c; double phase, ratio, ratio_inv, i_sum, bias, j; } gear;
-typedef struct { constraint c; double rate, i_sum, j; } motor;
+                 cpFloat clamp; vec r1, r2; cpFloat k[4]; vec j, bias; } groove;
+typedef struct { constraint c; vec anchor_a, anchor_b; cpFloat rest, stiffness, damping;
+                 void *force_func; cpFloat target_vrn, v_coef; vec r1, r2; cpFloat n_mass;
+                 vec n; cpFloat j; } spring;
+typedef struct { constraint c; cpFloat rest, stiffness, damping; void *torque_func;
+                 cpFloat target_wrn, w_coef, i_sum, j; } rotary_spring;
+typedef struct { constraint c; cpFloat min, max, i_sum, bias, j; } rotary_limit;
+typedef struct { constraint c; cpFloat angle, phase, ratchet, i_sum, bias, j; } ratchet;
+typedef struct { constraint c; cpFloat phase, ratio, ratio_inv, i_sum, bias, j; } gear;
+typedef struct { constraint c; cpFloat rate, i_sum, j; } motor;
 typedef struct {
     int iterations;
     vec gravity;
-    double damping, idle_speed, sleep_time, slop, bias;
-    unsigned int persistence;
+    cpFloat damping, idle_speed, sleep_time, slop, bias;
+    cpTimestamp persistence;
     void *user_data;
-    unsigned int stamp;
-    double dt;
+    cpTimestamp stamp;
+    cpFloat dt;
     array *dynamic_bodies, *static_bodies, *roused_bodies, *sleeping_components;
-    uintptr_t shape_ids;
+    cpHashValue shape_ids;
     void *static_shapes, *dynamic_shapes;
     array *constraints;
     array *arbiters;
+    void *contact_buffers, *cached_arbiters;
+    array *pooled_arbiters, *allocated_buffers;
+    int locked;
+    void *collision_handlers;
+    uintptr_t handler[HANDLER_WORDS];
+    cpBool skip_post_step;
+    array *post_step_callbacks;
+    void *static_body;
+    body own_static_body;
 } space;
 """
 
@@ -85,9 +110,75 @@ STRUCT = {"PinJoint": "pin", "SlideJoint": "slide", "PivotJoint": "pivot",
           "DampedRotarySpring": "rotary_spring", "RotaryLimitJoint": "rotary_limit",
           "RatchetJoint": "ratchet", "GearJoint": "gear", "SimpleMotor": "motor"}
 
+#: Most elements a solver array is believed to hold (a header past it is a misread).
+_ARRAY_MAX = 1 << 28
+#: Lowest address a live object can have (the first page is never mapped).
+_LOWEST = 4096
+
+
+#: Spaces -> the addresses of the ledgers' hooks in them (:mod:`._hook`): what a space's
+#: C constraint array holds beyond its constraints.
+HOOKS: Any = None
+
+
+def hooks(space: Any) -> set[int]:
+    """Addresses of the hooks now in ``space``."""
+    return set(_hooks().get(space, ()))
+
+
+def _hooks() -> Any:
+    global HOOKS
+    if HOOKS is None:
+        import weakref
+
+        HOOKS = weakref.WeakKeyDictionary()
+    return HOOKS
+
 
 class LayoutError(Exception):
     """pymunk's structs are not laid out as declared here (another pymunk build)."""
+
+
+@cache
+def _pymunk_ffi() -> Any:
+    from pymunk._chipmunk_cffi import ffi as pffi
+
+    return pffi
+
+
+@cache
+def _lib() -> Any:
+    from pymunk._chipmunk_cffi import lib
+
+    return lib
+
+
+def pymunk_version() -> str:
+    """The installed pymunk's version (``pymunk.version`` says Munk2D's on pymunk 7.0.x)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("pymunk")
+    except metadata.PackageNotFoundError:  # pragma: no cover - pymunk not from a package
+        import pymunk
+
+        return str(pymunk.version)
+
+
+def _unsigned(size: int) -> str:
+    return {1: "unsigned char", 2: "unsigned short", 4: "unsigned int",
+            8: "unsigned long long"}[size]
+
+
+@cache
+def _typedefs() -> str:
+    """pymunk's own sizes of Chipmunk's scalar types, as C typedefs."""
+    p = _pymunk_ffi()
+    return "\n".join([
+        "typedef double cpFloat;",
+        f"typedef {_unsigned(p.sizeof('cpBool'))} cpBool;",
+        f"typedef {_unsigned(p.sizeof('cpTimestamp'))} cpTimestamp;",
+        f"typedef {_unsigned(p.sizeof('cpHashValue'))} cpHashValue;"])
 
 
 @cache
@@ -95,29 +186,96 @@ def ffi() -> Any:
     """The cffi declarations (ABI mode: no compiler)."""
     import cffi
 
+    p = _pymunk_ffi()
+    words = p.sizeof("cpCollisionHandler") // p.sizeof("uintptr_t")
     f = cffi.FFI()
-    f.cdef(_DECLARATIONS)
+    f.cdef(_typedefs() + _DECLARATIONS.replace("HANDLER_WORDS", str(max(words, 1))))
     return f
+
+
+#: Size of a pointer in bytes (4 or 8), and the numpy type of one.
+def pointer_size() -> int:
+    return int(ffi().sizeof("void *"))
+
+
+def pointer_dtype() -> Any:
+    return np.uint64 if pointer_size() == 8 else np.uint32
+
+
+#: Float and pointer fields each struct's readers gather (checked for alignment).
+_FLOAT_FIELDS = {
+    "body": ("p.x", "p.y", "a", "v.x", "v.y", "w", "f.x", "f.y", "t", "m", "i", "cog.x",
+             "cog.y", "v_bias.x", "v_bias.y", "w_bias", "idle_time"),
+    "spring": ("rest", "stiffness", "damping", "c.max_force", "j", "n.x", "n.y", "r1.x",
+               "r1.y", "r2.x", "r2.y", "anchor_a.x", "anchor_a.y", "anchor_b.x",
+               "anchor_b.y"),
+    "rotary_spring": ("rest", "stiffness", "damping", "c.max_force", "j"),
+    "pin": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+    "slide": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+    "pivot": ("j.x", "j.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+    "groove": ("j.x", "j.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+    "rotary_limit": ("j", "bias"), "ratchet": ("j", "bias"), "gear": ("j", "ratio_inv"),
+    "motor": ("j",),
+}
+_POINTER_FIELDS = {"body": ("velocity_func", "position_func", "root"),
+                   "spring": ("force_func",), "rotary_spring": ("torque_func",)}
+
+
+@cache
+def platform_problem() -> str | None:
+    """Why the declared structs cannot be read on this platform, or None: pymunk's scalar
+    types, the pointer width, and the alignment the 8-byte gathers need."""
+    return _sizes_problem() or _alignment_problem()
+
+
+def _sizes_problem() -> str | None:
+    p = _pymunk_ffi()
+    ptr = p.sizeof("void *")
+    if ptr != 8:
+        return f"pointers are {ptr} bytes (the contact reads are written for 8)"
+    wrong = [f"{name} is {p.sizeof(name)} bytes, not {want}" for name, want in
+             (("cpFloat", 8), ("cpVect", 16), ("uintptr_t", ptr), ("cpHashValue", ptr),
+              ("int", 4)) if p.sizeof(name) != want]
+    wrong += [f"{name} is {p.sizeof(name)} bytes" for name in ("cpBool", "cpTimestamp")
+              if p.sizeof(name) not in (1, 2, 4, 8)]
+    if ffi().sizeof("void *") != ptr:
+        wrong.append("cffi and pymunk disagree on the pointer width")
+    if p.sizeof("cpCollisionHandler") % ptr:
+        wrong.append("cpCollisionHandler is not a whole number of pointers")
+    if p.sizeof("cpArbiter") % 8 or p.sizeof("cpContact") % 8:
+        wrong.append("cpArbiter or cpContact is not a whole number of 8-byte words")
+    return wrong[0] if wrong else None
+
+
+def _alignment_problem() -> str | None:
+    p = _pymunk_ffi()
+    ptr = p.sizeof("void *")
+    fields = [(kind, path, 8) for kind, paths in _FLOAT_FIELDS.items() for path in paths]
+    fields += [(kind, path, ptr) for kind, paths in _POINTER_FIELDS.items() for path in paths]
+    for kind, path, step in fields:
+        if offset(kind, *path.split(".")) % step:
+            return f"{kind}.{path} is not {step}-byte aligned on this platform"
+    # pymunk's own declarations of the arbiters and contacts the gathers read.
+    for struct, names, step in (("cpArbiter", ("n",), 8), ("cpArbiter", ("count", "state"), 4),
+                                ("cpArbiter", ("body_a", "body_b", "contacts"), ptr),
+                                ("cpContact", ("r1", "r2", "jnAcc", "jtAcc", "jBias"), 8)):
+        for name in names:
+            if p.offsetof(struct, name) % step:
+                return f"{struct}.{name} is not aligned for the gathers on this platform"
+    return None
 
 
 def address(cdata: Any) -> int:
     """The address a pymunk cffi pointer points to."""
-    return int(_cast()("uintptr_t", cdata))
+    return int(_pymunk_ffi().cast("uintptr_t", cdata))
 
 
 def addresses(objects: Any, attr: str) -> np.ndarray:
     """Addresses (uint64) of the structs of many pymunk objects (``attr``: '_body',
     '_constraint', ...)."""
-    cast = _cast()
+    cast = _pymunk_ffi().cast
     return np.array([int(cast("uintptr_t", getattr(o, attr))) for o in objects],
                     dtype=np.uint64)
-
-
-@cache
-def _cast() -> Any:
-    from pymunk._chipmunk_cffi import ffi as pffi
-
-    return pffi.cast
 
 
 def view(kind: str, at: int) -> Any:
@@ -127,27 +285,48 @@ def view(kind: str, at: int) -> Any:
 
 def offset(kind: str, *path: str) -> int:
     """Byte offset of a (nested) field, e.g. ``offset('spring', 'r1')``."""
-    return ffi().offsetof(kind, *path)
+    return int(ffi().offsetof(kind, *path))
 
 
 def size(kind: str) -> int:
-    return ffi().sizeof(kind)
+    return int(ffi().sizeof(kind))
+
+
+def _plausible(at: int) -> bool:
+    """An address a live, pointer-aligned object can have."""
+    top = 1 << (8 * pointer_size())
+    return _LOWEST <= at < top and at % pointer_size() == 0
+
+
+def array_items(arr_at: int) -> np.ndarray:
+    """The pointers held in a Chipmunk ``cpArray`` at ``arr_at`` (uint64 addresses), read
+    through pymunk's compiled declaration of ``cpArray``; a header that cannot be a live
+    array's raises :class:`LayoutError` before its items are read."""
+    p = _pymunk_ffi()
+    arr = p.cast("cpArray *", arr_at)
+    num, cap = int(arr.num), int(arr.max)
+    if not 0 <= num <= cap <= _ARRAY_MAX:
+        raise LayoutError(f"array: {num} of {cap} items")
+    if num == 0:
+        return np.zeros(0, dtype=np.uint64)
+    items = address(arr.arr)
+    if not _plausible(items):
+        raise LayoutError("array: its items are not at a valid address")
+    out = np.frombuffer(p.buffer(arr.arr, pointer_size() * num), dtype=pointer_dtype())
+    return out.astype(np.uint64)
 
 
 def pointers(arr_at: int) -> np.ndarray:
-    """The pointers held in a Chipmunk ``cpArray`` at ``arr_at`` (uint64 addresses)."""
-    f = ffi()
-    arr = f.cast("array *", arr_at)
-    n = int(arr.num)
-    if n == 0:
-        return np.zeros(0, dtype=np.uint64)
-    return np.frombuffer(f.buffer(arr.arr, 8 * n), dtype=np.uint64).copy()
+    """Alias of :func:`array_items` (the pointers held in a ``cpArray``)."""
+    return array_items(arr_at)
 
 
 class Span:
-    """A numpy view over the memory from ``lo`` to ``hi`` (bytes), typed three ways."""
+    """A numpy view over the memory from ``lo`` to ``hi`` (bytes), typed several ways;
+    ``ptr`` is the view of pointer-sized words and ``pshift`` the shift from a byte offset
+    to its index."""
 
-    __slots__ = ("f64", "i64", "lo", "u8", "u32", "u64")
+    __slots__ = ("f64", "i64", "lo", "pshift", "ptr", "u8", "u32", "u64")
 
     def __init__(self, lo: int, hi: int) -> None:
         f = ffi()
@@ -159,6 +338,9 @@ class Span:
         self.u64 = raw.view(np.uint64)
         self.i64 = raw.view(np.int64)
         self.f64 = raw.view(np.float64)
+        wide = pointer_size() == 8
+        self.ptr = self.u64 if wide else self.u32
+        self.pshift = 3 if wide else 2
 
     @classmethod
     def over(cls, at: np.ndarray, nbytes: int) -> Span | None:
@@ -167,91 +349,64 @@ class Span:
             return None
         return cls(int(at.min()), int(at.max()) + nbytes)
 
-    def _index(self, at: np.ndarray, off: int) -> np.ndarray:
-        return (at - np.uint64(self.lo)) + np.uint64(off)
+    def _index(self, at: np.ndarray, off: Any) -> np.ndarray:
+        return (at - np.uint64(self.lo)) + np.asarray(off, dtype=np.uint64)
 
-    def f(self, at: np.ndarray, off: int) -> np.ndarray:
+    def f(self, at: np.ndarray, off: Any) -> np.ndarray:
         """float64 fields at ``at + off`` (a copy)."""
         return self.f64[self._index(at, off) >> np.uint64(3)]
 
-    def p(self, at: np.ndarray, off: int) -> np.ndarray:
-        """Pointer (uint64) fields at ``at + off``."""
-        return self.u64[self._index(at, off) >> np.uint64(3)]
+    def p(self, at: np.ndarray, off: Any) -> np.ndarray:
+        """Pointer fields at ``at + off`` (uint64)."""
+        return self.ptr[self._index(at, off) >> np.uint64(self.pshift)].astype(np.uint64)
 
-    def i(self, at: np.ndarray, off: int) -> np.ndarray:
+    def i(self, at: np.ndarray, off: Any) -> np.ndarray:
         """32-bit unsigned fields at ``at + off``."""
         return self.u32[self._index(at, off) >> np.uint64(2)]
 
-    def b(self, at: np.ndarray, off: int) -> np.ndarray:
-        """Byte fields at ``at + off``."""
-        return self.u8[self._index(at, off)]
 
+class Reader:
+    """Fields of structs of one kind at fixed addresses, read in one numpy gather each:
+    ``floats()`` (fields, structs) float64, ``pointers()`` (fields, structs) uint64."""
 
-def _close(a: float, b: float) -> bool:
-    import math
+    def __init__(self, kind: str, at: np.ndarray, floats: tuple[str, ...],
+                 ptrs: tuple[str, ...] = ()) -> None:
+        self.span = Span.over(at, size(kind))
+        self.fi = self.pi = self._all = None
+        self.shape = (len(floats), len(ptrs))
+        if self.span is None:
+            return
+        if np.any(at % np.uint64(8)):
+            raise LayoutError(f"{kind}: a struct not 8-byte aligned")
+        rel = at - np.uint64(self.span.lo)
+        if floats:
+            self.fi = np.stack([(rel + np.uint64(offset(kind, *f.split(".")))) >> np.uint64(3)
+                                for f in floats])
+        if ptrs:
+            shift = np.uint64(self.span.pshift)
+            self.pi = np.stack([(rel + np.uint64(offset(kind, *f.split(".")))) >> shift
+                                for f in ptrs])
 
-    return a == b or (math.isnan(a) and math.isnan(b))
+    def floats(self) -> np.ndarray:
+        if self.span is None:
+            return np.zeros((self.shape[0], 0))
+        return self.span.f64[self.fi]
 
+    def both(self) -> tuple[np.ndarray, np.ndarray]:
+        """``floats()`` and ``pointers()``, in one gather where pointers are 8 bytes."""
+        if self.span is None or self.span.pshift != 3 or self.fi is None or self.pi is None:
+            return self.floats(), self.pointers()
+        if self._all is None:
+            self._all = np.concatenate([self.fi, self.pi])
+        out = self.span.u64[self._all]
+        nf = len(self.fi)
+        return out[:nf].view(np.float64), out[nf:]
 
-def check_body(body: Any) -> None:
-    """Raise :class:`LayoutError` unless the declared body struct reads what pymunk reads."""
-    r = view("body", address(body._body))
-    cog = body.local_to_world(body.center_of_gravity)
-    pairs = [(r.m, body.mass), (r.i, body.moment), (r.cog.x, body.center_of_gravity[0]),
-             (r.cog.y, body.center_of_gravity[1]), (r.p.x, cog[0]), (r.p.y, cog[1]),
-             (r.v.x, body.velocity[0]), (r.v.y, body.velocity[1]), (r.a, body.angle),
-             (r.w, body.angular_velocity), (r.f.x, body.force[0]), (r.t, body.torque)]
-    for got, want in pairs:
-        # The centre of gravity in world coordinates goes through pymunk's transform.
-        if not (_close(got, want) or abs(got - want) <= 1e-9 * (1.0 + abs(want))):
-            raise LayoutError(f"body: read {got!r}, pymunk says {want!r}")
-
-
-def check_space(space: Any) -> None:
-    """Raise :class:`LayoutError` unless the declared space struct reads pymunk's settings."""
-    from pymunk._chipmunk_cffi import lib
-
-    r = view("space", address(space._space))
-    pairs = [(r.iterations, space.iterations), (r.gravity.x, space.gravity[0]),
-             (r.gravity.y, space.gravity[1]), (r.damping, space.damping),
-             (r.idle_speed, space.idle_speed_threshold),
-             (r.sleep_time, space.sleep_time_threshold), (r.slop, space.collision_slop),
-             (r.bias, space.collision_bias), (r.persistence, space.collision_persistence),
-             (r.stamp, lib.cpSpaceGetTimestamp(space._space)),
-             (r.dt, space.current_time_step)]
-    for got, want in pairs:
-        if not _close(got, want):
-            raise LayoutError(f"space: read {got!r}, pymunk says {want!r}")
-    n = int(view("array", address(r.constraints)).num)
-    if n > len(space.constraints) + 1 or int(view("array", address(r.dynamic_bodies)).num) > \
-            len(space.bodies):
-        raise LayoutError("space: its arrays hold more than the space has")
-
-
-def _constraint_fields(c: Any) -> list[tuple[str, float]]:
-    name = next(kls.__name__ for kls in type(c).__mro__ if kls.__name__ in STRUCT)
-    fields: list[tuple[str, float]] = [("c.max_force", c.max_force),
-                                        ("c.error_bias", c.error_bias),
-                                        ("c.max_bias", c.max_bias)]
-    if hasattr(c, "anchor_a"):
-        fields += [("anchor_a.x", c.anchor_a[0]), ("anchor_a.y", c.anchor_a[1])]
-    if hasattr(c, "anchor_b"):
-        fields += [("anchor_b.x", c.anchor_b[0]), ("anchor_b.y", c.anchor_b[1])]
-    extra = {"PinJoint": ("distance:dist",), "SlideJoint": ("min", "max"),
-             "GrooveJoint": ("groove_a", "groove_b"),
-             "DampedSpring": ("rest_length:rest", "stiffness", "damping"),
-             "DampedRotarySpring": ("rest_angle:rest", "stiffness", "damping"),
-             "RotaryLimitJoint": ("min", "max"),
-             "RatchetJoint": ("angle", "phase", "ratchet"), "GearJoint": ("phase", "ratio"),
-             "SimpleMotor": ("rate",)}.get(name, ())
-    for spec in extra:
-        attr, _, field = spec.partition(":")
-        value = getattr(c, attr)
-        if isinstance(value, tuple):
-            fields += [(f"{field or attr}.x", value[0]), (f"{field or attr}.y", value[1])]
-        else:
-            fields.append((field or attr, value))
-    return fields
+    def pointers(self) -> np.ndarray:
+        if self.span is None:
+            return np.zeros((self.shape[1], 0), dtype=np.uint64)
+        out = self.span.ptr[self.pi]
+        return out if out.dtype == np.uint64 else out.astype(np.uint64)
 
 
 def struct_of(c: Any) -> str | None:
@@ -260,86 +415,3 @@ def struct_of(c: Any) -> str | None:
         if kls.__name__ in STRUCT and kls.__module__.startswith("pymunk"):
             return STRUCT[kls.__name__]
     return None
-
-
-def check_constraint(c: Any) -> None:
-    """Raise :class:`LayoutError` unless the declared struct of ``c`` reads its settings,
-    its bodies and (up to sign) the impulse pymunk reports."""
-    import math
-
-    kind = struct_of(c)
-    if kind is None:
-        raise LayoutError(f"{type(c).__name__}: not a constraint class the ledger reads")
-    at = address(c._constraint)
-    r = view(kind, at)
-    if address(r.c.a) != address(c.a._body) or address(r.c.b) != address(c.b._body):
-        raise LayoutError(f"{kind}: bodies do not match")
-    for path, want in _constraint_fields(c):
-        got = r
-        for part in path.split("."):
-            got = getattr(got, part)
-        if not _close(got, want):
-            raise LayoutError(f"{kind}.{path}: read {got!r}, pymunk says {want!r}")
-    j = r.j
-    got = math.hypot(j.x, j.y) if kind in ("pivot", "groove") else (
-        j if kind in ("spring", "rotary_spring") else abs(j))
-    if not _close(got, c.impulse):
-        raise LayoutError(f"{kind}: impulse {got!r}, pymunk says {c.impulse!r}")
-
-
-@cache
-def default_funcs() -> tuple[frozenset[int], frozenset[int]]:
-    """Addresses of pymunk's default velocity and position functions (as a new body holds
-    them, and as pymunk sets them back)."""
-    import pymunk
-    from pymunk._chipmunk_cffi import ffi as pffi
-    from pymunk._chipmunk_cffi import lib
-
-    r = view("body", address(pymunk.Body(1.0, 1.0)._body))
-    vel = {address(r.velocity_func), address(pffi.addressof(lib, "cpBodyUpdateVelocity"))}
-    pos = {address(r.position_func), address(pffi.addressof(lib, "cpBodyUpdatePosition"))}
-    return frozenset(vel), frozenset(pos)
-
-
-@cache
-def readable() -> bool:
-    """True when the declarations read this pymunk build's structs right: checked once per
-    process on a small space of every constraint kind, stepped with contacts."""
-    import pymunk
-
-    try:
-        space = pymunk.Space()
-        space.gravity = (0.3, -9.8)
-        floor = pymunk.Segment(space.static_body, (-5, -1), (5, -1), 0.1)
-        a, b = pymunk.Body(1.0, 0.5), pymunk.Body(2.0, 0.7)
-        a.position, b.position = (0.0, -0.85), (0.5, 0.3)
-        a.velocity, b.angular_velocity = (0.3, -1.0), 1.5
-        space.add(floor, a, pymunk.Circle(a, 0.1), b, pymunk.Circle(b, 0.1))
-        kinds = [pymunk.PinJoint(a, b), pymunk.SlideJoint(a, b, (0, 0), (0, 0), 0.1, 0.5),
-                 pymunk.PivotJoint(a, b, (0.2, 0.0)), pymunk.GrooveJoint(a, b, (0, 0), (1, 1),
-                                                                       (0, 0)),
-                 pymunk.DampedSpring(a, b, (0, 0), (0, 0), 1.0, 10.0, 0.1),
-                 pymunk.DampedRotarySpring(a, b, 0.1, 2.0, 0.1),
-                 pymunk.RotaryLimitJoint(a, b, -0.1, 0.1), pymunk.RatchetJoint(a, b, 0.0, 0.5),
-                 pymunk.GearJoint(a, b, 0.0, 2.0), pymunk.SimpleMotor(a, b, 1.0)]
-        for c in kinds:
-            c.max_force = 50.0
-        space.add(*kinds)
-        for _ in range(3):
-            space.step(0.01)
-        check_space(space)
-        for body in (a, b):
-            check_body(body)
-        kinematic = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-        for body, kind in ((a, pymunk.Body.DYNAMIC), (kinematic, pymunk.Body.KINEMATIC),
-                           (space.static_body, pymunk.Body.STATIC)):
-            r = view("body", address(body._body))
-            seen = (pymunk.Body.STATIC if r.idle_time == float("inf") else
-                    pymunk.Body.KINEMATIC if r.m == float("inf") else pymunk.Body.DYNAMIC)
-            if seen != kind or body.body_type != kind:
-                raise LayoutError("body: type")
-        for c in kinds:
-            check_constraint(c)
-    except LayoutError:
-        return False
-    return True

@@ -121,30 +121,51 @@ def _to_world(pos: np.ndarray, angle: np.ndarray, local: np.ndarray) -> np.ndarr
 
 
 def _motion(space: Any, bodies: list[Any]) -> np.ndarray:
-    """(n, 6): x, y, angle, vx, vy, angular velocity of ``bodies``, in their order, through
-    ``pymunk.batch`` (one call for the whole space) when it can, else one body at a time."""
-    n = len(bodies)
-    try:
-        import pymunk.batch as pb
-
-        fields = (pb.BodyFields.BODY_ID | pb.BodyFields.POSITION | pb.BodyFields.ANGLE
-                  | pb.BodyFields.VELOCITY | pb.BodyFields.ANGULAR_VELOCITY)
-        buf = pb.Buffer()
-        pb.get_space_bodies(space, fields, buf)
-        rows = np.frombuffer(buf.float_buf(), dtype=float).reshape(-1, 6)
-        ids = np.frombuffer(buf.int_buf(), dtype=np.uintp)
-        where = {int(k): j for j, k in enumerate(ids)}
-        order = [where.get(int(b.id), -1) for b in bodies]
-        if len(ids) == len(rows) and -1 not in order:
-            # batch order: x, y, angle, vx, vy, w (the fields' bit order)
-            return rows[order].copy()
-    except (ImportError, AttributeError, ValueError):  # pragma: no cover - an older pymunk
-        pass
-    out = np.empty((n, 6))
+    """(n, 6): x, y, angle, vx, vy, angular velocity of ``bodies``, in their order (see
+    :func:`batch`)."""
+    ids, rows = batch(space, ("POSITION", "ANGLE", "VELOCITY", "ANGULAR_VELOCITY"))
+    where = {int(k): j for j, k in enumerate(ids)}
+    order = [where.get(int(b.id), -1) for b in bodies]
+    if -1 not in order:
+        return rows[order].copy()
+    out = np.empty((len(bodies), 6))
     for i, b in enumerate(bodies):
         p, v = b.position, b.velocity
         out[i] = (p.x, p.y, b.angle, v.x, v.y, b.angular_velocity)
     return out
+
+
+def batch(space: Any, fields: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The ids of the space's bodies and the ``fields`` of each (rows of floats, in the order
+    of pymunk's ``BodyFields``: position x, y, angle, velocity x, y, spin, force x, y,
+    torque), through ``pymunk.batch`` when it can, else one body at a time."""
+    names = {"POSITION": ("position", 2), "ANGLE": ("angle", 1), "VELOCITY": ("velocity", 2),
+             "ANGULAR_VELOCITY": ("angular_velocity", 1), "FORCE": ("force", 2),
+             "TORQUE": ("torque", 1)}
+    width = sum(names[f][1] for f in fields)
+    try:
+        import pymunk.batch as pb
+
+        flags = pb.BodyFields.BODY_ID
+        for f in fields:
+            flags |= getattr(pb.BodyFields, f)
+        buf = pb.Buffer()
+        pb.get_space_bodies(space, flags, buf)
+        rows = np.frombuffer(buf.float_buf(), dtype=float).reshape(-1, width)
+        ids = np.frombuffer(buf.int_buf(), dtype=np.uintp)
+        if len(ids) == len(rows):
+            return ids, rows
+    except (ImportError, AttributeError, ValueError):  # pragma: no cover - an older pymunk
+        pass
+    bodies = list(space.bodies)
+    rows = np.empty((len(bodies), width))
+    for i, b in enumerate(bodies):
+        values: list[float] = []
+        for f in fields:
+            v = getattr(b, names[f][0])
+            values += [v.x, v.y] if names[f][1] == 2 else [v]
+        rows[i] = values
+    return np.array([b.id for b in bodies], dtype=np.uintp), rows
 
 
 def scan(space: Any) -> Scan:

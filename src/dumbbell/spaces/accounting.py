@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from .._pymunk import spring_function
 from ..model.energy import (
     angular_momentum,
     gravity_potential,
@@ -38,6 +39,7 @@ from ..model.energy import (
     spring_potential,
     translational_ke,
 )
+from .units import UNNAMED
 
 __all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
@@ -104,10 +106,8 @@ def inventory(space: Any) -> Inventory:
     where = {id(b): i for i, b in enumerate(tracked)}
 
     def name(body: Any) -> str:
-        if body is space.static_body:
-            return "static body"
         i = place.get(id(body))
-        return "body (not in the space)" if i is None else f"body {i}"
+        return f"body {i}" if i is not None else _outside(space, body)
 
     labels = [name(b) for b in dyn]
     moments = [i for i, kind in zip(moments_all, types, strict=True)
@@ -145,6 +145,16 @@ def inventory(space: Any) -> Inventory:
         springs=tuple(springs), skipped=tuple(skipped), unknown=tuple(unknown),
         notes=tuple(notes),
     )
+
+
+def _outside(space: Any, body: Any) -> str:
+    """The label of a body not among the space's bodies: the space's own static body
+    (found without making it: pymunk makes it on first use), or one not in the space."""
+    import pymunk
+
+    if body.body_type == pymunk.Body.STATIC and body.space is space:
+        return "static body"
+    return "body (not in the space)"
 
 
 def _constraints(space: Any, index: Callable[[Any], int]
@@ -189,9 +199,10 @@ def _kinds(bodies: list[Any]) -> tuple[list[int], list[float], list[float]]:
     when its mass is), or through pymunk's getters when the structs cannot be read."""
     import pymunk
 
+    from . import _layout as layout
     from . import _memory as mem
 
-    if not bodies or not mem.readable():
+    if not bodies or not layout.readable():
         return ([b.body_type for b in bodies], [b.mass for b in bodies],
                 [b.moment for b in bodies])
     at = mem.addresses(bodies, "_body")
@@ -369,9 +380,7 @@ def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped
     import pymunk
 
     rotary = isinstance(c, pymunk.DampedRotarySpring)
-    custom = c._torque_func if rotary else c._force_func
-    if custom is not None and custom not in (pymunk.DampedSpring.spring_force,
-                                             pymunk.DampedRotarySpring.spring_torque):
+    if spring_function(c) is not None:
         return Skipped(label, "custom force function: its energy is unknown")
     a, b = c.a, c.b
     ia, ib = index(a), index(b)
@@ -405,9 +414,10 @@ def read_state(inv: Inventory) -> State:
     """The present state of the tracked bodies, as one sample: read from pymunk's body
     structs in one pass (the centre of gravity as pymunk holds it), or through pymunk's
     getters on a pymunk build whose structs :mod:`._memory` cannot read."""
+    from . import _layout as layout
     from . import _memory as mem
 
-    if inv.bodies and mem.readable():
+    if inv.bodies and layout.readable():
         at = mem.addresses(inv.bodies, "_body")
         a = mem.Span.over(at, mem.size("body")).f(
             at, np.array([mem.offset("body", *f.split(".")) for f in
@@ -518,10 +528,10 @@ class _Sampler:
                ("rotary_spring", ("rest", "stiffness")))
 
     def __init__(self, space: Any) -> None:
-        from . import _memory as mem
+        from . import _layout as layout
 
         self.space = space
-        self.fast = mem.readable()
+        self.fast = layout.readable()
         self.inventories: list[Inventory] = []
         self.samples: list[tuple[int, np.ndarray]] = []
         self._bodies: list[Any] | None = None
@@ -561,8 +571,7 @@ class _Sampler:
         self._rows = np.array([rows[id(b)] for b in inv.bodies], dtype=np.intp)
         springs = [c for c in self._constraints
                    if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
-        self._funcs = [c._torque_func if isinstance(c, pymunk.DampedRotarySpring)
-                       else c._force_func for c in springs]
+        self._funcs = [spring_function(c) for c in springs]
         self._springs = []
         for kind, fields in self._SPRING:
             objs = [c for c in springs if mem.struct_of(c) == kind]
@@ -585,8 +594,7 @@ class _Sampler:
         n = len(self._PRINT)
         parts = [values[:n].ravel(), np.isinf(values[2])]
         parts += [span.f(at, fields).ravel() for span, at, fields in self._springs]
-        funcs = [c._torque_func if isinstance(c, pymunk.DampedRotarySpring) else c._force_func
-                 for c in self._constraints
+        funcs = [spring_function(c) for c in self._constraints
                  if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring)]
         same = len(funcs) == len(self._funcs) and all(
             f is g for f, g in zip(funcs, self._funcs, strict=True))
@@ -637,10 +645,11 @@ class _Sampler:
         return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
-    momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s)."""
+    momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
+    space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not)."""
 
     subject: str
     mass: float
@@ -650,20 +659,33 @@ class BodyEnergy:
     U_g: float
     momentum: tuple[float, float]
     L_about: float
+    units: tuple[str, str, str] = UNNAMED
+
+    def __repr__(self) -> str:
+        from .units import shown
+
+        return shown(self)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpringEnergy:
-    """One spring: its label, kind and potential energy U (J)."""
+    """One spring: its label, kind and potential energy U (J; in the space's ``units``)."""
 
     subject: str
     kind: str
     U: float
+    units: tuple[str, str, str] = UNNAMED
+
+    def __repr__(self) -> str:
+        from .units import shown
+
+        return shown(self)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SpaceEnergy:
-    """Energy and momentum of a space's dynamic bodies (SI units).
+    """Energy and momentum of a space's dynamic bodies (in the ``units``
+    :func:`energy` was given: (length, mass, time)).
 
     K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
     K_rot + U_g + U_spring in J; ``momentum`` (px, py) in kg m/s; ``L_cm`` and ``L_about`` in
@@ -687,20 +709,32 @@ class SpaceEnergy:
     skipped: tuple[Skipped, ...]
     unknown: tuple[Skipped, ...]
     notes: tuple[str, ...]
+    units: tuple[str, str, str] = UNNAMED
 
     @property
     def complete(self) -> bool:
         """True when nothing holding energy was left out (no unknown constraints)."""
         return not self.unknown
 
+    def __repr__(self) -> str:
+        from .units import shown
 
-def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
-    """Energy (J) and momentum of ``space`` now; angular momentum also about ``about`` (m).
-    See the module docstring for what is counted."""
+        return shown(self)
+
+
+def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
+           units: Any = None) -> SpaceEnergy:
+    """Energy and momentum of ``space`` now; angular momentum also about ``about``.
+    ``units`` names the space's units as the recorder takes them (the length unit alone,
+    'px' or 'm', or (length, mass, time); None: not named, and the reprs say "energy units",
+    never J for what may be pixels): the values are the same, their reprs carry them. See
+    the module docstring for what is counted."""
     from ..model import args
+    from .units import check_units
 
     args.space(space)
-    ox, oy = args.pair(about, "about", "m")
+    units = check_units(units)
+    ox, oy = args.pair(about, "about", units[0])
     inv = inventory(space)
     st = read_state(inv)
     n = inv.dynamic
@@ -717,13 +751,14 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0)) -> SpaceEnergy:
                terms["body_K_trans"][0].tolist(), terms["body_K_rot"][0].tolist(),
                terms["body_U_g"][0].tolist(), (inv.mass[:n] * st.vx[0, :n]).tolist(),
                (inv.mass[:n] * st.vy[0, :n]).tolist(), terms["body_L_about"][0].tolist())
-    bodies = tuple(BodyEnergy(label, m, i, kt, kr, ug, (px, py), lo)
+    bodies = tuple(BodyEnergy(label, m, i, kt, kr, ug, (px, py), lo, units)
                    for label, m, i, kt, kr, ug, px, py, lo in zip(*columns, strict=True))
-    springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]))
+    springs = tuple(SpringEnergy(s.subject, s.kind, float(terms["spring_U"][0, j]), units)
                     for j, s in enumerate(inv.springs))
     return SpaceEnergy(
         K_trans=f("K_trans"), K_rot=f("K_rot"), K_cm=f("K_cm"), K_int=f("K_int"), U_g=f("U_g"),
         U_spring=f("U_spring"), E=f("E"), momentum=(f("px"), f("py")), L_cm=f("L_cm"),
         L_about=f("L_about"), about=(ox, oy), cm=(f("X"), f("Y")), bodies=bodies,
         springs=springs, skipped=inv.skipped, unknown=inv.unknown, notes=inv.notes,
+        units=units,
     )

@@ -59,6 +59,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .._pymunk import spring_function
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import rotational_ke, spring_potential, translational_ke
@@ -106,7 +107,7 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     dt = args.real(dt, "dt", "s")
     unit = length_unit(units)
     sc = scan(space)
-    problem = settings_problem(space) or state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc, unit)
     if problem is not None:
         raise UsageError(f"space: {problem[0]}: {problem[1]}", param="space")
     est = estimate(sc, dt, unit)
@@ -114,27 +115,37 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
 
 
 def length_unit(units: Any) -> str:
-    """The name of the space's length unit for messages: ``units`` checked (a short str), or
-    'units' when None."""
-    if units is None:
-        return "units"
-    text = args.text(units, "units", "a str naming the length unit, such as 'm' or 'px'")
-    if not 0 < len(text) <= 12 or not text.isprintable() or text != text.strip():
-        raise UsageError(f"units = {args.show(units)}: must be a short name of the "
-                              "length unit (1 to 12 printable characters, e.g. 'm' or 'px')",
-                              param="units")
-    return text
+    """The name of the space's length unit for messages: ``units`` checked as
+    :func:`.units.check_units` checks it ('units' when None)."""
+    from .units import check_units
+
+    return check_units(units)[0]
+
+
+def percent(fraction: float) -> str:
+    """A fraction in words for messages: '1.5 %', or 'without bound' when infinite."""
+    return "without bound" if math.isinf(fraction) else f"{100 * fraction:.3g} %"
+
+
+def energy_units(unit: str) -> tuple[str, str]:
+    """The units of energy and power of a space whose length unit is ``unit`` (mass in kg,
+    time in s, as pymunk programs take them; 'units', the unnamed length, gives 'energy
+    units'): ('J', 'W') in metres."""
+    from .units import SI, UNNAMED, energy_unit, power_unit
+
+    u = UNNAMED if unit == UNNAMED[0] else (unit, SI[1], SI[2])
+    return energy_unit(u), power_unit(u)
 
 
 # --- what cannot be stepped ------------------------------------------------------------------
 
 
-def state_problem(sc: Scan) -> tuple[str, str, float] | None:
+def state_problem(sc: Scan, unit: str = "units") -> tuple[str, str, float] | None:
     """The first body whose state no step can fix: (subject, what is wrong, the value), or
     None. A position, angle, velocity or spin that is not finite (pymunk carries a NaN on
     forever), or a dynamic body whose mass or moment is not a number > 0 and < inf (pymunk
     refuses to step it); then the first shape whose geometry (radius, offset, ends,
-    vertices) is not finite."""
+    vertices) is not finite. Values are given in ``unit`` (the length unit), kg, rad, s."""
     motion = np.column_stack([sc.pos, sc.angle, sc.v, sc.w])
     bad = ~np.isfinite(motion).all(axis=1)
     dyn = sc.kind == DYNAMIC
@@ -144,27 +155,30 @@ def state_problem(sc: Scan) -> tuple[str, str, float] | None:
         i = int(i)
         who = sc.label(i)
         if bad[i]:
-            for name, value in (("position", tuple(sc.pos[i])), ("angle", sc.angle[i]),
-                                ("velocity", tuple(sc.v[i])),
-                                ("angular_velocity", sc.w[i])):
+            for name, value, of in (("position", tuple(sc.pos[i]), unit),
+                                    ("angle", sc.angle[i], "rad"),
+                                    ("velocity", tuple(sc.v[i]), f"{unit}/s"),
+                                    ("angular_velocity", sc.w[i], "rad/s")):
                 vals = value if isinstance(value, tuple) else (value,)
                 if not all(math.isfinite(x) for x in vals):
-                    shown = (f"({vals[0]:g}, {vals[1]:g})" if len(vals) == 2
-                             else f"{vals[0]:g}")
+                    shown = (f"({vals[0]:g}, {vals[1]:g}) {of}" if len(vals) == 2
+                             else f"{vals[0]:g} {of}")
                     what = (f"{name} = {shown} is not a finite number: no step fixes it "
                             "(pymunk carries it into every later step); set the body's state "
                             "again or rebuild the space")
                     return who, what, float(next(x for x in vals if not math.isfinite(x)))
         what = "mass" if bad_mass[i] else "moment"
         value = float(sc.mass[i] if bad_mass[i] else sc.moment[i])
-        text = (f"{what} = {value:g}: pymunk steps a dynamic body only with a mass > 0 and "
+        of = "kg" if bad_mass[i] else f"kg {unit}²"
+        text = (f"{what} = {value:g} {of}: pymunk steps a dynamic body only with a mass > 0 and "
                 "< inf and a moment > 0 (give its shapes a mass or density, or set "
                 f"body.{what})")
         return who, text, value
     for j in np.flatnonzero(np.isnan(sc.reach)):
         shape = sc.shapes[int(j)]
         name, vals = _bad_geometry(shape)
-        shown = f"({vals[0]:g}, {vals[1]:g})" if len(vals) == 2 else f"{vals[0]:g}"
+        shown = (f"({vals[0]:g}, {vals[1]:g}) {unit}" if len(vals) == 2
+                 else f"{vals[0]:g}")              # a radius that is not a number has no unit
         who = f"shape {int(j)} ({type(shape).__name__} on {sc.label(int(sc.owner[j]))})"
         what = (f"{name} = {shown} is not a finite number: no step fixes it (its contacts and "
                 "sizes would be NaN); give the shape finite geometry")
@@ -522,9 +536,7 @@ def _body_reach(sc: Scan, idx: np.ndarray) -> np.ndarray:
 def _spring_energy(c: Any, pymunk: Any) -> tuple[float, bool]:
     """A spring's energy now and whether a custom force function makes it unknown."""
     rotary = isinstance(c, pymunk.DampedRotarySpring)
-    custom = c._torque_func if rotary else c._force_func
-    unknown = custom is not None and custom not in (pymunk.DampedSpring.spring_force,
-                                                    pymunk.DampedRotarySpring.spring_torque)
+    unknown = spring_function(c) is not None
     if rotary:
         extent, rest = c.a.angle - c.b.angle, c.rest_angle
     else:

@@ -23,6 +23,11 @@ the fix and the reason for it):
 - ``slop``: ``space.collision_slop`` is the overlap pymunk leaves between touching shapes;
 - ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart, which
   adds energy at elastic contacts (flagged where any contact is elastic);
+- ``joint``: every constraint that is not a spring, its energy drift per second at this
+  step against ``tolerance`` of the energy scale a second, measured on a copy of the space
+  (:mod:`._probe`; a row past it is measured again at dt/2, to say which step clears it, or
+  that no step changes it); a motor's work is reported, not judged, and what the probe
+  cannot separate is a row "not checked" naming why;
 - ``state``: a body whose position or velocity is not a finite number, or a dynamic body
   without a valid mass or moment: no step fixes it.
 
@@ -31,15 +36,14 @@ Lengths are in the space's own unit: pymunk has none. ``units`` names it in the 
 
 :func:`suggest_dt` returns a step (dt divided into whole sub-steps) that clears every finding
 a step can clear; slop and bias are settings, not steps. :class:`Driver` steps a space at a
-fixed frame step in sub-steps. Each check reads the space once (:mod:`._scan`), so the guard
-costs time linear in bodies and shapes.
+fixed frame step in sub-steps (:mod:`.stepping`). Each check reads the space once
+(:mod:`._scan`), so the guard costs time linear in bodies and shapes.
 """
 
 from __future__ import annotations
 
 import math
 import numbers
-import os
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -49,10 +53,10 @@ from ..errors import UsageError
 from ..model import args
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from .accounting import settings_problem
-from .estimates import Estimates, estimate, length_unit, state_problem
+from .estimates import Estimates, estimate, length_unit, percent, state_problem
 
-__all__ = ["Driver", "Finding", "check", "energy_swing", "report", "shape_size",
-           "spring_omega", "step", "substeps", "suggest_dt", "survey"]
+__all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",
+           "substeps", "suggest_dt", "survey"]
 
 #: w*dt limit of the explicit spring step (stability).
 SPRING_LIMIT = 2.0
@@ -60,8 +64,9 @@ SPRING_LIMIT = 2.0
 TOLERANCE = 0.01
 #: Largest slop, as a fraction of the smallest shape's size.
 SLOP_FRACTION = 0.1
-#: Most sub-steps of one step, and most steps one call of :func:`step` or
-#: :meth:`Driver.step` takes: past it a loop would run for hours, so it is refused at once.
+#: Most sub-steps of one step, and most steps one call of :func:`~.stepping.step` or
+#: :meth:`~.stepping.Driver.step` takes: past it a loop would run for hours, so it is refused
+#: at once.
 MAX_STEPS = 10**9
 #: Slop suggested, as a fraction of the smallest shape's size.
 SLOP_SUGGESTED = 0.01
@@ -81,7 +86,11 @@ class Finding:
     springs, length units moved per step for tunnelling, length units for slop, the bias for
     bias), the ``relation`` a good value keeps to the limit ('<', '<=' or '>='; 'finite' for a
     state no step fixes), the ``fix`` with its reason in words, the largest step that clears it,
-    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none)."""
+    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none).
+    A constraint's row (kind ``joint``) may instead be ``relation`` 'measured' (a number
+    with no limit: a motor's work, a loss the step does not change; ok) or 'unchecked' (not
+    measured: ``fix`` says why; not ok, and not a failure :func:`check` lists); ``note`` says
+    in words what the number is."""
 
     kind: str
     subject: str
@@ -91,10 +100,18 @@ class Finding:
     dt_max: float | None = None
     relation: str = "<"
     unit: str = ""
+    note: str = ""
+
+    @property
+    def checked(self) -> bool:
+        """Whether the row was measured (False: 'unchecked')."""
+        return self.relation != "unchecked"
 
     @property
     def ok(self) -> bool:
         """Whether the value keeps its relation to the limit."""
+        if self.relation == "measured":
+            return True
         if self.relation == "<":
             return self.value < self.limit
         if self.relation == "<=":
@@ -106,10 +123,12 @@ class Finding:
     def comparison(self) -> str:
         """'value relation limit' with the relation that holds, the numbers printed with
         enough digits to show it."""
+        unit = f" {self.unit}" if self.unit else ""
+        if self.relation == "measured":
+            return f"{self.value:.4g}{unit}"
         if self.relation not in _FAILS:
             return ""
         rel = self.relation if self.ok else _FAILS[self.relation]
-        unit = f" {self.unit}" if self.unit else ""
         a, b = _distinct(self.value, self.limit, rel)
         return f"{_QUANTITY.get(self.kind, '')}{a}{unit} {rel} {b}{unit}"
 
@@ -144,10 +163,6 @@ def energy_swing(w_dt: float) -> float:
 def _swing_limit(tolerance: float) -> float:
     """The w*dt whose energy swing is ``tolerance`` (2 for an infinite tolerance)."""
     return SPRING_LIMIT if math.isinf(tolerance) else 2.0 * tolerance / (2.0 + tolerance)
-
-
-def _percent(fraction: float) -> str:
-    return "without bound" if math.isinf(fraction) else f"{100 * fraction:.3g} %"
 
 
 #: What ``speeds`` may be: the present speeds, the reach estimates, or the larger.
@@ -230,13 +245,16 @@ def _spring_row(kind: str, subject: str, w: float, at: _Judged, extra: str = "")
     dt_max = limit / w
     swing = energy_swing(z) if math.isfinite(z) else math.inf
     keeps = ("stays stable (w dt < 2)" if math.isinf(tolerance)
-             else f"keeps the swing under {_percent(tolerance)}")
+             else f"keeps the swing under {percent(tolerance)}")
     if z >= SPRING_LIMIT:
         now = "unstable: the energy grows without bound from w dt = 2"
     else:
-        now = f"the energy swings by {_percent(swing)} at this step (2 w dt / (2 - w dt))"
+        now = f"the energy swings by {percent(swing)} at this step (2 w dt / (2 - w dt))"
     fix = f"{extra}w = {w:.4g} rad/s: {now}; dt < {dt_max:.4g} s {keeps}"
-    return Finding(kind, subject, z, limit, fix, dt_max, "<")
+    # The closed form of its drift: none (the step keeps a modified energy), a bounded swing.
+    note = ("" if extra or z >= SPRING_LIMIT else
+            f"no drift: its energy swings by at most {percent(swing)} and back")
+    return Finding(kind, subject, z, limit, fix, dt_max, "<", note=note)
 
 
 def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
@@ -248,9 +266,12 @@ def _springs(space: Any, dt: float, tolerance: float) -> list[Finding]:
         if not isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
             continue
         w = spring_omega(c)
-        if w == 0.0:
-            continue
         kind = "rotary-spring" if isinstance(c, pymunk.DampedRotarySpring) else "spring"
+        if w == 0.0:
+            rows.append(Finding(kind, f"{type(c).__name__} {j}", 0.0, _swing_limit(tolerance),
+                                "it moves nothing (no stiffness, or no end that can move)",
+                                None, "<", note="moves nothing"))
+            continue
         rows.append(_spring_row(kind, f"{type(c).__name__} {j}", w, _Judged(dt, tolerance)))
     return rows
 
@@ -372,18 +393,23 @@ class _Advice:
     tolerance: float
     swing: float | None
     unit: str
+    probe: str = ""
 
 
 def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> _Advice:
     """Every check at ``dt`` and the sub-steps that clear the ones a step can clear."""
     sc = scan(space)
-    problem = settings_problem(space) or state_problem(sc)
+    problem = settings_problem(space) or state_problem(sc, unit)
     if problem is not None:
         who, what, value = problem
         return _Advice([Finding("state", who, value, math.nan, what, None, "finite")], dt, 1,
                        None, tolerance, None, unit)
     est = estimate(sc, dt, unit)
-    rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance)
+    from ._joints import joint_rows
+
+    rows_of_joints, probed = joint_rows(space, dt, tolerance, unit)
+    joints = [Finding(*r) for r in rows_of_joints]
+    rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance) + joints
             + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
     failing = [f for f in rows if not f.ok and f.dt_max is not None]
     tightest = min(failing, key=lambda f: f.dt_max) if failing else None
@@ -394,7 +420,7 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
     ws = [f.value / dt for f in rows if f.kind in ("spring", "rotary-spring", "spring-network")]
     swing = (energy_swing(max(ws) * dt / n) if ws and n is not None and math.isfinite(max(ws))
              else None)
-    return _Advice(rows, dt, n, tightest, tolerance, swing, unit)
+    return _Advice(rows, dt, n, tightest, tolerance, swing, unit, probed)
 
 
 def _refuse(advice: _Advice) -> int:
@@ -425,8 +451,9 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
 def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
           units: str | None = None) -> list[Finding]:
     """The checks that fail at step ``dt`` (s): each a :class:`Finding` with its fix (see
-    :func:`survey` for the arguments)."""
-    return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok]
+    :func:`survey` for the arguments; rows not checked are in :func:`survey` and
+    :func:`report`, not here)."""
+    return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok and f.checked]
 
 
 def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
@@ -448,16 +475,25 @@ def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = T
 
 
 def _line(f: Finding) -> str:
-    mark = "ok  " if f.ok else "FAIL"
+    mark = "ok  " if f.ok else ("FAIL" if f.checked else "--  ")
     shown = f.comparison()
+    if not f.checked:
+        return f"  {mark} {f.kind:14s} {f.subject:22s} {f.fix}"
     fix = "" if f.ok else (f"; {f.fix}" if shown else f.fix)
-    return f"  {mark} {f.kind:14s} {f.subject:22s} {shown}{fix}"
+    note = f" ({f.note})" if f.ok and f.note else ""
+    return f"  {mark} {f.kind:14s} {f.subject:22s} {shown}{note}{fix}"
 
 
 def _summary(kind: str, rows: list[Finding], ok: bool) -> str:
     """One line for the rows of ``kind`` beyond the ones listed."""
     mark = "ok  " if ok else "FAIL"
-    worst = max(rows, key=lambda f: f.value / f.limit if f.limit else math.inf)
+    judged = [f for f in rows if f.relation in _FAILS] or rows
+
+    def closeness(f: Finding) -> float:
+        ratio = f.value / f.limit if f.limit else math.inf
+        return ratio if not math.isnan(ratio) else -math.inf
+
+    worst = max(judged, key=closeness)
     what = "passed; the closest to its limit" if ok else "failed; the farthest past it"
     return f"  {mark} {kind:14s} {len(rows)} more {what}: {worst.subject}, {worst.comparison()}"
 
@@ -471,21 +507,33 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     advice = _advise(space, dt, speeds, tolerance, unit)
     named = (f"lengths in {unit}" if units is not None
              else "lengths in the space's own units: pass units='m' or 'px' to name them")
+    joints = any(f.kind == "joint" for f in advice.rows)
     tol = ("stability only" if math.isinf(tolerance)
-           else f"energy swing of springs under {_percent(tolerance)}")
+           else f"energy swing of springs under {percent(tolerance)}"
+                + (f", joints' drift under {percent(tolerance)}/s of the energy scale"
+                   if joints else ""))
     lines = [f"step-size guard at dt = {dt:g} s ({named}; {tol}):"]
     kinds: dict[str, list[Finding]] = {}
     for f in advice.rows:
         kinds.setdefault(f.kind, []).append(f)
     for kind, rows in kinds.items():
         for ok in (False, True):
-            these = [f for f in rows if f.ok == ok]
+            these = [f for f in rows if f.ok == ok and f.checked]
             lines += [_line(f) for f in these[:SHOWN]]
             if len(these) > SHOWN:
                 lines.append(_summary(kind, these[SHOWN:], ok))
+        unchecked = [f for f in rows if not f.checked]
+        lines += [_line(f) for f in unchecked[:SHOWN]]
+        if len(unchecked) > SHOWN:
+            rest = unchecked[SHOWN:]
+            lines.append(f"  --   {kind:14s} {len(rest)} more not checked: "
+                         f"{_listed([f.subject for f in rest])}")
+        if kind == "joint" and advice.probe:
+            lines.append(advice.probe)
+    unchecked = [f.subject for f in advice.rows if not f.checked]
     n = advice.substeps
     swing = ("" if advice.swing is None else
-             f"; the springs' energy swing at it: at most {_percent(advice.swing)}")
+             f"; the springs' energy swing at it: at most {percent(advice.swing)}")
     if any(f.kind == "state" for f in advice.rows):
         lines.append("  no step is suggested: fix the state first")
     elif n is None:
@@ -496,64 +544,17 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
         t = advice.tightest
         lines.append(f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
                      f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
-    elif any(not f.ok for f in advice.rows):
+    elif any(not f.ok and f.checked for f in advice.rows):
         lines.append(f"  the step is fine; the failures are settings{swing}")
+    elif unchecked:
+        lines.append(f"  nothing to fix in what was checked{swing}; not checked: "
+                     f"{_listed(unchecked)}")
     else:
         lines.append(f"  nothing to fix{swing}")
     return "\n".join(lines)
 
 
-def step(space: Any, dt: float, substeps: int = 1) -> None:
-    """Advance ``space`` by ``dt`` (s) in ``substeps`` equal steps."""
-    args.space(space)
-    substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
-    h = args.real(dt, "dt", "s") / substeps
-    _stepped(space, h, substeps)
-
-
-def _stepped(space: Any, h: float, count: int) -> None:
-    """``count`` steps of ``h`` (s); pymunk's refusal of a body it cannot step (an
-    AssertionError raised before it steps anything: a dynamic body of mass 0) as a
-    UsageError naming the space."""
-    step_ = space.step
-    try:
-        for _ in range(count):
-            step_(h)
-    except AssertionError as exc:
-        import traceback
-
-        if not traceback.extract_tb(exc.__traceback__)[-1].filename.endswith(
-                os.path.join("pymunk", "space.py")):
-            raise  # a callback's own assertion is the user's
-        raise UsageError(f"space: {' '.join(str(exc).split())}", param="space") from None
-
-
-class Driver:
-    """Steps a space at a fixed frame step ``dt`` (s) in whole sub-steps: ``substeps`` given,
-    or None for the guard's suggestion at the start (``speeds`` and ``tolerance`` as in
-    :func:`survey`). ``t`` (s) counts whole frames, so it does not drift with rounding."""
-
-    def __init__(self, space: Any, dt: float, substeps: int | None = None,
-                 speeds: str = "both", tolerance: float = TOLERANCE) -> None:
-        self.space, self.dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance)
-        if substeps is None:
-            substeps = _refuse(_advise(self.space, self.dt, speeds, tolerance, unit))
-        self.substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
-        self.h = self.dt / self.substeps
-        self.frames = 0
-
-    @property
-    def t(self) -> float:
-        """Time stepped so far (s)."""
-        return self.frames * self.dt
-
-    def __repr__(self) -> str:
-        return (f"Driver(dt={self.dt:.6g} s, substeps={self.substeps}, frames={self.frames}, "
-                f"t={self.t:.6g} s)")
-
-    def step(self, frames: int = 1) -> None:
-        """Advance ``frames`` frames."""
-        frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)
-        _stepped(self.space, self.h, frames * self.substeps)
-        self.frames += frames
-
+def _listed(names: list[str]) -> str:
+    """``names`` in a line: the first few and how many more."""
+    shown = ", ".join(names[:SHOWN])
+    return shown + (f" and {len(names) - SHOWN} more" if len(names) > SHOWN else "")

@@ -22,11 +22,19 @@ The counters of a space listen on its wildcard handler (``on_collision(None, Non
 through one dispatcher (``pre_solve`` and ``post_solve``): callbacks already there are kept
 and called after the counters with their own data, handlers the user sets for particular
 collision types keep firing, and when the last counter detaches (in any order; dropping a
-counter detaches it) the handler is exactly as it was. Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards
-stops the counters: each warns once (a ``RuntimeWarning`` naming what stopped counting) and
-says so in ``stopped``. ``Space.copy()`` and pickling work with counters attached; the copy
-has the callbacks the space had before them, and no counter.
-Impulses are read from pymunk's contact structs (``Arbiter._arbiter``; pymunk 7).
+counter detaches it) the handler's callbacks and data are as they were (a wildcard handler
+pymunk made for the counters stays, with no callbacks: pymunk offers no way to remove one).
+Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards stops the counters: each
+warns once (a ``RuntimeWarning`` naming what stopped counting, at the next contact it would
+have counted or when its count is read) and says so in ``stopped``. ``Space.copy()`` and
+pickling work with counters attached; the copy has the callbacks the space had before
+them, and no counter.
+
+Everything is set through pymunk's public API (``Space.on_collision``, the handler's
+``pre_solve``/``post_solve`` properties and its ``data`` dict) and nothing is stored on the
+space; pymunk 7 has no public getter for a handler, so the wildcard one is read from
+``Space._handlers`` (checked to be pymunk's ``CollisionHandler``). Impulses are read from
+pymunk's contact structs (``Arbiter._arbiter``, through pymunk's own compiled declarations).
 :class:`dumbbell.spaces.Ledger` counts the same contact heat per pair of bodies, with every
 other source of energy.
 """
@@ -45,12 +53,16 @@ _PHASES = ("pre_solve", "post_solve")
 class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
     the contact-steps counted. ``detach()`` stops counting; ``stopped`` says why counting
-    stopped (None while it counts)."""
+    stopped (None while it counts). ``units`` names the space's units as the recorder takes
+    them (its repr prints the total in them)."""
 
-    def __init__(self, space: Any) -> None:
+    def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
+        from .units import check_units
 
-        self._start(args.space(space))
+        args.space(space)
+        self.units = check_units(units)
+        self._start(space)
 
     @classmethod
     def _on(cls, space: Any) -> HeatCounter:
@@ -61,48 +73,92 @@ class HeatCounter:
 
     def _start(self, space: Any) -> None:
         self.space = space
-        self.total = 0.0
-        self.steps = 0
-        self.stopped: str | None = None
+        self._total = 0.0
+        self._steps = 0
+        self._stopped: str | None = None
         self._before: dict[int, list[tuple[float, float, float, float]]] = {}
         self._last_dt: float | None = None
         _Dispatch.of(space).add(self)
 
     @property
+    def total(self) -> float:
+        """Heat the space's contacts dissipated since the counter attached (energy units)."""
+        self._look()
+        return self._total
+
+    @property
+    def steps(self) -> int:
+        """Contact-steps counted."""
+        self._look()
+        return self._steps
+
+    @property
+    def stopped(self) -> str | None:
+        """Why the counter stopped counting (None while it counts)."""
+        self._look()
+        return self._stopped
+
+    def _dispatch(self) -> _Dispatch | None:
+        """The space's dispatcher (None for a copy, which has no space)."""
+        space = self.__dict__.get("space")
+        return None if space is None else _DISPATCH.get(space)
+
+    def _look(self) -> None:
+        """Notice callbacks the program set over the counters' since they last ran."""
+        d = self._dispatch()
+        if d is not None and self._stopped is None:
+            d.check()
+
+    @property
     def attached(self) -> bool:
         """True while the counter counts (False after ``detach()`` or once its callbacks
         were replaced)."""
-        d = self.space.__dict__.get(_KEY)
+        d = self._dispatch()
         return self.stopped is None and d is not None and self in d.counters
 
     def __repr__(self) -> str:
+        from .._display import one_line
+        from .units import UNNAMED, energy_unit
+
         state = "attached" if self.attached else (self.stopped or "not attached")
-        return f"HeatCounter({state}, total={self.total:.6g})"
+        unit = energy_unit(self.__dict__.get("units", UNNAMED))
+        return one_line(f"HeatCounter({state}, total={self.total:.6g} {unit})")
 
     def detach(self) -> None:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are
         the ones it had before the first counter attached."""
-        d = self.space.__dict__.get(_KEY)
+        self._look()
+        d = self._dispatch()
         if d is not None:
             d.remove(self)
-        if self.stopped is None:
-            self.stopped = "detached"
+        if self._stopped is None:
+            self._stopped = "detached"
 
     def __del__(self) -> None:
         # A counter dropped without detach() leaves the handler as the others need it.
         try:
-            if "space" in self.__dict__ and self.stopped is None:
+            if "space" in self.__dict__ and self._stopped is None:
                 self.detach()
         except Exception:  # noqa: BLE001, S110 - never raise from a finalizer
             pass
 
     def __getstate__(self) -> dict[str, Any]:
-        # A copy of a counter keeps its counts and does not count (no callbacks point to it).
+        # A copy of a counter keeps its counts and does not count (no callbacks point to
+        # it), and holds no space: a pickled space or state brings its own bodies, which a
+        # second space would claim.
         state = dict(self.__dict__)
         state["_before"] = {}
-        if state["stopped"] is None:
-            state["stopped"] = "a copy: it does not count"
+        state["space"] = None
+        if state["_stopped"] is None:
+            state["_stopped"] = "a copy: it does not count"
         return state
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> HeatCounter:
+        # In a copy of its space (space.copy()), the copy's counter names the copied space.
+        other = object.__new__(HeatCounter)
+        other.__dict__.update(self.__getstate__())
+        other.space = memo.get(id(self.space))
+        return other
 
     def _relative(self, arbiter: Any) -> tuple[Any, Any, Any]:
         raw = arbiter._arbiter
@@ -160,12 +216,12 @@ class HeatCounter:
                 # Impulse on b: n jn + t jt with t = perp(n); -that on a.
                 jx, jy = nx * jn - ny * jt, ny * jn + nx * jt
                 work += 0.5 * (jx * (ux0 + ux1) + jy * (uy0 + uy1))
-            self.total -= work
-            self.steps += 1
+            self._total -= work
+            self._steps += 1
 
 
-#: Where a space keeps its counters' dispatcher (a name pymunk's copy and pickle leave out).
-_KEY = "_dumbbell_heat"
+#: Each space's dispatcher (held weakly: the space keeps none of this).
+_DISPATCH: weakref.WeakKeyDictionary[Any, _Dispatch] = weakref.WeakKeyDictionary()
 
 
 def _same(value: Any) -> Any:
@@ -183,8 +239,9 @@ class _Phase:
         self.user = user
 
     def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
+        self.dispatch.check()
         for counter in self.dispatch.counters:
-            if counter.stopped is None:
+            if counter._stopped is None:
                 getattr(counter, f"_{self.phase}")(arbiter, space)
         if self.user is not None:
             return self.user(arbiter, space, data)
@@ -192,6 +249,25 @@ class _Phase:
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (_same, (self.user,)) if self.user is not None else (type(None), ())
+
+
+def _wildcard(space: Any) -> Any:
+    """The space's wildcard collision handler, made if it has none (``on_collision``).
+    pymunk 7 has no public getter for a handler: it is read from ``Space._handlers``,
+    checked to be pymunk's ``CollisionHandler`` with the public properties used here."""
+    from pymunk._collision_handler import CollisionHandler
+
+    from ..errors import DumbbellError
+
+    space.on_collision(None, None)
+    handler = getattr(space, "_handlers", {}).get((None, None))
+    if not isinstance(handler, CollisionHandler) or not isinstance(
+            getattr(handler, "data", None), dict):
+        from ._memory import pymunk_version
+
+        raise DumbbellError(f"dumbbell.spaces.HeatCounter: pymunk {pymunk_version()} does not "
+                            "keep its wildcard collision handler where pymunk 7 does")
+    return handler
 
 
 class _Dispatch:
@@ -202,25 +278,22 @@ class _Dispatch:
     def __init__(self, space: Any) -> None:
         self._space = weakref.ref(space)
         self._counters: list[weakref.ref[HeatCounter]] = []
-        self.created = (None, None) not in space._handlers
-        space.on_collision(None, None)  # make sure the wildcard handler exists
-        self.handler = space._handlers[(None, None)]
-        self.phases = {phase: _Phase(self, phase, getattr(self.handler, phase))
+        handler = _wildcard(space)
+        # Weakly: the map of dispatchers holds them, and the handler holds its space.
+        self._handler = weakref.ref(handler)
+        self.phases = {phase: _Phase(self, phase, getattr(handler, phase))
                        for phase in _PHASES}
         # pymunk passes the handler's data for the phase: the user's, or None if none.
-        self.no_data = [phase for phase in _PHASES if phase not in self.handler.data]
+        self.no_data = [phase for phase in _PHASES if phase not in handler.data]
         for phase, callback in self.phases.items():
-            self.handler.data.setdefault(phase, None)
-            setattr(self.handler, phase, callback)  # the property: data stays the user's
-        self.kind = type(self.handler)
-        self.handler.__class__ = _watched(self.kind)
-        self.handler._dumbbell_dispatch = self
+            handler.data.setdefault(phase, None)
+            setattr(handler, phase, callback)  # the property: data stays the user's
 
     @classmethod
     def of(cls, space: Any) -> _Dispatch:
-        d = space.__dict__.get(_KEY)
+        d = _DISPATCH.get(space)
         if d is None:
-            d = space.__dict__[_KEY] = cls(space)
+            d = _DISPATCH[space] = cls(space)
         return d
 
     @property
@@ -237,58 +310,35 @@ class _Dispatch:
             self.uninstall()
 
     def uninstall(self) -> None:
-        """Put back the handler as it was (phases the user replaced since stay theirs)."""
-        h = self.handler
-        h.__class__ = self.kind
-        del h._dumbbell_dispatch
+        """Put back the handler's callbacks and data as they were (phases the user
+        replaced since stay theirs). Nothing is touched once the space is going: its
+        handler lives in the C space, which pymunk may have freed already."""
+        space, h = self._space(), self._handler()
+        if space is None or h is None:
+            return
         for phase, callback in self.phases.items():
             if getattr(h, phase) is callback:
                 setattr(h, phase, callback.user)
                 if phase in self.no_data:
                     h.data.pop(phase, None)
-        space = self._space()
-        if space is None:
+        if _DISPATCH.get(space) is self:
+            del _DISPATCH[space]
+
+    def check(self) -> None:
+        """Stop the counters (each warning once) when the program set a wildcard
+        ``pre_solve`` or ``post_solve`` over theirs."""
+        handler = self._handler()
+        if handler is None:
             return
-        if self.created and h.begin is None and h.separate is None and not any(
-                getattr(h, phase) for phase in _PHASES) and not h.data:
-            # pymunk keeps the C handler; the Python side is as before the first counter.
-            del space._handlers[(None, None)]
-        space.__dict__.pop(_KEY, None)
-
-    def replaced(self, phase: str, new: Any) -> None:
-        """The user set the wildcard ``phase`` callback: the counters stop, each warning
-        once."""
-        if new is self.phases[phase]:
-            return
-        for counter in self.counters:
-            if counter.stopped is None:
-                counter.stopped = (f"the space's wildcard {phase} callback was replaced "
-                                   f"(by {getattr(new, '__name__', repr(new))}) after "
-                                   f"{counter.steps} contact-steps: contact heat after that "
-                                   "is not counted")
-                warnings.warn(f"dumbbell.spaces.HeatCounter stopped counting: {counter.stopped}",
-                              RuntimeWarning, stacklevel=4)
-
-
-_WATCHED: dict[type, type] = {}
-
-
-def _watched(kind: type) -> type:
-    """A subclass of pymunk's CollisionHandler that tells the dispatcher when a wildcard
-    ``pre_solve`` or ``post_solve`` is set over the counters'."""
-    sub = _WATCHED.get(kind)
-    if sub is None:
-        def make(phase: str) -> property:
-            base = getattr(kind, phase)
-
-            def setter(self: Any, func: Any) -> None:
-                base.fset(self, func)
-                d = self.__dict__.get("_dumbbell_dispatch")
-                if d is not None:
-                    d.replaced(phase, func)
-
-            return property(base.fget, setter, doc=base.__doc__)
-
-        sub = _WATCHED[kind] = type(f"Watched{kind.__name__}", (kind,),
-                                    {phase: make(phase) for phase in _PHASES})
-    return sub
+        for phase, mine in self.phases.items():
+            new = getattr(handler, phase)
+            if new is mine:
+                continue
+            for counter in self.counters:
+                if counter._stopped is None:
+                    counter._stopped = (f"the space's wildcard {phase} callback was replaced "
+                                        f"(by {getattr(new, '__name__', repr(new))}) after "
+                                        f"{counter._steps} contact-steps: contact heat after "
+                                        "that is not counted")
+                    warnings.warn("dumbbell.spaces.HeatCounter stopped counting: "
+                                  f"{counter._stopped}", RuntimeWarning, stacklevel=4)

@@ -15,10 +15,15 @@ yourself (in the space's time unit), when frames are not 1/fps of simulated time
 Whether the space was stepped is learnt from a pymunk post-step callback, which touches
 nothing else of the space.
 
-**Orientation.** ``y_up=None`` puts the ground at the bottom: up is against gravity; with no
-vertical gravity, y is down when ``pymunk.pygame_util`` is imported and its
-``positive_y_is_up`` is False (what a pygame program shows), else up. ``y_up=True`` or False
-says it; a ``world`` box (left, right, bottom, top) with bottom > top is y down.
+**Orientation.** ``y_up=None`` draws y the way the program's window does, decided when the
+recorder is made from what the program has imported (:func:`_window_y_up`): y up when
+``pymunk.pygame_util.positive_y_is_up`` is True; with pygame imported, y down (pygame's
+window), unless gravity points to -y (the program then flips y itself, as pymunk's
+``newtons_cradle`` does: in a y-down window its bodies would fall up); with pyglet, arcade or
+kivy imported (and not pygame), y up; with no window library (or both kinds), up against
+gravity, and up without vertical gravity. ``y_up=True`` or False says it; a ``world`` box
+(left, right, bottom, top) with bottom > top is y down. ``rec.orientation`` says which way
+and why.
 
 :class:`PaletteDrawOptions` is a ``pymunk.SpaceDebugDrawOptions``: ``space.debug_draw`` hands it
 circles, segments and polygons, which it keeps as primitives in world coordinates; it adds the
@@ -41,16 +46,20 @@ import numpy as np
 
 from ..errors import DumbbellError, UsageError
 
+# The units' rule, the one every printed value of a space follows.
+from .units import SI, UNIT_CHARS  # noqa: F401 - re-exported
+from .units import check_units as _check_units
+from .units import energy_unit as _energy_unit
+
 #: Energy terms shown: the fields of :func:`dumbbell.spaces.energy` they come from.
 TERMS = ("K_trans", "K_rot", "U_g", "U_spring", "E")
 #: Potential terms, shown from a reference (their value at t0, or one you set).
 POTENTIALS = ("U_g", "U_spring")
 #: Labels of the rows when the potentials are shown from a reference.
 DELTA_LABELS = {"U_g": "ΔU_g", "U_spring": "ΔU_spring", "E": "K + ΔU"}
-#: Units of a space (length, mass, time) in SI, whose energy is the joule.
-SI = ("m", "kg", "s")
-#: Longest unit name.
-UNIT_CHARS = 12
+#: Largest magnitude of a frame's time (``t0``, ``capture(t=...)``; the space's time unit):
+#: its label, with two decimals or more, fits the frame.
+TIME_MAX = 1e9
 
 __all__ = ["PaletteDrawOptions", "Recorder", "draw_options"]  # noqa: F822 - see __getattr__
 
@@ -277,6 +286,43 @@ def _constraint_items(space: Any, number_of: Any) -> list[tuple]:
     return items
 
 
+#: Libraries whose windows have y up (pyglet's, arcade's and kivy's origin is the
+#: bottom-left corner); pygame's has y down.
+Y_UP_WINDOWS = ("pyglet", "arcade", "kivy")
+
+
+def _window_y_up(space: Any) -> tuple[bool, str]:
+    """Whether y points up in the window the program draws ``space`` in, and why: read from
+    the window libraries the program has imported (``sys.modules``),
+    ``pymunk.pygame_util.positive_y_is_up`` and the space's gravity (the rule: see the
+    module docstring)."""
+    import sys
+
+    modules = sys.modules
+    gy = float(space.gravity.y)
+    gy = gy if math.isfinite(gy) else 0.0
+    util = modules.get("pymunk.pygame_util")
+    if util is not None and bool(getattr(util, "positive_y_is_up", False)):
+        return True, "pymunk.pygame_util.positive_y_is_up is True"
+    # (A name set to None in sys.modules is an import blocked, not a library imported.)
+    pygame = modules.get("pygame") is not None
+    up = [name for name in Y_UP_WINDOWS if modules.get(name) is not None]
+    if pygame and not up:
+        if gy < 0:
+            return True, ("pygame is imported (its window has y down) and gravity points to "
+                          "-y, so the program flips y itself (else its bodies would fall up); "
+                          "give y_up=False if it does not")
+        flag = "; pymunk.pygame_util.positive_y_is_up is False" if util is not None else ""
+        return False, (f"pygame is imported (its window has y down{flag}); give y_up=True if "
+                       "the program flips y itself")
+    if up and not pygame:
+        return True, f"{up[0]} is imported (its window has y up)"
+    found = f"pygame and {up[0]} are both imported" if up else "no window library is imported"
+    if gy != 0:
+        return gy < 0, f"{found}; up is against gravity"
+    return True, f"{found} and gravity has no vertical part"
+
+
 def draw_options() -> Any:
     """A new ``PaletteDrawOptions`` (a ``pymunk.SpaceDebugDrawOptions``)."""
     return _options_class()()
@@ -302,11 +348,19 @@ def _check_path(path: Any) -> Path:
     shown = args.show(path) if isinstance(path, str | os.PathLike) else None
     if shown is not None and "\0" in str(path):
         raise UsageError(f"path = {shown}: a path cannot hold a NUL character", param="path")
+    text = path
     path = args.path(path, "path")
     suffix = path.suffix.lower()
-    if suffix not in (".gif", ".mp4"):
-        raise UsageError(f"path {args.show(str(path))}: must end in .gif or .mp4", param="path")
-    check_writable(path, "path")
+    if suffix not in (".gif", ".mp4", ".html", ".htm"):
+        raise UsageError(f"path {args.show(str(path))}: must end in .gif, .mp4 or .html (the "
+                         "interactive player)", param="path")
+    try:
+        # As spelt (a Path drops a final '/': 'a.gif/' names a folder, not a file).
+        check_writable(text, "path")
+    except UsageError as exc:
+        from ..cli.app import clip  # its echo of the path, bounded
+
+        raise UsageError(clip(exc.reason), param="path") from None
     if suffix == ".mp4" and (problem := mp4_problem()) is not None:
         raise UsageError(f"path {args.show(str(path))}: {problem}", param="path")
     if not is_special(path):
@@ -325,8 +379,9 @@ def _check_path(path: Any) -> Path:
     return path
 
 
-def _check_world(world: Any) -> tuple[float, float, float, float]:
-    """``world`` = (left, right, bottom, top) as floats that can be drawn, else a UsageError."""
+def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, float, float]:
+    """``world`` = (left, right, bottom, top) as floats that can be drawn (in the length
+    ``unit``), else a UsageError."""
     from ..animation.recording import SPAN_MAX, SPAN_MIN
     from ..model import args
 
@@ -336,39 +391,26 @@ def _check_world(world: Any) -> tuple[float, float, float, float]:
         world = tuple(world.tolist()) if world.ndim == 1 else None
     if not isinstance(world, tuple | list) or len(world) != 4:
         raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-    x0, x1, y0, y1 = (args.real(v, "world", "space units", positive=False) for v in world)
+    x0, x1, y0, y1 = (args.real(v, "world", unit, positive=False) for v in world)
     if not (x1 > x0 and y1 != y0):
         raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
     for lo, hi in ((x0, x1), (min(y0, y1), max(y0, y1))):
         span = hi - lo
         if not (SPAN_MIN <= span <= SPAN_MAX and span >= 1e-9 * max(abs(lo), abs(hi))):
             raise UsageError(f"world = {args.show(world)}: each side must span between "
-                             f"{SPAN_MIN:g} and {SPAN_MAX:g} units, and at least 1e-9 of its "
+                             f"{SPAN_MIN:g} and {SPAN_MAX:g} {unit}, and at least 1e-9 of its "
                              "coordinates (else no pixel can be told from the next)",
                              param="world")
     return x0, x1, y0, y1
 
 
-def _check_units(units: Any) -> tuple[str, str, str]:
-    from ..model import args
-
-    allowed = (f"must be the length unit ('px', as the guard takes it; mass in kg, time in s) "
-               f"or three names (length, mass, time), each 1 to {UNIT_CHARS} characters, e.g. "
-               "('m', 'kg', 's')")
-    names = (units, SI[1], SI[2]) if isinstance(units, str) else units
-    if not isinstance(names, tuple | list) or len(names) != 3 or not all(
-            isinstance(u, str) and 0 < len(u) <= UNIT_CHARS and u.isprintable() for u in names):
-        raise UsageError(f"units = {args.show(units)}: {allowed}", param="units")
-    return tuple(names)  # type: ignore[return-value]
+def _listed(names: list[str], most: int = 8) -> str:
+    """``names`` joined by commas, the first ``most`` of them and how many more."""
+    shown = ", ".join(names[:most])
+    return shown if len(names) <= most else f"{shown} and {len(names) - most} more"
 
 
-def _energy_unit(units: tuple[str, str, str]) -> str:
-    """The energy unit of a space in ``units`` (length, mass, time): J in SI."""
-    length, mass, t = units
-    return "J" if tuple(units) == SI else f"{mass} {length}²/{t}²"
-
-
-def _check_reference(reference: Any) -> str | dict[str, float]:
+def _check_reference(reference: Any, unit: str = "energy units") -> str | dict[str, float]:
     from ..model import args
 
     allowed = ("must be 'start' (potential energies from their values at t0), 'space' (as "
@@ -381,7 +423,7 @@ def _check_reference(reference: Any) -> str | dict[str, float]:
     if not isinstance(reference, Mapping) or not reference or not set(reference) <= set(
             POTENTIALS):
         raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
-    return {k: args.real(v, "reference", "energy units", positive=False)
+    return {k: args.real(v, "reference", unit, positive=False)
             for k, v in reference.items()}
 
 
@@ -402,20 +444,25 @@ class Recorder:
       change from energies you set. ``units`` = (length, mass, time), or the length unit
       alone (mass in kg, time in s, as the guard's ``units``), names the space's units on
       every label (energy in mass·length²/time², J in SI).
-    - The view: ``camera="auto"`` frames the moving bodies (one fixed view for the file,
-      robust to a body flying away; see :mod:`dumbbell.animation.recording`), ``"all"``
-      everything captured, a ``pymunk.Body`` follows that body (a view ``span`` units across,
-      default 8 times the body's size); ``world`` = (left, right, bottom, top) fixes the box
-      (bottom > top: y is down). ``y_up``: None (ground at the bottom, see the module
-      docstring), True or False. ``size`` 'WxH' px; ``title`` is written at the top;
-      ``about`` is the point angular momentum is taken about.
+    - The view: ``camera="auto"`` frames where the moving bodies move (one fixed view for
+      the file, robust to a body flying away; static shapes never shrink the bodies: see
+      :mod:`dumbbell.animation.recording`), ``"all"`` everything captured, a
+      ``pymunk.Body`` follows that body (a view ``span`` units across, default 8 times the
+      body's size); ``world`` = (left, right, bottom, top) fixes the box (bottom > top: y is
+      down). ``y_up``: None (as the program's window shows it, see the module docstring),
+      True or False. ``size`` 'WxH' px; ``title`` is written at the top; ``about`` is the
+      point angular momentum is taken about.
+    - Every moving body is drawn at least 4 px across, larger than to scale if need be.
+      After writing, :attr:`view` is the box shown and :attr:`note` says what the picture
+      does not show as it is: which way y points and why (:attr:`orientation`), the bodies
+      drawn larger than to scale, those outside the picture in some frames.
     """
 
     def __init__(self, space: Any, path: str | Path, fps: int = 25, energy: bool = True, *,
                  size: str | tuple[int, int] = "640x360", strip: bool = True,
                  heat: Any = None, world: tuple[float, float, float, float] | None = None,
                  camera: Any = "auto", span: float | None = None, y_up: bool | None = None,
-                 units: str | tuple[str, str, str] = SI, reference: Any = "start",
+                 units: str | tuple[str, str, str] | None = None, reference: Any = "start",
                  t0: float = 0.0,
                  title: str = "", about: tuple[float, float] = (0.0, 0.0)) -> None:
         import pymunk
@@ -428,11 +475,12 @@ class Recorder:
         self.path = _check_path(path)
         self.fps = check_fps(fps)
         self.W, self.H = check_size(size)
+        self.units = _check_units(units)
         self.energy = args.flag(energy, "energy")
         self.strip = args.flag(strip, "strip") and self.energy
         self.heat = None if heat is None else args.instance(
             heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
-        self.world = None if world is None else _check_world(world)
+        self.world = None if world is None else _check_world(world, self.units[0])
         if isinstance(camera, pymunk.Body):
             if camera.body_type == pymunk.Body.STATIC:
                 raise UsageError("camera: a static body cannot be followed; give a moving "
@@ -444,7 +492,7 @@ class Recorder:
         if self.world is not None and self.camera != "auto":
             raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
                              "camera, not both", param="camera")
-        self.span = None if span is None else args.real(span, "span", "space units")
+        self.span = None if span is None else args.real(span, "span", self.units[0])
         if self.span is not None and not isinstance(self.camera, pymunk.Body):
             raise UsageError(f"span = {args.show(span)}: only for a followed body "
                              "(camera=<a pymunk.Body>)", param="span")
@@ -454,9 +502,17 @@ class Recorder:
             raise UsageError(f"y_up = {y_up}: the world box {args.show(world)} says y is "
                              f"{'up' if self.world[3] > self.world[2] else 'down'}; give one "
                              "of them", param="y_up")
-        self.units = _check_units(units)
-        self.reference = _check_reference(reference)
-        self.t0 = args.real(t0, "t0", self.units[2], positive=False)
+        if self.world is not None:
+            up, why = self.world[3] > self.world[2], "the world box says so"
+        elif self.y_up is not None:
+            up, why = self.y_up, "y_up says so"
+        else:
+            up, why = _window_y_up(self.space)
+        self._up = up
+        #: Which way y points in the picture, and why (see the module docstring).
+        self.orientation = f"y {'up' if up else 'down'}: {why}"
+        self.reference = _check_reference(reference, _energy_unit(self.units))
+        self.t0 = args.real(t0, "t0", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         self.title = args.text(title, "title", "a str (written at the top)")
         self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
@@ -469,6 +525,11 @@ class Recorder:
         self.timing: dict[str, float] = {}
         #: The world box shown (left, right, bottom, top, y up) once the file is written.
         self.view: tuple[float, float, float, float] | None = None
+        #: Once the file is written: what the picture does not show as it is, one line each
+        #: (the orientation and why; the bodies drawn larger than to scale; those outside
+        #: the picture in some frames).
+        self.note: str | None = None
+        self._names: dict[int, str] = {}  # moving body's number -> "body i" when first seen
         self._key = ("dumbbell.spaces.Recorder", id(self))
         self._stepped = False
         self._captured = False
@@ -525,7 +586,7 @@ class Recorder:
 
         previous = self.t[-1]
         if t is not None:
-            t = args.real(t, "t", self.units[2], positive=False)
+            t = args.real(t, "t", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         first = not self._captured and not self._stepped
         if t is not None and not first and not t >= previous:
             raise UsageError(f"t = {t:g}: must be at least the previous frame's time "
@@ -548,6 +609,7 @@ class Recorder:
         geometry = self.options._geometry_of(space)
         pose = geometry.poses(space)
         if geometry is not self._geometry:
+            self._name(geometry.bodies)
             self._geometry, self._static_pose = geometry, None
             self.shape_sets.append(geometry.moving)
         static_pose = pose[geometry.static_rows]
@@ -584,20 +646,6 @@ class Recorder:
         self._geometry = self._static_pose = None  # the next frame takes them again
 
     # --- writing -------------------------------------------------------------------------
-
-    def _y_up(self) -> bool:
-        """Whether y is up in the picture (see the module docstring)."""
-        import sys
-
-        if self.world is not None:
-            return self.world[3] > self.world[2]
-        if self.y_up is not None:
-            return self.y_up
-        gy = float(self.space.gravity.y)
-        if gy != 0 and math.isfinite(gy):
-            return gy < 0
-        util = sys.modules.get("pymunk.pygame_util")
-        return bool(util.positive_y_is_up) if util is not None else True
 
     def _rows(self) -> tuple[dict[str, np.ndarray], dict[str, str]]:
         """The energy rows shown (name -> values) and their labels."""
@@ -642,7 +690,7 @@ class Recorder:
                          poses=tuple(self.poses), extras=tuple(self.extras),
                          statics=tuple(self.statics), static_of=tuple(self.static_of),
                          t=tuple(self.t),
-                         size=(self.W, self.H), fps=self.fps, y_up=self._y_up(),
+                         size=(self.W, self.H), fps=self.fps, y_up=self._up,
                          strip=self.strip, title=self.title, time_unit=self.units[2], **kw)
 
     def _shapes_of(self, body: Any) -> list[tuple]:
@@ -663,7 +711,41 @@ class Recorder:
         if not self._captured:
             raise DumbbellError(f"{self.path}: no frames captured (call capture() after each "
                                 "frame's steps)")
-        painter = recording.write(self.path, self.recording(), self.timing)
+        if self.path.suffix.lower() in (".html", ".htm"):  # the interactive player
+            from ..animation import space_player
+
+            painter = space_player.write(self.path, self.recording(), self.timing)
+        else:
+            painter = recording.write(self.path, self.recording(), self.timing)
         x0, x1, y0, y1 = painter.view
         self.view = (x0, x1, y0, y1) if painter.rec.y_up else (x0, x1, y1, y0)
+        self.note = self._note(painter)
         return self.path
+
+    def _name(self, bodies: list[Any]) -> None:
+        """Name the moving bodies not named yet by their place in the space now, as the
+        accounting names them ("body 3")."""
+        number = self.options._number_of
+        new = [b for b in bodies if number(b) >= 0 and number(b) not in self._names]
+        if new:
+            place = {id(b): i for i, b in enumerate(self.space.bodies)}
+            for b in new:
+                i = place.get(id(b))
+                self._names[number(b)] = "a body not in the space" if i is None else f"body {i}"
+
+    def _note(self, painter: Any) -> str:
+        """The note on the picture (see :attr:`note`)."""
+        lines = [self.orientation]
+        name = self._names.get
+        if painter.grown:
+            grown = sorted(painter.grown)
+            lines.append(f"drawn larger than to scale, to be {painter.body_px:g} px across: "
+                         f"{_listed([name(n, f'body #{n}') for n in grown])} "
+                         f"({len(grown)} of {len(self._names)} moving bodies; camera=<a body> "
+                         "follows one at a larger scale)")
+        seen, shown = painter.frames_in, painter.frames_shown
+        out = np.flatnonzero(shown < seen).tolist()
+        if out:
+            lines.append("outside the picture (or not drawable) in some frames: " + _listed(
+                [f"{name(n, f'body #{n}')} in {seen[n] - shown[n]} of {seen[n]}" for n in out]))
+        return "\n".join(lines)

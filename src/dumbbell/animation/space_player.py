@@ -1,0 +1,159 @@
+"""The player page of a recorded pymunk space: what ``spaces.Recorder(space, "run.html")``
+writes.
+
+The page is :mod:`.player`'s, drawing a recorded space's frame as the recording's GIF painter
+(:class:`~.recording.Painter`) draws it, from that painter's own numbers: the frame's layout,
+the camera's views, the shapes (each set in its bodies' coordinates, grown as the painter
+grows them, a pose per body and frame), the constraints, the energy rows and the strip.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..io.files import atomic_output
+from . import recording as R
+from .picture import hex_colour
+from .player import b64_array, energy_array, page
+
+#: No public names: the page behind :class:`dumbbell.spaces.Recorder` for a path ending in
+#: .html.
+__all__: list[str] = []
+
+
+def write(path: Path, rec: R.Recording, timing: dict[str, float] | None = None) -> R.Painter:
+    """Write the player page of ``rec`` to ``path`` (atomically); ``timing`` receives the
+    seconds spent. Returns the painter (its ``view``), as :func:`.recording.write` does."""
+    t0 = time.perf_counter()
+    painter = R.Painter(rec)
+    with R._signals_end_cleanly():
+        text = space_page(painter)
+        # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
+        # for the recorder's note), counted without drawing.
+        panel = (painter.scene_w, painter.H)
+        for k in range(painter.n):
+            view = painter.views[k]
+            painter._count(R.Layer(rec, k, view, painter.u, panel, painter._flat,
+                                   painter._shapes(rec.shape_of[k], view)))
+        with atomic_output(path) as tmp:
+            Path(tmp).write_text(text, encoding="utf-8")
+    if timing is not None:
+        timing.update(frames=painter.n, total=time.perf_counter() - t0)
+    return painter
+
+def space_document(painter: Any) -> dict[str, Any]:
+    """The page's data for a recorded space, from the painter of its GIF
+    (:class:`~.recording.Painter`): the frame's layout, the camera's views, the static and
+    moving shapes (each moving set in its bodies' coordinates, a pose per body and frame),
+    the constraints per frame, the energy rows with their labels, scale and values, and the
+    strip of the whole run. The page draws what the painter draws, from the painter's own
+    numbers."""
+    from .picture import colours
+
+    rec, u = painter.rec, painter.u
+    views: list[Any] = []
+    view_of = []
+    for v in painter.views:
+        if not views or views[-1] is not v:
+            views.append(v)
+        view_of.append(len(views) - 1)
+    shape_sets = []
+    for i, shapes in enumerate(rec.shapes):
+        # As the painter draws them: each body at least its least size across.
+        first = next((k for k, s in enumerate(rec.shape_of) if s == i), None)
+        if first is not None:
+            shapes = painter._shapes(i, painter.views[first])
+        kinds = [""] * shapes.n
+        npts = [0] * shapes.n
+        local: list[list[float]] = [[] for _ in range(shapes.n)]
+        radius = [0.0] * shapes.n
+        for g in shapes.groups:
+            for i, j in enumerate(g.at.tolist()):
+                kinds[j], npts[j] = g.kind, int(g.local.shape[1])
+                local[j] = g.local[i].reshape(-1).tolist()
+                radius[j] = float(g.r[i])
+        shape_sets.append({"kind": kinds, "body": shapes.body.tolist(),
+                           "ink": shapes.ink.tolist(), "npts": npts,
+                           "local": b64_array(np.array([c for pts in local for c in pts]), "f8"),
+                           "r": radius})
+    counts = [len(p) for p in rec.poses]
+    poses = np.concatenate([np.asarray(p, dtype=float).reshape(-1, 3) for p in rec.poses]
+                           + [np.zeros((0, 3))])
+    shape_colours = [[hex_colour(out), hex_colour(fill)] for out, fill in R.SHAPE_COLOURS]
+    doc: dict[str, Any] = {
+        "size": [painter.W, painter.H], "u": u, "title": rec.title,
+        "time_unit": rec.time_unit, "t_decimals": painter.t_decimals,
+        "scene_w": painter.scene_w, "area": list(painter.area),
+        "views": [[v.s, v.ox, v.oy, v.flip] for v in views], "view_of": view_of,
+        "statics": [[list(it) for it in items] for items in rec.statics],
+        "static_of": list(rec.static_of),
+        "shapes": shape_sets, "shape_of": list(rec.shape_of),
+        "counts": counts, "poses": b64_array(poses, "f4"),
+        "extras": [[list(it) for it in items] for items in rec.extras],
+        "shape_colours": shape_colours, "spring": hex_colour(R.SPRING), "ink": hex_colour(R.INK),
+        "light": hex_colour(R.LIGHT), "grey": hex_colour(R.GREY), "grid": hex_colour(R.GRID),
+        "white": hex_colour(R.WHITE),
+        "factors": {"COILS": R.COILS, "SPRING_WIDTH": R.SPRING_WIDTH, "LEAD": R.LEAD,
+                    "SS": R.SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
+                    "FLAT_MANY": R.FLAT_MANY},
+        "label_box": list(painter.label_box), "colours": colours(),
+    }
+    if painter.energy:
+        labels = rec.labels or {}
+        doc["bars"] = {
+            "box": list(painter.bars_box), "rows": [list(r) for r in painter.rows],
+            "labels": {n: labels.get(n, n) for n in painter.names},
+            "title": rec.energy_title, "scale": {"lo": painter.scale.lo,
+                                                "hi": painter.scale.hi,
+                                                "decimals": painter.scale.decimals},
+            "left": painter.bar_left, "right": painter.bar_right, "zero": painter.bar_zero,
+            "px_per_j": painter.bar_scale, "heat": rec.heat,
+            "inks": {n: hex_colour(R.TERM_INKS[n]) for n in painter.names},
+            "heat_ink": hex_colour(R.blend(R.TERM_INKS["heat"], 0.6)),
+        }
+        if painter.strip:
+            from .glyphs import fmt_tick, nice_step
+
+            t0, end = float(painter.t[0]), float(painter.t[-1])
+            tstep = nice_step((end - t0) / 4) if end > t0 else 1.0
+            ticks = range(math.ceil(t0 / tstep - 1e-9), math.floor(end / tstep + 1e-9) + 1)
+            doc["strip"] = {"box": list(painter.strip_box), "pad": 3 * u, "t0": t0,
+                            "span": painter.t_end,
+                            "ticks": [[v, fmt_tick(v)] for v in painter.scale.ticks()],
+                            "time_ticks": [[k * tstep, fmt_tick(k * tstep)] for k in ticks]}
+    return doc
+
+
+def _strip_future() -> float:
+    from .strip import FUTURE
+
+    return FUTURE
+
+
+def _stack_below() -> int:
+    from .picture import STACK_BELOW
+
+    return STACK_BELOW
+
+
+def space_page(painter: Any) -> str:
+    """The player page of a recorded space (see :func:`space_document`)."""
+    rec = painter.rec
+    decimals = painter.scale.decimals if painter.energy else 2
+    run = {"label": rec.title or "", "note": "", "t": b64_array(np.asarray(painter.t), "f8"),
+           "energy": {name: energy_array(painter.e[name], decimals) for name in painter.names}}
+    doc = {"kind": "space", "fps": rec.fps, "t_end": float(painter.t[-1]),
+           "picture": space_document(painter), "runs": [run],
+           "units": {"energy": _energy_unit(rec), "time": rec.time_unit, "L_cm": ""}}
+    return page(doc, rec.title or "pymunk space")
+
+
+def _energy_unit(rec: Any) -> str:
+    """The energy's unit, as the bars' title gives it in parentheses ('Energy (J)')."""
+    title = rec.energy_title or ""
+    return title[title.find("(") + 1:title.rfind(")")] if "(" in title and ")" in title else ""

@@ -1,0 +1,495 @@
+"""What the ledger sees in a space, and when it changed: the bodies it reads (:class:`Table`),
+the constraints by struct kind (:class:`Group`), the pairs of bodies that touched
+(:class:`Pairs`), the declared fields, all gathered in one :class:`Build`, rebuilt when
+:func:`changed` says the space is no longer what it was built from.
+
+Bodies are named as :func:`dumbbell.spaces.energy` names them when the ledger attaches
+('body i', i their place in ``space.bodies``); bodies that come later take the next numbers
+(:class:`Names`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .._pymunk import spring_function
+from . import _layout as layout
+from . import _memory as mem
+
+#: Body fields read before the solver: position (x, y, angle), velocity (vx, vy, w),
+#: force (fx, fy, torque), settings (mass, moment, centre of gravity), idle time (infinite
+#: for a static body).
+PRE = ("p.x", "p.y", "a", "v.x", "v.y", "w", "f.x", "f.y", "t", "m", "i", "cog.x", "cog.y",
+       "idle_time")
+#: ... after it: velocity, and the bias velocity the next move adds.
+POST = ("v.x", "v.y", "w", "v_bias.x", "v_bias.y", "w_bias")
+PTRS = ("root", "velocity_func", "position_func")
+#: Per constraint struct: fields read before the solver (the impulse carried in; a spring's
+#: settings), and after it (the impulse, its geometry).
+BEFORE = {"pin": ("j",), "slide": ("j",), "pivot": ("j.x", "j.y"), "groove": ("j.x", "j.y"),
+          "spring": ("rest", "stiffness", "damping", "c.max_force"),
+          "rotary_spring": ("rest", "stiffness", "damping", "c.max_force"),
+          "rotary_limit": ("j",), "ratchet": ("j",), "gear": ("j",), "motor": ("j",)}
+AFTER = {"pin": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+         "slide": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+         "pivot": ("j.x", "j.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+         "groove": ("j.x", "j.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+         "spring": ("j", "n.x", "n.y", "r1.x", "r1.y", "r2.x", "r2.y"),
+         "rotary_spring": ("j",), "rotary_limit": ("j", "bias"), "ratchet": ("j", "bias"),
+         "gear": ("j", "ratio_inv"), "motor": ("j",)}
+#: Pair keys: min(uid) * PAIR + max(uid).
+PAIR = 1 << 31
+#: Longest name of a declared potential (characters).
+NAME_CHARS = 60
+
+
+class Names:
+    """Stable ids and labels of the bodies the ledger has seen, and the bodies themselves
+    (kept, so that an id is never reused while the ledger lives)."""
+
+    def __init__(self, space: Any) -> None:
+        self.space = space
+        self.uids: dict[int, int] = {}
+        self.labels: list[str] = []
+        self.kept: list[Any] = []
+        self.places = {id(b): i for i, b in enumerate(space.bodies)}
+        self.next = len(self.places)
+
+    def uid(self, body: Any) -> int:
+        """The stable id of ``body`` (its label is ``labels[uid]``)."""
+        import pymunk
+
+        uid = self.uids.get(id(body))
+        if uid is None:
+            space = self.space
+            if body.body_type == pymunk.Body.STATIC and body.space is space and \
+                    body not in space.bodies:
+                label = "static body"  # the space's own (pymunk makes it on first use)
+            else:
+                place = self.places.pop(id(body), None)
+                if place is None:
+                    place = self.next
+                    self.next += 1
+                kind = {pymunk.Body.KINEMATIC: "kinematic body ",
+                        pymunk.Body.STATIC: "static body "}.get(body.body_type, "body ")
+                outside = "" if body.space is space else " (not in the space)"
+                label = f"{kind}{place}{outside}"
+            uid = len(self.labels)
+            self.uids[id(body)] = uid
+            self.labels.append(label)
+            self.kept.append(body)
+        return uid
+
+
+class Table:
+    """The bodies the ledger reads at every hook: dynamic rows [0, n), kinematic rows
+    [n, n + k) (in the space, moved by its steps), then the other bodies constraints and
+    contacts touch: static ones (the bodies of the space's shapes that are not among its
+    bodies: its own static body, if pymunk made it), and bodies a constraint joins that are
+    not in the space (they do not move with it; what they take is work leaving the
+    system)."""
+
+    def __init__(self, space: Any, names: Names) -> None:
+        import pymunk
+
+        bodies = list(space.bodies)
+        dyn = [b for b in bodies if b.body_type == pymunk.Body.DYNAMIC]
+        kin = [b for b in bodies if b.body_type == pymunk.Body.KINEMATIC]
+        other = [b for b in bodies if b.body_type == pymunk.Body.STATIC]
+        seen = {id(b) for b in bodies}
+        for shape in space.shapes:
+            if id(shape.body) not in seen:
+                seen.add(id(shape.body))
+                other.append(shape.body)
+        self.constraint_key = tuple(space.constraints)
+        for c in self.constraint_key:
+            for b in (c.a, c.b):
+                if id(b) not in seen:
+                    seen.add(id(b))
+                    other.append(b)
+        self.bodies = [*dyn, *kin, *other]
+        self.body_key = tuple(bodies)
+        n, k = len(dyn), len(kin)
+        self.n, self.k, self.rows = n, k, len(self.bodies)
+        self.uid = np.array([names.uid(b) for b in self.bodies], dtype=np.int64)
+        self.labels = [names.labels[u] for u in self.uid.tolist()]
+        self.at = mem.addresses(self.bodies, "_body")
+        self.pre = mem.Reader("body", self.at, PRE, PTRS)
+        self.post = mem.Reader("body", self.at, POST, ("root",))
+        self.state = mem.Reader("body", self.at, PRE[:6])
+        first = self.pre.floats()
+        self.settings = first[9:13].copy()
+        self.static = np.isinf(first[13])
+        self.idle = first[13, n:].copy()  # 0 kinematic, infinite static: a type changed
+        Table._derive(self, first)
+        for r in range(n + k, self.rows):
+            self.drives[r] = self.bodies[r].body_type != pymunk.Body.STATIC
+        self.any_driven = bool(self.drives.any())
+        order = np.argsort(self.at)
+        self.order, self.sorted_at = order, self.at[order]
+        self.sorted_i64 = self.sorted_at.view(np.int64)
+
+    @staticmethod
+    def _derive(t: Any, first: np.ndarray) -> None:
+        """The arrays derived from the bodies' settings (``first``: rows as :data:`PRE`) of
+        a table ``t`` with ``n``, ``k`` and ``rows`` set."""
+        n, k = t.n, t.k
+        t.m = first[9, :n].copy()
+        moment = first[10, :n]
+        t.finite = np.isfinite(moment)
+        t.all_finite = bool(t.finite.all())
+        t.I = np.where(t.finite, moment, 0.0)
+        t.mass3 = np.stack([t.m, t.m, t.I])
+        # The same over every row (0 past the dynamic ones): products over whole rows.
+        t.m_rows = np.zeros(t.rows)
+        t.m_rows[:n] = t.m
+        t.mass3_rows = np.zeros((3, t.rows))
+        t.mass3_rows[:, :n] = t.mass3
+        # A dynamic body of mass or moment 0 cannot be stepped (pymunk divides by them):
+        # named in the build, and counted as if it had none.
+        t.unsteppable = ~(t.m > 0) | ~(moment > 0)
+        lin = t.m > 0
+        ang = t.finite & (moment > 0)
+        t.inv3 = np.stack([np.where(lin, 1.0 / np.where(lin, t.m, 1.0), 0.0),
+                           np.where(lin, 1.0 / np.where(lin, t.m, 1.0), 0.0),
+                           np.where(ang, 1.0 / np.where(ang, moment, 1.0), 0.0)])
+        t.lin_free = np.zeros(t.rows, dtype=bool)
+        t.lin_free[:n] = True
+        t.ang_free = np.zeros(t.rows, dtype=bool)
+        t.ang_free[:n] = t.finite
+        t.moves = np.zeros(t.rows, dtype=bool)
+        t.moves[: n + k] = True
+        # Rows whose motion is imposed and not counted in E: kinematic bodies and bodies
+        # outside the space (linear and angular), the spin of a body of infinite moment.
+        t.drives = np.zeros(t.rows, dtype=bool)
+        t.drives[n: n + k] = True
+        t.drives[:n] = ~t.finite
+        t.any_driven = bool(t.drives.any())
+
+    #: Most rows for which their pairs' slots are looked up in a dense map of rows (4 bytes
+    #: each: 16 MB at most); a body's row is looked up in a map of its place in memory when
+    #: the bodies lie close (the map at most 64 words a body).
+    DENSE = 2048
+
+    def rows_of(self, at: np.ndarray) -> np.ndarray:
+        """The rows of the bodies at the addresses ``at`` (int64); -1 where none."""
+        span = self.pre.span
+        if span is None:
+            return np.full(at.shape, -1)
+        if not hasattr(self, "_rowmap"):
+            words = len(span.u8) >> 3
+            self._rowmap = None
+            if words <= 64 * self.rows + 4096:  # bodies close in memory: a small map
+                self._rowmap = np.full(words + 1, -1, dtype=np.int32)  # last: outside
+                self._rowmap[(self.at.astype(np.int64) - span.lo) >> 3] = np.arange(self.rows)
+        if self._rowmap is None:
+            pos = np.minimum(np.searchsorted(self.sorted_i64, at), self.rows - 1)
+            return np.where(self.sorted_i64[pos] == at, self.order[pos], -1)
+        words = len(self._rowmap) - 1
+        w = (at - span.lo) >> 3
+        return self._rowmap[np.where((w >= 0) & (w < words), w, words)]
+
+    def slots_of(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
+        """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added: looked up
+        in a dense map of rows for a small table."""
+        if self.rows > self.DENSE:
+            return self.pair_slots(ra, rb, pairs)
+        if not hasattr(self, "_pairmap"):
+            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int32)
+        slots = self._pairmap[ra, rb]
+        if slots.min() < 0:
+            new = slots < 0
+            slots[new] = self.pair_slots(ra[new], rb[new], pairs)
+            self._pairmap[ra[new], rb[new]] = slots[new]
+        return slots
+
+    def pair_slots(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
+        """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added."""
+        ua, ub = self.uid[ra], self.uid[rb]
+        return pairs.slots(np.minimum(ua, ub) * PAIR + np.maximum(ua, ub))
+
+
+class Pairs:
+    """Running contact work, and gravity's part of the position correction, per pair of
+    bodies (stable ids). A pair's slot is given when it first touches and never moves."""
+
+    def __init__(self) -> None:
+        self.keys = np.zeros(0, dtype=np.int64)      # by slot
+        self.sorted = np.zeros(0, dtype=np.int64)    # keys, sorted
+        self.slot_of = np.zeros(0, dtype=np.int64)   # slot of each sorted key
+        self.work = np.zeros(0)
+        self.push = np.zeros(0)
+
+    def lookup(self, keys: np.ndarray) -> np.ndarray:
+        """The slots of ``keys`` (-1 where new)."""
+        if not len(self.sorted):
+            return np.full(len(keys), -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self.sorted, keys), len(self.sorted) - 1)
+        return np.where(self.sorted[pos] == keys, self.slot_of[pos], -1)
+
+    def slots(self, keys: np.ndarray) -> np.ndarray:
+        """The slots of ``keys``, adding the new ones."""
+        found = self.lookup(keys)
+        if np.all(found >= 0):
+            return found
+        fresh = np.unique(keys[found < 0])
+        self.keys = np.concatenate([self.keys, fresh])
+        self.work = np.concatenate([self.work, np.zeros(len(fresh))])
+        self.push = np.concatenate([self.push, np.zeros(len(fresh))])
+        order = np.argsort(self.keys, kind="stable")
+        self.sorted, self.slot_of = self.keys[order], order
+        return self.slot_of[np.searchsorted(self.sorted, keys)]
+
+
+class Members(NamedTuple):
+    """The constraints of one struct kind as the build lists them: the objects, their
+    labels, the table rows of their two bodies, and whether each (a spring) has pymunk's
+    own force."""
+
+    objs: list[Any]
+    labels: list[str]
+    a: list[int]
+    b: list[int]
+    default: list[bool]
+
+
+class Group:
+    """The constraints of one struct kind: rows of their two bodies in the table, readers,
+    and running sums (energy units) per constraint: ``work`` (work of its impulses on the
+    relative motion; for a spring, its elastic part), ``extra`` (a spring's damping part),
+    ``pot`` (a spring's potential change over the steps' moves), ``kin_a``/``kin_b`` (work
+    of a driven end through it)."""
+
+    def __init__(self, kind: str, members: Members) -> None:
+        objs = members.objs
+        self.kind = kind
+        self.objs = objs
+        self.labels = members.labels
+        self.at = mem.addresses(objs, "_constraint")
+        self.a = np.array(members.a, dtype=np.int64)
+        self.b = np.array(members.b, dtype=np.int64)
+        self.default = np.array(members.default, dtype=bool)
+        self.spring = kind in ("spring", "rotary_spring")
+        self.slot = -1  # place among the space's spring groups
+        func = {"spring": ("force_func",), "rotary_spring": ("torque_func",)}.get(kind, ())
+        self.before = mem.Reader(kind, self.at, BEFORE[kind], func)
+        self.after = mem.Reader(kind, self.at, AFTER[kind])
+        z = np.zeros(len(objs))
+        self.work, self.extra, self.pot, self.kin_a, self.kin_b = (z.copy() for _ in range(5))
+        self.settings = self.before.floats().copy() if self.spring else None
+        self.funcs = self.before.pointers().copy() if self.spring else None
+        if kind == "spring":
+            self.anchor = np.array(
+                [[c.anchor_a[0] - c.a.center_of_gravity[0],
+                  c.anchor_a[1] - c.a.center_of_gravity[1],
+                  c.anchor_b[0] - c.b.center_of_gravity[0],
+                  c.anchor_b[1] - c.b.center_of_gravity[1]] for c in objs],
+                dtype=float).reshape(len(objs), 4)
+
+    def changed(self) -> bool:
+        """A spring's settings or force function changed since the build."""
+        return self.spring and not (np.array_equal(self.before.floats(), self.settings)
+                                    and np.array_equal(self.before.pointers(), self.funcs))
+
+
+class Field(NamedTuple):
+    """A declared potential on the dynamic rows ``idx``: ``potential(x, y, m)`` and its
+    label."""
+
+    idx: np.ndarray
+    potential: Callable[..., Any]
+    label: str
+
+
+@dataclass(frozen=True, eq=False)
+class Build:
+    """What the space holds, as the ledger reads it until it changes: the table, the
+    constraint groups (``springs`` those of springs), the declared fields, gravity, the
+    dynamic rows' velocity and position function pointers, which velocity functions are
+    custom and which have a declared field, the custom functions themselves, and what
+    cannot be accounted for while this holds (``current``: label -> why)."""
+
+    table: Table
+    groups: dict[str, Group]
+    springs: list[Group]
+    fields: list[Field]
+    gravity: tuple[float, float]
+    vf: np.ndarray
+    pf: np.ndarray
+    custom: np.ndarray
+    declared: np.ndarray
+    vel_funcs: list[Any]
+    current: dict[str, str]
+
+    @cached_property
+    def any_custom(self) -> bool:
+        return bool(self.custom.any())
+
+    @cached_property
+    def funcs(self) -> np.ndarray:
+        """The velocity and position function pointers (2, dynamic rows)."""
+        return np.stack([self.vf, self.pf])
+
+
+def build(space: Any, names: Names, potentials: list[tuple[Any, Callable[..., Any], str]]
+          ) -> Build:
+    """Read what ``space`` holds now (``potentials``: the declared ones, as (key, function,
+    label), key ('func', f) or ('bodies', ids))."""
+    current: dict[str, str] = {}
+    t = Table(space, names)
+    n = t.n
+    labels = t.labels
+    groups, springs = _groups(t, current)
+    ptrs = t.pre.pointers()
+    vel_default, pos_default = layout.default_funcs()
+    vf, pf = ptrs[1, :n].copy(), ptrs[2, :n].copy()
+    custom = ~np.isin(vf, np.array(sorted(vel_default), dtype=np.uint64))
+    custom_pos = ~np.isin(pf, np.array(sorted(pos_default), dtype=np.uint64))
+    vel_funcs = [t.bodies[i].velocity_func if custom[i] else None for i in range(n)]
+    fields: list[Field] = []
+    declared = np.zeros(n, dtype=bool)
+    for key, potential, label in potentials:
+        if key[0] == "func":
+            idx = [i for i in range(n) if vel_funcs[i] is key[1]]
+        else:
+            idx = [i for i in range(n) if id(t.bodies[i]) in key[1]]
+        if idx:
+            fields.append(Field(np.array(idx, dtype=np.int64), potential, label))
+            declared[idx] = True
+    for i in np.nonzero(custom & ~declared)[0]:
+        current[labels[i]] = ("custom velocity_func and no declared potential "
+                              "(declare_potential): its kicks are counted as work, the "
+                              "energy of its field is not in E")
+    for i in np.nonzero(custom_pos)[0]:
+        current[labels[i]] = "custom position_func: its moves are not predicted"
+    for i in np.nonzero(t.unsteppable)[0]:
+        current[labels[i]] = (f"a dynamic body of mass {t.m[i]:g} and moment "
+                              f"{float(t.pre.floats()[10, i]):g}: pymunk cannot step it (it "
+                              "divides by both); spaces.energy refuses it")
+    gravity = tuple(float(g) for g in space.gravity)
+    return Build(t, groups, springs, fields, gravity, vf, pf, custom, declared, vel_funcs,
+                 current)
+
+
+def _groups(t: Table, current: dict[str, str]) -> tuple[dict[str, Group], list[Group]]:
+    """The constraints by struct kind, the springs among them; the constraints the ledger
+    cannot read or whose energy is not in E are named in ``current``."""
+    rows = {int(a): r for r, a in enumerate(t.at.tolist())}
+    spring_default, rotary_default = layout.default_spring_funcs()
+    by_kind: dict[str, tuple[list[Any], ...]] = {}
+    for i, c in enumerate(t.constraint_key):
+        name = type(c).__name__
+        kind = mem.struct_of(c)
+        clabel = f"{name} {i}"
+        if kind is None:
+            current[clabel] = f"{name}: a constraint class the ledger cannot read"
+            continue
+        layout.check_constraint(c)
+        default = True
+        if kind in ("spring", "rotary_spring"):
+            r = mem.view(kind, mem.address(c._constraint))
+            func = mem.address(r.force_func if kind == "spring" else r.torque_func)
+            # pymunk's own Python spring function, set explicitly, runs through a callback
+            # (another address) but is the default force: told apart as _pymunk does.
+            default = (func in (spring_default if kind == "spring" else rotary_default)
+                       or spring_function(c) is None)
+            if not default:
+                current[clabel] = ("custom force function: its potential is not in E (its "
+                                   "work is counted)")
+        entry = by_kind.setdefault(kind, ([], [], [], [], []))
+        for lst, value in zip(entry, (c, clabel, rows[mem.address(c.a._body)],
+                                      rows[mem.address(c.b._body)], default), strict=True):
+            lst.append(value)
+    groups = {kind: Group(kind, Members(*entry)) for kind, entry in by_kind.items()}
+    springs = [g for g in groups.values() if g.spring]
+    for slot, g in enumerate(springs):
+        g.slot = slot
+    return groups, springs
+
+
+def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
+    """What changed in ``space`` since the build ``b`` ('' when nothing); ``F`` and ``P``
+    the table's floats and pointers read now."""
+    t = b.table
+    if tuple(space.bodies) != t.body_key:
+        return "bodies added or removed"
+    if tuple(space.constraints) != t.constraint_key:
+        return "constraints added or removed"
+    if not ((F[9:13] == t.settings).all() and (t.n == t.rows or (F[13, t.n:] == t.idle).all())):
+        return "a mass, moment, centre of gravity or body type"
+    if not (P[1:3, : t.n] == b.funcs).all():
+        return "a velocity_func or position_func"
+    return _changed_settings(b, space)
+
+
+def _changed_settings(b: Build, space: Any) -> str:
+    """What changed since the build in gravity, the springs' settings and the custom
+    velocity functions ('' when nothing)."""
+    t = b.table
+    if tuple(space.gravity) != b.gravity:
+        return "space.gravity"
+    for g in b.springs:
+        if g.changed():
+            return f"a {g.kind.replace('_', ' ')}'s settings"
+    if b.any_custom:
+        bodies = t.bodies
+        for i in np.nonzero(b.custom)[0]:
+            if bodies[i].velocity_func is not b.vel_funcs[i]:
+                return "a velocity_func"
+    return ""
+
+
+def declared(target: Any, potential: Callable[..., Any], name: str | None, steps: int,
+             names: Names) -> tuple[Any, str]:
+    """The key and label of a potential to declare (``Ledger.declare_potential``), checked:
+    ``target`` a body, bodies or a velocity function, ``name`` at most :data:`NAME_CHARS`
+    printable characters, ``potential`` callable on numpy arrays with finite energies, and
+    no step counted yet (``steps``); the bodies are kept in ``names``."""
+    import pymunk
+
+    from ..errors import UsageError
+    from ..model import args
+
+    args.function(potential, "potential", "a function potential(x, y, m) -> energy")
+    if isinstance(target, pymunk.Body):
+        target = [target]
+    if callable(target):
+        key: Any = ("func", target)
+        label = name or f"field of {getattr(target, '__name__', 'a velocity_func')}"
+    else:
+        bodies = list(target) if isinstance(target, Iterable) and not isinstance(
+            target, str | bytes) else []
+        if not bodies or not all(isinstance(b, pymunk.Body) for b in bodies):
+            raise UsageError(f"target = {args.show(target)}: must be a body, a list of "
+                             "bodies or a velocity function", param="target")
+        key = ("bodies", frozenset(id(b) for b in bodies))
+        names.kept.extend(bodies)
+        label = name or "declared field"
+    label = args.text(label, "name")
+    if not (0 < len(label) <= NAME_CHARS and label.isprintable()):
+        raise UsageError(f"name = {args.show(label)}: must be 1 to {NAME_CHARS} printable "
+                         "characters (no newline or other control character)",
+                         param="name")
+    if steps:
+        raise UsageError(f"potential: declare it before the first step ({steps} "
+                         "counted already; attach a new Ledger to declare it)",
+                         param="potential")
+    probe = np.array([1.0, 2.0])
+    try:
+        raw = potential(probe, probe + 1.0, probe)
+        value = np.asarray(raw, dtype=float)
+    except Exception as e:  # noqa: BLE001 - the user's function: any failure is theirs
+        raise UsageError(f"potential: calling it with numpy arrays x, y, m failed "
+                         f"({type(e).__name__}: {args.show(str(e))})",
+                         param="potential") from None
+    if value.shape not in ((2,), ()):
+        raise UsageError(f"potential: returned shape {value.shape} for 2 bodies: must "
+                         "return one energy per body", param="potential")
+    if not np.all(np.isfinite(value)):
+        raise UsageError(f"potential: returned {args.show(raw)} for bodies at x = [1, 2], "
+                         "y = [2, 3]: must return finite energies", param="potential")
+    return key, label

@@ -1,0 +1,181 @@
+"""The ledger's account, as users read it: :class:`Term` (one source) and :class:`Balance`
+(the terms, E(0) and E(t), the check), with their text (:meth:`Balance.table`). Every number
+in them is a plain Python float (``json.dumps`` takes them), every energy carries the space's
+unit (:mod:`.units`: J in SI), and every text a program chose (a declared potential's name,
+a constraint's class name) is printed with its control characters escaped, on one line."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .._display import counted, one_line
+
+__all__ = ["Balance", "Term"]
+
+#: Kinds of terms that are heat (energy turned into heat, negative when energy leaves).
+HEAT_KINDS = ("contact", "spring damping", "damping")
+#: Longest text of a source, note or reason printed by :meth:`Balance.table`.
+TEXT_CHARS = 120
+
+
+def shown(text: str, limit: int = TEXT_CHARS) -> str:
+    """``text`` for one line of a table: control characters escaped (a newline as
+    ``\\n``), cut to ``limit`` characters with "..." where it was cut."""
+    out = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii")
+                  for ch in text)
+    return out if len(out) <= limit else out[: limit - 3] + "..."
+
+
+@dataclass(frozen=True, repr=False)
+class Term:
+    """One source in the ledger: ``energy`` it put into the bodies over the run (negative
+    when it took energy out, in ``unit``: J in SI), its ``kind`` (see
+    :mod:`dumbbell.spaces.ledger`) and a note."""
+
+    source: str
+    kind: str
+    energy: float
+    note: str = ""
+    unit: str = "J"
+
+    def __repr__(self) -> str:
+        return one_line(f"Term({shown(self.source)!r}, {self.kind!r}, "
+                        f"{self.energy:+.6g} {self.unit})")
+
+
+@dataclass(frozen=True, repr=False)
+class Balance:
+    """The ledger over a run: E(0) and E(t) (with the declared fields), the terms, and the
+    check, every energy in ``unit`` (J in SI). ``E + heat + work_out - work_in = E0 +
+    closure`` holds exactly; ``heat`` is what contacts, spring damping and ``space.damping``
+    dissipated, ``work_in`` and ``work_out`` the other terms' inputs and outputs. ``scale``
+    is the largest kinetic energy and change of a potential seen, ``worst_step`` the largest
+    closure of one step relative to it; ``complete`` is True when
+    the closure and anything unattributed stay within ``tolerance`` of it and every source
+    is accounted for (``unaccounted`` names the others, with why)."""
+
+    E0: float
+    E: float
+    terms: tuple[Term, ...]
+    closure: float
+    worst_step: float
+    scale: float
+    tolerance: float
+    unaccounted: tuple[tuple[str, str], ...]
+    steps: int
+    t: float
+    notes: tuple[str, ...] = ()
+    unit: str = "J"
+    time_unit: str = "s"
+
+    def __post_init__(self) -> None:
+        # Plain numbers only (numpy scalars neither print nor serialise as numbers).
+        from ..model import args
+
+        for name in ("E0", "E", "closure", "worst_step", "scale", "tolerance", "t"):
+            unit = self.time_unit if name == "t" else "-" if name in (
+                "worst_step", "tolerance") else self.unit
+            value = args.real(getattr(self, name), name, unit, positive=False)
+            object.__setattr__(self, name, value)
+        object.__setattr__(self, "steps", args.whole(self.steps, "steps", "steps", lo=0))
+
+    @property
+    def heat(self) -> float:
+        """Energy dissipated: minus the heat-kind terms."""
+        return -math.fsum(t.energy for t in self.terms if t.kind in HEAT_KINDS)
+
+    @property
+    def work_in(self) -> float:
+        """Energy the other terms put in."""
+        return math.fsum(t.energy for t in self.terms
+                         if t.kind not in HEAT_KINDS and t.energy > 0)
+
+    @property
+    def work_out(self) -> float:
+        """Energy the other terms took out (positive)."""
+        return -math.fsum(t.energy for t in self.terms
+                          if t.kind not in HEAT_KINDS and t.energy < 0)
+
+    @property
+    def relative_closure(self) -> float:
+        """|closure| / scale (0 when nothing moved)."""
+        return abs(self.closure) / self.scale if self.scale > 0 else 0.0
+
+    @property
+    def complete(self) -> bool:
+        """True when every joule is accounted for: nothing in ``unaccounted`` and the
+        closure within ``tolerance`` of ``scale``."""
+        return bool(not self.unaccounted
+                    and abs(self.closure) <= self.tolerance * self.scale)
+
+    def by_kind(self) -> dict[str, float]:
+        """Energy per kind of term."""
+        out: dict[str, float] = {}
+        for t in self.terms:
+            out[t.kind] = out.get(t.kind, 0.0) + t.energy
+        return out
+
+    def sources(self, kind: str | None = None, at_least: float = 0.0) -> list[Term]:
+        """Terms (of ``kind``, all when None) with |energy| >= ``at_least``, largest
+        first."""
+        from ..model import args
+
+        at_least = args.real(at_least, "at_least", self.unit, lo=0.0)
+        chosen = [t for t in self.terms if (kind is None or t.kind == kind)
+                  and abs(t.energy) >= at_least]
+        return sorted(chosen, key=lambda t: -abs(t.energy))
+
+    def __repr__(self) -> str:
+        u = self.unit
+        return one_line(
+            f"Balance({counted(self.steps, 'step')}, t = {self.t:.6g} {self.time_unit}, E0 = "
+            f"{self.E0:.9g} {u}, "
+            f"E = {self.E:.9g} {u}, closure = {self.closure:+.3g} {u}, complete = "
+            f"{self.complete}; {len(self.terms)} terms: .table())")
+
+    def table(self, top: int = 4) -> str:
+        """The ledger as text: totals per kind with the ``top`` largest sources of each,
+        then the check."""
+        from ..model import args
+
+        top = args.whole(top, "top", "sources", lo=0)
+        u = self.unit
+        lines = [(f"energy ledger over {counted(self.steps, 'step')}, t = {self.t:.6g} {self.time_unit}, "
+                 f"energies in {u}"),
+                 f"  E(0) = {self.E0:.9g}   E(t) = {self.E:.9g}   scale = {self.scale:.4g}"]
+        for kind, total in sorted(self.by_kind().items(), key=lambda kv: -abs(kv[1])):
+            terms = self.sources(kind)
+            lines.append(f"  {shown(kind):16s} {total:+.6g}  ({len(terms)} source"
+                         f"{'' if len(terms) == 1 else 's'})")
+            for t in terms[:top]:
+                lines.append(f"      {shown(t.source):40s} {t.energy:+.6g}")
+        lines.append(f"  closure E(t) - E(0) - sum = {self.closure:+.3g} "
+                     f"({self.relative_closure:.2e} of the scale; worst step "
+                     f"{self.worst_step:.2e})")
+        for note in self.notes:
+            lines.append(f"  note: {shown(note, 400)}")
+        for source, why in self.unaccounted:
+            lines.append(f"  unaccounted: {shown(source)}: {shown(why, 400)}")
+        lines.append(f"  complete: {self.complete}")
+        return "\n".join(lines)
+
+
+def notes(terms: list[Term], scale: float, unit: str) -> tuple[str, ...]:
+    """What deserves a word beyond the terms: shapes pushed apart (they overlapped) putting
+    energy in, with the pairs that did most."""
+    pushed = [t for t in terms if t.kind == "correction"]
+    total = sum(abs(t.energy) for t in pushed)
+    if scale <= 0 or total <= 0.01 * scale:
+        return ()
+    pairs = sorted((t for t in pushed if t.source.startswith("pushed apart")),
+                   key=lambda t: -abs(t.energy))[:3]
+    which = ", ".join(t.source.removeprefix("pushed apart ") for t in pairs)
+    return (f"overlapping shapes pushed apart by the contacts' position correction moved "
+            f"{total:.3g} {unit} ({total / scale:.2g} of the scale)"
+            + (f", most between {which}" if which else "")
+            + " (shapes that start overlapping, or that a joint holds in another)",)
+
+
+def order(t: Term) -> tuple[str, float]:
+    return (t.kind, -abs(t.energy))

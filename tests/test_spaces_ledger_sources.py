@@ -1,0 +1,424 @@
+"""spaces.Ledger names each source right: every ``program``, ``entered``, ``left`` and
+callback term against an independent measurement of what the program or the callback did
+(the bodies' energy before and after, read through pymunk's getters), on programs that
+change the space between steps and from callbacks; the general rules behind issue 28's
+cases; and what the ledger prints (plain numbers, units, no line a program's text wrote)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pymunk
+import pytest
+
+from dumbbell import spaces
+from dumbbell.errors import UsageError
+
+
+def _energy(body: pymunk.Body, g: tuple[float, float]) -> float:
+    """A body's kinetic and gravitational energy, from pymunk's getters (its centre of
+    gravity in world coordinates)."""
+    cog = body.local_to_world(body.center_of_gravity)
+    return (0.5 * body.mass * body.velocity.length_squared
+            + 0.5 * body.moment * body.angular_velocity ** 2
+            - body.mass * (g[0] * cog[0] + g[1] * cog[1]))
+
+
+def _terms(bal: spaces.Balance, kind: str) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for t in bal.terms:
+        if t.kind == kind:
+            out[t.source] = out.get(t.source, 0.0) + t.energy
+    return out
+
+
+def _ball(space: pymunk.Space, pos=(0.0, 1.0), v=(0.0, 0.0), m=1.0, r=0.1,
+          e=0.0) -> pymunk.Body:
+    b = pymunk.Body(m, pymunk.moment_for_circle(m, 0, r, (0.02, 0.0)))
+    b.center_of_gravity = (0.02, 0.0)  # off the origin: position is not the centre
+    b.position, b.velocity = pos, v
+    shape = pymunk.Circle(b, r)
+    shape.elasticity = e
+    space.add(b, shape)
+    return b
+
+
+def _floor(space: pymunk.Space, e: float = 0.0) -> None:
+    floor = pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.05)
+    floor.elasticity = e
+    space.add(floor)
+
+
+def test_the_minimal_case_keeps_counting_when_a_body_is_added():
+    # Issue 28, item 1: a pivot's impulse reads a few roundings from pymunk's own.
+    space = pymunk.Space()
+    ball = pymunk.Body(4, 100)
+    ball.velocity = (185.0, 51.0)
+    pivot = pymunk.PivotJoint(space.static_body, ball, (0, 0), (0, 0))
+    pivot.max_bias, pivot.max_force = 0, 400
+    space.add(ball, pymunk.Circle(ball, 18), pivot)
+    ledger = spaces.Ledger(space)
+    space.step(1 / 120)
+    space.add(pymunk.Body(1, 1))
+    for _ in range(200):
+        space.step(1 / 120)
+    bal = ledger.balance()
+    assert bal.complete is True and bal.steps == 201
+    assert bal.E == pytest.approx(spaces.energy(space).E, rel=1e-15, abs=1e-12)
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+
+
+def test_program_changes_between_steps_are_each_bodys_measured_change():
+    g = (0.0, -9.81)
+    space = pymunk.Space()
+    space.gravity = g
+    _floor(space)
+    a, b = _ball(space, pos=(0.0, 2.0)), _ball(space, pos=(1.0, 3.0), m=2.0)
+    ledger = spaces.Ledger(space)
+    expected = {"program: body 0": 0.0, "program: body 1": 0.0}
+    for i in range(300):
+        if i % 7 == 3:
+            before = _energy(a, g)
+            a.apply_impulse_at_local_point((0.3, 0.5))
+            expected["program: body 0"] += _energy(a, g) - before
+        if i % 11 == 5:
+            before = _energy(b, g)
+            b.position += (0.0, 0.2)
+            b.velocity *= 0.5
+            b.angular_velocity = 3.0
+            expected["program: body 1"] += _energy(b, g) - before
+        space.step(1 / 120)
+    bal = ledger.balance()
+    found = _terms(bal, "program")
+    scale = bal.scale
+    for source, value in expected.items():
+        assert abs(found[source] - value) <= 1e-9 * scale, source
+    assert set(dict(bal.unaccounted)) == set(expected) and bal.complete is False
+    assert abs(bal.closure) <= 1e-12 * scale
+
+
+def test_a_constraint_removed_beside_a_push_out_names_neither_as_the_program():
+    # Issue 28, item 2: a ball starts inside a floor and is pushed out while an idle
+    # PinJoint elsewhere is removed: the push is the pair's; the program changed nothing.
+    space = pymunk.Space()
+    space.gravity = (0.0, -9.81)
+    _floor(space)
+    ball = _ball(space, pos=(0.0, 0.05))  # radius 0.1: inside the floor
+    other = _ball(space, pos=(5.0, 5.0))
+    pin = pymunk.PinJoint(space.static_body, other, (5.0, 6.0), (0.0, 0.0))
+    space.add(pin)
+    ledger = spaces.Ledger(space)
+    for i in range(40):
+        if i == 10:
+            space.remove(pin)
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert "program" not in bal.by_kind()
+    assert _terms(bal, "correction")["pushed apart body 0 / static body"] > 0.0
+    assert bal.complete is True
+    del ball
+
+
+def test_a_groove_removed_and_an_impulse_in_the_same_gap_go_to_the_body():
+    space = pymunk.Space()
+    body = pymunk.Body(1, 1)
+    groove = pymunk.GrooveJoint(space.static_body, body, (-5, 0), (5, 0), (0, 0))
+    space.add(body, pymunk.Circle(body, 0.2), groove)
+    ledger = spaces.Ledger(space)
+    space.step(1 / 60)
+    space.remove(groove)
+    body.apply_impulse_at_local_point((3, 4))
+    space.step(1 / 60)
+    bal = ledger.balance()
+    assert _terms(bal, "program") == {"program: body 0": pytest.approx(12.5, rel=1e-15)}
+
+
+def test_a_spring_added_or_removed_is_the_change_of_its_potential():
+    # What a structural change itself does: a stretched spring brings its energy in, and
+    # takes it out when removed (its potential, by hand).
+    space = pymunk.Space()
+    a, b = _ball(space, pos=(0.0, 0.0)), _ball(space, pos=(2.0, 0.0))
+    ledger = spaces.Ledger(space)
+    space.step(0.01)
+    spring = pymunk.DampedSpring(a, b, (0, 0), (0, 0), 1.0, 30.0, 0.0)
+    stretch = (b.local_to_world((0, 0)) - a.local_to_world((0, 0))).length - 1.0
+    space.add(spring)
+    for _ in range(50):
+        space.step(0.01)
+    now = (b.local_to_world((0, 0)) - a.local_to_world((0, 0))).length - 1.0
+    space.remove(spring)
+    space.step(0.01)
+    bal = ledger.balance()
+    found = _terms(bal, "program")
+    assert found["program: constraints added or removed"] == pytest.approx(
+        0.5 * 30.0 * (stretch ** 2 - now ** 2), rel=1e-12)
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+
+
+def test_callbacks_after_the_solver_are_unattributed_and_measured():
+    # Issue 28, item 2: a post_solve callback halving a velocity inside the step. The
+    # term is what the callback changed, measured around it.
+    g = (0.0, -10.0)
+    space = pymunk.Space()
+    space.gravity = g
+    _floor(space, e=1.0)
+    ball = _ball(space, pos=(0.0, 1.0), v=(0.5, -3.0), e=1.0)
+    changed = [0.0]
+
+    def halve(arbiter, space_, data):
+        before = _energy(ball, g)
+        ball.velocity *= 0.5
+        changed[0] += _energy(ball, g) - before
+
+    space.on_collision(None, None, post_solve=halve)
+    ledger = spaces.Ledger(space)
+    for _ in range(120):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert changed[0] < 0
+    assert _terms(bal, "unattributed")["body 0"] == pytest.approx(changed[0], rel=1e-12)
+    assert "program" not in bal.by_kind()
+    assert "body 0" in dict(bal.unaccounted) and bal.complete is False
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+
+
+def test_bodies_removed_and_added_from_callbacks_carry_their_measured_energy():
+    # A pool table's pocket: a ball touching the pocket is removed from a post_solve
+    # callback (pymunk removes it at the end of the step), and a fresh ball is added.
+    g = (0.0, -9.81)
+    space = pymunk.Space()
+    space.gravity = g
+    _floor(space)
+    balls = [_ball(space, pos=(0.3 * i, 0.5 + 0.2 * i), v=(1.0, 0.0)) for i in range(4)]
+    gone: dict[int, float] = {}
+    came = [0.0]
+
+    def pocket(arbiter, space_, data):
+        for shape in arbiter.shapes:
+            body = shape.body
+            if body in balls and id(body) not in gone and len(gone) < 2:
+                gone[id(body)] = 0.0  # measured at the end of the step
+                space_.remove(body, *body.shapes)
+
+    def measure(space_, key):
+        for body in balls:
+            if id(body) in gone and gone[id(body)] == 0.0:
+                gone[id(body)] = _energy(body, g)
+
+    space.on_collision(None, None, post_solve=pocket)
+    ledger = spaces.Ledger(space)
+    for i in range(200):
+        space.step(1 / 100)
+        measure(space, None)
+        if i == 50:
+            new = _ball(space, pos=(2.0, 1.0), v=(-0.5, 0.0))
+            came[0] = _energy(new, g)
+    bal = ledger.balance()
+    left = _terms(bal, "left")
+    assert len(left) == 2
+    assert sorted(left.values()) == pytest.approx(sorted(-e for e in gone.values()),
+                                                  rel=1e-12)
+    entered = _terms(bal, "entered")
+    assert list(entered.values()) == [pytest.approx(came[0], rel=1e-12)]
+    assert bal.complete is True
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+
+
+@pytest.mark.parametrize("dts", [(1 / 60, 1 / 90), (1 / 50, 1 / 200, 1 / 120)])
+def test_a_pairs_push_and_the_correction_split_when_dt_changes(dts):
+    # A ball started inside a floor is pushed out by the position correction over steps of
+    # changing dt. Each move adds the last step's bias velocity times THIS step's dt:
+    # p(k+1) = p(k) + (v(k) + v_bias(k)) dt(k+1), so gravity's part of the push, by hand,
+    # is the sum of -m g . (p(k+1) - p(k) - v(k) dt(k+1)). It is the pair's term; the
+    # general correction term keeps none of it (no spring or field here).
+    g = (0.0, -9.81)
+    space = pymunk.Space()
+    space.gravity = g
+    _floor(space)
+    ball = _ball(space, pos=(0.0, 0.02), m=2.0)
+    ledger = spaces.Ledger(space)
+    hand = 0.0
+    for i in range(90):
+        dt = dts[i % len(dts)]
+        p0 = ball.local_to_world(ball.center_of_gravity)
+        v0 = ball.velocity
+        space.step(dt)
+        p1 = ball.local_to_world(ball.center_of_gravity)
+        bias = p1 - p0 - v0 * dt
+        hand += -ball.mass * (g[0] * bias[0] + g[1] * bias[1])
+    bal = ledger.balance()
+    correction = _terms(bal, "correction")
+    assert hand > 1e-3 * bal.scale  # the push matters
+    assert correction["pushed apart body 0 / static body"] == pytest.approx(hand, rel=1e-9)
+    assert abs(correction.get("position correction", 0.0)) <= 1e-12 * bal.scale
+    assert bal.complete is True
+
+
+def test_complete_is_a_bool_and_the_balance_serialises():
+    space = pymunk.Space()
+    space.gravity = (0.0, -9.81)
+    _floor(space)
+    _ball(space, pos=(0.0, 0.05))  # a position correction term exists
+    ledger = spaces.Ledger(space)
+    for _ in range(30):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert bal.complete is True
+    record = {k: getattr(bal, k) for k in ("E0", "E", "closure", "worst_step", "scale",
+                                           "tolerance", "steps", "t", "complete",
+                                           "relative_closure", "heat", "work_in",
+                                           "work_out")}
+    record["terms"] = [(t.source, t.kind, t.energy) for t in bal.terms]
+    json.dumps(record)  # raises on a numpy scalar
+    assert all(type(v) in (float, int, bool) for k, v in record.items() if k != "terms")
+    assert all(type(t.energy) is float for t in bal.terms)
+    assert "np." not in repr(bal) and "np." not in repr(bal.terms)
+
+
+def _no_numpy(value, path="") -> list[str]:
+    """Where a record holds a numpy scalar or array (paths), recursively."""
+    import dataclasses
+
+    if isinstance(value, np.generic | np.ndarray):
+        return [path]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return [p for f in dataclasses.fields(value)
+                for p in _no_numpy(getattr(value, f.name), f"{path}.{f.name}")]
+    if isinstance(value, tuple | list):
+        return [p for i, v in enumerate(value) for p in _no_numpy(v, f"{path}[{i}]")]
+    return []
+
+
+def test_no_public_record_of_spaces_holds_a_numpy_scalar():
+    space = pymunk.Space()
+    space.gravity = (0.0, -9.81)
+    _floor(space)
+    a, b = _ball(space, pos=(0.0, 0.05)), _ball(space, pos=(1.0, 1.0))
+    space.add(pymunk.DampedSpring(a, b, (0, 0), (0, 0), 1.0, 10.0, 0.1),
+              pymunk.SimpleMotor(a, b, 1.0))
+    heat = spaces.HeatCounter(space)
+    ledger = spaces.Ledger(space)
+    for _ in range(30):
+        space.step(1 / 60)
+    records = {"energy": spaces.energy(space), "balance": ledger.balance()}
+    for name, record in records.items():
+        assert _no_numpy(record) == [], name
+    assert type(heat.total) is float and type(heat.steps) is int
+
+
+def test_units_are_printed_with_every_value_of_a_space():
+    space = pymunk.Space()
+    space.gravity = (0.0, 900.0)  # a pixel space, y down
+    b = pymunk.Body(1, 100)
+    b.position = (100, 200)
+    space.add(b, pymunk.Circle(b, 10))
+    ledger = spaces.Ledger(space, units="px")
+    heat = spaces.HeatCounter(space, units="px")
+    space.step(1 / 60)
+    unit = "kg px²/s²"
+    bal = ledger.balance()
+    for text in (repr(ledger), repr(bal), repr(bal.terms[0]), bal.table(),
+                 repr(spaces.energy(space, units="px")),
+                 repr(spaces.energy(space, units="px").bodies[0]), repr(heat)):
+        assert unit in text, text
+    assert "kg px/s" in repr(spaces.energy(space, units="px"))
+    assert " J" in repr(spaces.Ledger(space, units="m").balance())
+    # Units not named: nothing is claimed (this space is in pixels; its energy is not in J).
+    assert " J" not in repr(spaces.Ledger(space).balance())
+    assert "energy units" in repr(spaces.Ledger(space).balance())
+    with pytest.raises(UsageError, match="units"):
+        spaces.Ledger(space, units="p\nx")
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, None])
+def test_a_declared_potential_that_is_not_a_number_is_named(value):
+    space = pymunk.Space()
+    body = _ball(space, pos=(1.0, 0.0))
+    ledger = spaces.Ledger(space)
+
+    def potential(x, y, m):  # finite at the declaration's probe, not where the body goes
+        if value is None:
+            return None if np.any(x > 2.5) else 0.0 * x
+        return np.where(x > 2.5, value, 0.0 * x)
+
+    ledger.declare_potential(body, potential, name="well")
+    body.velocity = (10.0, 0.0)
+    for _ in range(20):
+        space.step(0.01)
+    with pytest.raises(Exception, match=r"declared potential 'well' returned .* for body 0 "
+                                        r"at x = .*: it must return finite energies"):
+        ledger.balance()
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, None])
+def test_a_potential_not_a_number_at_the_declaration_is_refused(value):
+    space = pymunk.Space()
+    body = _ball(space)
+    ledger = spaces.Ledger(space)
+    with pytest.raises(UsageError, match="potential: returned .*: must return finite"):
+        ledger.declare_potential(body, lambda x, y, m: value)
+
+
+@pytest.mark.parametrize("name", ["well\ncomplete: True", "a\tb", "x" * 61, "\x1b[2J"])
+def test_a_potential_name_cannot_write_lines_into_the_table(name):
+    space = pymunk.Space()
+    body = _ball(space)
+    ledger = spaces.Ledger(space)
+    with pytest.raises(UsageError, match="name = .*: must be 1 to 60 printable characters"):
+        ledger.declare_potential(body, lambda x, y, m: 0.0 * x, name=name)
+
+
+def test_a_constraint_class_name_with_a_newline_is_escaped_in_the_table():
+    space = pymunk.Space()
+    space.gravity = (0.0, -1.0)
+    a = _ball(space)
+    Odd = type("Odd\ncomplete: True", (pymunk.PinJoint,), {})
+    space.add(Odd(space.static_body, a, (0.0, 2.0)))
+    ledger = spaces.Ledger(space)
+    for _ in range(100):
+        space.step(0.01)
+    text = ledger.balance().table()
+    lines = text.splitlines()
+    assert [line for line in lines if line.strip().startswith("complete:")] == [lines[-1]]
+    assert "Odd\\ncomplete: True 0" in text
+
+
+def test_ledger_heat_counter_and_recorder_leave_a_program_that_iterates_bodies_alone(
+        tmp_path):
+    # A program that iterates space.bodies and space.constraints each frame (drawing,
+    # applying forces) runs the same, bit for bit, with the three attached.
+    def build() -> pymunk.Space:
+        space = pymunk.Space()
+        space.gravity = (0.0, -9.81)
+        _floor(space, e=0.5)
+        for i in range(6):
+            _ball(space, pos=(0.25 * i, 0.5 + 0.3 * i), e=0.5)
+        bodies = list(space.bodies)
+        space.add(pymunk.PinJoint(bodies[0], bodies[1]),
+                  pymunk.DampedSpring(bodies[2], bodies[3], (0, 0), (0, 0), 0.3, 20, 0.2))
+        return space
+
+    def frame(space: pymunk.Space) -> tuple:
+        seen = []
+        for body in space.bodies:
+            body.apply_force_at_local_point((0.1, 0.0))
+            seen.append((tuple(body.position), tuple(body.velocity), body.angle))
+        return tuple(seen), len(space.constraints), len(space.shapes)
+
+    plain, watched = build(), build()
+    ledger = spaces.Ledger(watched)
+    heat = spaces.HeatCounter(watched)
+    with spaces.Recorder(watched, tmp_path / "r.gif", fps=10, heat=heat) as rec:
+        for i in range(120):
+            assert frame(plain) == frame(watched)
+            plain.step(1 / 120)
+            watched.step(1 / 120)
+            if i % 12 == 0:
+                rec.capture()
+    assert frame(plain) == frame(watched)
+    bal = ledger.balance()
+    assert bal.complete is True and heat.total > 0
+    # E(t) is spaces.energy's, but for the last roundings of a different order of sums.
+    assert abs(bal.E - spaces.energy(watched).E) <= 1e-15 * max(abs(bal.E), bal.scale)
