@@ -948,6 +948,7 @@ PLANNED = [
     ("run", ["--out", "OUT"], ["{name}.csv", "{name}-impacts.csv", "{name}.gif",
                                "{name}-positions.png"]),
     ("render", [], ["renders/{name}.gif"]),
+    ("play", [], ["renders/{name}.html"]),
     ("compare", ["--out", "OUT"], ["{name}-compare.csv", "{name}-compare-errors.csv",
                                    "{name}-compare-energy.png"]),
     ("bench", ["--out", "OUT", "--dts", "1e-3"], ["bench-{name}.json",
@@ -980,7 +981,7 @@ def test_a_folder_in_the_way_of_any_output_is_refused_before_the_run(tmp_path, m
     from dumbbell import load_scene
 
     blocked = name.format(name=load_scene(scene).name)
-    root = tmp_path if command == "render" else out
+    root = tmp_path if command in ("render", "play") else out
     (root / blocked).mkdir(parents=True)
     keep = set(files_in(tmp_path))
     monkeypatch.chdir(tmp_path)
@@ -1030,6 +1031,7 @@ def test_a_dangling_link_as_the_output_file_writes_its_target(work):
     ["simulate", "SCENE", "-o", "-", "--events", "sub/e.csv"],
     ["run", "SCENE"],
     ["render", "SCENE"],
+    ["play", "SCENE"],
     ["sweep", "SCENE", "--grid", "k=100,200"],
 ])
 def test_a_deleted_working_folder_is_refused_naming_the_output(work, argv):
