@@ -1185,6 +1185,7 @@ def test_every_output_a_command_writes_was_checked_before_the_work(tmp_path, mon
     short_scene(cases)
     monkeypatch.chdir(tmp_path)
     for argv in (["run", scene, "--out", "o1"], ["render", scene, "--t-end", "0.02"],
+                 ["play", scene, "--t-end", "0.02", "-o", "o7/x.html"],
                  ["compare", scene, "--out", "o2"], ["sweep", scene, "--grid", "k=100,200",
                                                      "--out", "o3", "--workers", "1"],
                  ["bench", scene, "--dts", "1e-3", "--t-end", "0.05", "--window", "0.05",
