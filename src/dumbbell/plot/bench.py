@@ -22,7 +22,7 @@ from .style import (
     legend,
     legend_below,
     legend_inside,
-    plain,
+    plain,  # the user's text, drawn as text
     solver_style,
     wrap_texts,
 )
