@@ -679,7 +679,7 @@ def test_a_title_with_dollars_is_text_in_run_and_compare(tmp_path, title):
     assert len(files_in(tmp_path / "r")) == 4 and len(files_in(tmp_path / "c")) == 6
 
 
-@pytest.mark.parametrize("title", MATH_TITLES[:2])
+@pytest.mark.parametrize("title", MATH_TITLES[:1])  # every text checked for a bare '$'
 def test_a_title_with_dollars_is_text_in_every_figure_of_the_api(tmp_path, title):
     """`plot.positions(t).figure.savefig()` raised too: every figure that shows a user's
     text (a title, a scene's file name, a solver name given to the figure) draws it as
