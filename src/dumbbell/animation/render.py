@@ -257,11 +257,9 @@ class Gif(bytes):
         UsageError
             A path that cannot be written (one line saying why).
         """
-        from ..io.files import check_writable
-        from ..model import args
+        from ..io.files import writable_path
 
-        path = args.path(path, "path")
-        check_writable(path, "path")
+        path = writable_path(path)
         with atomic_output(path) as tmp:
             Path(tmp).write_bytes(self)
         return path
@@ -341,11 +339,10 @@ def render_gif(
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
                          param="traj")
-    path = None if path is None else args.path(path, "path")
     if path is not None:
-        from ..io.files import check_writable
+        from ..io.files import writable_path
 
-        check_writable(path, "path")  # before the work: a folder, a file as a folder, ...
+        path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
     quiet = args.flag(quiet, "quiet")
     fps = check_fps(fps)
     width, height = check_size(size)

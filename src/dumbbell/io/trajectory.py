@@ -14,7 +14,7 @@ from typing import IO, Any
 
 from ..model import args
 from ..model.trajectory import Trajectory
-from .files import atomic_output
+from .files import atomic_output, writable_path
 from .tables import csv_text, write_text
 
 __all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
@@ -106,7 +106,7 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
     't,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E'
     """
     traj = _checked(traj)
-    path = args.path(path, "path")
+    path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
     # One open of our own: given a name, numpy opens the file twice, and the first,
     # empty open would end a FIFO's reader.
     with atomic_output(path) as tmp, open(tmp, "w") as fh:
@@ -182,4 +182,5 @@ def write_events(traj: Trajectory, path: str | Path) -> Path:
     3
     """
     traj = _checked(traj)
-    return write_text(args.path(path, "path"), events_csv(traj))
+    path = writable_path(path)
+    return write_text(path, events_csv(traj))

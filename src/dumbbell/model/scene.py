@@ -25,7 +25,7 @@ import stat
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
 from ..errors import SceneError, UsageError
 from .sizes import SIZE_RULE, pixel_size
@@ -357,7 +357,7 @@ class Scene:
             for part in parts[:-1]:
                 nxt = table.setdefault(part, {})
                 if not isinstance(nxt, dict):
-                    raise SceneError(f"{self.source}: {_printable(dotted)}: "
+                    raise SceneError(f"{_printable(self.source)}: {_printable(dotted)}: "
                                      f"'{_printable(part)}' is not a table")
                 table = nxt
             table[parts[-1]] = value
@@ -382,7 +382,7 @@ class _Checker:
         return f"{self.path}.{name}" if self.path else name
 
     def fail(self, dotted: str, value: Any, allowed: str) -> None:
-        raise SceneError(f"{self.source}: {dotted} = {_show(value)}: {allowed}")
+        raise SceneError(f"{_printable(self.source)}: {dotted} = {_show(value)}: {allowed}")
 
     def has(self, name: str) -> bool:
         return name in self.table
@@ -401,7 +401,8 @@ class _Checker:
         allowed = _range_text(lo, hi, lo_open, unit)
         if name not in self.table:
             if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: {allowed}")
+                raise SceneError(f"{_printable(self.source)}: "
+                                 f"{self.key(name)} is missing: {allowed}")
             return default
         raw = self.table[name]
         value = _finite(raw)
@@ -422,6 +423,12 @@ class _Checker:
         allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
         if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             self.fail(self.key(name), value, allowed)
+        if isinstance(value, _LongInteger) or abs(value) >= _UNREADABLE:
+            # Past what Python converts to and from text: no message could print it.
+            shown = value if isinstance(value, _LongInteger) else \
+                _LongInteger("-" if value < 0 else "", None)
+            self.fail(self.key(name), shown,
+                      allowed if hi is not None else f"{allowed}, of at most 4,300 digits")
         if value < lo or (hi is not None and value > hi):
             self.fail(self.key(name), value, allowed)
         return int(value)
@@ -439,7 +446,8 @@ class _Checker:
         self.used.add(name)
         if name not in self.table:
             if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: must be a string")
+                raise SceneError(f"{_printable(self.source)}: "
+                                 f"{self.key(name)} is missing: must be a string")
             return default
         value = self.table[name]
         if choices is not None:
@@ -459,16 +467,25 @@ class _Checker:
         unknown = sorted(set(self.table) - self.used, key=str)
         if unknown:
             allowed = ", ".join(sorted(self.used)) or "nothing"
-            where = f"in [{self.path}]" if self.path else "at the top level"
+            where = f"in [{_printable(self.path)}]" if self.path else "at the top level"
             raise SceneError(
-                f"{self.source}: unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
+                f"{_printable(self.source)}: "
+                f"unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
                 f"allowed: {allowed}"
             )
 
 
+#: Most characters of a key, a table's name or a file's name an error message echoes.
+MAX_ECHO = 120
+
+
 def _printable(text: str) -> str:
-    """``text`` with control characters escaped, so that an error stays on one line."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    """``text`` (a key, a table's name, the scene's source) for an error message: control
+    characters escaped, so that it stays on one line, and at most :data:`MAX_ECHO`
+    characters, its start and end kept (a key of 80,000 characters, spaces or not, is a
+    short line)."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+    return text if len(text) <= MAX_ECHO else f"{text[:MAX_ECHO - 43]}...{text[-40:]}"
 
 
 def _finite(value: Any) -> float | None:
@@ -614,7 +631,7 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
     try:
         return _scene_from_dict(data, source)
     except RecursionError:
-        raise SceneError(f"{source}: nested too deeply to be a scene") from None
+        raise SceneError(f"{_printable(source)}: nested too deeply to be a scene") from None
 
 
 def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
@@ -652,11 +669,13 @@ def _bodies_tables(top: _Checker, source: str) -> tuple[_Checker, _Checker]:
     """The checkers of [bodies.A] and [bodies.B], both required."""
     bodies = top.sub("bodies")
     if bodies is None:
-        raise SceneError(f"{source}: [bodies] is missing: needs [bodies.A] and [bodies.B]")
+        raise SceneError(f"{_printable(source)}: "
+                         "[bodies] is missing: needs [bodies.A] and [bodies.B]")
     cA, cB = bodies.sub("A"), bodies.sub("B")
     if cA is None or cB is None:
         missing = "bodies.A" if cA is None else "bodies.B"
-        raise SceneError(f"{source}: [{missing}] is missing: a dumbbell has particles A and B")
+        raise SceneError(f"{_printable(source)}: "
+                         f"[{missing}] is missing: a dumbbell has particles A and B")
     bodies.done()
     return cA, cB
 
@@ -694,7 +713,8 @@ def _particles(cA: _Checker, cB: _Checker, dims: int, tilt: float | None,
     A = _particle(cA, "A", dims, placed=tilt is not None)
     M = A.mass + B.mass
     if not (math.isfinite(M) and A.mass * B.mass / M > 0):
-        raise SceneError(f"{cB.source}: bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
+        raise SceneError(f"{_printable(cB.source)}: "
+                         f"bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
                          f"{_show(B.mass)}: their total and reduced mass must be finite and "
                          "> 0 (kg)")
     if tilt is not None:
@@ -727,12 +747,14 @@ def _check_placement(A: Particle, B: Particle, dims: int, floor: Floor | None,
         for p in (A, B):
             if p.height < 0:
                 raise SceneError(
-                    f"{source}: bodies.{p.name}.height = {_show(p.height)}: must be >= 0 "
+                    f"{_printable(source)}: "
+                    f"bodies.{p.name}.height = {_show(p.height)}: must be >= 0 "
                     "(the particle would start below the floor)"
                 )
     if dims == 1 and A.height < B.height:
         raise SceneError(
-            f"{source}: bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
+            f"{_printable(source)}: "
+            f"bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
             f"{_show(B.height)} (A is the top particle in 1D)"
         )
 
@@ -743,7 +765,8 @@ def _check_rod(A: Particle, B: Particle, rigid: Rigid | None, source: str) -> No
         dist = math.hypot(A.x - B.x, A.height - B.height)
         if abs(dist - rigid.length) > 1e-9 * max(1.0, rigid.length):
             raise SceneError(
-                f"{source}: rigid.length = {_show(rigid.length)}: must equal the distance "
+                f"{_printable(source)}: "
+                f"rigid.length = {_show(rigid.length)}: must equal the distance "
                 f"from B to A ({dist:.6g} m)"
             )
 
@@ -762,7 +785,7 @@ def _run(top: _Checker, source: str) -> RunSettings:
     """[run]: t_end and dt (s), solver, every, unstable_energy, inaccurate_energy."""
     crun = top.sub("run")
     if crun is None:
-        raise SceneError(f"{source}: [run] is missing: needs t_end and dt (s)")
+        raise SceneError(f"{_printable(source)}: [run] is missing: needs t_end and dt (s)")
     t_end = crun.number("t_end", lo=0.0, lo_open=True, unit="s")
     dt = crun.number("dt", lo=0.0, lo_open=True, unit="s")
     if dt > t_end:
@@ -794,6 +817,11 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
         value = co.table["figures"]
         if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
             co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+        twice = next((v for i, v in enumerate(value) if v in value[:i]), None) \
+            if len(set(value)) < len(value) else None
+        if twice is not None:
+            co.fail("outputs.figures", value, f"names '{twice}' more than once: each figure "
+                    "is one file, list it once")
         if "rotation" in value and dims != 2:
             co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
         if "contact" in value and (dims != 2 or not has_floor):
@@ -876,16 +904,21 @@ def load_scene(path: str | Path) -> Scene:
     if not isinstance(path, str | os.PathLike) or str(path) == "":
         raise SceneError(f"path = {_show(path)}: must be the path of a scene file (str or "
                          "pathlib.Path)")
-    path = Path(path)
-    source = str(path)
+    return load_scene_file(Path(path), str(path))
+
+
+def load_scene_file(path: Path, source: str) -> Scene:
+    """:func:`load_scene` of the file ``path``, named ``source`` in messages and outputs
+    (the showcase names a packaged scene ``scenes/NAME.toml``, not by its place in the
+    installation). Reads at most :data:`MAX_SCENE_BYTES` + 1 bytes of it, whatever it is."""
     try:
-        data = _read_scene_file(path)
+        data = _read_scene_file(path, source)
     except FileNotFoundError:
-        raise SceneError(f"{source}: no such scene file") from None
+        raise SceneError(f"{_printable(source)}: no such scene file") from None
     except IsADirectoryError:
-        raise SceneError(f"{source}: is a directory, not a scene file") from None
+        raise SceneError(f"{_printable(source)}: is a directory, not a scene file") from None
     except OSError as exc:
-        raise SceneError(f"{source}: cannot read: {exc.strerror or exc}") from None
+        raise SceneError(f"{_printable(source)}: cannot read: {exc.strerror or exc}") from None
     return load_scene_bytes(data, source)
 
 
@@ -896,46 +929,109 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     if not isinstance(source, str):
         raise SceneError(f"source = {_show(source)}: must be a str naming the scene")
     if not isinstance(data, bytes | bytearray):
-        raise SceneError(f"{source}: data = {_show(data)}: must be the bytes of a TOML "
+        raise SceneError(f"{_printable(source)}: data = {_show(data)}: must be the bytes of a TOML "
                          "document")
     if len(data) > MAX_SCENE_BYTES:
-        raise SceneError(f"{source}: more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
+        raise SceneError(f"{_printable(source)}: "
+                         f"more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
                          "most 1 MB")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
-        raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
+        raise SceneError(f"{_printable(source)}: not UTF-8 text; a scene is a TOML file") from None
     try:
-        data = tomllib.loads(text)
-    except ValueError as exc:  # TOMLDecodeError, or an integer too long to convert
+        data = _toml(text)
+    except ValueError as exc:  # TOMLDecodeError
         message = " ".join(str(exc).split())[:200]
-        raise SceneError(f"{source}: not valid TOML: {message}") from None
+        raise SceneError(f"{_printable(source)}: not valid TOML: {message}") from None
     except RecursionError:
-        raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
+        raise SceneError(f"{_printable(source)}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
 
 
-def _read_scene_file(path: Path) -> bytes:
-    """The bytes of ``path`` if it is a regular file of at most MAX_SCENE_BYTES; SceneError
-    for a device, a FIFO, a socket or a larger file. Opened without blocking, so that a FIFO
-    with no writer is refused rather than waited on."""
+#: A decimal integer of more digits than Python converts from text (sys.int_info's default
+#: limit, 4,300 digits), in a TOML document: a number's sign and digits, '_' between them.
+_LONG_INTEGER = r"(?<![\w.+-])([+-]?)([0-9](?:_?[0-9]){4300,})(?![\w.])"
+
+
+#: The least integer of more digits than Python converts to or from text by default.
+_UNREADABLE = 10**4300
+
+
+class _LongInteger(int):
+    """A TOML integer of more digits than Python reads (its value stands in: 10**4300 with
+    its sign, beyond every bound a scene has), shown in messages by its number of digits."""
+
+    digits: int | None
+
+    def __new__(cls, sign: str, digits: int | None) -> Self:
+        value = super().__new__(cls, -_UNREADABLE if sign == "-" else _UNREADABLE)
+        value.digits = digits
+        return value
+
+    def __str__(self) -> str:
+        size = "more than 4,300" if self.digits is None else f"{self.digits:,}"
+        return f"a {'negative ' if self < 0 else ''}whole number of {size} digits"
+
+    __repr__ = __str__
+
+
+def _toml(text: str) -> dict[str, Any]:
+    """``tomllib.loads(text)``, except that a decimal integer too long for Python to read
+    ('Exceeds the limit (4300 digits) for integer string conversion', naming no key) is
+    read as a :class:`_LongInteger` at its key, which the scene's checks then name."""
+    import re
+
+    try:
+        return tomllib.loads(text)
+    except ValueError as exc:
+        if isinstance(exc, tomllib.TOMLDecodeError) or "integer string" not in str(exc):
+            raise
+    longs: dict[int, _LongInteger] = {}
+
+    def stand_in(match: re.Match[str]) -> str:
+        # A hexadecimal integer (no limit on those) marks the place.
+        marker = 0x5CE7E << 64 | len(longs)
+        longs[marker] = _LongInteger(match[1], len(match[2].replace("_", "")))
+        return hex(marker)
+
+    data = tomllib.loads(re.sub(_LONG_INTEGER, stand_in, text))
+
+    def swap(node: Any) -> Any:
+        if isinstance(node, dict):
+            return {k: swap(v) for k, v in node.items()}
+        if isinstance(node, list):
+            return [swap(v) for v in node]
+        return longs.get(node, node) if type(node) is int else node
+
+    return swap(data)
+
+
+def _read_scene_file(path: Path, source: str) -> bytes:
+    """The bytes of ``path`` (named ``source``) if it is a regular file of at most
+    MAX_SCENE_BYTES; SceneError for a device, a FIFO, a socket or a larger file, before
+    reading (a 3 GB sparse file is refused from its size). Opened without blocking, so that
+    a FIFO with no writer is refused rather than waited on."""
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     try:
         info = os.fstat(fd)
         if stat.S_ISDIR(info.st_mode):
             raise IsADirectoryError
         if not stat.S_ISREG(info.st_mode):
-            raise SceneError(f"{path}: is {_file_kind(info.st_mode)}, not a regular file; a "
+            raise SceneError(f"{_printable(source)}: "
+                             f"is {_file_kind(info.st_mode)}, not a regular file; a "
                              "scene is a TOML file")
         if info.st_size > MAX_SCENE_BYTES:
-            raise SceneError(f"{path}: is {info.st_size:,} bytes; a scene file may be at most "
+            raise SceneError(f"{_printable(source)}: "
+                             f"is {info.st_size:,} bytes; a scene file may be at most "
                              f"{MAX_SCENE_BYTES:,} bytes (1 MB)")
         with os.fdopen(fd, "rb", closefd=False) as fh:
             data = fh.read(MAX_SCENE_BYTES + 1)
     finally:
         os.close(fd)
     if len(data) > MAX_SCENE_BYTES:  # it grew while we read it
-        raise SceneError(f"{path}: more than {MAX_SCENE_BYTES:,} bytes; a scene file may be at "
+        raise SceneError(f"{_printable(source)}: "
+                         f"more than {MAX_SCENE_BYTES:,} bytes; a scene file may be at "
                          "most 1 MB")
     return data
 
