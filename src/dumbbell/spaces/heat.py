@@ -239,19 +239,23 @@ class HeatCounter:
         carried = 0.0 if arbiter.is_first_contact else (
             space.current_time_step / self._last_dt if self._last_dt else 1.0)
         key = int(ffi.cast("uintptr_t", raw))
-        self._before[key] = [
+        before = [
             (ux, uy, raw.contacts[i].jnAcc * (1.0 - carried),
              raw.contacts[i].jtAcc * (1.0 - carried))
             for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb))
         ]
+        # The bodies first: a stop signal raised between these two lines (its handler runs
+        # inside this callback) leaves a pair whose post_solve counts nothing, never a
+        # contact whose bodies the first post_solve's snapshot of velocities lacks.
         self._ends[key] = (ba, bb)
+        self._before[key] = before
         # A contact whose post_solve never comes (the user rejected it) must not linger.
         space.add_post_step_callback(self._end_step, self)
 
     def _end_step(self, space: Any, key: Any) -> None:
+        self._after = None
         self._before.clear()
         self._ends.clear()
-        self._after = None
         # Arbiters that carry impulses into the next step had contacts in this one, so this
         # is the 'previous dt' pymunk scales them by.
         self._last_dt = space.current_time_step
@@ -266,6 +270,12 @@ class HeatCounter:
             # counters run first in every handler), so these are the solver's velocities.
             self._after = {id(b): (*b.velocity, b.angular_velocity)
                            for pair in self._ends.values() for b in pair}
+        for b in (ba, bb):
+            # A body the snapshot lacks had its pre_solve cut short by an exception raised
+            # inside it (a stop signal's handler runs inside whatever callback is running):
+            # its velocities now are the solver's unless a later callback changed them.
+            if id(b) not in self._after:
+                self._after[id(b)] = (*b.velocity, b.angular_velocity)
         if before is not None and len(before) == raw.count:
             nx, ny = raw.n.x, raw.n.y
             work = 0.0
