@@ -69,7 +69,7 @@ def _options_class() -> type:
     import pymunk
     from pymunk.space_debug_draw_options import SpaceDebugColor
 
-    from ..animation.recording import BODY_INKS
+    from ..animation.pens import BODY_INKS
 
     STATIC, DYNAMIC, BLACK = pymunk.Body.STATIC, pymunk.Body.DYNAMIC, SpaceDebugColor(0, 0, 0, 255)
 
@@ -164,7 +164,7 @@ def _options_class() -> type:
 
 class _Geometry:
     """A space's shapes as local geometry on their bodies (a moving and a static
-    :class:`~dumbbell.animation.recording.Shapes`), made again when the shapes change: a
+    :class:`~dumbbell.animation.recorded.Shapes`), made again when the shapes change: a
     capture then reads every body's pose at once (``pymunk.batch``), and the painter places
     each kind of shape with one numpy expression, instead of a Python call per shape from
     ``space.debug_draw``. Always the bodies' present pose, so a body placed by hand before a
@@ -175,7 +175,7 @@ class _Geometry:
     def __init__(self, shapes: list[Any], ink_of: Any, number_of: Any) -> None:
         import pymunk
 
-        from ..animation.recording import Shapes
+        from ..animation.recorded import Shapes
 
         self.shapes = shapes
         self.bodies: list[Any] = []
@@ -341,7 +341,7 @@ def __getattr__(name: str) -> Any:
 def _check_path(path: Any) -> Path:
     """``path`` as a Path the recording can be written to, else a UsageError naming it and
     what is wrong: checked before any capture, so a long run is not lost at the end."""
-    from ..animation.recording import mp4_problem
+    from ..animation.writer import mp4_problem
     from ..io.files import check_writable, is_special
     from ..model import args
 
@@ -382,7 +382,7 @@ def _check_path(path: Any) -> Path:
 def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, float, float]:
     """``world`` = (left, right, bottom, top) as floats that can be drawn (in the length
     ``unit``), else a UsageError."""
-    from ..animation.recording import SPAN_MAX, SPAN_MIN
+    from ..animation.camera import SPAN_MAX, SPAN_MIN
     from ..model import args
 
     allowed = ("must be four finite numbers (left, right, bottom, top) in the space's length "
@@ -665,8 +665,9 @@ class Recorder:
         return e, labels
 
     def recording(self) -> Any:
-        """The frozen :class:`dumbbell.animation.recording.Recording` of what was captured."""
-        from ..animation.recording import Recording, item_box
+        """The frozen :class:`dumbbell.animation.recorded.Recording` of what was captured."""
+        from ..animation.camera import item_box
+        from ..animation.recorded import Recording
 
         kw: dict[str, Any] = {}
         if self.energy:
