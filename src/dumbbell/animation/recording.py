@@ -34,7 +34,7 @@ from .layout import unit
 from .palette import GREY, INK, LIGHT, TERM_RGB, WHITE, blend, ink_index, to_palette
 from .pens import Layer, Pixels, union_px
 from .recorded import BODY_PX, Box, Recording, Shapes
-from .strip import GRID
+from .strip import GRID, fade_table
 
 #: No public names: the painter behind :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
@@ -224,6 +224,13 @@ class Painter(Backdrop):
                                          ("values", self._values_box()))}
         if self.energy:
             self._band_of = self._bands()
+        if self.strip:
+            # Inside the strip's frame: the whole run's curves, and the same faded, which a
+            # frame shows after its cursor (what has not happened yet, as the GIF's strip).
+            sx0, sy0, sx1, sy1 = (round(v) for v in self.strip_box)
+            self._inner = (sx0 + 1, sy0 + 1, sx1, sy1)
+            self._past = self.bg.crop(self._inner)
+            self._future = self._past.point(fade_table())
         return True
 
     def _strip_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
@@ -458,7 +465,8 @@ class Painter(Backdrop):
         return spans
 
     def _cursor(self, img: Image.Image, k: int) -> list[tuple[float, float, float, float]]:
-        """Move the strip's cursor if it moved; the boxes touched."""
+        """Move the strip's cursor if it moved, the curves after it faded; the boxes
+        touched."""
         u = self.u
         _, sy0, _, sy1 = self.strip_box
         x = round(float(self.strip_x(self.t[k])))
@@ -470,6 +478,15 @@ class Painter(Backdrop):
         boxes = [(x - half, sy0, x + half, sy1)]
         if before is not None:
             boxes.append(self._restore((before - half, sy0, before + half, sy1)))
+        # The columns between the two cursors turn from future to past (or back).
+        ix0, iy0, ix1, iy1 = self._inner
+        lo = ix0 if before is None else max(ix0, math.floor(min(before, x) - half) - 1)
+        hi = ix1 if before is None else min(ix1, math.ceil(max(before, x) + half) + 2)
+        for a, b, src in ((lo, min(hi, x + 1), self._past), (max(lo, x + 1), hi, self._future)):
+            if b > a:
+                img.paste(src.crop((a - ix0, 0, b - ix0, iy1 - iy0)), (a, iy0))
+        if hi > lo:
+            boxes.append((lo, iy0, hi, iy1))
         ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=self.idx["ink"],
                                  width=max(1, round(1.2 * u)))
         return boxes

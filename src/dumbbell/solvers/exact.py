@@ -225,12 +225,12 @@ class Exact(Solver):
     relative_cost = 0.01
     is_truth = True
     estimates_error = False
-    supports = staticmethod(supports)
-    solve = staticmethod(solve)
-    check_work = staticmethod(check_work)
+    _supports = staticmethod(supports)
+    _solve = staticmethod(solve)
+    _check_work = staticmethod(check_work)
     warm_up = staticmethod(warm_up)
 
     @staticmethod
-    def truth_for(scene: Scene) -> bool:
+    def _truth_for(scene: Scene) -> bool:
         """The truth for 1D scenes and the rigid 2D dumbbell."""
         return scene.system.dimensions == 1 or scene.system.rigid is not None

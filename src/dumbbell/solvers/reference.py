@@ -380,11 +380,11 @@ class Reference(Solver):
     relative_cost = 100.0
     is_truth = True
     estimates_error = True
-    supports = staticmethod(supports)
-    solve = staticmethod(solve)
+    _supports = staticmethod(supports)
+    _solve = staticmethod(solve)
     warm_up = staticmethod(warm_up)
 
     @staticmethod
-    def truth_for(scene: Scene) -> bool:
+    def _truth_for(scene: Scene) -> bool:
         """The truth for the 2D spring dumbbell."""
         return scene.system.dimensions == 2 and scene.system.rigid is None

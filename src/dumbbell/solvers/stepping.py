@@ -65,7 +65,7 @@ class Stepper(Solver):
         raise NotImplementedError
 
     @classmethod
-    def supports(cls, scene: Scene) -> str | None:
+    def _supports(cls, scene: Scene) -> str | None:
         """None if this solver has a step for the scene's dimensions (in 2D: two point
         particles, a spring and a frictionless floor), else why not."""
         if cls.kernel(scene.system.dimensions) is None:
@@ -73,7 +73,7 @@ class Stepper(Solver):
         return point_particle_limits(scene, cls.name) if scene.system.dimensions == 2 else None
 
     @classmethod
-    def solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
+    def _solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
         """Run ``scene`` at step ``options.dt`` (s). ``wall_time`` covers the kernel calls
         and the impact list, not the compiling, the array set-up, the verdict or the energy."""
         with compiling(f"the {cls.name} solver's kernels", options.quiet):
