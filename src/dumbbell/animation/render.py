@@ -35,7 +35,7 @@ from ..errors import UsageError
 from ..io.files import atomic_output
 from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
-from .timing import check_fps, check_size, delays_cs
+from .timing import _delays, check_fps, check_size, delays_cs  # noqa: F401 - delays_cs re-exported
 
 if TYPE_CHECKING:
     from .frames import Frames
@@ -57,8 +57,11 @@ def frame_count(t_end: float, fps: int) -> int:
     """Frames of an animation of ``t_end`` s at ``fps``: times 0, 1/fps, ... below t_end."""
     from ..model import args
 
-    t_end = args.real(t_end, "t_end", "s")
-    fps = check_fps(fps)
+    return _frame_count(args.real(t_end, "t_end", "s"), check_fps(fps))
+
+
+def _frame_count(t_end: float, fps: int) -> int:
+    """:func:`frame_count` of values checked already."""
     if not t_end * fps <= 1e15:
         raise UsageError(f"t_end = {t_end:g} s at {fps} fps: more than 1e15 frames", param="t_end")
     return max(1, math.ceil(t_end * fps - 1e-9))
@@ -70,11 +73,14 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
     from ..model import args
 
     where = args.text(where, "where", "the argument's name for the message (str)")
-    t_end = args.real(t_end, "t_end", "s")
-    fps = check_fps(fps)
-    max_frames = args.whole(max_frames, "max_frames", "frames")
+    return _check_frames(args.real(t_end, "t_end", "s"), check_fps(fps),
+                         args.whole(max_frames, "max_frames", "frames"), where)
+
+
+def _check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") -> int:
+    """:func:`check_frames` of values checked already (a scene's GIF settings, say)."""
     if t_end * fps <= max_frames + 1:
-        n = frame_count(t_end, fps)
+        n = _frame_count(t_end, fps)
         if n <= max_frames:
             return n
         count = counted(n, "frame", grouped=True)
@@ -106,10 +112,12 @@ def sample_every(dt: float, fps: int, t_end: float, every: int | None = None) ->
     bytes."""
     from ..model import args
 
-    dt = args.real(dt, "dt", "s")
-    fps = check_fps(fps)
-    t_end = args.real(t_end, "t_end", "s")
-    every = None if every is None else args.whole(every, "every", "steps")
+    return _sample_every(args.real(dt, "dt", "s"), check_fps(fps), args.real(t_end, "t_end", "s"),
+                         None if every is None else args.whole(every, "every", "steps"))
+
+
+def _sample_every(dt: float, fps: int, t_end: float, every: int | None = None) -> int:
+    """:func:`sample_every` of values checked already."""
     steps = max(1.0, t_end / dt)  # inf only past the step cap, which a run checks first
     # At most the run's steps, so that a subnormal dt cannot make it overflow.
     target = min(steps, max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES))
@@ -137,9 +145,11 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
     from ..model import args
 
-    traj = args.trajectory(traj)
-    fps = check_fps(fps)
-    t_end = args.real(t_end, "t_end", "s")
+    return _frames_of(args.trajectory(traj), check_fps(fps), args.real(t_end, "t_end", "s"))
+
+
+def _frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
+    """:func:`frames_of` of values checked already."""
     from .frames import Frames
 
     t = traj.t
@@ -147,7 +157,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
         raise UsageError(f"{traj.scene.source}: the trajectory has no samples to render")
     half = float(t[1] - t[0]) / 2 if len(t) > 1 else 0.0
     end = min(t_end, float(t[-1]) + half + 1e-12)
-    ft = np.arange(frame_count(end, fps)) / fps
+    ft = np.arange(_frame_count(end, fps)) / fps
     ft = ft[ft <= float(t[-1]) + half + 1e-12]
     i = np.clip(np.searchsorted(t, ft), 1, max(1, len(t) - 1))
     idx = np.where(np.abs(t[i - 1] - ft) <= np.abs(t[np.minimum(i, len(t) - 1)] - ft), i - 1,
@@ -253,11 +263,7 @@ def render_gif(
     series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
     end); more than ``max_frames`` frames are refused. ``timing``, when given, receives the
     seconds spent drawing and encoding."""
-    from .. import progress
     from ..model import args
-    from .drawing import Painter
-    from .gif import write_frames
-    from .picture import describe
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
@@ -276,11 +282,25 @@ def render_gif(
     max_frames = args.whole(max_frames, "max_frames", "frames")
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
     t_end = args.real(t_end, "t_end", "s")
-    check_frames(t_end, fps, max_frames)
+    _check_frames(t_end, fps, max_frames)
+    return _render_gif(traj, path, quiet, fps, (width, height), strip, t_end, timing)
+
+
+def _render_gif(traj: Trajectory, path: Path | None, quiet: bool, fps: int,
+                size: tuple[int, int], strip: bool, t_end: float,
+                timing: dict[str, float] | None) -> Path | Gif:
+    """:func:`render_gif` of values checked already (its frame count too): the scene's GIF
+    settings on the way from ``dumbbell run``, checked when the scene was read."""
+    from .. import progress
+    from .drawing import Painter
+    from .gif import write_frames
+    from .picture import describe
+
+    width, height = size
     t0 = time.perf_counter()
-    frames = frames_of(traj, fps, t_end)
+    frames = _frames_of(traj, fps, t_end)
     painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
-    delays = delays_cs(len(frames.t), fps)
+    delays = _delays(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"
     with contextlib.ExitStack() as stack:

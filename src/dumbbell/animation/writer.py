@@ -18,7 +18,7 @@ from ..io.files import atomic_output
 from ..parallel import STOP_SIGNALS
 from .gif import write_frames
 from .palette import palette
-from .timing import delays_cs
+from .timing import _delays
 
 #: No public names: the writer behind :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
@@ -71,7 +71,7 @@ def save(path: Path, painter: Any, fps: int) -> dict[str, float]:
         else:
             with atomic_output(path) as tmp, open(tmp, "wb") as fh:
                 stats["draw"], stats["encode"] = write_frames(
-                    fh, (painter.W, painter.H), painter.frame, delays_cs(painter.n, fps),
+                    fh, (painter.W, painter.H), painter.frame, _delays(painter.n, fps),
                     region=painter.region)
     return stats
 

@@ -107,14 +107,15 @@ def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, qui
     is used when it has those samples and lasts long enough; else the scene is run again.
     So ``dumbbell render`` and ``dumbbell run`` draw one scene from the same samples and
     write the same bytes."""
-    from ..animation.render import sample_every
-    from ..solvers import make_options, simulate
+    from ..animation.render import _sample_every
+    from ..solvers import run_scene
+    from ..solvers.base import scene_options
 
-    options = make_options(scene, t_end=t_end)
-    every = sample_every(options.dt, fps, options.t_end, scene.run.every)
+    options = scene_options(scene, t_end=t_end)
+    every = _sample_every(options.dt, fps, options.t_end, scene.run.every)
     if (traj is not None and traj.every == every and traj.dt == options.dt
             and (solver is None or traj.solver == solver)
             and (not traj.verdict.complete  # ended early: a new run would end there too
                  or traj.t[-1] >= options.t_end - options.dt * every / 2)):
         return traj
-    return simulate(scene, solver, t_end=options.t_end, every=every, quiet=quiet)
+    return run_scene(scene, solver, t_end=options.t_end, every=every, quiet=quiet)

@@ -409,7 +409,14 @@ def make_options(
     the samples kept against it, both as exact integers before anything is allocated."""
     from ..model import args
 
-    scene = args.scene(scene)
+    return scene_options(args.scene(scene), dt, t_end, every, max_samples)
+
+
+def scene_options(scene: Scene, dt: float | None = None, t_end: float | None = None,
+                  every: int | None = None, max_samples: int | None = None) -> RunOptions:
+    """:func:`make_options` of a Scene (checked already, when it was read)."""
+    from ..model import args
+
     if dt is not None:
         dt = args.real(dt, "dt", "s")
     if t_end is not None:
