@@ -19,15 +19,20 @@ allowed.
 from __future__ import annotations
 
 import math
-import numbers
 import os
-import stat
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import SceneError, UsageError
+from .checker import MIN_MASS, _check_magnitude, _Checker, _finite, _printable, _show
+from .scene_file import (
+    MAX_SCENE_BYTES,
+    _read_scene_file,
+    packaged_scene,  # noqa: F401 - re-exported, as it always was
+    scenes_dir,
+)
 from .sizes import SIZE_RULE, pixel_size
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
@@ -37,13 +42,6 @@ FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topp
 #: What a GIF size must be.
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
-#: Largest magnitude of any number in a scene (m, kg, m/s, N/m, ...), and the smallest mass
-#: (kg): the energy formulas multiply up to four of them (1/2 I w^2 = 1/4 m r^2 w^2), which then
-#: stay below 1e300, and positions stay far below the solvers' blow-up threshold (1e150).
-MAX_MAGNITUDE = 1e75
-MIN_MASS = 1e-75
-#: Largest scene file read (bytes).
-MAX_SCENE_BYTES = 1_000_000
 #: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
 DEFAULT_UNSTABLE_ENERGY = 10.0
 #: Default ``run.inaccurate_energy``: past a relative energy error of 0.1 a run that stays
@@ -293,149 +291,6 @@ class Scene:
 
 
 # --- validation -----------------------------------------------------------------------------
-
-
-class _Checker:
-    """Reads one TOML table, remembering which keys were used, and raises SceneError."""
-
-    def __init__(self, source: str, table: Any, path: str):
-        self.source = source
-        self.path = path
-        if not isinstance(table, dict):
-            self.fail(path, table, "must be a table")
-        self.table = table
-        self.used: set[str] = set()
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def fail(self, dotted: str, value: Any, allowed: str) -> None:
-        raise SceneError(f"{self.source}: {dotted} = {_show(value)}: {allowed}")
-
-    def has(self, name: str) -> bool:
-        return name in self.table
-
-    def number(
-        self,
-        name: str,
-        default: float | None = None,
-        *,
-        lo: float | None = None,
-        hi: float | None = None,
-        lo_open: bool = False,
-        unit: str = "",
-    ) -> float:
-        self.used.add(name)
-        allowed = _range_text(lo, hi, lo_open, unit)
-        if name not in self.table:
-            if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: {allowed}")
-            return default
-        raw = self.table[name]
-        value = _finite(raw)
-        if value is None:
-            self.fail(self.key(name), raw, allowed)
-        if lo is not None and (value < lo or (lo_open and value == lo)):
-            self.fail(self.key(name), value, allowed)
-        if hi is not None and value > hi:
-            self.fail(self.key(name), value, allowed)
-        _check_magnitude(self, self.key(name), value, unit)
-        return value
-
-    def integer(self, name: str, default: int, *, lo: int, hi: int | None = None) -> int:
-        self.used.add(name)
-        if name not in self.table:
-            return default
-        value = self.table[name]
-        allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-            self.fail(self.key(name), value, allowed)
-        if value < lo or (hi is not None and value > hi):
-            self.fail(self.key(name), value, allowed)
-        return int(value)
-
-    def boolean(self, name: str, default: bool | None) -> bool | None:
-        self.used.add(name)
-        if name not in self.table:
-            return default
-        value = self.table[name]
-        if not isinstance(value, bool):
-            self.fail(self.key(name), value, "must be true or false")
-        return value
-
-    def string(self, name: str, default: str | None, choices: tuple[str, ...] | None = None) -> str:
-        self.used.add(name)
-        if name not in self.table:
-            if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: must be a string")
-            return default
-        value = self.table[name]
-        if choices is not None:
-            if value not in choices:
-                self.fail(self.key(name), value, "must be one of " + ", ".join(choices))
-        elif not isinstance(value, str):
-            self.fail(self.key(name), value, "must be a string")
-        return value
-
-    def sub(self, name: str) -> _Checker | None:
-        self.used.add(name)
-        if name not in self.table:
-            return None
-        return _Checker(self.source, self.table[name], self.key(name))
-
-    def done(self) -> None:
-        unknown = sorted(set(self.table) - self.used, key=str)
-        if unknown:
-            allowed = ", ".join(sorted(self.used)) or "nothing"
-            where = f"in [{self.path}]" if self.path else "at the top level"
-            raise SceneError(
-                f"{self.source}: unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
-                f"allowed: {allowed}"
-            )
-
-
-def _printable(text: str) -> str:
-    """``text`` with control characters escaped, so that an error stays on one line."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
-def _finite(value: Any) -> float | None:
-    """``value`` as a finite float, or None if it is not a finite number (a bool, a string, an
-    integer too large for a float, nan or inf)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        return None
-    try:
-        number = float(value)
-    except (OverflowError, ValueError, TypeError):
-        return None
-    return number if math.isfinite(number) else None
-
-
-def _check_magnitude(c: _Checker, dotted: str, value: float, unit: str) -> None:
-    if abs(value) > MAX_MAGNITUDE:
-        c.fail(dotted, value, f"must be at most {MAX_MAGNITUDE:g} in magnitude"
-                              + (f" ({unit})" if unit else "")
-                              + ": larger values overflow the energies")
-
-
-def _show(value: Any) -> str:
-    try:
-        text = repr(value) if isinstance(value, str) else str(value)
-    except ValueError:  # an integer with more digits than Python will print
-        text = "a whole number too large to read"
-    if isinstance(value, bool):
-        text = "true" if value else "false"
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _range_text(lo: float | None, hi: float | None, lo_open: bool, unit: str) -> str:
-    parts = []
-    if lo is not None:
-        parts.append(f"{'>' if lo_open else '>='} {lo:g}")
-    if hi is not None:
-        parts.append(f"<= {hi:g}")
-    text = "must be a finite number" + (" " + " and ".join(parts) if parts else "")
-    return text + (f" ({unit})" if unit else "")
 
 
 def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
@@ -775,56 +630,3 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     except RecursionError:
         raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
-
-
-def _read_scene_file(path: Path) -> bytes:
-    """The bytes of ``path`` if it is a regular file of at most MAX_SCENE_BYTES; SceneError
-    for a device, a FIFO, a socket or a larger file. Opened without blocking, so that a FIFO
-    with no writer is refused rather than waited on."""
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    try:
-        info = os.fstat(fd)
-        if stat.S_ISDIR(info.st_mode):
-            raise IsADirectoryError
-        if not stat.S_ISREG(info.st_mode):
-            raise SceneError(f"{path}: is {_file_kind(info.st_mode)}, not a regular file; a "
-                             "scene is a TOML file")
-        if info.st_size > MAX_SCENE_BYTES:
-            raise SceneError(f"{path}: is {info.st_size:,} bytes; a scene file may be at most "
-                             f"{MAX_SCENE_BYTES:,} bytes (1 MB)")
-        with os.fdopen(fd, "rb", closefd=False) as fh:
-            data = fh.read(MAX_SCENE_BYTES + 1)
-    finally:
-        os.close(fd)
-    if len(data) > MAX_SCENE_BYTES:  # it grew while we read it
-        raise SceneError(f"{path}: more than {MAX_SCENE_BYTES:,} bytes; a scene file may be at "
-                         "most 1 MB")
-    return data
-
-
-def _file_kind(mode: int) -> str:
-    """'a character device', 'a FIFO', ... for an ``st_mode``."""
-    for test, kind in ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-                       (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket")):
-        if test(mode):
-            return kind
-    return "not a regular file"
-
-
-def packaged_scene(name: str = "textbook-1d") -> Path:
-    """Path of a scene shipped with the package (wheel) or found in the source checkout."""
-    if not isinstance(name, str) or not name or Path(name).name != name:
-        raise UsageError(f"name = {_show(name)}: must be the name of a shipped scene (a file "
-                         "name without .toml)", param="name")
-    package = Path(__file__).resolve().parent.parent  # src/dumbbell, or dumbbell in a wheel
-    for folder in (package / "scenes", package.parent.parent / "scenes"):
-        candidate = folder / f"{name}.toml"
-        if candidate.is_file():
-            return candidate
-    raise SceneError(f"name = {name!r}: no packaged scene {name}.toml (looked in the package "
-                     "and scenes/)")
-
-
-def scenes_dir() -> Path:
-    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout)."""
-    return packaged_scene("textbook-1d").parent
