@@ -27,6 +27,7 @@ from typing import Any
 
 from ..errors import SceneError, UsageError
 from .checker import MIN_MASS, _check_magnitude, _Checker, _finite, _printable, _show
+from .pymunk_settings import PymunkSettings
 from .scene_file import (
     MAX_SCENE_BYTES,
     _read_scene_file,
@@ -99,22 +100,6 @@ class RunSettings:
     every: int
     unstable_energy: float
     inaccurate_energy: float = DEFAULT_INACCURATE_ENERGY
-
-
-#: The scene tables a solver owns, by table name: where the owner's settings class lives
-#: ("module:class"), loaded when a scene is read. The model names no solver's settings: they
-#: stay on their owner, as pymunk keeps a space's settings on the space. The class reads its
-#: table (``_read(table)``, the table's checker, or None for a scene without it) and writes
-#: it back (``_table()``, the keys the scene gave) for :meth:`Scene.to_dict`.
-OWNED_TABLES: dict[str, str] = {"pymunk": "dumbbell.solvers.pymunk_settings:PymunkSettings"}
-
-
-def _owner(table: str) -> Any:
-    """The settings class that owns the scene table ``table`` (:data:`OWNED_TABLES`)."""
-    import importlib
-
-    module, _, name = OWNED_TABLES[table].partition(":")
-    return getattr(importlib.import_module(module), name)
 
 
 @dataclass(frozen=True)
@@ -226,7 +211,7 @@ class Scene:
     system: System
     run: RunSettings
     outputs: OutputSettings
-    pymunk: Any
+    pymunk: PymunkSettings
     source: str = "<scene>"
 
     @property
@@ -566,10 +551,10 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
 
 
 def _pymunk(top: _Checker) -> tuple[Any, bool]:
-    """[pymunk]: the engine's settings, as their owner reads them (:data:`OWNED_TABLES`), and
+    """[pymunk]: the engine's settings, as :class:`~.pymunk_settings.PymunkSettings` reads them, and
     the table's ``spin`` key, which says whether the particles are spinning discs
     (:attr:`System.discs`)."""
-    owner = _owner("pymunk")
+    owner = PymunkSettings
     cp = top.sub("pymunk")
     if cp is None:
         return owner._read(None), False

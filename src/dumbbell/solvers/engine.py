@@ -80,7 +80,7 @@ _PARTICLE_TYPE = {"A": 2, "B": 3}
 
 def settings(scene: Scene) -> dict[str, Any]:
     """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else the
-    defaults declared on :class:`~dumbbell.solvers.pymunk_settings.PymunkSettings`."""
+    defaults declared on :class:`~dumbbell.model.pymunk_settings.PymunkSettings`."""
     return scene.pymunk.resolved()
 
 
