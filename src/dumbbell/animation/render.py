@@ -283,20 +283,21 @@ def render_gif(
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
     t_end = args.real(t_end, "t_end", "s")
     _check_frames(t_end, fps, max_frames)
-    return _render_gif(traj, path, quiet, fps, (width, height), strip, t_end, timing)
+    gif = GifSettings(t_end, fps, f"{width}x{height}", strip)
+    return _render_gif(traj, path, gif, quiet, timing)
 
 
-def _render_gif(traj: Trajectory, path: Path | None, quiet: bool, fps: int,
-                size: tuple[int, int], strip: bool, t_end: float,
+def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bool,
                 timing: dict[str, float] | None) -> Path | Gif:
     """:func:`render_gif` of values checked already (its frame count too): the scene's GIF
     settings on the way from ``dumbbell run``, checked when the scene was read."""
     from .. import progress
+    from ..model.sizes import pixel_size
     from .drawing import Painter
     from .gif import write_frames
     from .picture import describe
 
-    width, height = size
+    (width, height), fps, strip, t_end = pixel_size(gif.size), gif.fps, gif.strip, gif.t_end
     t0 = time.perf_counter()
     frames = _frames_of(traj, fps, t_end)
     painter = Painter(describe(traj.scene, (frames,), (width, height), strip))

@@ -94,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")
-    trajs = [gif_trajectory(scene, fps, t_end, name, quiet=args.quiet) for name in solvers]
+    trajs = [gif_trajectory(scene, GifSettings(t_end, fps), name, quiet=args.quiet)
+             for name in solvers]
     player(trajs if len(trajs) > 1 else trajs[0], fps=fps, size=size, strip=strip,
            t_end=t_end).save(out)
     if not args.quiet:

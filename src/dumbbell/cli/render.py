@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     check_frames(t_end, fps, args.max_frames,
                  "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
                  else "run.t_end")
-    traj = gif_trajectory(scene, fps, t_end, args.solver, quiet=args.quiet)
+    traj = gif_trajectory(scene, GifSettings(t_end, fps), args.solver, quiet=args.quiet)
     render_gif(traj, out, quiet=args.quiet, fps=fps, size=size, strip=strip, t_end=t_end,
                max_frames=args.max_frames)
     if not args.quiet:
@@ -99,23 +99,26 @@ def run(args: argparse.Namespace) -> int:
     return verdict_status(traj.verdict)
 
 
-def gif_trajectory(scene, fps: int, t_end: float, solver: str | None = None, quiet: bool = True,
-                   traj=None):
-    """The run a GIF of ``scene`` at ``fps`` over ``t_end`` s is drawn from: sampled as
+def gif_trajectory(scene, gif, solver: str | None = None, quiet: bool = True, traj=None):
+    """The run a GIF of ``scene`` with the settings ``gif`` (its ``fps`` over ``t_end`` s)
+    is drawn from: sampled as
     :func:`dumbbell.animation.render.sample_every` says, which keeps the scene's own
     ``run.every`` when it serves the GIF. ``traj``, a run already made (``dumbbell run``'s),
     is used when it has those samples and lasts long enough; else the scene is run again.
     So ``dumbbell render`` and ``dumbbell run`` draw one scene from the same samples and
     write the same bytes."""
+    from dataclasses import replace
+
     from ..animation.render import _sample_every
-    from ..solvers import run_scene
+    from ..solvers import MAX_SAMPLES, run_scene
     from ..solvers.base import scene_options
 
-    options = scene_options(scene, t_end=t_end)
-    every = _sample_every(options.dt, fps, options.t_end, scene.run.every)
+    options = scene_options(scene, t_end=gif.t_end)
+    every = _sample_every(options.dt, gif.fps, options.t_end, scene.run.every)
     if (traj is not None and traj.every == every and traj.dt == options.dt
             and (solver is None or traj.solver == solver)
             and (not traj.verdict.complete  # ended early: a new run would end there too
                  or traj.t[-1] >= options.t_end - options.dt * every / 2)):
         return traj
-    return run_scene(scene, solver, t_end=options.t_end, every=every, quiet=quiet)
+    options = scene_options(scene, t_end=options.t_end, every=every, max_samples=MAX_SAMPLES)
+    return run_scene(scene, solver, replace(options, quiet=quiet))

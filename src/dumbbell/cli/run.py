@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import gc
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -129,6 +130,7 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     way."""
     from ..io.files import atomic_output
     from ..solvers import run_scene
+    from ..solvers.base import scene_options
     from .app import verdict_status
     from .beside import beside
 
@@ -141,7 +143,8 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
         figures = stack.enter_context(beside(
             lambda traj, alive: _draw_figures(files, traj, alive), _figure_imports,
             fork=None if files else False))
-        traj = run_scene(scene, quiet=quiet, max_samples=max_samples)
+        options = scene_options(scene, max_samples=max_samples)
+        traj = run_scene(scene, None, replace(options, quiet=quiet))
         # numba, its kernels and whatever else the run imported stay until the command ends:
         # the garbage collector need not look at them again.
         gc.freeze()
@@ -173,15 +176,13 @@ def _write_rest(scene, traj: Any, names: dict[str, Path], quiet: bool, max_frame
             write_events(traj, names["impacts"])
     if scene.outputs.gif is not None:
         from ..animation.render import _render_gif
-        from ..model.sizes import pixel_size
         from .render import gif_trajectory
 
         gif = scene.outputs.gif
         # The samples `dumbbell render` would draw from: one scene, one GIF's bytes. Its
         # settings were checked when the scene was read, its frames by _check_budgets.
-        drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
-        _render_gif(drawn, names["gif"], quiet, gif.fps, pixel_size(gif.size), gif.strip,
-                    gif.t_end, None)
+        drawn = gif_trajectory(scene, gif, quiet=quiet, traj=traj)
+        _render_gif(drawn, names["gif"], gif, quiet, None)
 
 
 def _figure_imports() -> None:

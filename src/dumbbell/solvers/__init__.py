@@ -161,18 +161,21 @@ def simulate(
     scene's ``[run]``; ``every`` keeps every N-th step; a run that would keep more than
     ``max_samples`` samples is refused before it starts (None: no budget). Returns a
     :class:`Trajectory` whose ``verdict`` says whether the run ended well."""
-    return run_scene(args.scene(scene), solver, dt, t_end, every, quiet, max_samples)
-
-
-def run_scene(scene: Scene, solver: str | type[Solver] | None = None, dt: float | None = None,
-              t_end: float | None = None, every: int | None = None, quiet: bool = True,
-              max_samples: int | None = MAX_SAMPLES) -> Trajectory:
-    """:func:`simulate` of a Scene (checked already, when it was read: the commands' path)."""
+    scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)
     options = scene_options(scene, dt, t_end, every, max_samples)
     if quiet is not True:
         options = replace(options, quiet=args.flag(quiet, "quiet"))
+    return cls._solve(scene, options)
+
+
+def run_scene(scene: Scene, solver: str | type[Solver] | None, options: RunOptions
+              ) -> Trajectory:
+    """:func:`simulate` of a Scene and its run options (both checked already: the commands'
+    path, from the scene file they read)."""
+    cls = scene_class(scene) if solver is None else solver_class(solver)
+    runnable(cls, scene)
     return cls._solve(scene, options)
 
 
