@@ -537,9 +537,9 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "camera": "auto", "span": None, "y_up": None, "units": ("m", "kg", "s"),
         "reference": "start", "t0": 0.0, "title": "t", "about": (0.0, 0.0)},
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: {"t": None},
-    "dumbbell.spaces.recorder.PaletteDrawOptions": lambda f: {},
-    "dumbbell.spaces.recorder.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
-    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of": lambda f: {
+    "dumbbell.spaces._draw.PaletteDrawOptions": lambda f: {},
+    "dumbbell.spaces._draw.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
+    "dumbbell.spaces._draw.PaletteDrawOptions.ink_of": lambda f: {
         "body": next(iter(f.space().bodies))},
     "dumbbell.spaces.recorder.draw_options": lambda f: {},
 }
@@ -587,9 +587,9 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: f.recorder(),
-    "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
+    "dumbbell.spaces._draw.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
-    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
+    "dumbbell.spaces._draw.PaletteDrawOptions.ink_of":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,

@@ -88,6 +88,7 @@ def test_dumbbell_run_checks_the_fps_and_the_scene_once_on_the_way_to_its_gif(tm
 
     from dumbbell.animation import timing
     from dumbbell.cli import main
+    from dumbbell.model import checker
     from dumbbell.model import scene as scene_module
 
     text = re.sub(r"\[outputs\][\s\S]*", "", TEXTBOOK.read_text())
@@ -102,13 +103,13 @@ def test_dumbbell_run_checks_the_fps_and_the_scene_once_on_the_way_to_its_gif(tm
         code = frame.f_code
         if code.co_filename == timing.__file__ and code.co_name == "check_fps":
             counts["fps"] += 1
-        elif (code.co_filename == scene_module.__file__ and code.co_name == "integer"
+        elif (code.co_filename == checker.__file__ and code.co_name == "integer"
               and frame.f_locals.get("name") == "fps"):
             counts["fps"] += 1  # the scene reader's check of outputs.gif.fps
         elif code.co_filename == args.__file__ and code.co_name in ("scene", "trajectory"):
             counts["scene"] += 1
         elif code.co_filename == scene_module.__file__ and code.co_name == "load_scene":
-            counts["scene"] += 1
+            counts["scene"] += 1  # the scene read and checked from its file
 
     sys.setprofile(profile)
     try:

@@ -14,7 +14,7 @@ from PIL import Image, ImageDraw
 from .backdrop import SS
 from .camera import SHAPES, View
 from .palette import GREY, INK, SPRING, TERM_RGB, blend, ink_index
-from .recorded import Group, Recording, Shapes
+from .recorded import Group, Shapes
 from .world import LEAD
 
 #: No public names: the pens behind :class:`dumbbell.spaces.Recorder`.
@@ -462,22 +462,21 @@ class Layer:
     draw again: where a primitive's whole-pixel numbers changed (so every other primitive
     there is drawn as it was)."""
 
-    def __init__(self, rec: Recording, k: int, view: View, u: float,
-                 panel: tuple[int, int], flat: dict[tuple[int, int], bool] | None = None,
-                 shapes: Shapes | None = None) -> None:
-        shapes = rec.shapes[rec.shape_of[k]] if shapes is None else shapes
-        self.px = Pixels(shapes, rec.poses[k], rec.extras[k], view, u)
+    def __init__(self, px: Pixels, panel: tuple[int, int], flat: bool) -> None:
+        self.px = px
         self.panel = panel
         box = self.px.box
         self.box = self._clipped(box) if box is not None else None
         # Flat or smooth: decided when a set of shapes is first seen through a view.
-        key = (rec.shape_of[k], id(view))
-        known = flat if flat is not None else {}
-        if key not in known:
-            b = self.px.boxes[:self.px.n_shapes][self.px.ok[:self.px.n_shapes]]
-            size = np.maximum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1]) - 2 if len(b) else b
-            known[key] = self.px.n_shapes >= FLAT_MANY and bool((size <= FLAT_PX).all())
-        self.flat = known[key]
+        self.flat = flat
+
+    @staticmethod
+    def many_small(px: Pixels) -> bool:
+        """Whether the shapes of ``px`` are drawn flat: at least :data:`FLAT_MANY` of them,
+        each within :data:`FLAT_PX` px."""
+        b = px.boxes[:px.n_shapes][px.ok[:px.n_shapes]]
+        size = np.maximum(b[:, 2] - b[:, 0], b[:, 3] - b[:, 1]) - 2 if len(b) else b
+        return px.n_shapes >= FLAT_MANY and bool((size <= FLAT_PX).all())
 
     def _clipped(self, box: tuple[float, float, float, float]
                  ) -> tuple[float, float, float, float] | None:

@@ -272,9 +272,7 @@ class Painter(Backdrop):
         layer's changed boxes (see :class:`Layer`), the time label, the bars and the cursor
         when theirs changed."""
         fresh = self.background(k)
-        view = self.views[k]
-        layer = Layer(self.rec, k, view, self.u, (self.scene_w, self.H), self._flat,
-                      self._shapes(self.rec.shape_of[k], view))
+        layer = self.layer(k)
         self._count(layer)
         touched: list[tuple[float, float, float, float]] | None = []
         if fresh or self._canvas is None or self._layer is None:
@@ -316,6 +314,16 @@ class Painter(Backdrop):
             touched += parts
             self.changed = union_px(touched) if touched else (0.0, 0.0, 0.0, 0.0)
         return img
+
+    def layer(self, k: int) -> Layer:
+        """Frame ``k``'s moving layer, flat or smooth as decided when its set of shapes was
+        first seen through its view."""
+        rec, view, i = self.rec, self.views[k], self.rec.shape_of[k]
+        px = Pixels(self._shapes(i, view), rec.poses[k], rec.extras[k], view, self.u)
+        key = (i, id(view))
+        if key not in self._flat:
+            self._flat[key] = Layer.many_small(px)
+        return Layer(px, (self.scene_w, self.H), self._flat[key])
 
     def _shapes(self, i: int, view: View) -> Shapes:
         """Set ``i`` of moving shapes as drawn through ``view``: each body at least

@@ -20,7 +20,7 @@ from ..io.files import atomic_output
 from . import recording as R
 from .backdrop import SS
 from .palette import GREY, INK, LIGHT, SPRING, WHITE, blend
-from .pens import COILS, FLAT_MANY, SHAPE_COLOURS, SPRING_WIDTH, Layer
+from .pens import COILS, FLAT_MANY, SHAPE_COLOURS, SPRING_WIDTH
 from .picture import hex_colour
 from .player import b64_array, energy_array, page
 from .recorded import Recording
@@ -42,11 +42,8 @@ def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) ->
         text = space_page(painter)
         # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
         # for the recorder's note), counted without drawing.
-        panel = (painter.scene_w, painter.H)
         for k in range(painter.n):
-            view = painter.views[k]
-            painter._count(Layer(rec, k, view, painter.u, panel, painter._flat,
-                                   painter._shapes(rec.shape_of[k], view)))
+            painter._count(painter.layer(k))
         with atomic_output(path) as tmp:
             Path(tmp).write_text(text, encoding="utf-8")
     if timing is not None:

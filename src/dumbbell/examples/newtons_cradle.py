@@ -17,7 +17,7 @@ import sys
 from typing import Any
 
 from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.newtons_cradle``.
 __all__: list[str] = []
@@ -62,7 +62,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     run (default: a new one); ``recorder`` captures each frame."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder)
     space = build() if space is None else space
     balls = [b for b in space.bodies]
     e0 = spaces.energy(space).E

@@ -21,7 +21,7 @@ import sys
 from typing import Any
 
 from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.pendulum``.
 __all__: list[str] = []
@@ -74,7 +74,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     of the rod's angle (s) and the largest |E - E0| / E0."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder)
     space = build() if space is None else space
     rod = next(iter(space.bodies))
     e0 = spaces.energy(space).E

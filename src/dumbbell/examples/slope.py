@@ -17,7 +17,7 @@ import sys
 from typing import Any
 
 from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard
 
 #: No public names: a program, run as ``python -m dumbbell.examples.slope``.
 __all__: list[str] = []
@@ -59,7 +59,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
     box travelled (m)."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder, heat)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder, heat)
     space = build() if space is None else space
     heat = spaces.HeatCounter(space, units="m") if heat is None else heat
     box = next(iter(space.bodies))

@@ -530,28 +530,31 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
                          f"{_listed([f.subject for f in rest])}")
         if kind == "joint" and advice.probe:
             lines.append(advice.probe)
+    lines.append(_suggestion(advice, dt))
+    return "\n".join(lines)
+
+
+def _suggestion(advice: Any, dt: float) -> str:
+    """The report's last line: the sub-steps suggested and why, or why none."""
     unchecked = [f.subject for f in advice.rows if not f.checked]
     n = advice.substeps
     swing = ("" if advice.swing is None else
              f"; the springs' energy swing at it: at most {percent(advice.swing)}")
     if any(f.kind == "state" for f in advice.rows):
-        lines.append("  no step is suggested: fix the state first")
-    elif n is None:
+        return "  no step is suggested: fix the state first"
+    if n is None:
         t = advice.tightest
-        lines.append(f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
-                     f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of a step")
-    elif n > 1:
+        return (f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
+                f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of a step")
+    if n > 1:
         t = advice.tightest
-        lines.append(f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
-                     f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
-    elif any(not f.ok and f.checked for f in advice.rows):
-        lines.append(f"  the step is fine; the failures are settings{swing}")
-    elif unchecked:
-        lines.append(f"  nothing to fix in what was checked{swing}; not checked: "
-                     f"{_listed(unchecked)}")
-    else:
-        lines.append(f"  nothing to fix{swing}")
-    return "\n".join(lines)
+        return (f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
+                f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
+    if any(not f.ok and f.checked for f in advice.rows):
+        return f"  the step is fine; the failures are settings{swing}"
+    if unchecked:
+        return f"  nothing to fix in what was checked{swing}; not checked: {_listed(unchecked)}"
+    return f"  nothing to fix{swing}"
 
 
 def _listed(names: list[str]) -> str:

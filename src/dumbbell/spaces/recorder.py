@@ -187,6 +187,26 @@ def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, f
     return x0, x1, y0, y1
 
 
+def _check_camera(camera: Any, world: Any) -> Any:
+    """``camera`` checked: 'auto', 'all' or a moving pymunk.Body to follow; with a fixed
+    ``world`` box, 'auto' only."""
+    import pymunk
+
+    from ..model import args
+
+    if isinstance(camera, pymunk.Body):
+        if camera.body_type == pymunk.Body.STATIC:
+            raise UsageError("camera: a static body cannot be followed; give a moving "
+                             "body, 'auto' or 'all'", param="camera")
+    elif not (isinstance(camera, str) and camera in ("auto", "all")):
+        raise UsageError(f"camera = {args.show(camera)}: must be 'auto', 'all' or a "
+                         "pymunk.Body to follow", param="camera")
+    if world is not None and camera != "auto":
+        raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
+                         "camera, not both", param="camera")
+    return camera
+
+
 def _listed(names: list[str], most: int = 8) -> str:
     """``names`` joined by commas, the first ``most`` of them and how many more."""
     shown = ", ".join(names[:most])
@@ -264,17 +284,7 @@ class Recorder:
         self.heat = None if heat is None else args.instance(
             heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
         self.world = None if world is None else _check_world(world, self.units[0])
-        if isinstance(camera, pymunk.Body):
-            if camera.body_type == pymunk.Body.STATIC:
-                raise UsageError("camera: a static body cannot be followed; give a moving "
-                                 "body, 'auto' or 'all'", param="camera")
-        elif not (isinstance(camera, str) and camera in ("auto", "all")):
-            raise UsageError(f"camera = {args.show(camera)}: must be 'auto', 'all' or a "
-                             "pymunk.Body to follow", param="camera")
-        self.camera: Any = camera
-        if self.world is not None and self.camera != "auto":
-            raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
-                             "camera, not both", param="camera")
+        self.camera: Any = _check_camera(camera, self.world)
         self.span = None if span is None else args.real(span, "span", self.units[0])
         if self.span is not None and not isinstance(self.camera, pymunk.Body):
             raise UsageError(f"span = {args.show(span)}: only for a followed body "
