@@ -109,3 +109,23 @@ def print_guard(space: Any, args: argparse.Namespace) -> None:
 
     print(spaces.report(space, 1.0 / args.fps, units="m"))
     print(spaces.report(space, args.dt, units="m"))
+
+
+def record_and_compare(args: argparse.Namespace, space: Any, first: Any, again: Any,
+                       line: Any, header: str = "", **recorder: Any) -> int:
+    """An example's run: ``first(rec)`` measures at ``args.dt`` while a Recorder (with the
+    keywords ``recorder``) captures each frame into ``args.out``; ``again(dt)`` measures
+    again at dt / 10; then ``header`` (if any), a ``line(dt, measured)`` for each run and the
+    file written. Returns the exit status, 0."""
+    from .. import spaces
+    from .._display import counted
+
+    with spaces.Recorder(space, args.out, fps=args.fps, units="m", **recorder) as rec:
+        rec.capture()
+        measured = first(rec)
+    if header:
+        print(header)
+    for dt, m in ((args.dt, measured), (args.dt / 10, again(args.dt / 10))):
+        print(line(dt, m))
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
+    return 0
