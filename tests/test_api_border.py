@@ -516,7 +516,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.stepping.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
     "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
     "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
-    "dumbbell.spaces.guard.Finding": lambda f: fields(f.finding),
+    "dumbbell.spaces._finding.Finding": lambda f: fields(f.finding),
     "dumbbell.spaces.stepping.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
                                                "speeds": "both", "tolerance": math.inf},
     "dumbbell.spaces.stepping.Driver.step": lambda f: {"frames": 2},

@@ -28,12 +28,7 @@ from typing import Any
 from ..errors import SceneError, UsageError
 from .checker import MIN_MASS, _check_magnitude, _Checker, _finite, _printable, _show
 from .pymunk_settings import PymunkSettings
-from .scene_file import (
-    MAX_SCENE_BYTES,
-    _read_scene_file,
-    packaged_scene,  # noqa: F401 - re-exported, as it always was
-    scenes_dir,
-)
+from .scene_file import MAX_SCENE_BYTES, _read_scene_file
 from .sizes import SIZE_RULE, pixel_size
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
@@ -615,3 +610,22 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     except RecursionError:
         raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
+
+
+def packaged_scene(name: str = "textbook-1d") -> Path:
+    """Path of a scene shipped with the package (wheel) or found in the source checkout."""
+    if not isinstance(name, str) or not name or Path(name).name != name:
+        raise UsageError(f"name = {_show(name)}: must be the name of a shipped scene (a file "
+                         "name without .toml)", param="name")
+    package = Path(__file__).resolve().parent.parent  # src/dumbbell, or dumbbell in a wheel
+    for folder in (package / "scenes", package.parent.parent / "scenes"):
+        candidate = folder / f"{name}.toml"
+        if candidate.is_file():
+            return candidate
+    raise SceneError(f"name = {name!r}: no packaged scene {name}.toml (looked in the package "
+                     "and scenes/)")
+
+
+def scenes_dir() -> Path:
+    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout)."""
+    return packaged_scene("textbook-1d").parent

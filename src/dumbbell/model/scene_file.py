@@ -1,5 +1,5 @@
 """Scene files on disk: a file read safely (a regular file, at most :data:`MAX_SCENE_BYTES`,
-never waiting on a FIFO) and the scenes shipped with the package."""
+never waiting on a FIFO)."""
 
 from __future__ import annotations
 
@@ -7,10 +7,9 @@ import os
 import stat
 from pathlib import Path
 
-from ..errors import SceneError, UsageError
-from .checker import _show
+from ..errors import SceneError
 
-#: No public names: ``load_scene`` and ``scenes_dir`` are :mod:`dumbbell.model.scene`'s.
+#: No public names: ``load_scene`` is :mod:`dumbbell.model.scene`'s.
 __all__: list[str] = []
 
 #: Largest scene file read (bytes).
@@ -49,22 +48,3 @@ def _file_kind(mode: int) -> str:
         if test(mode):
             return kind
     return "not a regular file"
-
-
-def packaged_scene(name: str = "textbook-1d") -> Path:
-    """Path of a scene shipped with the package (wheel) or found in the source checkout."""
-    if not isinstance(name, str) or not name or Path(name).name != name:
-        raise UsageError(f"name = {_show(name)}: must be the name of a shipped scene (a file "
-                         "name without .toml)", param="name")
-    package = Path(__file__).resolve().parent.parent  # src/dumbbell, or dumbbell in a wheel
-    for folder in (package / "scenes", package.parent.parent / "scenes"):
-        candidate = folder / f"{name}.toml"
-        if candidate.is_file():
-            return candidate
-    raise SceneError(f"name = {name!r}: no packaged scene {name}.toml (looked in the package "
-                     "and scenes/)")
-
-
-def scenes_dir() -> Path:
-    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout)."""
-    return packaged_scene("textbook-1d").parent

@@ -251,6 +251,19 @@ class ExplicitSpring:
         return ratio / (2.0 - ratio) if ratio < 2.0 else math.inf
 
 
+class Truth(Solver):
+    """The facts the truth solvers share (the exact solution, the reference integrator): no
+    step (``dt`` only spaces the samples, so no order and no step limit), a floor that reverses
+    velocities at impacts, and an error far below any stepping solver's, so that analysis may
+    take them as the truth for the scenes they claim (:meth:`Solver.truth_for`)."""
+
+    order = None
+    has_step = False
+    step_limit = None
+    flip_floor = True
+    is_truth = True
+
+
 #: The registered solvers by name: :data:`dumbbell.solvers.METHODS` is this dict, filled
 #: there; kept here so that the solvers' own modules can read it without importing the
 #: package that imports them.
