@@ -81,7 +81,7 @@ class Player:
 
     def save(self, path: str | Path) -> Path:
         """Write the page to ``path`` (atomically) and return the path."""
-        from ..io.files import atomic_output, check_writable
+        from ..files import atomic_output, check_writable
         from ..model import args
 
         path = args.path(path, "path")

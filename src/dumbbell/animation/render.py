@@ -32,7 +32,7 @@ import numpy as np
 
 from .._display import counted
 from ..errors import UsageError
-from ..io.files import atomic_output
+from ..files import atomic_output
 from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
 from .timing import _delays, check_fps, check_size, delays_cs  # noqa: F401 - delays_cs re-exported
@@ -228,7 +228,7 @@ class Gif(bytes):
 
     def save(self, path: str | Path) -> Path:
         """Write the GIF to ``path`` (atomically) and return the path."""
-        from ..io.files import check_writable
+        from ..files import check_writable
         from ..model import args
 
         path = args.path(path, "path")
@@ -270,7 +270,7 @@ def render_gif(
                          param="traj")
     path = None if path is None else args.path(path, "path")
     if path is not None:
-        from ..io.files import check_writable
+        from ..files import check_writable
 
         check_writable(path, "path")  # before the work: a folder, a file as a folder, ...
     quiet = args.flag(quiet, "quiet")

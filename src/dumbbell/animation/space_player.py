@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..io.files import atomic_output
+from ..files import atomic_output
 from . import recording as R
 from .backdrop import SS
 from .palette import GREY, INK, LIGHT, SPRING, WHITE, blend

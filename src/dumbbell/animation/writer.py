@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DumbbellError
-from ..io.files import atomic_output
+from ..files import atomic_output
 from ..parallel import STOP_SIGNALS
 from .gif import write_frames
 from .palette import palette

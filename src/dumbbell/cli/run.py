@@ -128,7 +128,7 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     exit status (0, 3 or 4: :func:`~.app.verdict_status`). The figures are drawn beside the CSVs and the GIF, in a forked
     process, where there is a CPU for it (:mod:`.beside`); the bytes are the same either
     way."""
-    from ..io.files import atomic_output
+    from ..files import atomic_output
     from ..solvers import run_scene
     from ..solvers.base import scene_options
     from .app import verdict_status

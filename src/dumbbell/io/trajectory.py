@@ -16,15 +16,12 @@ from typing import IO, Any
 
 from ..model import args
 from ..model.trajectory import Trajectory
-from .files import atomic_output
 from .tables import csv_text, write_text
 
 __all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
 
 #: Columns of the impacts' CSV (s, -, m/s, m/s).
 EVENT_COLUMNS = ("t", "body", "v_before", "v_after")
-#: Rows of the samples' CSV formatted at once (a few MB of text).
-CSV_BLOCK = 8192
 
 
 def _checked(traj: Any) -> Trajectory:
@@ -40,26 +37,13 @@ def dump_csv(traj: Trajectory, stream: IO[str]) -> None:
 
         raise UsageError(f"stream = {args.show(stream)}: must be an open text file "
                          "(with a write method)", param="stream")
-    table = traj.table()
-    stream.write(",".join(traj.columns) + "\n")
-    # np.savetxt's text (fmt "%.17g", "," between cells), formatted a block of rows at a time
-    # rather than row by row.
-    row = ",".join(["%.17g"] * table.shape[1]) + "\n"
-    for start in range(0, len(table), CSV_BLOCK):
-        block = table[start:start + CSV_BLOCK]
-        stream.write((row * len(block)) % tuple(block.ravel().tolist()))
+    traj._write_csv(stream)
 
 
 def write_csv(traj: Trajectory, path: str | Path) -> Path:
     """Write the samples as CSV to ``path`` (see :func:`dump_csv`), whole or not at all (a
     device or a FIFO is written directly); returns the path."""
-    traj = _checked(traj)
-    path = args.path(path, "path")
-    # One open of our own: given a name, numpy opens the file twice, and the first,
-    # empty open would end a FIFO's reader.
-    with atomic_output(path) as tmp, open(tmp, "w") as fh:
-        dump_csv(traj, fh)
-    return path
+    return _checked(traj).to_csv(path)
 
 
 def events_csv(traj: Trajectory) -> str:

@@ -125,7 +125,7 @@ def _check_path(path: Any) -> Path:
     """``path`` as a Path the recording can be written to, else a UsageError naming it and
     what is wrong: checked before any capture, so a long run is not lost at the end."""
     from ..animation.writer import mp4_problem
-    from ..io.files import check_writable, is_special
+    from ..files import check_writable, is_special
     from ..model import args
 
     shown = args.show(path) if isinstance(path, str | os.PathLike) else None

@@ -35,7 +35,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
 
-from ..errors import UsageError
+from .errors import UsageError
 
 #: No public names: the one way every writer of the package writes a file.
 __all__: list[str] = []
@@ -43,7 +43,7 @@ __all__: list[str] = []
 
 def _inputs(inputs: object) -> list[tuple[str | Path, str]]:
     """``inputs`` as (path, how the user named it) pairs, else a UsageError."""
-    from ..model import args
+    from .model import args
 
     allowed = "must be (path, name) pairs, e.g. [('x.toml', 'the scene x.toml')]"
     if isinstance(inputs, str | bytes) or not isinstance(inputs, Iterable):
@@ -63,7 +63,7 @@ def _key(path: Path) -> str:
 def is_special(path: str | Path) -> bool:
     """True when ``path`` exists and is neither a regular file nor a folder (a device, a FIFO,
     a socket): such an output is written directly, never replaced."""
-    from ..model import args
+    from .model import args
 
     path = args.path(path, "path")
     try:
@@ -205,7 +205,7 @@ class OutputTransaction:
     def claim(self, path: str | Path, what: str | None = None) -> None:
         """Check that the output ``path`` is no input; with ``what`` (how the user named it,
         e.g. '-o x.csv') also reserve it, refusing a second output on the same file."""
-        from ..model import args
+        from .model import args
 
         path = args.path(path, "path")
         if what is not None:
@@ -226,7 +226,7 @@ class OutputTransaction:
         created or replaced, :func:`check_writable`) and reserve it, refusing one that is an
         input or another output. ``flag`` is how the user set them (``'--out r'``): a
         refusal names it, then the file. Returns the paths."""
-        from ..model import args
+        from .model import args
 
         flag = args.text(flag, "flag", "how the user set these outputs (str), e.g. '--out r'")
         if isinstance(paths, str | bytes | os.PathLike) or not isinstance(paths, Iterable):
@@ -366,7 +366,7 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     >>> with atomic_output("out.csv") as tmp:        # doctest: +SKIP
     ...     tmp.write_text("t,x\\n")
     """
-    from ..model import args
+    from .model import args
 
     path = args.path(path, "path")
     if "\0" in str(path):
@@ -520,7 +520,7 @@ def check_writable(path: str | Path, flag: str, folder: bool = False, *,
     write permission; an existing file another user owns in a sticky folder that is not ours.
     With ``within``, ``flag`` is a prefix (``'--out r:'``) and the message names ``path``
     after it."""
-    from ..model import args
+    from .model import args
 
     args.text(flag, "flag", "the flag or argument that names the path (str)")
     if not isinstance(path, str | os.PathLike):
