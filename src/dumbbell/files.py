@@ -36,6 +36,7 @@ from contextvars import ContextVar
 from pathlib import Path
 
 from .errors import UsageError
+from .parallel import STOP_SIGNALS
 
 #: No public names: the one way every writer of the package writes a file.
 __all__: list[str] = []
@@ -89,7 +90,7 @@ _temporary: dict[str, int] = {}
 _lock = threading.Lock()
 #: Signals given :func:`_remove_and_resend` while temporary files exist.
 _armed: set[int] = set()
-_STOP = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGINT") if hasattr(signal, n))
+_STOP = tuple(getattr(signal, n) for n in STOP_SIGNALS if hasattr(signal, n))
 
 
 def _remove_temporary() -> None:

@@ -26,7 +26,6 @@ from .player import b64_array, energy_array, page
 from .recorded import Recording
 from .strip import GRID
 from .world import LEAD
-from .writer import signals_end_cleanly
 
 #: No public names: the page behind :class:`dumbbell.spaces.Recorder` for a path ending in
 #: .html.
@@ -38,14 +37,13 @@ def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) ->
     seconds spent. Returns the painter (its ``view``), as :func:`.recording.write` does."""
     t0 = time.perf_counter()
     painter = R.Painter(rec)
-    with signals_end_cleanly():
-        text = space_page(painter)
-        # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
-        # for the recorder's note), counted without drawing.
-        for k in range(painter.n):
-            painter._count(painter.layer(k))
-        with atomic_output(path) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
+    text = space_page(painter)
+    # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
+    # for the recorder's note), counted without drawing.
+    for k in range(painter.n):
+        painter._count(painter.layer(k))
+    with atomic_output(path) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
     if timing is not None:
         timing.update(frames=painter.n, total=time.perf_counter() - t0)
     return painter
