@@ -32,7 +32,6 @@ import numpy as np
 
 from .._display import counted
 from ..errors import UsageError
-from ..files import atomic_output
 from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
 from .timing import _delays, check_fps, check_size, delays_cs  # noqa: F401 - delays_cs re-exported
@@ -230,11 +229,12 @@ class Gif(bytes):
         """Write the GIF to ``path`` (atomically) and return the path."""
         from ..files import check_writable
         from ..model import args
+        from .writer import binary_output
 
         path = args.path(path, "path")
         check_writable(path, "path")
-        with atomic_output(path) as tmp:
-            Path(tmp).write_bytes(self)
+        with binary_output(path) as fh:
+            fh.write(self)
         return path
 
 
@@ -296,6 +296,7 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
     from .drawing import Painter
     from .gif import write_frames
     from .picture import describe
+    from .writer import binary_output
 
     (width, height), fps, strip, t_end = pixel_size(gif.size), gif.fps, gif.strip, gif.t_end
     t0 = time.perf_counter()
@@ -308,8 +309,7 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
         if path is None:
             fh = stack.enter_context(io.BytesIO())
         else:
-            tmp = stack.enter_context(atomic_output(path))
-            fh = stack.enter_context(open(tmp, "wb"))
+            fh = stack.enter_context(binary_output(path))
         pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
         stats["draw"], stats["encode"] = write_frames(fh, (width, height), painter.frame, delays,
                                                       on_frame=lambda: pbar.update(1))

@@ -3,8 +3,10 @@ file, as for every output: :mod:`dumbbell.files`)."""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -18,6 +20,15 @@ from .timing import _delays
 __all__: list[str] = []
 
 
+@contextlib.contextmanager
+def binary_output(path: Path) -> Iterator[BinaryIO]:
+    """The open binary file an animation is written to: ``path`` whole or not at all
+    (:func:`dumbbell.files.atomic_output`). Every GIF, the scene's and the space's, is
+    written through here."""
+    with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        yield fh
+
+
 def save(path: Path, painter: Any, fps: int) -> dict[str, float]:
     """Write ``painter``'s frames (``W`` x ``H`` px, ``n`` of them, ``frame(k)`` and
     ``region(k)``) to ``path`` at ``fps``: a GIF, or an MP4 through imageio's ffmpeg plugin
@@ -28,7 +39,7 @@ def save(path: Path, painter: Any, fps: int) -> dict[str, float]:
     if path.suffix.lower() == ".mp4":
         _write_mp4(path, painter, fps)
     else:
-        with atomic_output(path) as tmp, open(tmp, "wb") as fh:
+        with binary_output(path) as fh:
             stats["draw"], stats["encode"] = write_frames(
                 fh, (painter.W, painter.H), painter.frame, _delays(painter.n, fps),
                 region=painter.region)
