@@ -111,21 +111,24 @@ def print_guard(space: Any, args: argparse.Namespace) -> None:
     print(spaces.report(space, args.dt, units="m"))
 
 
-def record_and_compare(args: argparse.Namespace, space: Any, first: Any, again: Any,
-                       line: Any, header: str = "", **recorder: Any) -> int:
-    """An example's run: ``first(rec)`` measures at ``args.dt`` while a Recorder (with the
-    keywords ``recorder``) captures each frame into ``args.out``; ``again(dt)`` measures
-    again at dt / 10; then ``header`` (if any), a ``line(dt, measured)`` for each run and the
-    file written. Returns the exit status, 0."""
+def record_and_compare(args: argparse.Namespace, space: Any, measure: Any, line: Any,
+                       header: str = "", **recorder: Any) -> int:
+    """An example's run: ``measure(dt, seconds, fps, space, rec)`` measures ``space`` at
+    ``args.dt`` while a Recorder ``rec`` (with the keywords ``recorder``; its ``heat`` counter
+    is given to ``measure`` too) captures each frame into ``args.out``, then a new space again
+    at dt / 10; then ``header`` (if any), a ``line(dt, measured)`` for each run and the file
+    written. Returns the exit status, 0."""
     from .. import spaces
     from .._display import counted
 
+    tools = {"heat": recorder["heat"]} if "heat" in recorder else {}
     with spaces.Recorder(space, args.out, fps=args.fps, units="m", **recorder) as rec:
         rec.capture()
-        measured = first(rec)
+        measured = measure(args.dt, args.seconds, args.fps, space, rec, **tools)
     if header:
         print(header)
-    for dt, m in ((args.dt, measured), (args.dt / 10, again(args.dt / 10))):
+    again = measure(args.dt / 10, args.seconds, args.fps)
+    for dt, m in ((args.dt, measured), (args.dt / 10, again)):
         print(line(dt, m))
     print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
     return 0

@@ -100,8 +100,7 @@ def main(argv: list[str] | None = None) -> int:
     space = build()
     print_guard(space, args)
     return record_and_compare(
-        args, space, lambda rec: measure(args.dt, args.seconds, args.fps, space, rec),
-        lambda dt: measure(dt, args.seconds, args.fps),
+        args, space, measure,
         lambda dt, m: (f"dt = {dt:.3g} s over {args.seconds:g} s: energy drift max "
                        f"{m['energy_drift_max']:.2e}, at the end {m['energy_drift_end']:.2e}; "
                        f"momentum change across an impact max {m['momentum_change_max']:.2e}"),

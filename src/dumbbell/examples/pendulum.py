@@ -105,8 +105,7 @@ def main(argv: list[str] | None = None) -> int:
     print_guard(space, args)
     T0, T1 = small_angle_period(), amplitude_corrected_period()
     return record_and_compare(
-        args, space, lambda rec: measure(args.dt, args.seconds, args.fps, space, rec),
-        lambda dt: measure(dt, args.seconds, args.fps),
+        args, space, measure,
         lambda dt, m: (f"dt = {dt:.3g} s: period {m['period']:.6f} s over {m['periods']} "
                        f"swings, {(m['period'] - T0) / T0:+.3%} from the small-angle formula, "
                        f"{(m['period'] - T1) / T1:+.1e} from the corrected one; energy drift "

@@ -91,8 +91,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"{left:+.2e} J ({left / m['heat']:+.2e} of the heat)")
 
     return record_and_compare(
-        args, space, lambda rec: measure(args.dt, args.seconds, args.fps, space, rec, heat),
-        lambda dt: measure(dt, args.seconds, args.fps), line, heat=heat, title="Box on a slope",
+        args, space, measure, line, heat=heat, title="Box on a slope",
         world=(-0.1, RAMP * c + 0.05, -0.15, RAMP * s + 0.45))
 
 
