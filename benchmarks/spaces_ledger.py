@@ -1,8 +1,8 @@
 """spaces.Ledger: how well it closes on pymunk's own examples, and what it costs per step.
 
     python benchmarks/spaces_ledger.py            # the closure table, then the costs
-    python benchmarks/spaces_ledger.py --table    # only the table (the one in docs/spaces.md)
-    python benchmarks/spaces_ledger.py --cost [--steps 300] [--repeat 3]
+    python benchmarks/spaces_ledger.py --table    # only the table (the one in docs/spaces-reference.md)
+    python benchmarks/spaces_ledger.py --cost [--steps 300] [--repeat 3] [--space pyramid]
 
 The table runs every case of ``tests/ledger_cases.py``: each constraint kind of pymunk's
 constraints demo alone, and the corpus examples (headless, loaded from the installed
@@ -21,6 +21,12 @@ blocks more often. Printed: median CPU time of a bare ``space.step`` and of a st
 ledger, over the blocks; the ledger's own (their difference) as a ratio to the step, the
 median and the quartiles of that ratio over the pairs of blocks; and the machine's load.
 Then ``spaces.energy`` on the same pyramid, median of 50 calls.
+
+``--space large`` (or ``all``) times the same way a larger space built here: a pyramid of
+820 boxes on a floor, 200 balls thrown into a heap beside it, a chain of 60 links on pivot
+joints (every third with a finite ``max_force``) swinging from the static body, and 23
+springs and 23 pin joints between bodies of the pyramid (1,080 bodies, about 2,300
+touching pairs, 106 joints), copied after its first 100 steps, awake.
 """
 
 from __future__ import annotations
@@ -54,10 +60,58 @@ def pyramid() -> tuple[object, float]:
     return space, run.dts[0]
 
 
-def cost(steps: int, repeat: int, block: int = 10) -> None:
+def large() -> tuple[object, float]:
+    """The larger space (see the module docstring) after 100 steps, awake, and its step."""
+    import pymunk
+
+    space = pymunk.Space()
+    space.gravity = (0.0, -900.0)
+    space.sleep_time_threshold = math.inf
+    floor = pymunk.Segment(space.static_body, (-2000, 0), (4000, 0), 5)
+    floor.friction = 0.8
+    space.add(floor)
+    bodies = []
+    for i in range(40):  # 820 boxes of 20 x 20
+        for j in range(40 - i):
+            box = pymunk.Body(1, pymunk.moment_for_box(1, (20, 20)))
+            box.position = (j * 21 + i * 10.5 + (j % 7) * 0.01, 10 + i * 21)
+            shape = pymunk.Poly.create_box(box, (20, 20))
+            shape.friction, shape.elasticity = 0.6, 0.1
+            space.add(box, shape)
+            bodies.append(box)
+    for k in range(200):  # balls in a heap
+        ball = pymunk.Body(2, pymunk.moment_for_circle(2, 0, 6))
+        ball.position = (1000 + (k % 20) * 13, 20 + (k // 20) * 13)
+        ball.velocity = ((k * 37) % 101 - 50.0, (k * 53) % 101 - 50.0)
+        shape = pymunk.Circle(ball, 6)
+        shape.friction, shape.elasticity = 0.3, 0.5
+        space.add(ball, shape)
+        bodies.append(ball)
+    prev = space.static_body
+    for k in range(60):  # a chain on pivots
+        link = pymunk.Body(1, 10)
+        link.position = (1510 + 10 * k, 600)
+        joint = pymunk.PivotJoint(prev, link, (1500 + 10 * k, 600))
+        joint.max_force = 5e5 if k % 3 else math.inf
+        space.add(link, pymunk.Circle(link, 3), joint)
+        prev = link
+    for k in range(0, 820, 37):
+        space.add(pymunk.DampedSpring(bodies[k], bodies[k + 1], (0, 0), (0, 0), 25, 50, 0.5),
+                  pymunk.PinJoint(bodies[k], bodies[k + 2]))
+    dt = 1 / 60
+    for _ in range(100):
+        space.step(dt)
+    return space, dt
+
+
+SPACES = {"pyramid": ("box2d_pyramid", pyramid), "large": ("the large space", large)}
+
+
+def cost(steps: int, repeat: int, space: str = "pyramid", block: int = 10) -> None:
     from dumbbell import spaces
 
-    base, dt = pyramid()
+    name, make = SPACES[space]
+    base, dt = make()
     bare_t: list[float] = []
     with_t: list[float] = []
     ratios: list[float] = []
@@ -85,12 +139,15 @@ def cost(steps: int, repeat: int, block: int = 10) -> None:
     q = statistics.quantiles(ratios, n=4)
     load = Path("/proc/loadavg").read_text().split()[:3] if Path("/proc/loadavg").exists() \
         else ["?"] * 3
-    print(f"box2d_pyramid, {len(list(base.bodies))} bodies awake, {steps} x {repeat} steps each "
-          f"in blocks of {block}, alternately; CPU time of this thread (load {' '.join(load)})")
+    print(f"{name}, {len(list(base.bodies))} bodies awake, {len(base.constraints)} joints, "
+          f"{steps} x {repeat} steps each in blocks of {block}, alternately; CPU time of this "
+          f"thread (load {' '.join(load)})")
     print(f"  space.step alone      {step * 1e3:.3f} ms (median)")
     print(f"  space.step + ledger   {both * 1e3:.3f} ms")
     print(f"  ledger                {(both - step) * 1e3:.3f} ms  = "
           f"{statistics.median(ratios):.2f} x space.step (quartiles {q[0]:.2f}-{q[2]:.2f})")
+    if space != "pyramid":
+        return
     calls = []
     for _ in range(50):
         t0 = clock()
@@ -106,13 +163,16 @@ def main() -> None:
     parser.add_argument("--cost", action="store_true", help="only the costs")
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--space", choices=[*SPACES, "all"], default="pyramid",
+                        help="the space the costs are taken on (default: the pyramid)")
     a = parser.parse_args()
     if not a.cost:
         print(closure_table())
     if not a.table:
         if not a.cost:
             print()
-        cost(a.steps, a.repeat)
+        for which in (SPACES if a.space == "all" else [a.space]):
+            cost(a.steps, a.repeat, which)
 
 
 if __name__ == "__main__":

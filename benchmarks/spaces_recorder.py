@@ -21,7 +21,7 @@ process (interpreter start, imports, building, stepping, drawing, writing), alte
 ``--repeat`` times. ``--corpus``: pymunk's own example programs (run headless through
 ``tests/pymunk_corpus.py``): each side records the same run in one process, alternately; timed
 is each side's own work (its per-frame calls and writing the file), not the program's stepping,
-which is the same for all. ``--table``: the per-example table of docs/spaces.md (orientation,
+which is the same for all. ``--table``: the per-example table of docs/spaces-reference.md (orientation,
 frame size, the smallest body drawn, the recorder's cost per frame against pygame_util).
 
     python benchmarks/spaces_recorder.py --side SIDE --out OUT.gif --world X0,X1,Y0,Y1
@@ -348,7 +348,7 @@ def corpus(names: list[str], seconds: float, repeat: int) -> None:
 
 
 def table(seconds: float) -> None:
-    """The per-example table of docs/spaces.md."""
+    """The per-example table of docs/spaces-reference.md."""
     _, rc = _corpus()
     print("| example | y | frame (px) | smallest body drawn, first / last frame (px) | "
           "recorder, CPU ms per frame | pygame_util + Pillow, CPU ms per frame | ratio |")

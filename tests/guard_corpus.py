@@ -30,7 +30,7 @@ other programs), run headless by :mod:`pymunk_corpus`:
     guard's tolerance is 0.01 a second);
   - a program the guard calls fine: that overlap at its own step (it must stay under 1).
 
-``python tests/guard_corpus.py`` prints the table (Markdown) that docs/spaces.md holds.
+``python tests/guard_corpus.py`` prints the table (Markdown) that docs/spaces-reference.md holds.
 """
 
 from __future__ import annotations
@@ -385,7 +385,7 @@ def row(case: str, p: Peaks, a: Advice) -> str:
 
 
 def table() -> str:
-    """The per-example table of docs/spaces.md (Markdown)."""
+    """The per-example table of docs/spaces-reference.md (Markdown)."""
     lines = [HEAD, "|---|---|---|---|---|---|---|---|---|"]
     lines += [row(case, peaks(case), advice(case)) for case in CASES]
     return "\n".join(lines)

@@ -1,5 +1,5 @@
 """The energy ledger over pymunk's own example programs: the cases, one run each, and the
-table of docs/spaces.md ("The ledger on pymunk's examples").
+table of docs/spaces-reference.md ("The ledger on pymunk's examples").
 
 Shared by ``tests/test_spaces_ledger_corpus.py`` (which checks each case and that the table
 in the docs is the one these runs give) and ``benchmarks/spaces_ledger.py`` (which prints

@@ -609,7 +609,7 @@ def test_every_public_module_declares_its_api():
 
 
 #: The documents of the public API: every public callable is named in code in one of them.
-API_DOCS = ("docs/api.md", "docs/spaces.md")
+API_DOCS = ("docs/api.md", "docs/spaces.md", "docs/spaces-reference.md")
 
 
 def _code_in(path: Path) -> str:
@@ -621,8 +621,8 @@ def _code_in(path: Path) -> str:
 
 
 def test_every_public_callable_is_documented():
-    """Each public callable's name (a method's too) stands in code in docs/api.md or
-    docs/spaces.md; ``__getitem__`` is documented as ``traj[name]``."""
+    """Each public callable's name (a method's too) stands in code in docs/api.md,
+    docs/spaces.md or docs/spaces-reference.md; ``__getitem__`` is documented as ``traj[name]``."""
     root = Path(__file__).resolve().parent.parent
     code = "\n".join(_code_in(root / doc) for doc in API_DOCS)
     names = {key.rsplit(".", 1)[1] for key in public()} - {"__getitem__"}

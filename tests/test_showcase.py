@@ -189,7 +189,7 @@ def test_the_untimed_bench_table_still_sees_a_changed_error():
     retimed = re.sub(r"\| [\d.]+ (µs|ms|s) \([\d.]+ (µs|ms|s)\) \|", "| 1 s (2 s) |", table)
     assert retimed != table and _untimed(retimed) == _untimed(table)
     # The reference row's error, whatever this machine's BLAS made of it, as another CPU's.
-    tracked = re.search(r"^\| reference \|(?:[^|]*\|){3} ([\d.]+e-\d+) \|", table, re.M)
+    tracked = re.search(r"^\| reference \|(?:[^|]*\|){3} ([\d.]+e-\d+) \|", table, re.MULTILINE)
     assert tracked, "the reference row lost its error column"
     other = "9.99e-12" if tracked.group(1) != "9.99e-12" else "1.11e-11"
     other_cpu = table.replace(f"| {tracked.group(1)} |", f"| {other} |", 1)

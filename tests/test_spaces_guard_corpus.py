@@ -2,7 +2,7 @@
 estimates stay above the real peak speeds where they claim to bound them, come within 3x of
 them on the constraints demo and the pyramid, and its advice, applied, changes nothing where
 the guard finds nothing and reduces what it names where it finds something. Each case's row
-of the table in docs/spaces.md is what this run measures."""
+of the table in docs/spaces-reference.md is what this run measures."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from .pymunk_corpus import run_example
 
 pytest.importorskip("pygame")
 
-DOCS = Path(__file__).resolve().parent.parent / "docs" / "spaces.md"
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "spaces-reference.md"
 #: Issue 20's targets: the largest estimate within 3x of the largest real peak.
 WITHIN_3X = ("constraints", "box2d_pyramid")
 #: Cases with a body alone among fixed shapes, whose estimate claims to bound its speed.
@@ -25,7 +25,7 @@ BOUNDED = ("contact_with_friction", "bouncing_balls")
 
 
 def _docs_rows() -> dict[str, str]:
-    """The rows of the guard's table in docs/spaces.md (the table under its header line)."""
+    """The rows of the guard's table in docs/spaces-reference.md (the table under its header line)."""
     lines = DOCS.read_text(encoding="utf-8").splitlines()
     start = lines.index(HEAD) + 2
     rows = {}

@@ -123,6 +123,41 @@ def test_what_the_probe_cannot_separate_is_not_checked_and_named():
                                      "PinJoint 0, PinJoint 1")
 
 
+def test_balls_at_rest_on_friction_joints_are_checked():
+    # The outside corpus's pool table: balls held by the usual friction joints (a pivot and
+    # a gear to the static body, max_bias 0, finite max_force); one slides, five rest with
+    # velocities of a few roundings (1e-17 px/s) where no ball comes near. Their joints'
+    # impulses, of 1e-34 to 1e-17, are checked (as doing nothing), not "not checked" because
+    # two roundings of nothing differ. By hand: the sliding ball's pivot pulls with its
+    # max_force F against the motion for the 2 s of the probe (it slows by F/m = 245 px/s^2
+    # from 2,000 px/s, never stopping): its power, averaged, F (v0 - F/m T/2).
+    space = pymunk.Space()
+    m, r, force = 0.17, 14.0, 0.17 * 0.25 * 981
+
+    def ball(at, v):
+        b = pymunk.Body(m, pymunk.moment_for_circle(m, 0, r))
+        b.position, b.velocity = at, v
+        slide = pymunk.PivotJoint(space.static_body, b, (0, 0), (0, 0))
+        slide.max_bias, slide.max_force = 0, force
+        roll = pymunk.GearJoint(space.static_body, b, 0.0, 1.0)
+        roll.max_bias, roll.max_force = 0, 40.0
+        space.add(b, pymunk.Circle(b, r), slide, roll)
+
+    ball((100, 300), (2000, 0))
+    for k in range(5):
+        ball((400 + 40 * k, 600), (1e-17 * (k + 1), -3e-18 * k))
+    rows = {f.subject: f for f, _ in spaces.survey(space, 1 / 120, units="px")}
+    text = spaces.report(space, 1 / 120, units="px")
+    assert all(rows[f"{type(c).__name__} {j}"].checked
+               for j, c in enumerate(space.constraints)), text
+    assert "not checked" not in text and text.endswith("nothing to fix")
+    seconds = float(re.search(r"over ([\d.]+) s: (\d+) steps", text).group(1))
+    assert seconds == 2.0
+    assert rows["PivotJoint 0"].value == pytest.approx(
+        force * (2000 - force / m * seconds / 2), rel=1e-12)
+    assert max(rows[f"PivotJoint {j}"].value for j in range(2, 12, 2)) < 1e-30
+
+
 def test_a_space_past_the_probe_s_budget_is_not_checked(monkeypatch):
     monkeypatch.setattr(_probe, "MAX_WORK", 10)
     text = spaces.report(pendulum(), 1 / 60, units="px")

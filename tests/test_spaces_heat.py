@@ -229,3 +229,48 @@ def test_a_counter_dropped_without_detach_gives_the_handler_back():
     del heat
     gc.collect()
     assert _handler_state(space) == before
+
+
+@pytest.mark.parametrize("before", [True, False])
+def test_a_velocity_set_in_a_typed_post_solve_is_not_heat(before):
+    # pymunk calls a post_solve set for particular collision types before the wildcard one
+    # the counter listens on (the outside corpus's bumpers: a kick and a mud strip). A 1 kg
+    # ball meets a frictionless floor with e = 0 at 10 m/s; the program's post_solve then
+    # sets its velocity to (3, 4). By hand: the contact's impulse 10 N s stops the normal
+    # motion (u from -10 to 0), heat 1/2 1 10^2 = 50 J, whatever the program does after it;
+    # the kick (1/2 1 5^2 = 12.5 J, then the ball flies off) is the program's, not heat.
+    # The handler set before the counter attaches, or after.
+    space = _si(pymunk.Space())
+    floor = pymunk.Segment(space.static_body, (-5, 0), (5, 0), 0.0)
+    floor.collision_type, floor.elasticity, floor.friction = 2, 0.0, 0.0
+    ball = pymunk.Body(1.0, 1.0)
+    ball.position, ball.velocity = (0.0, 0.2), (0.0, -10.0)
+    shape = pymunk.Circle(ball, 0.1)
+    shape.collision_type, shape.elasticity, shape.friction = 1, 0.0, 0.0
+    space.add(floor, ball, shape)
+    calls = []
+
+    def kick(arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        calls.append(data)
+        if arbiter.is_first_contact:
+            arbiter.shapes[0].body.velocity = (3.0, 4.0)
+
+    def handler() -> None:
+        space.on_collision(1, 2, post_solve=kick, data="mine")
+
+    if before:
+        handler()
+    counter = spaces.HeatCounter(space)
+    ledger = spaces.Ledger(space)
+    if not before:
+        handler()
+    for _ in range(20):
+        space.step(0.005)
+    assert calls and set(calls) == {"mine"}   # the callback fired, with its data
+    assert ball.velocity.y > 0 and ball.position.y > 0.2
+    assert counter.total == pytest.approx(50.0, rel=1e-12)
+    unattributed = {t.source: t.energy for t in ledger.balance().terms
+                    if t.kind == "unattributed"}
+    assert unattributed == {"body 0": pytest.approx(12.5, rel=1e-12)}
+    counter.detach()
+    assert space._handlers[(1, 2)].post_solve is kick  # given back as it was

@@ -1,7 +1,7 @@
 """spaces.Ledger on pymunk's own example programs (run headless from the installed package):
 each closes to rounding, its E(t) is what spaces.energy gives, every constraint kind shows
 up as a named term, and what cannot be accounted for is named, exactly. The table in
-docs/spaces.md is the one these runs give."""
+docs/spaces-reference.md is the one these runs give."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from .ledger_cases import CASES, run, table
 
 pytest.importorskip("pygame")
 
-DOCS = Path(__file__).resolve().parent.parent / "docs" / "spaces.md"
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "spaces-reference.md"
 
 
 @pytest.fixture(scope="module")
@@ -113,5 +113,5 @@ def test_named_sources_of_the_examples(results):
 def test_the_docs_table_is_these_runs(results):
     text = DOCS.read_text(encoding="utf-8")
     found = re.search(r"<!-- ledger-table -->\n(.*?)\n<!-- /ledger-table -->", text, re.DOTALL)
-    assert found, "docs/spaces.md has no ledger table"
+    assert found, "docs/spaces-reference.md has no ledger table"
     assert found.group(1).strip() == table(list(results.values())).strip()

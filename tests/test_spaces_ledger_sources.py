@@ -157,6 +157,64 @@ def test_a_spring_added_or_removed_is_the_change_of_its_potential():
     assert abs(bal.closure) <= 1e-12 * bal.scale
 
 
+def test_a_spring_and_a_body_changed_in_one_gap_are_each_named():
+    # A stretched spring added while another body is added in the same gap between steps
+    # (the outside corpus's spawner): the spring's potential is the constraints' change,
+    # the new body's energy its own; then both go again, and gravity is changed beside a
+    # body added. By hand, with no gravity for the first two gaps: the spring k = 2, rest
+    # 4, between bodies 10 apart holds 1/2 2 6^2 = 36; the new body, 2 kg at (3, 4), brings
+    # 1/2 2 5^2 = 25. Gravity (0, -10) set: bodies 0 and 1 (1 kg each, centres of gravity
+    # at height 0) keep their U_g, body 2 (2 kg at height 50) gains -2 (-10) 50 = 1,000;
+    # a body 3 added at height 0 brings its 1/2 1 1^2.
+    space = pymunk.Space()
+    a, b = pymunk.Body(1, 1), pymunk.Body(1, 1)
+    a.position, b.position = (0, 0), (10, 0)
+    space.add(a, b, pymunk.Circle(a, 1), pymunk.Circle(b, 1))
+    ledger = spaces.Ledger(space)
+    space.step(0.01)
+    spring = pymunk.DampedSpring(a, b, (0, 0), (0, 0), 4.0, 2.0, 0.0)
+    c = pymunk.Body(2, 1)
+    c.position, c.velocity = (50, 50), (3, 4)
+    space.add(spring, c, pymunk.Circle(c, 1))
+    space.step(0.01)
+    bal = ledger.balance()
+    assert _terms(bal, "program") == {"program: constraints added or removed": 36.0}
+    assert _terms(bal, "entered") == {"body 2": 25.0}
+    # One step on, both removed in one gap: the spring's potential leaves (pymunk moves
+    # bodies before it solves: the spring's 12 N for 0.01 s on 1 kg moved each 0.0012 in
+    # the second step, the stretch 6 - 0.0024) and the body's 25.
+    space.step(0.01)
+    stretch = (b.position - a.position).length - 4.0
+    assert stretch == pytest.approx(6.0 - 0.0024, rel=1e-12)
+    space.remove(spring, c, *c.shapes)
+    space.step(0.01)
+    bal = ledger.balance()
+    assert _terms(bal, "program") == {
+        "program: constraints added or removed": pytest.approx(36.0 - 0.5 * 2.0 * stretch ** 2,
+                                                               rel=1e-15)}
+    assert _terms(bal, "left") == {"body 2": pytest.approx(-25.0, rel=1e-15)}
+    # Gravity set beside a body added: the change of U_g of the bodies already there is
+    # gravity's, not the new body's coming.
+    c.velocity = (0, 0)
+    space.add(c, *c.shapes)
+    space.step(0.01)
+    before = {"body 0": a.local_to_world(a.center_of_gravity).y,
+              "body 1": b.local_to_world(b.center_of_gravity).y,
+              "body 2": c.local_to_world(c.center_of_gravity).y}
+    d = pymunk.Body(1, 1)
+    d.velocity = (0, 1)
+    space.gravity = (0, -10)
+    space.add(d, pymunk.Circle(d, 1))
+    space.step(0.01)
+    bal = ledger.balance()
+    program = _terms(bal, "program")
+    assert program.pop("program: space.gravity") == pytest.approx(
+        10.0 * (before["body 0"] + before["body 1"]) + 2 * 10.0 * before["body 2"], rel=1e-15)
+    assert program == {"program: constraints added or removed": pytest.approx(
+        36.0 - 0.5 * 2.0 * stretch ** 2, rel=1e-15)}
+    assert _terms(bal, "entered")["body 3"] == 0.5  # at height 0, moving at 1
+
+
 def test_callbacks_after_the_solver_are_unattributed_and_measured():
     # Issue 28, item 2: a post_solve callback halving a velocity inside the step. The
     # term is what the callback changed, measured around it.

@@ -1,9 +1,6 @@
 """The analyses as Python functions, for scripts and notebooks: each returns a typed, frozen
 result with ``to_pandas()``, and writes nothing (the CLI writes the files).
 
->>> result = dumbbell.compare("scenes/textbook-1d.toml")               # doctest: +SKIP
->>> result.to_pandas()[["dt", "window_error", "energy_error"]]           # doctest: +SKIP
-
 A scene may be given as a loaded :class:`Scene` or as the path of its file. Each function's
 options are the fields of one frozen record (:class:`~.compare.CompareOptions`,
 :class:`~.bench.BenchOptions`, :class:`~.sweep.SweepOptions`,
@@ -36,24 +33,112 @@ if TYPE_CHECKING:
 
 
 def compare(scene: Scene | str | Path, **options: Any) -> Comparison:
-    """Run solvers at their steps and the truth (exact in 1D and rigid 2D, the reference for
-    2D springs); measure position errors over a window, energy errors, impact times and run
-    times. ``options`` are the fields of :class:`~dumbbell.analysis.compare.CompareOptions`:
-    ``solvers`` (names or Solver classes; default: pymunk and the hand-written method),
-    ``dts`` (s; default the scene's), ``window`` (s), ``t_end`` (s) and ``quiet``.
-    ``.to_pandas()`` is the summary table, ``.impacts_to_pandas()`` the impacts."""
+    """Run solvers at their steps and the truth (exact in 1D and rigid 2D, the reference for 2D
+    springs); measure position errors over a window, energy errors, impact times and run
+    times: ``dumbbell compare`` without the files. The keywords are the fields of
+    :class:`~dumbbell.analysis.compare.CompareOptions`, each checked when it is built.
+
+    Parameters
+    ----------
+    scene : Scene or str or pathlib.Path
+        The scene, or its file.
+    solvers : list of str or Solver classes, optional
+        Default: pymunk and the hand-written method.
+    dts : list of float, optional
+        Steps (s); default the scene's.
+    window : float, default 2.0
+        The span [0, window] (s) the position error is measured over.
+    t_end : float, optional
+        The runs' end (s); default the scene's.
+    quiet : bool, default True
+        No progress bar.
+
+    Returns
+    -------
+    Comparison
+        ``.to_pandas()`` is the summary table (one row per run), ``.impacts_to_pandas()``
+        the impacts.
+
+    Raises
+    ------
+    SceneError
+        A scene file that is missing or not valid.
+    UsageError
+        An option that does not exist or a value it does not allow, or runs beyond the
+        budget (one line naming it and what would do).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> table = result.to_pandas()
+    >>> table.loc["euler-cromer", ["dt", "window_error"]].to_dict()   # m, over [0, 1] s
+    {'dt': 0.0001, 'window_error': 0.00151...}
+    >>> dumbbell.compare(scene, step=1e-4)
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: step: not an option; the options are solvers, dts, window, t_end, quiet
+    """
     from .compare import compare as run
 
     return run(scene, _record(CompareOptions, options))
 
 
 def bench(scene: Scene | str | Path, **options: Any) -> BenchResult:
-    """Error against run time for every solver at every step: the data of ``dumbbell
-    bench``'s work-precision diagram. ``options`` are the fields of
-    :class:`~dumbbell.analysis.bench.BenchOptions`: ``solvers`` (names or Solver classes),
-    ``dts`` (s), ``window`` (s), ``repeat`` timed runs after a warm-up, ``t_end`` (s),
-    ``budget`` (s: a step whose runs would take longer is skipped), ``spacing`` (s) and
-    ``quiet``. ``.to_pandas()`` has one row per (solver, dt)."""
+    """Error against run time for every solver at every step: the data of ``dumbbell bench``'s
+    work-precision diagram. The keywords are the fields of
+    :class:`~dumbbell.analysis.bench.BenchOptions`, each checked when it is built.
+
+    Parameters
+    ----------
+    scene : Scene or str or pathlib.Path
+        The scene, or its file.
+    solvers : list of str or Solver classes, optional
+        Default: every one that runs the scene.
+    dts : sequence of float, default 1e-3 down to 1e-6
+        Steps (s).
+    window : float, default 2.0
+        The span [0, window] (s) the position error is measured over.
+    repeat : int, default 5
+        Timed runs after a warm-up; the fastest counts.
+    t_end : float, optional
+        The runs' end (s); default the scene's.
+    budget : float, default 120.0
+        Seconds; a step whose runs would take longer is skipped (and says so).
+    spacing : float, optional
+        The sample spacing (s) errors are measured at.
+    quiet : bool, default True
+        No progress bar.
+
+    Returns
+    -------
+    BenchResult
+        ``.to_pandas()`` has one row per (solver, dt); ``.fits`` the measured orders.
+
+    Raises
+    ------
+    SceneError
+        A scene file that is missing or not valid.
+    UsageError
+        An option that does not exist or a value it does not allow.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer"], dts=[1e-3, 1e-4, 1e-5],
+    ...                         window=1.0, t_end=1.0, repeat=1)
+    >>> table = result.to_pandas()                  # the truth's row too, without a step
+    >>> table[["solver", "dt", "verdict"]].values.tolist()
+    [['euler-cromer', 0.001, 'ok'], ['euler-cromer', 0.0001, 'ok'], ['euler-cromer', 1e-05, 'ok'], ['exact', nan, 'ok']]
+    >>> errors = table["error"][:3].tolist()        # m: smaller with every smaller step
+    >>> errors[0] > errors[1] > errors[2]
+    True
+    """
     from .bench import run_bench
 
     return run_bench(scene, _record(BenchOptions, options))
@@ -61,14 +146,59 @@ def bench(scene: Scene | str | Path, **options: Any) -> BenchResult:
 
 def sweep(scene: Scene | str | Path,
           grid: Mapping[str, str | Sequence[Any]] | Sequence[str], **options: Any) -> SweepResult:
-    """Run the scene at every point of a grid of one or two scene keys. ``grid`` maps a
-    dotted key (``k`` and ``dt`` are short names) to a spec ``"log:A:B:N"``/``"lin:A:B:N"``
-    or a list of values, or is a list of ``"NAME=SPEC"`` as on the command line. ``options``
-    are the fields of :class:`~dumbbell.analysis.sweep.SweepOptions`: ``solver`` (a name or
-    a Solver class; default the scene's), ``t_end`` (s), ``workers`` local processes (None:
-    one per CPU) or a Dask ``scheduler``, and ``quiet``. ``.to_pandas()`` has one row per
-    point: the values, w*dt, the verdict, the time of failure (s) and the largest relative
-    energy error."""
+    """Run the scene at every point of a grid of one or two scene keys. The keywords are the fields
+    of :class:`~dumbbell.analysis.sweep.SweepOptions`, each checked when it is built.
+
+    Parameters
+    ----------
+    scene : Scene or str or pathlib.Path
+        The scene, or its file.
+    grid : mapping or list of str
+        A dotted key (``k`` and ``dt`` are short names) -> a spec ``"log:A:B:N"`` or
+        ``"lin:A:B:N"`` or a list of values; or a list of ``"NAME=SPEC"`` as on the command
+        line.
+    solver : str or Solver class, optional
+        Default the scene's.
+    t_end : float, optional
+        Each run's end (s); default the scene's.
+    workers : int or None, default 1
+        Local processes (None: one per CPU).
+    scheduler : str or None, default None
+        A Dask scheduler's address, to run on its cluster instead (the ``dask`` extra).
+    quiet : bool, default True
+        No progress bar.
+    processes : bool, default True
+        With Dask: worker processes rather than threads.
+    connect_timeout : float, default 10.0
+        With Dask: seconds to wait for the scheduler.
+
+    Returns
+    -------
+    SweepResult
+        ``.to_pandas()`` has one row per point: the values, w*dt, the verdict, the time of
+        failure (s) and the largest relative energy error.
+
+    Raises
+    ------
+    SceneError
+        A scene file that is missing or not valid.
+    UsageError
+        A grid or an option that is not allowed (one line naming it).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                         workers=1)
+    >>> result.to_pandas()[["spring.stiffness", "run.dt", "verdict"]].values.tolist()
+    [[200.0, 1e-05, 'ok'], [200.0, 0.001, 'ok'], [2000000.0, 1e-05, 'ok'], [2000000.0, 0.001, 'unstable']]
+    >>> dumbbell.sweep(scene, {"k": "log:1:2"})
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: ...
+    """
     from .sweep import check_axes, parse_axis, run_sweep
 
     if isinstance(grid, Mapping):
@@ -88,11 +218,55 @@ def sweep(scene: Scene | str | Path,
 
 
 def stability(cases: str | Path | None = None, **options: Any) -> StabilityResult:
-    """Run the extreme-case catalogue (or the scenes in the folder ``cases``) with every
-    solver that can run each case, each verdict beside the theory's. ``options`` are the
-    other fields of :class:`~dumbbell.analysis.stability.StabilityOptions`: ``solvers`` (names
-    or Solver classes), ``workers`` and ``quiet``. ``.to_pandas()`` has one row per run;
-    :func:`dumbbell.io.stability.markdown` is the report ``dumbbell stability`` writes."""
+    """Run the extreme-case catalogue (or the scenes in a folder) with every solver that can run
+    each case, each verdict beside the theory's. The keywords are the other fields of
+    :class:`~dumbbell.analysis.stability.StabilityOptions`, each checked when it is built.
+
+    Parameters
+    ----------
+    cases : str or pathlib.Path or None, default None
+        A folder of scene files; None: the shipped catalogue (minutes on 2 cores).
+    solvers : list of str or Solver classes, optional
+        Default: every one that runs each case.
+    workers : int or None, default None
+        Processes (None: one per CPU).
+    quiet : bool, default True
+        No progress bar.
+
+    Returns
+    -------
+    StabilityResult
+        ``.to_pandas()`` has one row per run; :func:`dumbbell.io.stability.markdown` is the
+        report ``dumbbell stability`` writes.
+
+    Raises
+    ------
+    UsageError
+        A folder that is missing or holds no scene file, or an option that is not allowed.
+    SceneError
+        A scene file in the folder that is not valid.
+
+    Examples
+    --------
+    A folder with one case: a spring so stiff that w·dt = 4.5, past the limit of 2 of both
+    explicit methods.
+
+    >>> from pathlib import Path
+    >>> import dumbbell
+    >>> Path("cases").mkdir()
+    >>> _ = Path("cases/stiff.toml").write_text('''
+    ... dimensions = 1
+    ... bodies.A = { mass = 0.1, height = 1.2 }
+    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... spring = { stiffness = 1e8, rest_length = 0.2 }
+    ... floor = { elasticity = 1.0 }
+    ... gravity = { g = 9.8 }
+    ... run = { t_end = 0.5, dt = 1e-4 }
+    ... ''')
+    >>> result = dumbbell.stability("cases", solvers=["euler-cromer", "verlet"], workers=1)
+    >>> result.to_pandas()[["case", "solver", "verdict"]].values.tolist()
+    [['stiff', 'euler-cromer', 'unstable'], ['stiff', 'verlet', 'unstable']]
+    """
     from .stability import run_stability
 
     return run_stability(_record(StabilityOptions, {"cases": cases, **options}))

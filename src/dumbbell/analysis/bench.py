@@ -105,8 +105,53 @@ SKIPPED = "skipped"
 
 @dataclass
 class Point:
-    """One (solver, dt) point. Times in s, ``error`` in m, ``energy_error`` relative;
-    ``verdict`` the run's verdict status, or None when the step was skipped (not run)."""
+    """One (solver, dt) point of a benchmark: a row of its CSV (the module's docstring says
+    how each is measured).
+
+    Parameters
+    ----------
+    solver : str
+        The solver's name.
+    dt : float or None
+        The step (s; None for a solver without one).
+    seconds, seconds_median : float
+        The fastest and the median of the timed runs (s, the solver's own clock).
+    error : float
+        The largest position error over [0, ``window``] s (m).
+    seconds_call : float
+        The fastest whole ``solve`` call, verdict included (s).
+    energy_error : float
+        The largest relative energy error over the run.
+    impact_time_error : float
+        The largest impact-time difference from the truth's before ``window`` (s).
+    impacts_compared, impacts_truth : int
+        Impacts compared, and the truth's impacts before ``window``.
+    verdict : str or None
+        The run's verdict status; None when the step was skipped (not run).
+    verdict_t : float or None
+        When a run that failed failed (s).
+    compile_seconds : float
+        The solver's ``warm_up()`` (s): numba compile, or load from its cache.
+    steps, every, repeat : int
+        Steps per run, steps per sample, timed runs.
+    window, t_end : float
+        The error's window and the run's end (s).
+    truth : str
+        The truth's solver.
+    reason : str
+        Why a run failed or a step was skipped.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
+    >>> point = result.points[0]
+    >>> point.solver, point.dt, point.steps, point.verdict, point.truth
+    ('euler-cromer', 0.001, 1000, 'ok', 'exact')
+    """
 
     solver: str
     dt: float | None
@@ -152,8 +197,32 @@ class Point:
 
 @dataclass
 class Fit:
-    """A fitted convergence order: error ~ C dt^order over the steps ``dts`` (s), beside the
-    order the solver declares (``expected``; None: it declares none)."""
+    """A fitted convergence order: error ~ C dt^order, beside the order the solver declares.
+
+    Parameters
+    ----------
+    solver : str
+        The solver's name.
+    order : float
+        The measured order (the slope of log error against log dt).
+    log10_c : float
+        log10 of C (C in m / s^order).
+    dts : list of float
+        The steps (s) the fit is over.
+    expected : int or None
+        The order the solver declares (None: it declares none).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
+    >>> fit = result.fits["verlet"]
+    >>> round(fit.order, 2), fit.expected, fit.dts
+    (2.0, 2, [1e-05, 0.0001, 0.001])
+    """
 
     solver: str
     order: float
@@ -172,7 +241,44 @@ CSV_UNITS = {"solver": "", "dt": "s", "seconds": "s", "error": "m", "seconds_med
 
 @dataclass(frozen=True)
 class BenchResult:
-    """Everything one benchmark measured."""
+    """Everything one benchmark measured: what :func:`dumbbell.bench` returns.
+
+    Parameters
+    ----------
+    scene, source : str
+        The scene's name and its file.
+    truth : str or None
+        The truth's solver (None: none).
+    window, t_end : float
+        The position error's window [0, window] and the runs' end (s).
+    repeat : int
+        Timed runs per point asked for.
+    budget : float
+        Seconds a step's runs may take before it is skipped.
+    points : list of Point
+        One per (solver, dt), the truth's last.
+    fits : dict of str to Fit
+        The measured order of each solver with enough points in its line.
+    notes : list of str
+        What the benchmark says about itself (skipped steps, ...).
+    spacing : float
+        The sample spacing (s) errors are measured at.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
+    >>> len(result.points), sorted(result.fits)
+    (7, ['verlet'])
+    >>> result.to_pandas()["solver"].tolist()[:2]
+    ['euler-cromer', 'euler-cromer']
+    >>> timing = result.speedups(1e-5)          # the run time each needs for 1e-5 m
+    >>> sorted(timing["seconds"])
+    ['verlet']
+    """
 
     scene: str
     source: str
@@ -213,9 +319,27 @@ class BenchResult:
         return html_table(repr(self), head, rows, [*fits, *self.notes])
 
     def speedups(self, target: float | None = None) -> dict[str, Any]:
-        """Run time each solver needs for the error ``target`` (m; default: Euler-Cromer's at
-        the textbook's dt), read off its work-precision line by log-log interpolation, and the
-        speed-up against Euler-Cromer (2D: euler-cromer-2d) there."""
+        """Run time each solver needs for an error, read off its work-precision line by
+        log-log interpolation, and the speed-up against Euler-Cromer (2D: euler-cromer-2d)
+        there.
+
+        Parameters
+        ----------
+        target : float or None, default None
+            The error (m); None: Euler-Cromer's at the textbook's dt (1e-5 s).
+
+        Returns
+        -------
+        dict
+            ``target_error`` (m), ``baseline`` (the solver compared against), ``seconds``
+            (solver -> s) and ``speedup`` (solver -> times faster than the baseline); empty
+            when there is no target (no baseline point at the textbook's dt).
+
+        Raises
+        ------
+        UsageError
+            A target that is not a finite number.
+        """
         target = None if target is None else args.real(target, "target", "m")
         base_name = self.baseline
         ref = next((p for p in self.points if p.solver == base_name and p.complete
@@ -242,7 +366,18 @@ class BenchResult:
 
     def to_pandas(self) -> pandas.DataFrame:
         """One row per point with the CSV's columns (numbered from 0), units in
-        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
+        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The columns of :class:`Point`.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
 
         rows = [asdict(p) for p in self.points]

@@ -143,7 +143,28 @@ class Timing:
     warm (the fastest of ``runs`` runs after the first, or the first when it was the only
     one), and ``warm_up``, what the first run paid on top (numba's start-up and compile, or
     the load from its cache; the solver's ``warm_up()`` included): NaN when nothing was
-    measured (one run of a solver with nothing to compile)."""
+    measured (one run of a solver with nothing to compile).
+
+    Parameters
+    ----------
+    seconds : float
+        The warm run time (s).
+    warm_up : float
+        What the first run paid on top (s).
+    runs : int, default 1
+        Runs timed.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> timing = result.rows[0].timing
+    >>> timing.seconds > 0, timing.runs >= 1
+    (True, True)
+    """
 
     seconds: float
     warm_up: float
@@ -156,7 +177,40 @@ class Row:
     error series (m, at the samples both have), its largest value over [0, ``error_until``]
     s (m; inf if the run stopped before then), ``error_until`` the window's end or where the
     runs part by chaos (:class:`Parting`, ``parted``) when that comes sooner, when the error
-    first passed 1 mm (s) and the energy error (dimensionless, over the whole run)."""
+    first passed 1 mm (s) and the energy error (dimensionless, over the whole run).
+
+    Parameters
+    ----------
+    label : str
+        The run's label (its solver, and its dt when several).
+    traj : Trajectory
+        The run.
+    error : numpy.ndarray
+        The position error (m) at the samples both have.
+    window_error : float
+        Its largest value over [0, ``error_until``] s (m).
+    diverged_at : float or None
+        When it first passed 1 mm (s).
+    energy_error : float
+        The energy error over the whole run (relative).
+    timing : Timing or None, default None
+        Its run time.
+    error_until : float, default nan
+        The window's end, or where the runs part by chaos (s).
+    parted : Parting or None, default None
+        Where and why the runs part, if they do.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> row = result.rows[0]
+    >>> row.label, round(row.window_error, 5), row.error_until, row.parted
+    ('euler-cromer', 0.00151, 1.0, None)
+    """
 
     label: str
     traj: Trajectory
@@ -192,7 +246,46 @@ class Row:
 
 @dataclass(frozen=True)
 class Comparison:
-    """The truth, the compared runs and the window (s) of the position errors."""
+    """The truth, the compared runs and the window (s) of the position errors.
+
+    What :func:`dumbbell.compare` returns.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene compared.
+    truth : Trajectory
+        The truth's run.
+    truth_note : str
+        What the truth is and how exact, in words.
+    rows : list of Row
+        One per compared run.
+    window : float
+        The position errors' window [0, window] (s).
+    notes : list of str, default []
+        What else to know.
+    truth_timing : Timing or None, default None
+        The truth's run time.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> result
+    <Comparison textbook-1d: truth exact; largest position error over [0, 1] s: euler-cromer 0.00151 m>
+    >>> result.to_pandas().index.tolist()
+    ['exact', 'euler-cromer']
+    >>> result.summary()[1]["label"], round(result.summary()[1]["window_error"], 5)   # m
+    ('euler-cromer', 0.00151)
+    >>> first = result.impacts()[0]                    # matched in order with the truth's
+    >>> first["body"], round(first["euler-cromer_diff"] * 1e3, 3)                      # ms
+    ('B', 0.046)
+    >>> result.impacts_to_pandas().columns.tolist()
+    ['body', 'truth_t', 'euler-cromer_t', 'euler-cromer_diff']
+    """
 
     scene: Scene
     truth: Trajectory
@@ -236,7 +329,13 @@ class Comparison:
         (s; None if never), energy error (the truth's own drift; NaN for a dissipative truth,
         which has nothing to be measured against) and impacts, both over the whole run,
         [0, ``run_until``] s, verdict and the first run's warm-up (s, :class:`Timing`; see
-        :data:`SUMMARY_UNITS`)."""
+        :data:`SUMMARY_UNITS`).
+
+        Returns
+        -------
+        list of dict
+            One per run, the truth first.
+        """
         out = []
         for row in [None, *self.rows]:
             r = self.truth if row is None else row.traj
@@ -261,7 +360,18 @@ class Comparison:
 
     def to_pandas(self) -> pandas.DataFrame:
         """:meth:`summary` as a DataFrame indexed by label, the verdict as text, units in
-        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'."""
+        ``df.attrs["units"]``. Needs pip install 'dumbbell[pandas]'.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
 
         records = self.summary()
@@ -271,7 +381,18 @@ class Comparison:
         return data_frame(columns, index="label", units=SUMMARY_UNITS)
 
     def impacts_to_pandas(self) -> pandas.DataFrame:
-        """:meth:`impacts` as a DataFrame indexed by impact number (times in s)."""
+        """:meth:`impacts` as a DataFrame indexed by impact number (times in s).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per impact.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
 
         records = self.impacts()
@@ -281,7 +402,14 @@ class Comparison:
 
     def impacts(self) -> list[dict[str, object]]:
         """Impacts matched in order: truth time and body, then each run's time and its
-        difference from the truth (s)."""
+        difference from the truth (s).
+
+        Returns
+        -------
+        list of dict
+            One per impact: ``n``, ``body``, ``truth_t``, then ``{label}_t`` and ``{label}_diff``
+            per run.
+        """
         out = []
         for i, ev in enumerate(self.truth.events):
             rec: dict[str, object] = {"n": i + 1, "body": ev.body, "truth_t": ev.t}

@@ -25,10 +25,38 @@ __all__ = ["ContactMomentum", "about_contact"]
 
 @dataclass(frozen=True)
 class ContactMomentum:
-    """Angular momentum about the contact point P = (``px``, 0) (m) of ``impact``: samples
-    ``t`` (s) around it, with ``L_cm``, the orbital part ``L_orbit`` = M (R - P) x V and their
-    sum ``L_P`` (kg m^2/s); and L_P, L_cm just before and just after, carried to the impact's
-    time (kg m^2/s)."""
+    """Angular momentum about the contact point P of one impact, before, through and after it:
+    what :func:`about_contact` returns. ``change`` is L_P after minus before.
+
+    Parameters
+    ----------
+    impact : Impact
+        The impact.
+    px : float
+        P's x (m); P = (px, 0) on the floor.
+    t : numpy.ndarray
+        Sample times around the impact (s).
+    L_cm, L_orbit, L_P : numpy.ndarray
+        At those samples (kg m²/s): the spin about the centre of mass, the orbital part
+        M (R - P) x V, and their sum.
+    before, after : float
+        L_P just before and just after, carried to the impact's time (kg m²/s).
+    L_cm_before, L_cm_after : float
+        L_cm just before and just after (kg m²/s).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.contact import about_contact
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
+    >>> about = about_contact(traj)
+    >>> round(about.before, 6), round(about.after, 6), abs(about.change) < 1e-12   # kg m²/s
+    (-0.044272, -0.044272, True)
+    >>> round(about.L_cm_before, 6), round(about.L_cm_after, 6)   # the spin jumps
+    (0.0, -0.070835)
+    """
 
     impact: Impact
     px: float
@@ -65,9 +93,42 @@ class ContactMomentum:
 
 
 def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> ContactMomentum:
-    """Angular momentum about the contact point of impact ``index`` (0: the first) of a 2D
-    trajectory, over ``window`` s either side. Sample finely (every step or two) for a sharp
-    before and after."""
+    """Angular momentum about the contact point of one impact of a 2D run. A frictionless
+    floor exerts no torque about P, so L_P is the same just before and just after, although
+    its two parts both jump.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A 2D run, sampled finely (every step or two) for a sharp before and after.
+    index : int, default 0
+        Which impact (0: the first).
+    window : float, default 0.02
+        Seconds either side of the impact to keep.
+
+    Returns
+    -------
+    ContactMomentum
+        L_P, L_cm and the orbital part around the impact, and before and after it.
+
+    Raises
+    ------
+    UsageError
+        A 1D run, an impact it does not have, or a window that is not a positive number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.contact import about_contact
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
+    >>> about = about_contact(traj)
+    >>> round(about.before, 6), round(about.after, 6), abs(about.change) < 1e-12   # kg m²/s
+    (-0.044272, -0.044272, True)
+    >>> round(about.L_cm_before, 6), round(about.L_cm_after, 6)   # the spin jumps
+    (0.0, -0.070835)
+    """
     traj = args.trajectory(traj)
     index = args.whole(index, "index", "impacts", lo=0)
     window = args.real(window, "window", "s")

@@ -46,8 +46,34 @@ def _formula_args(theta_deg: Any, e: Any, q: Any) -> tuple[np.ndarray, float, fl
 
 
 def e_eff_rigid(theta_deg: np.ndarray | float, e: float, q: float = 1.0) -> np.ndarray:
-    """The rigid dumbbell's apparent restitution (dimensionless) at tilt ``theta_deg``
-    (degrees from vertical), floor restitution ``e`` and q = M a_B^2 / I."""
+    """The rigid dumbbell's apparent restitution, (e - q sin² θ) / (1 + q sin² θ): minus the
+    centre of mass's vertical velocity after its first impact over before.
+
+    Parameters
+    ----------
+    theta_deg : float or array_like
+        The tilt (degrees from vertical).
+    e : float
+        The floor's restitution, 0..1.
+    q : float, default 1.0
+        M a_B² / I (1 for two equal point masses).
+
+    Returns
+    -------
+    numpy.ndarray
+        e_eff (dimensionless), one per tilt.
+
+    Raises
+    ------
+    UsageError
+        A tilt, ``e`` or ``q`` that is not allowed.
+
+    Examples
+    --------
+    >>> from dumbbell.analysis.restitution import e_eff_rigid
+    >>> e_eff_rigid([0.0, 30.0, 60.0], 1.0)      # upright, it bounces as the floor does
+    array([1.        , 0.6       , 0.14285714])
+    """
     theta_deg, e, q = _formula_args(theta_deg, e, q)
     s2 = np.sin(np.radians(theta_deg)) ** 2
     return (e - q * s2) / (1.0 + q * s2)
@@ -77,12 +103,31 @@ def rigid_q(scene: Scene) -> float:
 
 @dataclass(frozen=True)
 class Bounce:
-    """What one drop did at the floor. ``e_first``: -V_y after / V_y before the first impact;
-    ``e_cluster``: V_y as the dumbbell leaves the floor after the whole first cluster of
-    impacts (at its last impact) over V_y before the first (dimensionless; every velocity is
-    carried along the free fall to its impact's time); ``impacts``: impacts in the
-    cluster; ``share_first`` and ``share_cluster``: K_rot right after the first impact and
-    after the cluster, over the kinetic energy just before the first impact."""
+    """What one drop did at the floor: what :func:`bounce` measures. Every velocity is carried
+    along the free fall to its impact's time.
+
+    Parameters
+    ----------
+    e_first : float
+        -V_y after / V_y before the first impact (dimensionless).
+    e_cluster : float
+        V_y as the dumbbell leaves the floor after the whole first cluster of impacts (at its
+        last impact) over -V_y before the first.
+    impacts : int
+        Impacts in the cluster.
+    share_first, share_cluster : float
+        K_rot right after the first impact and after the cluster, over the kinetic energy
+        just before the first impact.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import bounce
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")       # tilted 30 deg
+    >>> bounce(dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4))
+    <Bounce e_first=0.6, e_cluster=0.6 after 1 impact, K_rot share 0.64 after the first, 0.64 after the cluster>
+    """
 
     e_first: float
     e_cluster: float
@@ -114,7 +159,36 @@ def _cm_vy(traj: Trajectory) -> np.ndarray:
 def bounce(traj: Trajectory, gap: float = CLUSTER_GAP) -> Bounce:
     """Measure the first impact cluster of a tilted drop. Velocities are read at the samples
     on either side and carried to the impact's time with the free fall's -g, so sampling does
-    not bias them; the run must continue ``gap`` s past the cluster."""
+    not bias them.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A 2D drop that runs on ``gap`` s past its first cluster of impacts.
+    gap : float, default 0.1
+        Seconds without an impact that end a cluster.
+
+    Returns
+    -------
+    Bounce
+        The apparent restitution and the K_rot share, after the first impact and after the
+        cluster.
+
+    Raises
+    ------
+    UsageError
+        A 1D run, a run without an impact, or one that ends within ``gap`` of its cluster.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import bounce, e_eff_rigid
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> drop = bounce(dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4))
+    >>> round(float(drop.e_first), 12), round(float(e_eff_rigid(30.0, 1.0)), 12)  # formula
+    (0.6, 0.6)
+    """
     traj = args.trajectory(traj)
     gap = args.real(gap, "gap", "s")
     return _bounce(traj, gap, cluster=True)
@@ -249,10 +323,42 @@ def truth_for(scene: Scene) -> str:
 
 @dataclass(frozen=True)
 class RestitutionResult:
-    """e_eff against tilt: ``theta`` (degrees), the formula, the rigid dumbbell in the truth
-    and in pymunk (first impact), each spring dumbbell (after the first cluster, with its
-    impacts and K_rot share), for floor restitution ``e`` and q = M a_B^2 / I. The rigid
-    dumbbell's K_rot share is taken right after its first impact, like its e_eff."""
+    """e_eff against tilt: the formula, the rigid dumbbell in the truth and in pymunk (first
+    impact), each spring dumbbell (after the first cluster, with its impacts and K_rot
+    share). What :func:`restitution` returns.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        The tilts (degrees).
+    e : float
+        The floor's restitution.
+    q : float
+        M a_B² / I.
+    formula, truth, pymunk : numpy.ndarray
+        e_eff by :func:`e_eff_rigid`, by the truth's rigid run, and by pymunk's.
+    truth_solver : str
+        The truth's solver.
+    pymunk_dt : float
+        pymunk's step (s).
+    springs : dict of float to dict of str to numpy.ndarray
+        Stiffness (N/m) -> its ``e_eff``, ``impacts`` and ``K_rot_share`` columns.
+    rigid_k_rot_share, rigid_impacts : numpy.ndarray or None
+        The rigid dumbbell's K_rot share right after its first impact (like its e_eff), and
+        its impacts.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import restitution
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> result = restitution(scene, [0.0, 30.0], stiffnesses=(), dt=1e-4)
+    >>> result
+    <RestitutionResult e=1, q=1: 2 tilts 0..30 deg; exact within 0 of the formula>
+    >>> list(result.columns())
+    ['theta', 'formula', 'truth', 'pymunk', 'rigid_impacts', 'rigid_K_rot_share']
+    """
 
     theta: np.ndarray
     e: float
@@ -292,7 +398,14 @@ class RestitutionResult:
         return sign_change_deg(self.e, self.q)
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The CSV's columns by name, in order."""
+        """The CSV's columns by name, in order.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``theta``, ``formula``, ``truth``, ``pymunk``, the rigid dumbbell's impacts and
+            K_rot share, then ``k{stiffness}_{e_eff, impacts, K_rot_share}`` per spring.
+        """
         out = {"theta": self.theta, "formula": self.formula, "truth": self.truth,
                "pymunk": self.pymunk}
         if self.rigid_impacts is not None:
@@ -385,9 +498,43 @@ def _check_elasticity(scene: Scene) -> None:
 def restitution(scene: Scene, thetas: np.ndarray | list[float],
                 stiffnesses: tuple[float, ...] = STIFFNESSES, dt: float = 1e-5,
                 progress=None) -> RestitutionResult:
-    """Run ``scene``'s dumbbell dropped at each tilt of ``thetas`` (degrees): rigid in the
-    truth and in pymunk at step ``dt`` (s), and as spring dumbbells of ``stiffnesses`` (N/m) in
-    pymunk. ``progress``, if given, is called once per run."""
+    """Drop the scene's dumbbell at each tilt: rigid in the truth and in pymunk, and as spring
+    dumbbells in pymunk; ``dumbbell restitution`` without the files.
+
+    Parameters
+    ----------
+    scene : Scene
+        A rigid 2D scene (its floor's restitution and masses are used).
+    thetas : array_like
+        Tilts (degrees from vertical).
+    stiffnesses : tuple of float, default (200.0, 2000.0, 20000.0)
+        Springs (N/m) to drop as well; () for none.
+    dt : float, default 1e-5
+        pymunk's step (s).
+    progress : callable or None, default None
+        Called once per run.
+
+    Returns
+    -------
+    RestitutionResult
+        e_eff of each tilt by the formula, the truth, pymunk and each spring.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, a scene that is not a rigid 2D drop, or runs that
+        would keep more samples than allowed.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import restitution
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> result = restitution(scene, [0.0, 30.0, 60.0], stiffnesses=(), dt=1e-4)
+    >>> result.formula, result.truth
+    (array([1.        , 0.6       , 0.14285714]), array([1.        , 0.6       , 0.14285714]))
+    """
     from ..solvers import simulate
 
     scene = args.scene(scene)

@@ -89,8 +89,31 @@ def variants(scene: Scene, stiffnesses: tuple[float, ...] = STIFFNESSES) -> dict
 
 @dataclass(frozen=True)
 class Series:
-    """The runs of the preview: label -> trajectory, the solver and step (s) used, and the
-    scene they were built from."""
+    """The runs of the rotation chapter's preview: what :func:`series` returns.
+
+    Parameters
+    ----------
+    runs : dict of str to Trajectory
+        Label (``"k = 200 N/m"``, ``"rigid"``) -> its run.
+    solver : str
+        The solver asked for.
+    dt : float
+        The step used (s).
+    scene : Scene
+        The scene they were built from.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.rotation import series
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
+    >>> runs = series(scene, dt=1e-4, t_end=0.3, stiffnesses=(200.0,))
+    >>> runs
+    <Series tilted-2d: 2 runs (k = 200 N/m, rigid), pymunk at dt = 0.0001 s>
+    >>> runs.runs["rigid"].columns[-3:]
+    ['U_g', 'E', 'L_cm']
+    """
 
     runs: dict[str, Trajectory]
     solver: str
@@ -113,8 +136,45 @@ class Series:
 
 def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float = 2.0,
            stiffnesses: tuple[float, ...] = STIFFNESSES) -> Series:
-    """Run every variant of ``scene`` with ``solver`` at step ``dt`` (s) up to ``t_end`` (s).
-    The step is cut where needed to keep w*dt <= 0.05 for the stiffest spring."""
+    """Run every variant of a 2D scene, one per spring stiffness and a rigid one, as the
+    rotation chapter's preview compares them. The step is cut where needed to keep
+    w*dt <= 0.05 for the stiffest spring; a variant the solver cannot run runs in pymunk.
+
+    Parameters
+    ----------
+    scene : Scene
+        A 2D scene.
+    solver : str, default "pymunk"
+        The solver's name.
+    dt : float, default 1e-5
+        The step (s), at most.
+    t_end : float, default 2.0
+        The runs' end (s), at most the scene's.
+    stiffnesses : tuple of float, default (200.0, 2000.0, 20000.0)
+        The springs (N/m).
+
+    Returns
+    -------
+    Series
+        The runs by label.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.rotation import series
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
+    >>> runs = series(scene, dt=1e-4, t_end=0.3, stiffnesses=(200.0,))
+    >>> runs
+    <Series tilted-2d: 2 runs (k = 200 N/m, rigid), pymunk at dt = 0.0001 s>
+    >>> runs.runs["rigid"].columns[-3:]
+    ['U_g', 'E', 'L_cm']
+    """
     from ..solvers import available, simulate, solver_class
 
     scene = args.scene(scene)

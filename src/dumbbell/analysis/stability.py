@@ -70,7 +70,56 @@ class StabilityRow:
     """One (case, solver) run beside the theory: one line of stability.csv, the fields in
     column order (units in :data:`UNITS`). ``inaccurate_energy`` is the case's threshold
     (``run.inaccurate_energy``): a run that stays stable is ``ok`` within it and
-    ``inaccurate`` past it, dated (``t_fail``) where its energy error first passed it."""
+    ``inaccurate`` past it, dated (``t_fail``) where its energy error first passed it.
+
+    Parameters
+    ----------
+    case, title : str
+        The case's name and its scene's title.
+    solver : str
+        The solver.
+    dt, w_dt : float
+        The step (s) and w*dt.
+    verdict : str
+        How the run ended.
+    t_fail : float or None
+        When it failed (s).
+    max_rel_energy_error : float
+        The largest relative energy error.
+    inaccurate_energy : float
+        The case's threshold.
+    dissipative : bool
+        Whether the scene loses energy.
+    predicted : str
+        The theory's verdict.
+    agreement : str
+        Whether the run agrees with it.
+    reason : str
+        The verdict's reason.
+    theory : str
+        The theory's reason.
+    wall_s : float
+        The run time (s).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import dumbbell
+    >>> Path("cases").mkdir()
+    >>> _ = Path("cases/stiff.toml").write_text('''
+    ... dimensions = 1
+    ... bodies.A = { mass = 0.1, height = 1.2 }
+    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... spring = { stiffness = 1e8, rest_length = 0.2 }
+    ... floor = { elasticity = 1.0 }
+    ... gravity = { g = 9.8 }
+    ... run = { t_end = 0.5, dt = 1e-4 }
+    ... ''')
+    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> row = result.rows[0]
+    >>> row.verdict, row.predicted, round(row.w_dt, 2)
+    ('unstable', 'unstable', 4.47)
+    """
 
     case: str
     title: str
@@ -101,7 +150,37 @@ COLUMNS = tuple(f.name for f in fields(StabilityRow))
 @dataclass(frozen=True)
 class StabilityResult:
     """The catalogue's report: one row per (case, solver) run, and the pairs not run because
-    the solver cannot run the scene."""
+    the solver cannot run the scene.
+
+    What :func:`dumbbell.stability` returns.
+
+    Parameters
+    ----------
+    rows : tuple of StabilityRow
+        One per run.
+    skipped : tuple of str, default ()
+        The pairs not run, and why.
+    guard : tuple of str, default ()
+        What the step-size guard said about the pymunk runs.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import dumbbell
+    >>> Path("cases").mkdir()
+    >>> _ = Path("cases/stiff.toml").write_text('''
+    ... dimensions = 1
+    ... bodies.A = { mass = 0.1, height = 1.2 }
+    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... spring = { stiffness = 1e8, rest_length = 0.2 }
+    ... floor = { elasticity = 1.0 }
+    ... gravity = { g = 9.8 }
+    ... run = { t_end = 0.5, dt = 1e-4 }
+    ... ''')
+    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> result.to_pandas()[["case", "solver", "verdict", "agreement"]].values.tolist()
+    [['stiff', 'verlet', 'unstable', 'agrees']]
+    """
 
     rows: tuple[StabilityRow, ...]
     skipped: tuple[str, ...] = ()
@@ -135,7 +214,18 @@ class StabilityResult:
 
     def to_pandas(self) -> pandas.DataFrame:
         """One row per run with the CSV's columns, units in ``df.attrs["units"]``. Needs
-        pip install 'dumbbell[pandas]'."""
+        pip install 'dumbbell[pandas]'.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The fields of :class:`StabilityRow`.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
 
         return data_frame({c: [getattr(r, c) for r in self.rows] for c in COLUMNS},

@@ -58,8 +58,30 @@ MAX_AXIS_VALUES = 10_000
 
 @dataclass(frozen=True)
 class Axis:
-    """One grid axis: the dotted scene key, the text it came from, its values and how they
-    are spaced ('log', 'lin' or 'list')."""
+    """One axis of a sweep's grid.
+
+    Parameters
+    ----------
+    key : str
+        The dotted scene key (``spring.stiffness``; ``k`` and ``dt`` are short names for it
+        and ``run.dt``).
+    text : str
+        The text it came from (``"k=log:1e2:1e7:8"``).
+    values : tuple
+        Its values, in order.
+    spacing : {'log', 'lin', 'list'}
+        How they are spaced.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                         workers=1)
+    >>> result.axes[0]
+    Axis(key='spring.stiffness', text='k=200.0,2000000.0', values=(200.0, 2000000.0), spacing='list')
+    """
 
     key: str
     text: str
@@ -239,10 +261,36 @@ def _plan(scene: Scene, axes: Sequence[Axis], cls: type[Solver], t_end: float | 
 
 @dataclass(frozen=True)
 class PointResult:
-    """One grid point's run: the dotted scene values it set (``values``, (key, value) pairs
-    in the order given), then the result fields in CSV column order: w*dt (1), the verdict,
-    the time of failure (s, None if none), the largest relative energy error over the kept
-    samples (1) and the verdict's reason."""
+    """One grid point's run: a row of the sweep's CSV.
+
+    Parameters
+    ----------
+    values : tuple of (str, value) pairs
+        The dotted scene values it set, in the order given.
+    w_dt : float
+        w*dt (dimensionless), w = sqrt(k/mu).
+    verdict : str
+        The run's verdict status.
+    t_fail : float or None
+        The time of failure (s; None if none).
+    max_rel_energy_error : float
+        The largest relative energy error over the kept samples.
+    reason : str
+        The verdict's reason.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                         workers=1)
+    >>> point = result.rows[-1]
+    >>> point.values, round(point.w_dt, 2), point.verdict
+    ((('spring.stiffness', 2000000.0), ('run.dt', 0.001)), 6.32, 'unstable')
+    >>> print(point.reason)
+    w*dt = 6.32 > 2 (w = sqrt(k/mu) = 6325 rad/s): the step is stable only for dt < 3.16e-4 s; try dt = ...
+    """
 
     values: tuple[tuple[str, Any], ...]
     w_dt: float
@@ -307,7 +355,40 @@ RESULT_UNITS = {"w_dt": "1", "verdict": "", "t_fail": "s", "max_rel_energy_error
 
 @dataclass(frozen=True)
 class SweepResult:
-    """The rows of a sweep in grid order, with the axes, the scene and how long it took."""
+    """The rows of a sweep in grid order, with the axes, the scene and how long it took: what
+    :func:`dumbbell.sweep` returns.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene swept.
+    axes : list of Axis
+        One or two.
+    solver : str
+        The solver's name.
+    t_end : float
+        Each run's end (s).
+    rows : list of PointResult
+        One per grid point, the last axis varying fastest.
+    wall_time : float, default 0.0
+        The sweep's run time (s).
+    backend : str, default ""
+        Where it ran (serial, processes, a Dask cluster).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                         workers=1)
+    >>> result.counts()
+    {'ok': 3, 'unstable': 1}
+    >>> result.to_pandas()["verdict"].tolist()
+    ['ok', 'ok', 'ok', 'unstable']
+    >>> [(line["spring.stiffness"], float(line["largest_ok_dt"])) for line in result.boundary()]
+    [(200.0, 0.001), (2000000.0, 1e-05)]
+    """
 
     scene: Scene
     axes: list[Axis]
@@ -347,7 +428,18 @@ class SweepResult:
     def to_pandas(self) -> pandas.DataFrame:
         """One row per grid point in grid order, the CSV's columns, units in
         ``df.attrs["units"]`` (an axis's unit is left empty: any scene key can be swept).
-        Needs pip install 'dumbbell[pandas]'."""
+        Needs pip install 'dumbbell[pandas]'.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The axes' values, then the fields of :class:`PointResult`.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
 
         units = {a.key: "" for a in self.axes} | RESULT_UNITS
@@ -356,17 +448,30 @@ class SweepResult:
                           units=units)
 
     def counts(self) -> dict[str, int]:
-        """How many points ended with each verdict."""
+        """How many points ended with each verdict.
+
+        Returns
+        -------
+        dict of str to int
+            Verdict status -> points.
+        """
         out: dict[str, int] = {}
         for row in self.rows:
             out[row.verdict] = out.get(row.verdict, 0) + 1
         return out
 
     def boundary(self) -> list[dict[str, float]]:
-        """Where a (something, run.dt) sweep stops being stable: for each value of the other
-        axis, the largest dt below which every point reached its end (``ok`` or
-        ``inaccurate``: the stability boundary, not the accuracy's), its w*dt and the
-        theory's 2/w (s). Empty unless one of two axes is run.dt."""
+        """Where a (something, run.dt) sweep stops being stable.
+
+        Returns
+        -------
+        list of dict
+            For each value of the other axis: that value, ``largest_ok_dt`` (the largest dt
+            below which every point reached its end, ``ok`` or ``inaccurate``: the stability
+            boundary, not the accuracy's; s), its ``w_dt``, ``first_failing_dt`` (s; nan if
+            none) and ``theory_dt``, the theory's 2/w (s). Empty unless one of two axes is
+            run.dt.
+        """
         if len(self.axes) != 2 or "run.dt" not in (a.key for a in self.axes):
             return []
         di = [a.key for a in self.axes].index("run.dt")

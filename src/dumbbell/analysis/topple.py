@@ -37,7 +37,45 @@ MAX_CURVE_POINTS = 100_000
 @dataclass(frozen=True)
 class ToppleClosedForm:
     """The closed form of the topple for a rigid dumbbell with B resting on a frictionless
-    floor. Masses in kg, lengths in m, angles in rad from vertical, g in m/s^2."""
+    floor: what :func:`closed_form` returns. Angles are in rad from vertical.
+
+    Parameters
+    ----------
+    mA, mB : float
+        The top and bottom particles' masses (kg).
+    L : float
+        The rod's length (m).
+    I : float
+        The moment of inertia about the centre of mass (kg m²).
+    g : float
+        Gravity (m/s²).
+    theta0 : float
+        The angle it is released at (rad).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.topple import closed_form
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> topple = closed_form(dumbbell.load_scene(scenes_dir() / "topple-2d.toml"))
+    >>> topple
+    <ToppleClosedForm mA=0.1 kg, mB=0.1 kg, L=0.2 m, I=0.002 kg m^2, g=9.8 m/s^2, released at 5 deg>
+    >>> round(topple.fall_time(), 6), topple.check()          # s; B stays on the floor
+    (0.406387, None)
+    >>> [round(v, 4) for v in topple.landing_speeds()]         # centre of mass, top (m/s)
+    [0.9881, 1.9761]
+    >>> round(topple.landing_omega(), 4)                        # rad/s
+    9.8806
+    >>> topple.omega([0.5, 1.0]).round(4)                      # rad/s at 0.5 and 1 rad
+    array([4.3478, 7.2328])
+    >>> round(float(topple.alpha(1.0)), 4)                     # rad/s²
+    34.3545
+    >>> topple.normal_force([topple.theta0, 1.0]).round(4)     # N: M g at the release
+    array([1.9452, 0.8165])
+    >>> t, theta = topple.angle_curve(5)
+    >>> t.round(4), theta.round(4)
+    (array([0.    , 0.1377, 0.2425, 0.328 , 0.4064]), array([0.0873, 0.18  , 0.4581, 0.9218, 1.5708]))
+    """
 
     mA: float
     mB: float
@@ -73,7 +111,23 @@ class ToppleClosedForm:
         return self.mA * self.L / self.M
 
     def omega(self, theta: np.ndarray | float) -> np.ndarray:
-        """Angular speed |theta'| (rad/s) at angle ``theta`` (rad), from energy conservation."""
+        """Angular speed |theta'| at an angle, from energy conservation.
+
+        Parameters
+        ----------
+        theta : float or array_like
+            The angle from vertical (rad), from ``theta0`` to pi/2.
+
+        Returns
+        -------
+        numpy.ndarray
+            The angular speed (rad/s).
+
+        Raises
+        ------
+        UsageError
+            Angles that are not finite numbers.
+        """
         return self._omega_past(args.array(theta, "theta", "rad") - self.theta0)
 
     def _omega_past(self, delta: np.ndarray | float) -> np.ndarray:
@@ -86,8 +140,24 @@ class ToppleClosedForm:
         return np.sqrt(2.0 * M * self.g * a * drop / (M * a * a * np.sin(th) ** 2 + self.I))
 
     def alpha(self, theta: np.ndarray | float) -> np.ndarray:
-        """Angular acceleration theta'' (rad/s^2) at ``theta`` (rad): half the derivative of
-        omega^2 with respect to theta."""
+        """Angular acceleration theta'' at an angle: half the derivative of omega² with
+        respect to theta.
+
+        Parameters
+        ----------
+        theta : float or array_like
+            The angle from vertical (rad).
+
+        Returns
+        -------
+        numpy.ndarray
+            The angular acceleration (rad/s²).
+
+        Raises
+        ------
+        UsageError
+            Angles that are not finite numbers.
+        """
         th = args.array(theta, "theta", "rad")
         M, a, g = self.M, self.a, self.g
         s, c = np.sin(th), np.cos(th)
@@ -96,27 +166,61 @@ class ToppleClosedForm:
         return 0.5 * (2.0 * M * g * a * s * den - num * 2.0 * M * a * a * s * c) / den**2
 
     def normal_force(self, theta: np.ndarray | float) -> np.ndarray:
-        """The floor's push on B (N) at ``theta`` (rad): M (g + Y''). It must stay >= 0 for B
-        to keep touching the floor; :meth:`check` says where it does not."""
+        """The floor's push on B at an angle: M (g + Y''). It must stay >= 0 for B to keep
+        touching the floor; :meth:`check` says where it does not.
+
+        Parameters
+        ----------
+        theta : float or array_like
+            The angle from vertical (rad).
+
+        Returns
+        -------
+        numpy.ndarray
+            The normal force (N).
+
+        Raises
+        ------
+        UsageError
+            Angles that are not finite numbers.
+        """
         th = args.array(theta, "theta", "rad")
         w, al = self.omega(th), self.alpha(th)
         y_dd = -self.a * (np.cos(th) * w * w + np.sin(th) * al)
         return self.M * (self.g + y_dd)
 
     def landing_omega(self) -> float:
-        """Angular speed at the landing, theta = 90 degrees (rad/s)."""
+        """Angular speed at the landing, theta = 90 degrees.
+
+        Returns
+        -------
+        float
+            rad/s.
+        """
         return float(self.omega(math.pi / 2))
 
     def landing_speeds(self) -> tuple[float, float]:
-        """(centre of mass, top particle A) speeds at the landing (m/s), both straight down."""
+        """Speeds at the landing, both straight down.
+
+        Returns
+        -------
+        tuple of float
+            The centre of mass's and the top particle A's (m/s).
+        """
         w = self.landing_omega()
         return self.a * w, self.L * w
 
     def fall_time(self) -> float:
-        """Time from release to the landing (s), by quadrature of d(theta)/theta'.
+        """Time from release to the landing, by quadrature of d(theta)/theta'.
 
         theta' vanishes at the release like sqrt(theta - theta0); writing
-        theta = theta0 + (pi/2 - theta0) u^2 turns that into a smooth integrand."""
+        theta = theta0 + (pi/2 - theta0) u^2 turns that into a smooth integrand.
+
+        Returns
+        -------
+        float
+            The fall time (s).
+        """
         from scipy.integrate import quad
 
         return quad(self._dt_du, 0.0, 1.0, epsabs=1e-13, epsrel=1e-12, limit=200)[0]
@@ -131,8 +235,26 @@ class ToppleClosedForm:
         return 2.0 * span * u / float(self._omega_past(span * u * u))
 
     def angle_curve(self, n: int = 400) -> tuple[np.ndarray, np.ndarray]:
-        """(t in s, theta in rad) from the release to the landing, ``n`` points, each time by
-        its own quadrature from the release."""
+        """The angle against time from the release to the landing, each time by its own
+        quadrature from the release.
+
+        Parameters
+        ----------
+        n : int, default 400
+            Points, at least 2.
+
+        Returns
+        -------
+        t : numpy.ndarray
+            Times (s).
+        theta : numpy.ndarray
+            Angles (rad).
+
+        Raises
+        ------
+        UsageError
+            ``n`` not a whole number from 2 to the most allowed.
+        """
         n = args.whole(n, "n", "points", lo=2, hi=MAX_CURVE_POINTS)
         from scipy.integrate import quad
 
@@ -143,8 +265,13 @@ class ToppleClosedForm:
         return t, self.theta0 + (math.pi / 2 - self.theta0) * u * u
 
     def check(self) -> str | None:
-        """None when B stays on the floor all the way down; else why the closed form does not
-        hold (the floor would have to pull)."""
+        """Whether the closed form holds: B stays on the floor all the way down.
+
+        Returns
+        -------
+        str or None
+            None when it holds; else why not (the floor would have to pull).
+        """
         th = np.linspace(self.theta0, math.pi / 2, 2001)
         n = self.normal_force(th)
         if float(n.min()) < 0:
@@ -156,8 +283,35 @@ class ToppleClosedForm:
 
 def closed_form(scene: Scene) -> ToppleClosedForm:
     """The closed form for a topple scene: a rigid dumbbell, B at rest on a frictionless floor
-    at height 0, A above it, tilted by a small nonzero angle. Raises UsageError naming what
-    does not fit."""
+    at height 0, A above it, tilted by a small nonzero angle.
+
+    Parameters
+    ----------
+    scene : Scene
+        The topple scene.
+
+    Returns
+    -------
+    ToppleClosedForm
+        Its masses, length, moment of inertia, gravity and release angle.
+
+    Raises
+    ------
+    UsageError
+        A scene that does not fit, naming what does not.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.topple import closed_form
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> round(closed_form(dumbbell.load_scene(scenes_dir() / "topple-2d.toml")).fall_time(), 6)
+    0.406387
+    >>> closed_form(dumbbell.load_scene(scenes_dir() / "textbook-1d.toml"))
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: ...textbook-1d.toml: the topple needs a rigid 2D dumbbell ([rigid], dimensions = 2)
+    """
     scene = args.scene(scene)
     where = scene.source
     if scene.system.dimensions != 2 or scene.system.rigid is None:
@@ -184,10 +338,32 @@ def closed_form(scene: Scene) -> ToppleClosedForm:
 
 @dataclass(frozen=True)
 class ToppleMeasure:
-    """The topple as read off a trajectory: landing time (s, A's centre reaches the floor),
-    speeds at the landing (m/s), the largest horizontal drift of the centre of mass (m), and
-    the angle from vertical (rad), the centre of mass's horizontal displacement (m) and the
-    top particle's speed (m/s) against time (s), up to the landing."""
+    """The topple as read off a trajectory: what :func:`measure` returns.
+
+    Parameters
+    ----------
+    fall_time : float
+        When A's centre reaches the floor (s).
+    v_top, v_cm : float
+        The top particle's and the centre of mass's speeds at the landing (m/s).
+    cm_drift : float
+        The largest horizontal drift of the centre of mass (m).
+    t : numpy.ndarray
+        Times up to the landing (s).
+    theta, cm_x, v_top_curve : numpy.ndarray
+        At those times: the angle from vertical (rad), the centre of mass's horizontal
+        displacement (m) and the top particle's speed (m/s).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.topple import measure
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "topple-2d.toml")
+    >>> topple = measure(dumbbell.simulate(scene, dt=1e-4, every=1, t_end=0.45))  # pymunk
+    >>> round(topple.fall_time, 6), round(topple.v_top, 4), len(topple.t)   # s, m/s
+    (0.406437, 1.9763, 4065)
+    """
 
     fall_time: float
     v_top: float
@@ -214,9 +390,34 @@ class ToppleMeasure:
 
 
 def measure(traj: Trajectory) -> ToppleMeasure:
-    """Measure the topple in ``traj`` (2D, B on the floor): the landing is where A's height
-    first reaches 0, found by linear interpolation between samples; the speeds are taken at
-    the last sample before it (sample finely: ``every`` of 1 ms or less)."""
+    """Measure the topple in a run: the landing is where A's height first reaches 0, found by
+    linear interpolation between samples; the speeds are taken at the last sample before it.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A 2D run of the topple scene (B on the floor), sampled finely (1 ms or less).
+
+    Returns
+    -------
+    ToppleMeasure
+        The fall time, the landing speeds and the curves up to the landing.
+
+    Raises
+    ------
+    UsageError
+        A 1D run, or one in which A never reaches the floor.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.topple import closed_form, measure
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "topple-2d.toml")
+    >>> pymunk = measure(dumbbell.simulate(scene, dt=1e-4, every=1, t_end=0.45)).fall_time
+    >>> f"{pymunk - closed_form(scene).fall_time():.1e} s"   # late by about half a step
+    '5.0e-05 s'
+    """
     traj = args.trajectory(traj)
     if traj.scene.system.dimensions != 2:
         raise UsageError(f"traj: {traj.scene.source} is 1D; the topple is measured in 2D",

@@ -56,7 +56,33 @@ NOTEBOOK_EXTRA = 230
 
 class Player:
     """An interactive player page (HTML text, self-contained): ``save(path)`` writes it,
-    a notebook shows it inline (``_repr_html_``: the page in a frame of its own)."""
+    a notebook shows it inline (``_repr_html_``: the page in a frame of its own). Made by
+    :func:`player`.
+
+    Parameters
+    ----------
+    html_text : str
+        The page.
+    size : tuple of int, default (640, 360)
+        The picture's size (px), for the frame a notebook shows it in.
+
+    Raises
+    ------
+    UsageError
+        A page that is not a str, or a size that is not allowed.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> page = dumbbell.player(traj, fps=10, size="320x180")
+    >>> page.save("textbook.html").name
+    'textbook.html'
+    >>> page.html.startswith("<!DOCTYPE html>")
+    True
+    """
 
     def __init__(self, html_text: str, size: tuple[int, int] = (640, 360)) -> None:
         if not isinstance(html_text, str):
@@ -80,7 +106,23 @@ class Player:
                 'sandbox="allow-scripts"></iframe>')
 
     def save(self, path: str | Path) -> Path:
-        """Write the page to ``path`` (atomically) and return the path."""
+        """Write the page, whole or not at all.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The HTML file.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+
+        Raises
+        ------
+        UsageError
+            A path that cannot be written (one line saying why).
+        """
         from ..files import atomic_output, check_writable
         from ..model import args
 
@@ -293,8 +335,45 @@ def player(source: Any, *, fps: int | None = None, size: str | tuple[int, int] |
     the energy time series; by default the scene's ``[outputs.gif]`` settings, else 25 fps,
     640x360, strip on. ``t_end`` (s) ends it early (default: the longest run's end);
     ``labels`` name the runs (default: the solvers). At most ``max_samples`` samples of each
-    run are kept (evenly thinned beyond). Returns a :class:`Player`: ``.save(path)`` writes
-    the HTML file; a notebook shows it inline."""
+    run are kept (evenly thinned beyond).
+
+    Parameters
+    ----------
+    source : Trajectory or Comparison or list of Trajectory
+        What to play.
+    fps : int or None, default None
+        Frames per second.
+    size : str or tuple of int or None, default None
+        The picture, 'WxH' (px).
+    strip : bool or None, default None
+        Show the energy time series.
+    t_end : float or None, default None
+        End early (s).
+    labels : sequence of str or None, default None
+        The runs' names.
+    max_samples : int, default 40001
+        Samples kept of each run.
+
+    Returns
+    -------
+    Player
+        ``.save(path)`` writes the HTML file; a notebook shows it inline.
+
+    Raises
+    ------
+    UsageError
+        A source or an argument that is not allowed.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> runs = [traj, dumbbell.simulate(scene, solver="verlet", t_end=1.0, dt=1e-3)]
+    >>> dumbbell.player(runs, labels=["exact", "verlet"], fps=10).save("two.html").name
+    'two.html'
+    """
     from ..model import args
     from ..model.scene import GifSettings
     from .picture import describe

@@ -195,7 +195,30 @@ def since_previous(values: np.ndarray, idx: np.ndarray, ufunc: np.ufunc) -> np.n
 
 class Gif(bytes):
     """The bytes of a GIF file that shows itself in a notebook: ``_repr_html_`` embeds the
-    animation, ``_repr_png_`` gives its first frame. It is ``bytes`` in every other way."""
+    animation, ``_repr_png_`` gives its first frame. It is ``bytes`` in every other way.
+
+    Parameters
+    ----------
+    data : bytes-like, default b""
+        The GIF file's bytes.
+
+    Raises
+    ------
+    UsageError
+        Data that is not bytes-like.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> gif = dumbbell.render_gif(traj, fps=10, size="320x180", quiet=True)
+    >>> gif[:6], type(gif).__name__
+    (b'GIF89a', 'Gif')
+    >>> gif.save("textbook.gif").name
+    'textbook.gif'
+    """
 
     def __new__(cls, data: bytes | bytearray | memoryview = b"") -> Self:
         if not isinstance(data, bytes | bytearray | memoryview):
@@ -226,7 +249,23 @@ class Gif(bytes):
         return out.getvalue()
 
     def save(self, path: str | Path) -> Path:
-        """Write the GIF to ``path`` (atomically) and return the path."""
+        """Write the GIF, whole or not at all.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+
+        Raises
+        ------
+        UsageError
+            A path that cannot be written (one line saying why).
+        """
         from ..files import check_writable
         from ..model import args
         from .writer import binary_output
@@ -259,10 +298,50 @@ def render_gif(
     """An animated GIF of ``traj``: written to ``path`` (atomically) and the path returned,
     or with no path its bytes returned as a :class:`Gif`, which a notebook shows inline.
 
-    ``fps`` frames per second (1..50), ``size`` 'WxH' in px, ``strip`` adds the energy time
-    series with a cursor, ``t_end`` (s) ends the animation early (default: the trajectory's
-    end); more than ``max_frames`` frames are refused. ``timing``, when given, receives the
-    seconds spent drawing and encoding."""
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    path : str or pathlib.Path or None, default None
+        The GIF file; None: return the bytes.
+    quiet : bool, default False
+        No progress bar.
+    fps : int, default 25
+        Frames per second (1..50).
+    size : str or tuple of int, default "640x360"
+        'WxH' or (W, H), in px.
+    strip : bool, default True
+        Add the energy time series with a cursor below the picture.
+    t_end : float or None, default None
+        End the animation early (s; None: the trajectory's end).
+    timing : dict or None, default None
+        When given, receives the seconds spent drawing and encoding.
+    max_frames : int, default 15000
+        More frames than this are refused before any is drawn.
+
+    Returns
+    -------
+    pathlib.Path or Gif
+        The file written, or the GIF's bytes.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, or a path that cannot be written.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> dumbbell.render_gif(traj, "textbook.gif", fps=10, size=(320, 180), quiet=True).name
+    'textbook.gif'
+    >>> dumbbell.render_gif(traj, fps=100)
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: fps = 100: ...
+    """
     from ..model import args
 
     if not isinstance(traj, Trajectory):

@@ -84,7 +84,35 @@ def _sci(x: float | None, digits: int = 2) -> str:
 
 
 def markdown(result: BenchResult) -> str:
-    """The table, fitted orders and matched-error speed-ups as markdown."""
+    """The table, fitted orders and matched-error speed-ups as markdown: the
+    ``bench-SCENE.md`` that ``dumbbell bench`` writes.
+
+    Parameters
+    ----------
+    result : BenchResult
+        What :func:`dumbbell.bench` measured.
+
+    Returns
+    -------
+    str
+        The Markdown text.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a BenchResult.
+
+    Examples
+    --------
+    >>> from dumbbell.io.bench import markdown
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["verlet"], dts=[1e-3, 1e-4, 1e-5], window=1.0,
+    ...                         t_end=1.0, repeat=1)
+    >>> print(markdown(result).splitlines()[2])
+    | solver | dt (s) | steps | run time min (median) | position error (m) | ...
+    """
     result = _checked(result)
     lines = [
         (f"Work-precision benchmark of `{result.source}` over t_end = {result.t_end:g} s; "
@@ -161,9 +189,39 @@ def write_markdown(result: BenchResult, path: Path) -> Path:
 
 
 def write_all(result: BenchResult, out: Path) -> list[Path]:
-    """CSV, JSON and markdown into ``out``, named bench-SCENE*. (The figures are
+    """CSV, JSON and markdown into a folder, named bench-SCENE*. (The figures are
     :mod:`dumbbell.plot`'s: :func:`~dumbbell.plot.work_precision` and
-    :func:`~dumbbell.plot.convergence`; the command saves them.)"""
+    :func:`~dumbbell.plot.convergence`; the command saves them.)
+
+    Parameters
+    ----------
+    result : BenchResult
+        What :func:`dumbbell.bench` measured.
+    out : pathlib.Path
+        The folder (made if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, each whole or not at all.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a BenchResult, or a folder that cannot be written.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from dumbbell.io.bench import write_all
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["verlet"], dts=[1e-3, 1e-4, 1e-5], window=1.0,
+    ...                         t_end=1.0, repeat=1)
+    >>> [path.name for path in write_all(result, Path("bench"))]
+    ['bench-textbook-1d.csv', 'bench-textbook-1d.json', 'bench-textbook-1d.md']
+    """
     result = _checked(result)
     out = args.path(out, "out")
     stem = f"bench-{result.scene}"

@@ -72,8 +72,38 @@ def write_errors(result: Comparison, path: Path) -> Path:
 
 
 def write(result: Comparison, out: Path) -> list[Path]:
-    """SCENE-compare.csv, -compare-impacts.csv and -compare-errors.csv into ``out``; returns
-    the paths."""
+    """SCENE-compare.csv, -compare-impacts.csv and -compare-errors.csv into a folder: what
+    ``dumbbell compare`` writes.
+
+    Parameters
+    ----------
+    result : Comparison
+        What :func:`dumbbell.compare` measured.
+    out : pathlib.Path
+        The folder (made if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, each whole or not at all.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a Comparison, or a folder that cannot be written.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from dumbbell.io.compare import write
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> [path.name for path in write(result, Path("compare"))]
+    ['textbook-1d-compare.csv', 'textbook-1d-compare-impacts.csv', 'textbook-1d-compare-errors.csv']
+    """
     result = _checked(result)
     out = args.path(out, "out")
     stem = out / f"{result.scene.name}-compare"
@@ -84,7 +114,34 @@ def write(result: Comparison, out: Path) -> list[Path]:
 
 def text(result: Comparison) -> str:
     """The summary as a fixed-width text table (times in s, position errors in m, steps/s),
-    then the impacts inside the window and the notes: what ``dumbbell compare`` prints."""
+    then the impacts inside the window and the notes: what ``dumbbell compare`` prints.
+
+    Parameters
+    ----------
+    result : Comparison
+        What :func:`dumbbell.compare` measured.
+
+    Returns
+    -------
+    str
+        The text, lines of at most about 130 characters.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a Comparison.
+
+    Examples
+    --------
+    >>> from dumbbell.io.compare import text
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> print(text(result).splitlines()[0])
+    Bouncing dumbbell, textbook section 13.5.1  (...textbook-1d.toml)
+    """
     result = _checked(result)
     head = (f"{'solver':<26}{'dt [s]':>9}{'run time [s]':>14}{'warm-up [s]':>13}"
             f"{'steps/s':>10}{'max |dr| [m]':>14}{'over [s]':>11}{'parts at':>10}"

@@ -22,7 +22,36 @@ def _checked(result: object) -> RestitutionResult:
 
 
 def write_csv(result: RestitutionResult, path: str | Path) -> Path:
-    """Write the columns as CSV to ``path`` atomically; returns the path."""
+    """Write the columns as CSV, whole or not at all.
+
+    Parameters
+    ----------
+    result : RestitutionResult
+        What :func:`~dumbbell.analysis.restitution.restitution` measured.
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a RestitutionResult, or a path that cannot be written.
+
+    Examples
+    --------
+    >>> from dumbbell.io.restitution import write_csv
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import restitution
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> result = restitution(scene, [0.0, 30.0], stiffnesses=(), dt=1e-4)
+    >>> write_csv(result, "restitution.csv").read_text().splitlines()[0]
+    'theta,formula,truth,pymunk,rigid_impacts,rigid_K_rot_share'
+    """
     from ..model import args
 
     result = _checked(result)
@@ -33,7 +62,37 @@ def write_csv(result: RestitutionResult, path: str | Path) -> Path:
 
 
 def markdown(result: RestitutionResult) -> str:
-    """The columns as a Markdown table, one row per tilt, 6 significant digits."""
+    """The columns as a Markdown table, one row per tilt, 6 significant digits.
+
+    Parameters
+    ----------
+    result : RestitutionResult
+        What :func:`~dumbbell.analysis.restitution.restitution` measured.
+
+    Returns
+    -------
+    str
+        The Markdown table.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a RestitutionResult.
+
+    Examples
+    --------
+    >>> from dumbbell.io.restitution import markdown
+    >>> import dumbbell
+    >>> from dumbbell.analysis.restitution import restitution
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> result = restitution(scene, [0.0, 30.0], stiffnesses=(), dt=1e-4)
+    >>> print(markdown(result))
+    | theta | formula | truth | pymunk | rigid_impacts | rigid_K_rot_share |
+    |---|---|---|---|---|---|
+    | 0 | 1 | 1 | 0.999779 | 1 | 0 |
+    | 30 | 0.6 | 0.6 | 0.599823 | 1 | 0.639858 |
+    """
     cols = _checked(result).columns()
     head = "| " + " | ".join(cols) + " |"
     rule = "|" + "---|" * len(cols)

@@ -39,7 +39,45 @@ def _fmt(value: Any, kind: str = "") -> str:
 def markdown(result: StabilityResult) -> str:
     """The report as a markdown table, then the verdict lines of the runs that did not end ok
     or disagree with the theory, the step-size guard on the pymunk runs and the runs not
-    made."""
+    made: the ``stability.md`` that ``dumbbell stability`` writes.
+
+    Parameters
+    ----------
+    result : StabilityResult
+        What :func:`dumbbell.stability` ran.
+
+    Returns
+    -------
+    str
+        The Markdown text.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a StabilityResult.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from dumbbell.io.stability import markdown
+    >>> import dumbbell
+    >>> Path("cases").mkdir()
+    >>> _ = Path("cases/stiff.toml").write_text('''
+    ... dimensions = 1
+    ... bodies.A = { mass = 0.1, height = 1.2 }
+    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... spring = { stiffness = 1e8, rest_length = 0.2 }
+    ... floor = { elasticity = 1.0 }
+    ... gravity = { g = 9.8 }
+    ... run = { t_end = 0.5, dt = 1e-4 }
+    ... ''')
+    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> print(markdown(result))
+    | case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | ...
+    |---|...
+    | stiff | stiff | verlet | 0.0001 | 4.47 | unstable | 0.0011 | ...
+    ...
+    """
     result = _checked(result)
     rows, skipped, guard = result.rows, result.skipped, result.guard
     out = [("| case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | "
@@ -97,7 +135,44 @@ def csv_text(result: StabilityResult) -> str:
 
 
 def write(result: StabilityResult, out: Path) -> list[Path]:
-    """OUT/stability.md and OUT/stability.csv; returns the paths."""
+    """OUT/stability.md and OUT/stability.csv: what ``dumbbell stability`` writes.
+
+    Parameters
+    ----------
+    result : StabilityResult
+        What :func:`dumbbell.stability` ran.
+    out : pathlib.Path
+        The folder (made if missing).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, each whole or not at all.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a StabilityResult, or a folder that cannot be written.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> from dumbbell.io.stability import write
+    >>> import dumbbell
+    >>> Path("cases").mkdir()
+    >>> _ = Path("cases/stiff.toml").write_text('''
+    ... dimensions = 1
+    ... bodies.A = { mass = 0.1, height = 1.2 }
+    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... spring = { stiffness = 1e8, rest_length = 0.2 }
+    ... floor = { elasticity = 1.0 }
+    ... gravity = { g = 9.8 }
+    ... run = { t_end = 0.5, dt = 1e-4 }
+    ... ''')
+    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> [path.name for path in write(result, Path("stability"))]
+    ['stability.md', 'stability.csv']
+    """
     from ..model import args
 
     result = _checked(result)

@@ -35,6 +35,42 @@ def csv_text(result: SweepResult) -> str:
 
 
 def write_csv(result: SweepResult, path: str | Path) -> Path:
-    """Write :func:`csv_text` to ``path`` atomically; returns the path."""
+    """Write the sweep as CSV (:func:`csv_text`), whole or not at all: one row per grid
+    point, the axes' values then w*dt, the verdict, the time of failure (s), the largest
+    relative energy error and the reason.
+
+    Parameters
+    ----------
+    result : SweepResult
+        What :func:`dumbbell.sweep` ran.
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    UsageError
+        A result that is not a SweepResult, or a path that cannot be written.
+
+    Examples
+    --------
+    >>> from dumbbell.io.sweep import write_csv
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                         workers=1)
+    >>> print(write_csv(result, "sweep.csv").read_text())
+    spring.stiffness,run.dt,w_dt,verdict,t_fail,max_rel_energy_error,reason
+    200.0,1e-05,0.0006324555320336759,ok,,0.00030916674793161035,
+    200.0,0.001,0.06324555320336758,ok,,0.030021882013879935,
+    2000000.0,1e-05,0.06324555320336758,ok,,0.029257371854075474,
+    2000000.0,0.001,6.324555320336758,unstable,0.009000000000000001,41.59376249599365,"w*dt = 6.32 > 2 ..."
+    <BLANKLINE>
+    """
     result = _checked(result)
     return write_text(path, csv_text(result))

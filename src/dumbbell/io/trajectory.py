@@ -3,8 +3,6 @@ columns of ``traj.columns``: t in s, positions in m, velocities in m/s, energies
 impacts as CSV (``t,body,v_before,v_after``: s, -, m/s, m/s). ``dumbbell simulate`` and
 ``dumbbell run`` write these.
 
->>> write_csv(traj, "out.csv"); write_events(traj, "out-impacts.csv")   # doctest: +SKIP
-
 Every float is written with 17 significant digits (samples) or ``repr`` (impacts), so the
 numbers read back exactly.
 """
@@ -29,8 +27,33 @@ def _checked(traj: Any) -> Trajectory:
 
 
 def dump_csv(traj: Trajectory, stream: IO[str]) -> None:
-    """Write the samples with a header row to the open text ``stream`` (standard output,
-    say): one row per sample, the columns of ``traj.columns``."""
+    """Write the samples with a header row to an open text stream: one row per sample, the
+    columns of ``traj.columns``, every float with 17 significant digits.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    stream : text file
+        Where to write (standard output, say): anything with a ``write`` method.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, or a stream without ``write``.
+
+    Examples
+    --------
+    >>> from dumbbell.io.trajectory import dump_csv
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> import sys
+    >>> dump_csv(traj, sys.stdout)
+    t,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E
+    0,1.2000000000000002,0,1,0,0,0,2.1560000000000006,...
+    """
     traj = _checked(traj)
     if not callable(getattr(stream, "write", None)):
         from ..errors import UsageError
@@ -41,18 +64,106 @@ def dump_csv(traj: Trajectory, stream: IO[str]) -> None:
 
 
 def write_csv(traj: Trajectory, path: str | Path) -> Path:
-    """Write the samples as CSV to ``path`` (see :func:`dump_csv`), whole or not at all (a
-    device or a FIFO is written directly); returns the path."""
+    """Write the samples as CSV (see :func:`dump_csv`), whole or not at all (a device or a
+    FIFO is written directly): ``dumbbell simulate -o FILE``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, or a path that cannot be written (one line
+        saying why).
+
+    Examples
+    --------
+    >>> from dumbbell.io.trajectory import write_csv
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> write_csv(traj, "exact.csv").read_text().splitlines()[0]
+    't,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E'
+    """
     return _checked(traj).to_csv(path)
 
 
 def events_csv(traj: Trajectory) -> str:
-    """The impacts as CSV text with :data:`EVENT_COLUMNS`, one line per impact."""
+    """The impacts as CSV text: ``t,body,v_before,v_after`` (s, -, m/s, m/s), one line per
+    impact, each float as its ``repr``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+
+    Returns
+    -------
+    str
+        The CSV text.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory.
+
+    Examples
+    --------
+    >>> from dumbbell.io.trajectory import events_csv
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> print(events_csv(traj))
+    t,body,v_before,v_after
+    0.4517539514526256,B,-4.42718872423573,4.42718872423573
+    0.49895130056316217,B,-4.835568954040384,4.835568954040384
+    <BLANKLINE>
+    """
     traj = _checked(traj)
     return csv_text(EVENT_COLUMNS, ((e.t, e.body, e.v_before, e.v_after) for e in traj.events))
 
 
 def write_events(traj: Trajectory, path: str | Path) -> Path:
-    """Write :func:`events_csv` to ``path``, whole or not at all; returns the path."""
+    """Write :func:`events_csv` to a file, whole or not at all: ``dumbbell simulate --events
+    FILE``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, or a path that cannot be written.
+
+    Examples
+    --------
+    >>> from dumbbell.io.trajectory import write_events
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> len(write_events(traj, "impacts.csv").read_text().splitlines())   # header, 2 impacts
+    3
+    """
     traj = _checked(traj)
     return write_text(args.path(path, "path"), events_csv(traj))

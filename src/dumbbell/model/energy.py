@@ -267,9 +267,42 @@ def impact_heat(mass: float, v_before: float, v_after: float) -> float:
 
 
 def heat(scene: Scene, t: np.ndarray, state: Columns, events: Impacts) -> np.ndarray:
-    """Energy the contacts dissipated up to each sample time ``t`` (s), in J: counted by the
-    solver where the state has a ``heat`` column (pymunk), else summed over the impacts up to
-    each sample (an impact's own ``heat``, or :func:`impact_heat` with the particle's mass)."""
+    """Energy the contacts dissipated up to each sample time: counted by the solver where the
+    state has a ``heat`` column (pymunk), else summed over the impacts up to each sample (an
+    impact's own ``heat``, or :func:`impact_heat` with the particle's mass).
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene that was run (its masses, kg).
+    t : numpy.ndarray
+        Sample times (s).
+    state : mapping of str to numpy.ndarray
+        The state columns, each as long as ``t``.
+    events : sequence of Impact
+        The impacts.
+
+    Returns
+    -------
+    numpy.ndarray
+        The dissipated energy (J) at each time of ``t``: the trajectory's ``E_heat``.
+
+    Raises
+    ------
+    UsageError
+        Arguments of the wrong kind or columns of another length.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.energy import heat
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "friction-2d.toml")
+    >>> traj = dumbbell.simulate(scene, t_end=1.0)
+    >>> e_heat = heat(scene, traj.t, traj.state, traj.events)
+    >>> bool(e_heat[-1] == traj["E_heat"][-1]), round(float(e_heat[-1]), 4)
+    (True, 0.1629)
+    """
     scene = args.scene(scene)
     t = np.asarray(args.array(t, "t", "s"))
     return _heat(scene, t, _state(scene, state, t.size), args.impacts(events))
@@ -325,9 +358,43 @@ def _disc_spin(scene: Scene, state: Columns) -> np.ndarray:
 def partition(
     scene: Scene, t: np.ndarray, state: Columns, events: Impacts = (),
 ) -> dict[str, np.ndarray]:
-    """All energy columns (J, :func:`energy_columns` order) of ``scene`` at the sample times
-    ``t`` (s) with the state columns ``state`` (m, m/s, rad/s) and the impacts ``events``
-    (needed for E_heat on dissipative scenes)."""
+    """All energy columns of a run, from its state: what a trajectory's energy columns are
+    when its solver did not count them itself.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene that was run (masses in kg, spring in N/m and m, ``g`` in m/s²).
+    t : numpy.ndarray
+        Sample times (s), 1-d.
+    state : mapping of str to numpy.ndarray
+        The state columns (m, m/s, rad/s), each as long as ``t``.
+    events : sequence of Impact, default ()
+        The impacts (needed for ``E_heat`` on dissipative scenes).
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Each energy column (J) in ``energy_columns`` order: 1D ``K_cm``, ``K_int``,
+        ``U_g``, ``U_spring``, ``E``; 2D ``K_rot``, ``K_vib`` (and ``K_spin``) in place of
+        ``K_int``; ``E_lost``, ``E_heat``, ``E_err`` where energy can leave.
+
+    Raises
+    ------
+    UsageError
+        Arguments of the wrong kind, ``t`` not 1-d, or columns of another length.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.energy import partition
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> parts = partition(scene, traj.t, traj.state, traj.events)
+    >>> list(parts), parts["E"][:3]            # M g X = 0.2 x 9.8 x 1.1 J
+    (['K_cm', 'K_int', 'U_g', 'U_spring', 'E'], array([2.156, 2.156, 2.156]))
+    """
     scene = args.scene(scene)
     t = args.array(t, "t", "s")
     if t.ndim != 1:
@@ -348,9 +415,38 @@ def _partition(scene: Scene, t: np.ndarray, state: Columns, events: Impacts = ()
 
 
 def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
-    """Angular momentum about the centre of mass at each sample of a 2D ``state`` (kg m^2/s):
-    the particles' ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus
-    the discs' own spin ``1/2 m r^2 omega_i`` where particles may spin."""
+    """Angular momentum about the centre of mass at each sample of a 2D run: the particles'
+    ``m (r - R) x v`` summed (= mu d x w, or I omega for the rigid body), plus the discs' own
+    spin ``1/2 m r^2 omega_i`` where particles may spin.
+
+    Parameters
+    ----------
+    scene : Scene
+        A 2D scene (masses in kg, radii in m).
+    state : mapping of str to numpy.ndarray
+        Its state columns (m, m/s, rad/s).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``L_cm`` (kg m²/s, counter-clockwise positive) at each sample.
+
+    Raises
+    ------
+    UsageError
+        A 1D scene, or state columns missing or of unequal lengths.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.energy import angular_momentum_cm
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-3)
+    >>> L = angular_momentum_cm(scene, traj.state)   # none before the impact, then a spin
+    >>> float(L[0]), round(float(L[-1]), 4)
+    (0.0, -0.0708)
+    """
     scene = args.scene(scene)
     if scene.system.dimensions != 2:
         raise UsageError(f"scene = {scene.name}: must be a 2D scene (dimensions = 2)",
@@ -395,7 +491,7 @@ def partition_from_terms(
     split the dumbbell's way, which the general accounting does not know: K_rot and K_vib of
     the axis from :func:`partition_2d`, and K_spin, the particles' own spin (the bodies' K_rot
     when each particle is a body; the discs' share of the one body when rigid). Equal to
-    :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces.md)."""
+    :func:`partition` to rounding where pymunk's model is the scene's (see docs/spaces-reference.md)."""
     parts = {name: terms[name] for name in ("K_cm", "U_g", "U_spring", "E")}
     if scene.system.dimensions == 1:
         parts["K_int"] = terms["K_int"]

@@ -197,9 +197,37 @@ class System:
 class Scene:
     """A validated scene: a title, the physics (:class:`System`), the default run options, the
     outputs ``dumbbell run`` makes and the pymunk engine's settings. Build it with
-    :func:`load_scene` or :func:`scene_from_dict`.
+    :func:`load_scene` or :func:`scene_from_dict`, not by hand: they check every value.
 
-    >>> scene.system.spring.stiffness, scene.system.omega, scene.run.dt  # doctest: +SKIP
+    Parameters
+    ----------
+    title : str
+        What figures and GIFs are titled.
+    system : System
+        The physics: the particles, the spring or rigid rod, the floor, ``g`` (m/s²), and
+        derived ``M``, ``mu`` (kg), ``omega`` (rad/s).
+    run : RunSettings
+        The default run: ``t_end`` and ``dt`` (s), ``solver``, ``every``, ...
+    outputs : OutputSettings
+        What ``dumbbell run`` writes: figures, CSV, GIF settings.
+    pymunk : PymunkSettings
+        The pymunk engine's settings (iterations, spin, ...).
+    source : str, default "<scene>"
+        The file it was read from; :attr:`name` (which names outputs) is its stem.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> scene.name, scene.system.spring.stiffness, scene.run.dt
+    ('textbook-1d', 200.0, 1e-05)
+    >>> round(scene.system.omega, 4)                   # sqrt(k / mu), rad/s
+    63.2456
+    >>> scene.with_values({"spring.stiffness": 2e4}).system.spring.stiffness
+    20000.0
+    >>> scene.to_dict()["spring"]
+    {'stiffness': 200.0, 'rest_length': 0.2}
     """
 
     title: str
@@ -218,7 +246,23 @@ class Scene:
         """The scene as a parsed TOML document, built afresh from the fields:
         ``scene_from_dict(scene.to_dict(), scene.source) == scene``. Every key is written
         except two that follow another key, as they do in a file: A's position when ``tilt``
-        places it, and ``outputs.gif.t_end`` when it is the run's ``t_end``."""
+        places it, and ``outputs.gif.t_end`` when it is the run's ``t_end``.
+
+        Returns
+        -------
+        dict
+            Tables and keys as a TOML file has them (``{"title": ..., "bodies": {...}}``).
+
+        Examples
+        --------
+        >>> import dumbbell
+        >>> from dumbbell.model.scene import scene_from_dict, scenes_dir
+        >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+        >>> scene.to_dict()["bodies"]["A"]
+        {'mass': 0.1, 'radius': 0.02, 'height': 1.2, 'velocity': 0.0}
+        >>> scene_from_dict(scene.to_dict(), scene.source) == scene
+        True
+        """
         s, run, out = self.system, self.run, self.outputs
         doc: dict[str, Any] = {"title": self.title, "dimensions": s.dimensions}
         if s.tilt is not None:
@@ -251,7 +295,35 @@ class Scene:
     def with_values(self, values: dict[str, Any]) -> Scene:
         """A new scene with keys replaced by dotted name, validated like a file.
 
-        >>> scene.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})   # doctest: +SKIP
+        Parameters
+        ----------
+        values : dict of str to value
+            Dotted key (``"spring.stiffness"``, ``"run.dt"``, ``"bodies.A.mass"``) -> its new
+            value, in the units the scene file uses.
+
+        Returns
+        -------
+        Scene
+            The changed copy; this scene is left as it is.
+
+        Raises
+        ------
+        SceneError
+            A key the scene file does not have, or a value it does not allow (one line
+            naming the key and what is allowed).
+
+        Examples
+        --------
+        >>> import dumbbell
+        >>> from dumbbell.model.scene import scenes_dir
+        >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+        >>> stiff = scene.with_values({"spring.stiffness": 2e4, "run.dt": 1e-4})
+        >>> stiff.system.spring.stiffness, stiff.run.dt, scene.system.spring.stiffness
+        (20000.0, 0.0001, 200.0)
+        >>> scene.with_values({"spring.stiffness": -1})
+        Traceback (most recent call last):
+        ...
+        dumbbell.errors.SceneError: ...textbook-1d.toml: spring.stiffness = -1.0: must be a finite number >= 0 (N/m)
         """
         if not isinstance(values, dict) or not all(isinstance(k, str) for k in values):
             raise SceneError(f"values = {_show(values)}: must be a dict of dotted key names "
@@ -332,7 +404,44 @@ def _particle_table(p: Particle, dims: int, placed: bool) -> dict[str, Any]:
 
 
 def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
-    """Validate a parsed TOML document and build a :class:`Scene` (raises SceneError)."""
+    """Validate a parsed TOML document and build a :class:`Scene`, as :func:`load_scene` does
+    with a file's.
+
+    Parameters
+    ----------
+    data : dict
+        The document: tables and keys as in a scene file (docs/scenes.md).
+    source : str, default "<scene>"
+        What messages and outputs call the scene (a file's path, for a file).
+
+    Returns
+    -------
+    Scene
+        The validated, frozen scene.
+
+    Raises
+    ------
+    SceneError
+        Any key or value the scene file does not allow, in one line naming it.
+
+    Examples
+    --------
+    >>> from dumbbell.model.scene import scene_from_dict
+    >>> scene = scene_from_dict({
+    ...     "dimensions": 1,
+    ...     "bodies": {"A": {"mass": 0.1, "height": 1.2}, "B": {"mass": 0.1, "height": 1.0}},
+    ...     "spring": {"stiffness": 200.0, "rest_length": 0.2},
+    ...     "floor": {"elasticity": 1.0},
+    ...     "gravity": {"g": 9.8},
+    ...     "run": {"t_end": 1.0, "dt": 1e-4},
+    ... }, source="mine.toml")
+    >>> scene.name, scene.system.M, scene.system.g    # without [gravity], g = 0
+    ('mine', 0.2, 9.8)
+    >>> scene_from_dict({"dimensions": 3})
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.SceneError: <scene>: ...
+    """
     if not isinstance(data, dict):
         raise SceneError(f"data = {_show(data)}: must be a dict (a parsed scene document)")
     if not isinstance(source, str):
@@ -568,8 +677,37 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file (TOML) of at most :data:`MAX_SCENE_BYTES` bytes. Raises
-    :class:`SceneError` on any problem, also when ``path`` is not a regular file."""
+    """Read and validate a scene file (TOML) of at most :data:`MAX_SCENE_BYTES` bytes.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The scene file (docs/scenes.md lists its keys; the shipped ones are in
+        :func:`scenes_dir`).
+
+    Returns
+    -------
+    Scene
+        The validated, frozen scene; ``scene.source`` is ``path``.
+
+    Raises
+    ------
+    SceneError
+        Any problem, in one line naming the file, the key and what is allowed; also when
+        ``path`` is not a regular file.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> scene.title
+    'Bouncing dumbbell, textbook section 13.5.1'
+    >>> dumbbell.load_scene("nowhere.toml")
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.SceneError: nowhere.toml: no such scene file
+    """
     if not isinstance(path, str | os.PathLike) or str(path) == "":
         raise SceneError(f"path = {_show(path)}: must be the path of a scene file (str or "
                          "pathlib.Path)")
@@ -627,5 +765,17 @@ def packaged_scene(name: str = "textbook-1d") -> Path:
 
 
 def scenes_dir() -> Path:
-    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout)."""
+    """The folder of shipped scenes (package data in a wheel, ``scenes/`` in a checkout).
+
+    Returns
+    -------
+    pathlib.Path
+        The folder holding ``textbook-1d.toml`` and the other shipped scenes.
+
+    Examples
+    --------
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> sorted(p.name for p in scenes_dir().glob("*.toml"))[:3]
+    ['friction-2d.toml', 'rigid-2d.toml', 'textbook-1d.toml']
+    """
     return packaged_scene("textbook-1d").parent

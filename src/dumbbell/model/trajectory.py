@@ -68,9 +68,40 @@ CSV_BLOCK = 8192
 
 @dataclass(frozen=True)
 class Impact:
-    """One impact with the floor: time (s), body ('A' or 'B'), the body's vertical velocity
-    just before and just after (m/s), and the energy the impact dissipated (J) where the
-    solver states it (None: a free particle's ``1/2 m (v_before^2 - v_after^2)``)."""
+    """One impact with the floor, as a run's ``events`` hold them.
+
+    Parameters
+    ----------
+    t : float
+        When (s).
+    body : {'A', 'B'}
+        Which particle hit the floor.
+    v_before, v_after : float
+        Its vertical velocity just before and just after (m/s).
+    heat : float or None, default None
+        The energy the impact dissipated (J) where the solver states it; None: a free
+        particle's ``1/2 m (v_before^2 - v_after^2)``.
+
+    Raises
+    ------
+    UsageError
+        A body other than 'A' or 'B', a time that is not a finite number of seconds, or a
+        velocity or heat that is not a number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj.events[0]
+    Impact(t=0.4517539514526256, body='B', v_before=-4.42718872423573, v_after=4.42718872423573, heat=None)
+    >>> from dumbbell.model.trajectory import Impact
+    >>> Impact(0.45, "C", -4.4, 4.4)
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: body = 'C': must be 'A' or 'B'
+    """
 
     t: float
     body: str
@@ -97,9 +128,35 @@ class Impact:
 
 @dataclass(frozen=True)
 class Contact:
-    """A lasting contact with the floor, not an impact: body ('A' or 'B') resting or rolling on
-    the floor from ``t_start`` to ``t_end`` (s; the run's end if it still touches then). Only a
-    contact solver (pymunk) has them; how they are told from impacts: docs/solvers.md."""
+    """A lasting contact with the floor, not an impact: a particle resting or rolling on the
+    floor. Only a contact solver (pymunk) has them; how they are told from impacts:
+    docs/solvers.md.
+
+    Parameters
+    ----------
+    t_start, t_end : float
+        When the contact starts and ends (s; ``t_end`` is the run's end if it still touches
+        then); :attr:`duration` is the difference.
+    body : {'A', 'B'}
+        Which particle touches.
+
+    Raises
+    ------
+    UsageError
+        A body other than 'A' or 'B', a time that is not a finite number of seconds, or
+        ``t_end`` before ``t_start``.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "topple-2d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="pymunk", dt=1e-4, t_end=0.5)
+    >>> traj.contacts[1]                        # A lands at 0.4065 s and stays down
+    Contact(t_start=0.40650000000000003, t_end=0.5, body='A')
+    >>> round(traj.contacts[1].duration, 4)
+    0.0935
+    """
 
     t_start: float
     t_end: float
@@ -122,10 +179,34 @@ class Contact:
 
 @dataclass(frozen=True)
 class Verdict:
-    """How a run ended. ``status`` is one of ok, inaccurate, unstable, tunnelled, failed
-    (:data:`VERDICTS`); ``t`` is the time of failure (s, None when ok; for ``inaccurate`` the
-    step where the energy error first passed ``run.inaccurate_energy``, the run going on to
-    its end); ``reason`` says why in words and what to change."""
+    """How a run ended: a trajectory's ``verdict``. ``str(verdict)`` is ``ok`` or one line with
+    the status, the time and the reason.
+
+    Parameters
+    ----------
+    status : {'ok', 'inaccurate', 'unstable', 'tunnelled', 'failed'}, default 'ok'
+        How the run ended (:data:`VERDICTS`); :attr:`ok` is ``status == 'ok'``.
+    t : float or None, default None
+        The time of failure (s; None when ok; for ``inaccurate`` the step where the energy
+        error first passed ``run.inaccurate_energy``, the run going on to its end).
+    reason : str, default ''
+        Why, in words, and what to change.
+
+    Raises
+    ------
+    UsageError
+        A status not in the list, a time that is not a finite number of seconds, or a reason
+        that is not a str.
+
+    Examples
+    --------
+    >>> from dumbbell.model.trajectory import Verdict
+    >>> verdict = Verdict("unstable", 0.3, "energy grew 10-fold")
+    >>> verdict.ok, str(verdict)
+    (False, 'unstable at t = 0.3 s: energy grew 10-fold')
+    >>> Verdict().ok
+    True
+    """
 
     status: str = "ok"
     t: float | None = None
@@ -173,16 +254,71 @@ def _first_rows(cells: list[list[str]], total: int) -> str:
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
-    """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict.
+    """Samples of one run: ``t`` (s), state columns by name, impacts, and a verdict. Made by
+    :func:`dumbbell.simulate`; ``traj["E"]`` is any CSV column. Every array is read-only and
+    every column as long as ``t``; a run that failed ends at its failure, energy columns
+    included.
 
-    ``events`` are the impacts; ``contacts`` the lasting contacts with the floor (resting or
-    rolling: a contact solver's, told apart from impacts as docs/solvers.md says).
-    ``dt`` is the step used (s; None for the exact solution), ``every`` how many steps lie
-    between samples, ``wall_time`` the solver's run time (s), ``info`` solver-specific notes
-    (for example settings used, or an estimated error). ``energy`` holds the energy columns
-    (J) when the solver counted them itself; left None they are computed from the state by
-    :func:`dumbbell.model.energy.partition`. Every array is read-only and every column as long
-    as ``t``; a run that failed ends at its failure, energy columns included.
+    Parameters
+    ----------
+    scene : Scene
+        The scene that was run.
+    solver : str
+        The solver's name.
+    t : numpy.ndarray
+        Sample times (s): step * dt, the same for every solver.
+    state : mapping of str to numpy.ndarray
+        The state columns by name: positions (m) and velocities (m/s) (``xA``, ``vA``, ...;
+        in 2D also angles and spins).
+    events : tuple of Impact, default ()
+        The impacts.
+    verdict : Verdict, default Verdict()
+        How the run ended.
+    dt : float or None, default None
+        The step used (s; None for the exact solution).
+    every : int, default 1
+        How many steps lie between samples.
+    wall_time : float, default 0.0
+        The solver's run time (s).
+    info : mapping, default {}
+        Solver-specific notes (settings used, an estimated error, ...).
+    energy : mapping of str to numpy.ndarray or None, default None
+        The energy columns (J) when the solver counted them itself; None: computed from the
+        state by :func:`dumbbell.model.energy.partition`.
+    contacts : tuple of Contact, default ()
+        The lasting contacts with the floor (resting or rolling: a contact solver's, told
+        apart from impacts as docs/solvers.md says).
+
+    Raises
+    ------
+    UsageError
+        A field of the wrong kind, or columns not as long as ``t`` (a trajectory built by
+        hand is checked).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj
+    <Trajectory textbook-1d: solver=exact, dt=0.001 s, t=0..1 s, 11 samples, 2 impacts, verdict: ok>
+    >>> traj.columns
+    ['t', 'xA', 'vA', 'xB', 'vB', 'K_cm', 'K_int', 'U_g', 'U_spring', 'E']
+    >>> traj["K_cm"][:3]                        # J, every 0.1 s
+    array([0.     , 0.09604, 0.38416])
+    >>> traj["nope"]
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.ColumnError: name = 'nope': no such column; columns are t, xA, vA, xB, vB, K_cm, K_int, U_g, U_spring, E
+    >>> traj.table().shape                      # (samples, columns)
+    (11, 10)
+    >>> traj.first_impact("B").t, traj.first_impact("A")
+    (0.4517539514526256, None)
+    >>> traj.to_pandas().attrs["units"]["E"]
+    'J'
+    >>> traj.to_csv("exact.csv").name
+    'exact.csv'
     """
 
     scene: Scene
@@ -275,6 +411,23 @@ class Trajectory:
         return _view(angular_momentum_cm(self.scene, self.state))
 
     def __getitem__(self, name: str) -> np.ndarray:
+        """One column by name: ``t``, a state column, an energy term, ``L_cm`` in 2D.
+
+        Parameters
+        ----------
+        name : str
+            One of :attr:`columns`.
+
+        Returns
+        -------
+        numpy.ndarray
+            The column (read-only), as long as ``t``.
+
+        Raises
+        ------
+        ColumnError
+            A name that is not a column (the message lists the columns).
+        """
         if not isinstance(name, str):
             from ..errors import ColumnError
             from .args import show
@@ -338,8 +491,19 @@ class Trajectory:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the samples as ``dumbbell simulate -o FILE`` does (the :attr:`columns`,
-        atomically, through :func:`dumbbell.files.atomic_output`) and return the path; what
-        :func:`dumbbell.io.trajectory.write_csv` writes."""
+        atomically, through :func:`dumbbell.files.atomic_output`; what
+        :func:`dumbbell.io.trajectory.write_csv` writes).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The CSV file to write (replaced whole, or left as it was on failure).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
         from ..files import atomic_output
 
         path = args.path(path, "path")
@@ -363,7 +527,18 @@ class Trajectory:
 
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every
-        column's unit in ``df.attrs["units"]``. Needs the extra: pip install 'dumbbell[pandas]'."""
+        column's unit in ``df.attrs["units"]``. Needs the extra: pip install 'dumbbell[pandas]'.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sample.
+
+        Raises
+        ------
+        MissingExtraError
+            pandas is not installed.
+        """
         from ..frames import data_frame
         from .energy import column_unit
 
@@ -371,11 +546,33 @@ class Trajectory:
                           units={name: column_unit(name) for name in self.columns})
 
     def table(self) -> np.ndarray:
-        """All CSV columns as one (samples, columns) float array."""
+        """All CSV columns as one array.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (samples, columns), the columns in the order of :attr:`columns`.
+        """
         return np.column_stack([self[c] for c in self.columns])
 
     def first_impact(self, body: str | None = None) -> Impact | None:
-        """The first impact (of ``body`` if given), or None."""
+        """The first impact, of one particle or of either.
+
+        Parameters
+        ----------
+        body : {'A', 'B'} or None, default None
+            The particle; None: either.
+
+        Returns
+        -------
+        Impact or None
+            The first such impact; None when there is none.
+
+        Raises
+        ------
+        UsageError
+            A body other than 'A', 'B' or None.
+        """
         if body is not None:
             args.choice(body, "body", ("A", "B"))
         return next((e for e in self.events if body in (None, e.body)), None)

@@ -28,7 +28,36 @@ def _checked(result: Any, ax: Any) -> tuple[BenchResult, Any]:
 
 def work_precision(result: BenchResult, ax: Any = None) -> Any:
     """Log-log error (m) against run time (s), one line per solver, dt beside each point,
-    failed runs as crosses on the top edge."""
+    failed runs as crosses on the top edge: the work-precision diagram.
+
+    Parameters
+    ----------
+    result : BenchResult
+        What :func:`dumbbell.bench` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a BenchResult, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
+    >>> ax = dumbbell.plot.work_precision(result)
+    >>> ax.get_xscale(), ax.get_yscale()
+    ('log', 'log')
+    """
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
@@ -149,7 +178,36 @@ def _place_labels(ax: Any, labels: list[tuple[str, float, float, str]],
 
 
 def convergence(result: BenchResult, ax: Any = None) -> Any:
-    """Log-log error (m) against dt (s), one line per solver, with the fitted order."""
+    """Log-log error (m) against dt (s), one line per solver, with the fitted order.
+
+    Parameters
+    ----------
+    result : BenchResult
+        What :func:`dumbbell.bench` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a BenchResult, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
+    >>> ax = dumbbell.plot.convergence(result)
+    >>> ax.get_ylabel()
+    'largest position error over [0, 1 s] [m]'
+    """
     result, ax = _checked(result, ax)
     own = ax is None
     if own:

@@ -53,7 +53,36 @@ def _heights_panel(ax: Any, result: Comparison, body: str, own: bool) -> None:
 
 def compare_positions(result: Comparison, ax: Any = None) -> Any:
     """Heights (m) of each solver over the truth's, twice the error window long: on ``ax``
-    particle B only; without, A above B. Returns the (last) axes."""
+    particle B only; without, A above B.
+
+    Parameters
+    ----------
+    result : Comparison
+        What :func:`dumbbell.compare` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on (the last panel of a new figure).
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> ax = dumbbell.plot.compare_positions(result)
+    >>> ax.get_ylabel()
+    'x_B [m]'
+    """
     result, ax = _checked(result, ax)
     if ax is not None:
         ax.set_xlabel("t [s]")
@@ -70,7 +99,36 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
 
 def compare(result: Comparison, ax: Any = None) -> Any:
     """Largest position error (m, log scale) of each solver against the truth over time, with
-    the truth's impacts and the error window marked."""
+    the truth's impacts and the error window marked.
+
+    Parameters
+    ----------
+    result : Comparison
+        What :func:`dumbbell.compare` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> ax = dumbbell.plot.compare(result)
+    >>> ax.get_yscale()
+    'log'
+    """
     result, ax = _checked(result, ax)
     own = ax is None
     if own:
@@ -131,7 +189,36 @@ def _truth_label(truth: Any, own: bool) -> str:
 
 
 def compare_energy(result: Comparison, ax: Any = None) -> Any:
-    """E(t)/E(0) - 1 of each solver and of the truth."""
+    """E(t)/E(0) - 1 of each solver and of the truth.
+
+    Parameters
+    ----------
+    result : Comparison
+        What :func:`dumbbell.compare` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                           window=1.0)
+    >>> ax = dumbbell.plot.compare_energy(result)
+    >>> ax.get_ylabel()
+    'E(t) / E(0) - 1 [1]'
+    """
     result, ax = _checked(result, ax)
     own = ax is None
     if own:

@@ -66,7 +66,36 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
 
     A map's colour bar takes its room from ``ax`` (as ``Figure.colorbar(ax=)`` does); its
     legend hangs below the x label on a figure of its own, and on the user's axes sits inside
-    them, in a band above the map (:func:`~.style.legend_inside`)."""
+    them, in a band above the map (:func:`~.style.legend_inside`).
+
+    Parameters
+    ----------
+    result : SweepResult
+        What :func:`dumbbell.sweep` ran.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a SweepResult, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e4, 2e6], "dt": [1e-5, 1e-4, 1e-3]},
+    ...                         t_end=0.2, workers=1)
+    >>> ax = dumbbell.plot.sweep_map(result)
+    >>> ax.get_ylabel()
+    'dt, time step [s]'
+    """
     result = args.instance(result, "result", SweepResult, "a SweepResult (from dumbbell.sweep)")
     ax = args.axes(ax)
     own = ax is None
@@ -251,7 +280,32 @@ def draw_line(ax: Any, axis: Axis, rows: list[PointResult], title: str, own: boo
 def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     """One panel per solver (rows of :func:`dumbbell.analysis.stability.map_rows`): log10 of
     the largest relative energy error over (w*dt, mass ratio), blow-ups marked, and the line
-    w*dt = 2. Makes its own figure (the panels share one colour bar); returns the panels."""
+    w*dt = 2. Makes its own figure (the panels share one colour bar).
+
+    Parameters
+    ----------
+    maps : dict of str to list of PointResult
+        Solver name -> its map's rows, in grid order.
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        The panels, one per solver.
+
+    Raises
+    ------
+    UsageError
+        Maps that are not such a dict of rows.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.stability import map_rows
+    >>> panels = dumbbell.plot.stability_map({"euler-cromer": map_rows("euler-cromer",
+    ...                                                                workers=1)})
+    >>> len(panels)
+    1
+    """
     _check_maps(maps)
     n = len(maps)
     fig, axes = _subplots(1, n, figsize=(4.6 * n + 1.2, 4.6), squeeze=False)

@@ -70,7 +70,36 @@ def rotation(s: Series, ax: Any = None) -> Any:
 
     On ``ax``: every spring dumbbell's K_rot over the rigid one's. Without: one panel per run,
     with the vibration energy and the mean K_rot after the first impacts, and a last panel
-    with every run's L_cm on one scale (2D runs); returns the top panel."""
+    with every run's L_cm on one scale (2D runs).
+
+    Parameters
+    ----------
+    s : Series
+        The runs of :func:`dumbbell.analysis.rotation.series`.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on, or the top panel of the new figure.
+
+    Raises
+    ------
+    UsageError
+        An ``s`` that is not a Series, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.analysis.rotation import series
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
+    >>> runs = series(scene, dt=1e-4, t_end=0.5, stiffnesses=(200.0, 2000.0))
+    >>> ax = dumbbell.plot.rotation(runs)
+    >>> ax.get_ylabel()
+    'E [J]'
+    """
     from ..model import args
 
     s = args.instance(s, "s", Series, "a Series (from dumbbell.analysis.rotation.series)")

@@ -43,8 +43,35 @@ def _end(axes: list[Any], own: bool) -> None:
 
 def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     """e_eff against tilt (degrees), then the impacts in the first cluster and the share of
-    kinetic energy that went into rotation. ``ax``: three axes, or None for a new figure.
-    Returns the three axes."""
+    kinetic energy that went into rotation.
+
+    Parameters
+    ----------
+    result : RestitutionResult
+        What :func:`~dumbbell.analysis.restitution.restitution` measured.
+    ax : sequence of three matplotlib.axes.Axes or None, default None
+        Draw on these; None: a new figure.
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        The three axes.
+
+    Raises
+    ------
+    UsageError
+        A ``result`` that is not a RestitutionResult, or an ``ax`` that is not three Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> from dumbbell.analysis.restitution import restitution
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> result = restitution(scene, [0.0, 30.0, 60.0], stiffnesses=(), dt=1e-4)
+    >>> len(dumbbell.plot.restitution(result))
+    3
+    """
     from ..analysis.restitution import RestitutionResult, e_eff_rigid, k_rot_share_rigid
     from ..model import args
     args.instance(result, "result", RestitutionResult,
@@ -112,7 +139,40 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
 def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
            solver: str = "pymunk") -> Any:
     """The topple against its closed form: angle, the centre of mass's horizontal position and
-    the top particle's speed, all against time (s). ``ax``: three axes, or None."""
+    the top particle's speed, all against time (s).
+
+    Parameters
+    ----------
+    cf : ToppleClosedForm
+        The closed form (:func:`~dumbbell.analysis.topple.closed_form`).
+    measured : ToppleMeasure
+        The run's topple (:func:`~dumbbell.analysis.topple.measure`).
+    ax : sequence of three matplotlib.axes.Axes or None, default None
+        Draw on these; None: a new figure.
+    solver : str, default "pymunk"
+        The run's solver, for the legend.
+
+    Returns
+    -------
+    list of matplotlib.axes.Axes
+        The three axes.
+
+    Raises
+    ------
+    UsageError
+        Arguments of the wrong kind, or an ``ax`` that is not three Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> from dumbbell.analysis.topple import closed_form, measure
+    >>> scene = dumbbell.load_scene(scenes_dir() / "topple-2d.toml")
+    >>> run = dumbbell.simulate(scene, dt=1e-4, every=1, t_end=0.45)
+    >>> axes = dumbbell.plot.topple(closed_form(scene), measure(run))
+    >>> axes[0].get_ylabel()
+    'tilt θ [degrees]'
+    """
     from ..analysis.topple import ToppleClosedForm, ToppleMeasure
     from ..model import args
 
@@ -174,7 +234,38 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
 
 def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> Any:
     """Angular momentum about the contact point through one impact: L_cm and the orbital part
-    jump, their sum L_P does not. Time in ms from the impact. Returns the axes."""
+    jump, their sum L_P does not. Time in ms from the impact.
+
+    Parameters
+    ----------
+    cm : ContactMomentum
+        What :func:`~dumbbell.analysis.contact.about_contact` measured.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+    solver : str, default ""
+        The run's solver, for the title.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on.
+
+    Raises
+    ------
+    UsageError
+        A ``cm`` that is not a ContactMomentum, or an ``ax`` that is not one Axes.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> from dumbbell.analysis.contact import about_contact
+    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
+    >>> run = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
+    >>> ax = dumbbell.plot.contact_momentum(about_contact(run), solver="exact")
+    >>> ax.get_ylabel()
+    'angular momentum [kg m²/s]'
+    """
     from ..analysis.contact import ContactMomentum
     from ..model import args
 

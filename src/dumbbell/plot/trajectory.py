@@ -122,7 +122,37 @@ def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle:
 
 
 def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
-    """Fig. 13.13: heights of A, B and the centre of mass (m) over [0, window] s."""
+    """Fig. 13.13: heights of A, B and the centre of mass (m) over [0, window] s.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure (see below).
+    window : float, default 2.0
+        The span [0, window] (s) drawn.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on (``ax.figure`` is the figure).
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
+        that is not a positive number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=2.0, dt=1e-3)
+    >>> ax = dumbbell.plot.positions(traj)
+    >>> ax.figure.savefig("positions.png")
+    """
     traj, ax, window = _checked(traj, ax, window)
     if ax is not None:
         _positions_panel(ax, traj, window)
@@ -152,7 +182,40 @@ def _two_panel(traj: Trajectory, ax: Any, names: list[str], window: float,
 
 def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.14: the kinetic energy split into K_cm and K_int (in 2D K_rot, K_vib, K_spin),
-    and E (J); without ``ax``, below the positions."""
+    and E (J); without ``ax``, below the positions.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure (see below).
+    window : float, default 2.0
+        The span [0, window] (s) drawn.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The energy panel.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
+        that is not a positive number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=2.0, dt=1e-3)
+    >>> import matplotlib.pyplot as plt
+    >>> fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.5), layout="constrained")
+    >>> _ = dumbbell.plot.kinetic(traj, ax=left)
+    >>> _ = dumbbell.plot.potential(traj, ax=right)
+    >>> fig.savefig("energies.png")
+    """
     traj, ax, window = _checked(traj, ax, window)
     names = ["K_cm", "K_int", "E"] if traj.scene.system.dimensions == 1 else [
         n for n in ("K_cm", "K_rot", "K_vib", "K_spin", "E") if n in traj.columns]
@@ -162,7 +225,38 @@ def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 
 def potential(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """Fig. 13.15: the external (U_g) and internal (U_spring) potential energy (J); without
-    ``ax``, below the positions."""
+    ``ax``, below the positions.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure (see below).
+    window : float, default 2.0
+        The span [0, window] (s) drawn.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The energy panel.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
+        that is not a positive number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=2.0, dt=1e-3)
+    >>> ax = dumbbell.plot.potential(traj)
+    >>> len(ax.figure.axes)                          # the positions above it
+    2
+    """
     traj, ax, window = _checked(traj, ax, window)
     names = [n for n in ("U_g", "U_spring") if n in traj.columns]
     return _two_panel(traj, ax, names, window,
@@ -226,8 +320,38 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     """How the energy is shared (J). On ``ax``: every energy term the scene has. Without:
     positions (and, in 2D, the motion in the plane), then two panels, the centre of mass's
     terms (K_cm, U_g) with E and E_lost, and the internal ones (K_int, or K_rot, K_vib,
-    U_spring and K_spin), and in 2D a panel of L_cm (:func:`momentum_panel`); returns the
-    centre-of-mass panel."""
+    U_spring and K_spin), and in 2D a panel of L_cm (:func:`momentum_panel`).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run.
+    ax : matplotlib.axes.Axes or None, default None
+        Draw on these axes; None: a new figure.
+    window : float, default 2.0
+        The span [0, window] (s) drawn.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The axes drawn on, or the centre-of-mass panel of the new figure.
+
+    Raises
+    ------
+    UsageError
+        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
+        that is not a positive number.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
+    >>> traj = dumbbell.simulate(scene, dt=1e-4, t_end=1.0)
+    >>> ax = dumbbell.plot.energy(traj)              # positions, plane, energies, L_cm
+    >>> ax.get_ylabel()
+    'E [J]'
+    """
     traj, ax, window = _checked(traj, ax, window)
     cols = traj.columns
     outer = [n for n in ("K_cm", "U_g", "E", "E_lost", "E_heat") if n in cols]

@@ -1,7 +1,5 @@
 """Solvers: each takes a Scene plus run options and returns a :class:`Trajectory`.
 
->>> traj = simulate(load_scene("scenes/textbook-1d.toml"), "exact", every=100)  # doctest: +SKIP
-
 A solver is a :class:`Solver` subclass (the contract is in :mod:`dumbbell.solvers.base`): its
 facts (order, step limit, floor, cost, ...) are class attributes, and ``supports(scene)`` and
 ``solve(scene, options)`` are class methods. A stepping solver subclasses :class:`Stepper` and
@@ -105,7 +103,19 @@ def scene_class(scene: Scene) -> type[Solver]:
 
 
 def available() -> list[str]:
-    """Names of all solvers this installation has."""
+    """Names of all solvers this installation has (``dumbbell.available_solvers()``).
+
+    Returns
+    -------
+    list of str
+        In the order listings show them.
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> dumbbell.available_solvers()
+    ['euler-cromer', 'exact', 'verlet', 'pymunk', 'reference', 'euler-cromer-2d']
+    """
     return list(METHODS)
 
 
@@ -156,11 +166,50 @@ def simulate(
     quiet: bool = True,
     max_samples: int | None = MAX_SAMPLES,
 ) -> Trajectory:
-    """Run ``scene`` (a Scene or the path of a scene file) with ``solver`` (a name, or a
-    :class:`Solver` subclass; default: the scene's). ``dt`` and ``t_end`` in s override the
-    scene's ``[run]``; ``every`` keeps every N-th step; a run that would keep more than
-    ``max_samples`` samples is refused before it starts (None: no budget). Returns a
-    :class:`Trajectory` whose ``verdict`` says whether the run ended well."""
+    """Run a scene with a solver (``dumbbell.simulate``).
+
+    Parameters
+    ----------
+    scene : Scene or str or pathlib.Path
+        The scene, or its file.
+    solver : str or Solver subclass or None, default None
+        A name of :func:`available`, or a :class:`Solver` subclass; None: the scene's.
+    dt, t_end : float or None, default None
+        The step and the run's end (s); None: the scene's ``[run]``.
+    every : int or None, default None
+        Keep every N-th step (None: the scene's), so memory follows the samples, not the
+        steps.
+    quiet : bool, default True
+        No progress bar.
+    max_samples : int or None, default MAX_SAMPLES
+        A run that would keep more samples is refused before it starts (None: no budget).
+
+    Returns
+    -------
+    Trajectory
+        The run; its ``verdict`` says whether it ended well.
+
+    Raises
+    ------
+    SceneError
+        A scene file that is missing or not valid.
+    UsageError
+        A solver that does not exist or cannot run the scene, an argument that is not
+        allowed, or a run past the budget (one line saying what would do).
+
+    Examples
+    --------
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> traj = dumbbell.simulate(scenes_dir() / "textbook-1d.toml", solver="exact",
+    ...                          dt=1e-5, t_end=2.0, every=100)
+    >>> traj.events[0].t, traj.verdict.status
+    (0.4517539514526256, 'ok')
+    >>> dumbbell.simulate(scenes_dir() / "textbook-1d.toml", solver="rk45")
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: solver 'rk45': must be one of euler-cromer, exact, verlet, pymunk, reference, euler-cromer-2d
+    """
     scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)

@@ -42,8 +42,35 @@ MAX_SAMPLES = 5_000_000
 
 @dataclass(frozen=True)
 class RunOptions:
-    """Options of one run: ``dt`` and ``t_end`` in s, keep every ``every``-th step,
-    ``quiet`` silences the progress bar."""
+    """Options of one run, as a solver's ``solve`` takes them (checked when built).
+
+    Parameters
+    ----------
+    dt : float
+        The step (s).
+    t_end : float
+        The run's end (s).
+    every : int, default 1
+        Keep every ``every``-th step as a sample.
+    quiet : bool, default True
+        No progress bar.
+
+    Raises
+    ------
+    UsageError
+        A field that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> from dumbbell.solvers import RunOptions
+    >>> options = RunOptions(1e-3, 0.01, every=5)
+    >>> options.n_steps, options.n_samples, options.sample_times()
+    (10, 3, array([0.   , 0.005, 0.01 ]))
+    >>> RunOptions(0.0, 1.0)
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: dt = 0.0: must be a finite number > 0 (s)
+    """
 
     dt: float
     t_end: float
@@ -75,8 +102,24 @@ class RunOptions:
         return self.n_steps // self.every + 1
 
     def sample_times(self, count: int | None = None) -> np.ndarray:
-        """Times of the first ``count`` samples (s; all by default): step * dt, with the step
-        index j * every kept whole so every solver and every ``every`` share the same floats."""
+        """Times of the samples: step * dt, with the step index j * every kept whole so every
+        solver and every ``every`` share the same floats.
+
+        Parameters
+        ----------
+        count : int or None, default None
+            How many of the first samples (None: all).
+
+        Returns
+        -------
+        numpy.ndarray
+            The times (s).
+
+        Raises
+        ------
+        UsageError
+            A count that is not a whole number >= 0.
+        """
         if count is not None and type(count) is not int:
             from ..model import args
 
@@ -126,6 +169,35 @@ class Solver:
     subclasses write ``_step_impl``: the public methods (:data:`CHECKED`) check their
     arguments and call them; the package, which has checked them at its border, calls them
     directly (``cls._solve(scene, options)``).
+
+    Examples
+    --------
+    The registered solvers are such classes, in :data:`dumbbell.solvers.METHODS`:
+
+    >>> from dumbbell.solvers import METHODS, RunOptions
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> verlet = METHODS["verlet"]
+    >>> verlet.name, verlet.order, verlet.step_limit, verlet.supports(scene)
+    ('verlet', 2, 2.0, None)
+    >>> verlet.solve(scene, RunOptions(1e-3, 0.01, every=5))
+    <Trajectory textbook-1d: solver=verlet, dt=0.001 s, t=0..0.01 s, 3 samples, 0 impacts, verdict: ok>
+    >>> verlet.swing(1.0)             # the largest energy swing of a stable run at w*dt = 1
+    1.0
+    >>> verlet.drift(1.0, 1000) is None           # a symplectic step: no steady drift
+    True
+    >>> exact = METHODS["exact"]
+    >>> exact.truth_for(scene), verlet.truth_for(scene), exact.catch_depth(scene)
+    (True, False, None)
+    >>> METHODS["pymunk"].catch_depth(scene)          # m: its floor is a thick segment
+    1.04
+    >>> exact.check_work(scene, RunOptions(1e-3, 1e7))
+    Traceback (most recent call last):
+    ...
+    dumbbell.errors.UsageError: t_end = 1e+07 s: the exact solution would locate at least ... impacts ...
+    >>> verlet.warm_up() >= 0                         # s spent compiling or loading
+    True
     """
 
     name: ClassVar[str]
@@ -152,34 +224,97 @@ class Solver:
 
     @classmethod
     def supports(cls, scene: Scene | str | PathLike) -> str | None:
-        """None if this solver can run ``scene``, else why not (one sentence)."""
+        """Whether this solver can run a scene (the subclass's :meth:`_supports`, the scene
+        checked first).
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene (or a scene file's path).
+
+        Returns
+        -------
+        str or None
+            None if it can; else why not, in one sentence.
+        """
         return cls._supports(_scene(scene))
 
     @classmethod
     def solve(cls, scene: Scene | str | PathLike, options: RunOptions, **keywords: Any
               ) -> Trajectory:
-        """Run ``scene`` with ``options``; the trajectory's ``verdict`` says how it ended."""
+        """Run a scene (the subclass's :meth:`_solve`, the arguments checked first).
+
+        Parameters
+        ----------
+        scene : Scene
+            A scene this solver supports (or a scene file's path).
+        options : RunOptions
+            The step, the end, the samples kept.
+        **keywords
+            What the solver's own ``_solve`` takes besides (``estimate_error`` of the
+            reference solver).
+
+        Returns
+        -------
+        Trajectory
+            The run; its ``verdict`` says how it ended.
+        """
         scene = cls._runnable(scene, options)
         return cls._solve(scene, options, **keywords)
 
     @classmethod
     def check_work(cls, scene: Scene | str | PathLike, options: RunOptions) -> None:
-        """UsageError, before any work, when the run is known to exceed this solver's work
-        budget (the default: no such estimate). :meth:`solve` calls it first; callers that
-        plan several runs call it for each before the first."""
+        """Refuse, before any work, a run known to exceed this solver's work budget (the
+        subclass's :meth:`_check_work`; the default: no such estimate). :meth:`solve` calls
+        it first; callers that plan several runs call it for each before the first.
+
+        Parameters
+        ----------
+        scene : Scene
+            A scene this solver supports (or a scene file's path).
+        options : RunOptions
+            The run planned.
+
+        Raises
+        ------
+        UsageError
+            The run is past the budget; the message says what would do.
+        """
         cls._check_work(cls._runnable(scene, options), options)
 
     @classmethod
     def truth_for(cls, scene: Scene | str | PathLike) -> bool:
-        """Whether this (``is_truth``) solver is the truth for scenes of ``scene``'s kind,
-        whether or not it can run this one (False for every other solver)."""
+        """Whether this (``is_truth``) solver is the truth for scenes of a scene's kind,
+        whether or not it can run this one (the subclass's :meth:`_truth_for`).
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene (or a scene file's path).
+
+        Returns
+        -------
+        bool
+            False for every solver that is not a truth.
+        """
         return cls._truth_for(_scene(scene))
 
     @classmethod
     def catch_depth(cls, scene: Scene | str | PathLike) -> float | None:
-        """How far (m) a particle may move in one step and still be caught by a floor that is
-        a body of finite thickness (beyond it, it passes through); None when the floor is not
-        such a body."""
+        """How far a particle may move in one step and still be caught by a floor that is a
+        body of finite thickness (beyond it, it passes through); the subclass's
+        :meth:`_catch_depth`.
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene (or a scene file's path).
+
+        Returns
+        -------
+        float or None
+            The depth (m); None when the floor is not such a body.
+        """
         return cls._catch_depth(_scene(scene))
 
     @classmethod
@@ -215,8 +350,18 @@ class Solver:
     @classmethod
     def swing(cls, ratio: float) -> float | None:
         """The largest relative swing of the vibration energy that a *stable* run of this
-        solver makes at w*dt = ``ratio``, for the verdict's message near the step limit; None
-        where the theory gives no such bound (the default)."""
+        solver makes at a given w*dt, for the verdict's message near the step limit.
+
+        Parameters
+        ----------
+        ratio : float
+            w*dt, w = sqrt(k/mu).
+
+        Returns
+        -------
+        float or None
+            The swing (relative); None where the theory gives no such bound (the default).
+        """
         return None
 
     @classmethod
@@ -224,13 +369,31 @@ class Solver:
         """How far (relative) the vibration energy has moved after ``steps`` stable steps
         at w*dt = ``ratio``, for a step that loses or gains energy steadily rather than
         swinging about it (classic Runge-Kutta loses it: 1 - |R(i h)|^(2 steps)); None for a
-        step that keeps it (the default). The accuracy theory reads it beside :meth:`swing`."""
+        step that keeps it (the default). The accuracy theory reads it beside :meth:`swing`.
+
+        Parameters
+        ----------
+        ratio : float
+            w*dt, w = sqrt(k/mu).
+        steps : float
+            Stable steps taken.
+
+        Returns
+        -------
+        float or None
+            The drift (relative); None for a step that keeps the energy.
+        """
         return None
 
     @classmethod
     def warm_up(cls) -> float:
-        """Compile or load what the first run would; returns the seconds it took, NaN when
-        there is nothing to compile (the default)."""
+        """Compile or load what the first run would.
+
+        Returns
+        -------
+        float
+            The seconds it took; NaN when there is nothing to compile (the default).
+        """
         return math.nan
 
 

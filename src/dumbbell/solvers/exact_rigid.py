@@ -298,14 +298,42 @@ def first_impact_state(
     tilt: float, elasticity: float, mA: float = 0.1, mB: float = 0.1, length: float = 0.2,
     height: float = 1.0, g: float = 9.8,
 ) -> tuple[RigidState, RigidState]:
-    """The rigid dumbbell dropped from rest with B at ``height`` (m) and its axis ``tilt``
-    degrees from vertical (A above B, masses in kg, rod ``length`` in m, ``g`` in m/s^2) onto a
-    frictionless floor of restitution ``elasticity``: its state just before and just after the
-    first impact, found by the same search and impulse law as the ``exact`` solver.
+    """The rigid dumbbell dropped from rest onto a frictionless floor: its state just before
+    and just after the first impact, found by the same search and impulse law as the
+    ``exact`` solver.
 
+    Parameters
+    ----------
+    tilt : float
+        Its axis from vertical (degrees), A above B.
+    elasticity : float
+        The floor's restitution, 0..1.
+    mA, mB : float, default 0.1
+        The masses (kg).
+    length : float, default 0.2
+        The rod (m).
+    height : float, default 1.0
+        B's height at the release (m).
+    g : float, default 9.8
+        Gravity (m/s²).
+
+    Returns
+    -------
+    before, after : RigidState
+        The state (t, centre of mass X, Y, VX, VY, theta, omega, heights hA, hB) just before
+        and just after the impact.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> from dumbbell.solvers.exact_rigid import first_impact_state
     >>> before, after = first_impact_state(30.0, 1.0)
-    >>> round(after.omega, 4)
-    -35.4175
+    >>> round(after.omega, 4), round(-after.VY / before.VY, 12)    # rad/s, e_eff
+    (-35.4175, 0.6)
     """
     from ..model import args
 

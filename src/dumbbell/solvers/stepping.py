@@ -48,7 +48,38 @@ class Stepper(Solver):
     ``name``, ``order`` and ``step_limit`` and writes :meth:`kernel`; ``supports`` and
     ``solve`` are written here, from the kernels it has (a subclass may say more in its own
     ``supports``). Its floor reverses velocities (``flip_floor``), and its step costs about
-    Euler-Cromer's (``relative_cost``; a costlier step says so)."""
+    Euler-Cromer's (``relative_cost``; a costlier step says so).
+
+    Examples
+    --------
+    A solver whose step leaves every particle where it is (numba compiles it on first use):
+
+    >>> import dumbbell
+    >>> from dumbbell.model.scene import scenes_dir
+    >>> from dumbbell.solvers import Kernel, Stepper
+    >>> def still(s, p):
+    ...     return s
+    >>> class Still(Stepper):
+    ...     name = "still"
+    ...     order = 1
+    ...     step_limit = None
+    ...     @staticmethod
+    ...     def kernel(dimensions):
+    ...         return Kernel(still) if dimensions == 1 else None
+    >>> Still.supports(dumbbell.load_scene(scenes_dir() / "tilted-2d.toml"))
+    'still has no step for 2D scenes'
+    >>> Still.kernel(2) is None
+    True
+    >>> traj = dumbbell.simulate(scenes_dir() / "textbook-1d.toml", Still, t_end=0.01)
+    >>> traj.solver, bool(traj["xA"][-1] == traj["xA"][0])
+    ('still', True)
+    >>> from dumbbell.solvers import RunOptions
+    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
+    >>> len(Still.solve(scene, RunOptions(1e-3, 0.01)).t)     # the class, called directly
+    11
+    >>> Still.warm_up() >= 0                       # compiled already: loads at once
+    True
+    """
 
     has_step = True
     flip_floor = True
@@ -60,22 +91,57 @@ class Stepper(Solver):
 
     @classmethod
     def kernel(cls, dimensions: int) -> Kernel | None:
-        """The compiled step for scenes of ``dimensions`` (1 or 2), None where there is none:
-        the one thing a stepping solver writes."""
+        """The compiled step for scenes of some dimensions: the one thing a stepping solver
+        writes.
+
+        Parameters
+        ----------
+        dimensions : {1, 2}
+            The scene's.
+
+        Returns
+        -------
+        Kernel or None
+            The step; None where there is none.
+        """
         raise NotImplementedError
 
     @classmethod
     def _supports(cls, scene: Scene) -> str | None:
-        """None if this solver has a step for the scene's dimensions (in 2D: two point
-        particles, a spring and a frictionless floor), else why not."""
+        """Whether this solver has a step for the scene's dimensions (in 2D: two point
+        particles, a spring and a frictionless floor).
+
+        Parameters
+        ----------
+        scene : Scene
+            The scene.
+
+        Returns
+        -------
+        str or None
+            None if it can run it; else why not.
+        """
         if cls.kernel(scene.system.dimensions) is None:
             return f"{cls.name} has no step for {scene.system.dimensions}D scenes"
         return point_particle_limits(scene, cls.name) if scene.system.dimensions == 2 else None
 
     @classmethod
     def _solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
-        """Run ``scene`` at step ``options.dt`` (s). ``wall_time`` covers the kernel calls
-        and the impact list, not the compiling, the array set-up, the verdict or the energy."""
+        """Run a scene at step ``options.dt``. ``wall_time`` covers the kernel calls and the
+        impact list, not the compiling, the array set-up, the verdict or the energy.
+
+        Parameters
+        ----------
+        scene : Scene
+            A scene this solver supports.
+        options : RunOptions
+            The step (s), the end (s), the samples kept.
+
+        Returns
+        -------
+        Trajectory
+            The run; its ``verdict`` says how it ended.
+        """
         with compiling(f"the {cls.name} solver's kernels", options.quiet):
             run = _Steps.of(cls, scene, options.dt)
             if scene.system.dimensions == 1:
@@ -107,7 +173,13 @@ class Stepper(Solver):
     @classmethod
     def warm_up(cls) -> float:
         """Compile (or load from numba's cache) the loop of every kernel the solver has, and
-        the 1D energy partition; returns the seconds it took."""
+        the 1D energy partition.
+
+        Returns
+        -------
+        float
+            The seconds it took.
+        """
         t0 = time.perf_counter()
         params = Params(1e-5, 0.1, 0.1, 200.0, 0.2, 9.8, 1.0, True, 0.02, 0.02)
         for dimensions, width in ((1, 4), (2, 8)):

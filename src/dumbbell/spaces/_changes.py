@@ -73,6 +73,7 @@ class Changes:
         b0 = self._b
         old = phys.energy(b0, self._snap)
         old_dyn = b0.table.uid[: b0.table.n].copy()
+        springs_what, bodies_what = _what_changed(b0, self.space, reason)
         old_rows = self._snap_uid.copy()
         self._sums.fold(b0, self._scale)
         self._rebuild()
@@ -99,11 +100,19 @@ class Changes:
                            "energy of a body removed from the space")
             left -= float(old.body[j])
             self._Uref -= (old.Ugb[j], 0.0, old.Udb[j])
+        # What the change itself did: the springs' potential (constraints that came or
+        # went, a spring's settings) and the bodies that stayed (gravity, a mass...), each
+        # named by what changed it.
         rest = e.E - old.E - entered - left
-        if abs(rest) > 1e-12 * max(abs(old.E), abs(e.E), self._scale):
-            source = f"program: {reason}" if kind == "program" else f"{reason} (a callback)"
-            self._sums.add(source, kind, rest,
-                           "energy changed by what was changed in the space")
+        springs = e.Us - old.Us
+        parts = {springs_what: springs}
+        parts[bodies_what] = parts.get(bodies_what, 0.0) + (rest - springs)
+        floor = 1e-12 * max(abs(old.E), abs(e.E), self._scale)
+        for what, value in parts.items():
+            if abs(value) > floor:
+                source = f"program: {what}" if kind == "program" else f"{what} (a callback)"
+                self._sums.add(source, kind, value,
+                               "energy changed by what was changed in the space")
         self._Uref[1] += e.Us - old.Us
         self._E = e.E
 
@@ -113,8 +122,10 @@ class Changes:
         ``kind`` ('program' or 'unattributed'); ``rows``: only those (dynamic) rows."""
         s = self._snap
         n = self._b.table.n
-        if rows is None and (F[0:3] == s.pos).all() and (F[3:6, :n] == s.vel[:, :n]).all():
-            return
+        if rows is None and ((F[0:3].tobytes() == s.pos.tobytes()
+                              and F[3:6].tobytes() == s.vel.tobytes())
+                             or ((F[0:3] == s.pos).all() and (F[3:6, :n] == s.vel[:, :n]).all())):
+            return  # the same bytes are the same values; other bytes may be too (-0, +0)
         pos, vel = F[0:3].copy(), F[3:6].copy()
         if rows is not None:
             pos = np.where(rows, pos, s.pos)
@@ -151,3 +162,29 @@ class Changes:
         reason = changed(self._b, self.space, F, P)
         if reason:
             self._restructure(reason, None, "program")
+
+
+class _Held:
+    """The bodies and constraints a build holds, with the space's gravity now: what
+    :func:`._inventory.changed` compares a build against to find what else changed beside
+    bodies or constraints that came or went."""
+
+    def __init__(self, b: Any, space: Any) -> None:
+        self.bodies = b.table.body_key
+        self.constraints = b.table.constraint_key
+        self.gravity = space.gravity
+
+
+def _what_changed(b: Any, space: Any, reason: str) -> tuple[str, str]:
+    """What changed the springs' potential and what changed the energy of the bodies that
+    stayed, when the space changed from build ``b`` for ``reason`` (the first change
+    noticed): constraints that came or went, else the reason; for the bodies, the first
+    change noticed beside bodies or constraints that came or went, else the reason."""
+    t = b.table
+    constraints = tuple(space.constraints) != t.constraint_key
+    if not constraints and tuple(space.bodies) == t.body_key:
+        return reason, reason
+    inside = " inside the step" if reason.endswith(" inside the step") else ""
+    F, P = t.pre.both()
+    other = changed(b, _Held(b, space), F, P) or reason
+    return (f"constraints added or removed{inside}" if constraints else other), other

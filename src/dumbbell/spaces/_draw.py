@@ -22,11 +22,29 @@ STATIC, DYNAMIC, BLACK = pymunk.Body.STATIC, pymunk.Body.DYNAMIC, SpaceDebugColo
 
 class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
     """Collects a space's shapes and constraints as primitives in world coordinates for
-    the recorder's painter (their format: :mod:`dumbbell.animation.recording`).
+    the recorder's painter (their format: :mod:`dumbbell.animation.recorded`).
     ``capture(space)`` returns the moving ones (dynamic and kinematic bodies'
     shapes, constraints) and keeps the static ones of the same moment in ``static``;
     ``space.debug_draw(options)`` collects the same shapes into ``items`` and
-    ``static``, through pymunk's callbacks."""
+    ``static``, through pymunk's callbacks.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> options = spaces.draw_options()
+    >>> isinstance(options, pymunk.SpaceDebugDrawOptions), options.ink_of(ball)
+    (True, 0)
+    >>> len(options.capture(space))                 # the ball and the spring
+    2
+    """
 
     def __init__(self) -> None:
         super().__init__()
@@ -41,7 +59,18 @@ class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
 
     def ink_of(self, body: Any) -> int:
         """Index into the recorder's body colours of a dynamic body (in the order the
-        bodies are first seen); -1 for static and kinematic ones (grey)."""
+        bodies are first seen); -1 for static and kinematic ones (grey).
+
+        Parameters
+        ----------
+        body : pymunk.Body
+            The body.
+
+        Returns
+        -------
+        int
+            The colour's index; -1 for grey.
+        """
         from ..model import args
 
         return self._ink_of(args.pymunk_object(body, "body", ("Body",)))
@@ -91,7 +120,18 @@ class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
         """The primitives of ``space`` now: the moving ones are returned (dynamic and
         kinematic shapes, constraints), the static ones kept in ``static``. The same
         primitives as ``space.debug_draw(self)`` collects, computed from each body's pose
-        and its shapes' local geometry (see :class:`_Geometry`)."""
+        and its shapes' local geometry (see :class:`_Geometry`).
+
+        Parameters
+        ----------
+        space : pymunk.Space
+            The space.
+
+        Returns
+        -------
+        list of tuple
+            The moving primitives.
+        """
         from ..model import args
 
         args.space(space)

@@ -25,7 +25,44 @@ class Finding:
     A constraint's row (kind ``joint``) may instead be ``relation`` 'measured' (a number
     with no limit: a motor's work, a loss the step does not change; ok) or 'unchecked' (not
     measured: ``fix`` says why; not ok, and not a failure :func:`check` lists); ``note`` says
-    in words what the number is."""
+    in words what the number is.
+
+    Parameters
+    ----------
+    kind : str
+        What is checked.
+    subject : str
+        What it is about.
+    value, limit : float
+        The measured value and its limit.
+    fix : str
+        The fix, with its reason in words.
+    dt_max : float or None, default None
+        The largest step that clears it (None when no step can).
+    relation : str, default '<'
+        What a good value keeps to the limit.
+    unit : str, default ''
+        The unit of value and limit.
+    note : str, default ''
+        What else the row says.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> finding = spaces.check(space, 1 / 60)[0]
+    >>> finding.kind, round(finding.value, 4), finding.comparison()
+    ('spring', 0.7454, 'w dt = 0.7454 >= 0.00995')
+    >>> round(finding.dt_max, 7)                    # s
+    0.0002225
+    """
 
     kind: str
     subject: str
@@ -57,7 +94,13 @@ class Finding:
 
     def comparison(self) -> str:
         """'value relation limit' with the relation that holds, the numbers printed with
-        enough digits to show it."""
+        enough digits to show it.
+
+        Returns
+        -------
+        str
+            'value relation limit', e.g. ``'w dt = 0.7454 >= 0.00995'``.
+        """
         unit = f" {self.unit}" if self.unit else ""
         if self.relation == "measured":
             return f"{self.value:.4g}{unit}"

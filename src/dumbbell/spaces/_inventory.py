@@ -47,6 +47,11 @@ PAIR = 1 << 31
 NAME_CHARS = 60
 
 
+class UnknownBody(Exception):
+    """A contact touches a body that is not in the ledger's table (one pymunk made since:
+    the space's static body, say): the table must be built again."""
+
+
 class Names:
     """Stable ids and labels of the bodies the ledger has seen, and the bodies themselves
     (kept, so that an id is never reused while the ledger lives)."""
@@ -159,10 +164,16 @@ class Table:
                            np.where(ang, 1.0 / np.where(ang, moment, 1.0), 0.0)])
         t.lin_free = np.zeros(t.rows, dtype=bool)
         t.lin_free[:n] = True
+        t.lin_free_f = t.lin_free.astype(float)
         t.ang_free = np.zeros(t.rows, dtype=bool)
         t.ang_free[:n] = t.finite
         t.moves = np.zeros(t.rows, dtype=bool)
         t.moves[: n + k] = True
+        t.none_asleep = np.zeros(n, dtype=bool)
+        t.none_asleep.flags.writeable = False
+        # What every step compares its reads with, as bytes (see :func:`changed`).
+        t.settings_bytes, t.idle_bytes = t.settings.tobytes(), t.idle.tobytes()
+        t.by_dt = {}
         # Rows whose motion is imposed and not counted in E: kinematic bodies and bodies
         # outside the space (linear and angular), the spin of a body of infinite moment.
         t.drives = np.zeros(t.rows, dtype=bool)
@@ -171,37 +182,62 @@ class Table:
         t.any_driven = bool(t.drives.any())
 
     #: Most rows for which their pairs' slots are looked up in a dense map of rows (4 bytes
-    #: each: 16 MB at most); a body's row is looked up in a map of its place in memory when
-    #: the bodies lie close (the map at most 64 words a body).
+    #: each: 16 MB at most).
     DENSE = 2048
+    #: Most entries of the map from a body's address to its row (4 bytes each: 8 MB at
+    #: most): one entry every 2**k bytes from the lowest body to the highest (2**k at most
+    #: a body's size: 256 bytes); farther apart, rows are searched for in the sorted
+    #: addresses.
+    MAP = 1 << 21
 
     def rows_of(self, at: np.ndarray) -> np.ndarray:
         """The rows of the bodies at the addresses ``at`` (int64); -1 where none."""
-        span = self.pre.span
-        if span is None:
-            return np.full(at.shape, -1)
         if not hasattr(self, "_rowmap"):
-            words = len(span.u8) >> 3
-            self._rowmap = None
-            if words <= 64 * self.rows + 4096:  # bodies close in memory: a small map
-                self._rowmap = np.full(words + 1, -1, dtype=np.int32)  # last: outside
-                self._rowmap[(self.at.astype(np.int64) - span.lo) >> 3] = np.arange(self.rows)
+            self._rowmap = self._address_map()
         if self._rowmap is None:
+            if not self.rows:
+                return np.full(at.shape, -1)
             pos = np.minimum(np.searchsorted(self.sorted_i64, at), self.rows - 1)
             return np.where(self.sorted_i64[pos] == at, self.order[pos], -1)
-        words = len(self._rowmap) - 1
-        w = (at - span.lo) >> 3
-        return self._rowmap[np.where((w >= 0) & (w < words), w, words)]
+        lo, shift, rowmap = self._rowmap
+        # Addresses outside the map clip to its ends, which hold no row.
+        return rowmap.take((at - lo) >> shift, mode="clip")
 
-    def slots_of(self, ra: np.ndarray, rb: np.ndarray, pairs: Pairs) -> np.ndarray:
-        """The slots in ``pairs`` of the pairs of rows (ra, rb), new ones added: looked up
-        in a dense map of rows for a small table."""
+    def _address_map(self) -> tuple[int, int, np.ndarray] | None:
+        """(lo, shift, map): the row of the body at address a is ``map[(a - lo) >>
+        shift]`` (-1 where no body of the table is). An entry covers 2**shift bytes, at most
+        a body's struct: two live bodies' addresses are at least that far apart, so that no
+        other live body's address falls on a table body's entry (and the map is small
+        enough to stay in the caches); the first and the last entry hold no body. None when
+        the map would pass :data:`MAP`."""
+        if not self.rows:
+            return None
+        at = self.at.astype(np.int64)
+        shift = max(3, mem.size("body").bit_length() - 1)
+        lo = int(at.min()) - (1 << shift)
+        entries = ((int(at.max()) - lo) >> shift) + 2
+        if entries > self.MAP:
+            return None
+        rowmap = np.full(entries, -1, dtype=np.int32)
+        rowmap[(at - lo) >> shift] = np.arange(self.rows)
+        return lo, shift, rowmap
+
+    def slots_of(self, rows: np.ndarray, pairs: Pairs) -> np.ndarray:
+        """The slots in ``pairs`` of the pairs of rows (``rows``: (2, m), -1 where a body
+        is not in the table, which raises :class:`UnknownBody`), new ones added: looked up
+        in a dense map of rows for a small table (a row and a column of -1 past its end,
+        which row -1 reads)."""
+        ra, rb = rows[0], rows[1]
         if self.rows > self.DENSE:
+            if rows.min() < 0:
+                raise UnknownBody
             return self.pair_slots(ra, rb, pairs)
         if not hasattr(self, "_pairmap"):
-            self._pairmap = np.full((self.rows, self.rows), -1, dtype=np.int32)
+            self._pairmap = np.full((self.rows + 1, self.rows + 1), -1, dtype=np.int32)
         slots = self._pairmap[ra, rb]
         if slots.min() < 0:
+            if rows.min() < 0:
+                raise UnknownBody
             new = slots < 0
             slots[new] = self.pair_slots(ra[new], rb[new], pairs)
             self._pairmap[ra[new], rb[new]] = slots[new]
@@ -213,36 +249,89 @@ class Table:
         return pairs.slots(np.minimum(ua, ub) * PAIR + np.maximum(ua, ub))
 
 
+def spans(t: Any, dt: float) -> np.ndarray:
+    """How long each row of the table ``t`` moves in a step of ``dt`` when no body sleeps:
+    dt for the dynamic and kinematic rows, 0 for the others."""
+    return _per_dt(t, "spans", dt, lambda: np.where(t.moves, dt, 0.0))
+
+
+def mass_dt(t: Any, dt: float) -> np.ndarray:
+    """m dt of each dynamic row of the table ``t``."""
+    return _per_dt(t, "mass_dt", dt, lambda: t.m * dt)
+
+
+def _per_dt(t: Any, name: str, dt: float, make: Callable[[], np.ndarray]) -> np.ndarray:
+    """An array of the table ``t`` that depends on dt only: made once for the last dt seen
+    (a space steps at one dt, or at few), read-only."""
+    got = t.by_dt.get(name)
+    if got is None or got[0] != dt:
+        value = make()
+        value.flags.writeable = False
+        got = t.by_dt[name] = (dt, value)
+    return got[1]
+
+
 class Pairs:
     """Running contact work, and gravity's part of the position correction, per pair of
-    bodies (stable ids). A pair's slot is given when it first touches and never moves."""
+    bodies (stable ids). A pair's slot is given when it first touches and never moves.
+
+    ``keys``, ``work`` and ``push`` are the first slots of buffers that grow by doubling
+    (pairs come a few at a time, step after step); the sorted keys a search needs are
+    sorted again only when a search comes after pairs were added."""
+
+    #: Most keys looked up one by one in a dict (more are searched for in the sorted keys).
+    FEW = 32
 
     def __init__(self) -> None:
-        self.keys = np.zeros(0, dtype=np.int64)      # by slot
-        self.sorted = np.zeros(0, dtype=np.int64)    # keys, sorted
+        self._bufs = (np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0))
+        self.keys, self.work, self.push = self._bufs  # by slot
+        self.sorted = np.zeros(0, dtype=np.int64)    # keys, sorted (when a search needs it)
         self.slot_of = np.zeros(0, dtype=np.int64)   # slot of each sorted key
-        self.work = np.zeros(0)
-        self.push = np.zeros(0)
+        self.slot: dict[int, int] = {}               # key -> slot
 
     def lookup(self, keys: np.ndarray) -> np.ndarray:
         """The slots of ``keys`` (-1 where new)."""
-        if not len(self.sorted):
+        if len(keys) <= self.FEW:
+            slot = self.slot
+            return np.array([slot.get(k, -1) for k in keys.tolist()], dtype=np.int64)
+        if not len(self.keys):
             return np.full(len(keys), -1, dtype=np.int64)
+        if len(self.sorted) != len(self.keys):  # pairs added since the last search
+            order = np.argsort(self.keys, kind="stable")
+            self.sorted, self.slot_of = self.keys[order], order
         pos = np.minimum(np.searchsorted(self.sorted, keys), len(self.sorted) - 1)
         return np.where(self.sorted[pos] == keys, self.slot_of[pos], -1)
 
     def slots(self, keys: np.ndarray) -> np.ndarray:
-        """The slots of ``keys``, adding the new ones."""
+        """The slots of ``keys``, adding the new ones (in the order of their keys)."""
+        if len(keys) <= self.FEW:  # a few: in Python
+            slot = self.slot
+            listed = keys.tolist()
+            fresh = sorted({k for k in listed if k not in slot})
+            if fresh:
+                self._add(fresh)
+            return np.array([slot[k] for k in listed], dtype=np.int64)
         found = self.lookup(keys)
-        if np.all(found >= 0):
+        if found.min(initial=0) >= 0:
             return found
-        fresh = np.unique(keys[found < 0])
-        self.keys = np.concatenate([self.keys, fresh])
-        self.work = np.concatenate([self.work, np.zeros(len(fresh))])
-        self.push = np.concatenate([self.push, np.zeros(len(fresh))])
-        order = np.argsort(self.keys, kind="stable")
-        self.sorted, self.slot_of = self.keys[order], order
-        return self.slot_of[np.searchsorted(self.sorted, keys)]
+        self._add(np.unique(keys[found < 0]).tolist())
+        return self.lookup(keys)
+
+    def _add(self, fresh: list[int]) -> None:
+        """Give the new keys ``fresh`` (sorted) the next slots."""
+        k, f = len(self.keys), len(fresh)
+        if k + f > len(self._bufs[0]):
+            cap = max(64, 2 * (k + f))
+            grown = []
+            for old in self._bufs:
+                buf = np.zeros(cap, dtype=old.dtype)
+                buf[:k] = old[:k]
+                grown.append(buf)
+            self._bufs = (grown[0], grown[1], grown[2])
+        keys, work, push = self._bufs
+        keys[k: k + f] = fresh
+        self.slot.update(zip(fresh, range(k, k + f), strict=True))
+        self.keys, self.work, self.push = keys[: k + f], work[: k + f], push[: k + f]
 
 
 class Members(NamedTuple):
@@ -282,6 +371,9 @@ class Group:
         self.work, self.extra, self.pot, self.kin_a, self.kin_b = (z.copy() for _ in range(5))
         self.settings = self.before.floats().copy() if self.spring else None
         self.funcs = self.before.pointers().copy() if self.spring else None
+        # The same bytes are the same settings (unless one is NaN, never equal to itself).
+        self._same = None if not self.spring or np.isnan(self.settings).any() else (
+            self.settings.tobytes(), self.funcs.tobytes())
         if kind == "spring":
             self.anchor = np.array(
                 [[c.anchor_a[0] - c.a.center_of_gravity[0],
@@ -292,8 +384,13 @@ class Group:
 
     def changed(self) -> bool:
         """A spring's settings or force function changed since the build."""
-        return self.spring and not (np.array_equal(self.before.floats(), self.settings)
-                                    and np.array_equal(self.before.pointers(), self.funcs))
+        if not self.spring:
+            return False
+        settings, funcs = self.before.both()
+        if self._same is not None and (settings.tobytes(), funcs.tobytes()) == self._same:
+            return False
+        return not (np.array_equal(settings, self.settings)
+                    and np.array_equal(funcs, self.funcs))
 
 
 class Field(NamedTuple):
@@ -333,6 +430,10 @@ class Build:
     def funcs(self) -> np.ndarray:
         """The velocity and position function pointers (2, dynamic rows)."""
         return np.stack([self.vf, self.pf])
+
+    @cached_property
+    def funcs_bytes(self) -> bytes:
+        return self.funcs.tobytes()
 
 
 def build(space: Any, names: Names, potentials: list[tuple[Any, Callable[..., Any], str]]
@@ -419,9 +520,13 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
-    if not ((F[9:13] == t.settings).all() and (t.n == t.rows or (F[13, t.n:] == t.idle).all())):
+    # The same bytes are the same values; other bytes may be too (-0 and +0): compared
+    # as numbers then.
+    if not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
+            ) and not ((F[9:13] == t.settings).all() and (
+                t.n == t.rows or (F[13, t.n:] == t.idle).all())):
         return "a mass, moment, centre of gravity or body type"
-    if not (P[1:3, : t.n] == b.funcs).all():
+    if P[1:3, : t.n].tobytes() != b.funcs_bytes and not (P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
     return _changed_settings(b, space)
 

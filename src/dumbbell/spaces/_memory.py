@@ -114,6 +114,9 @@ STRUCT = {"PinJoint": "pin", "SlideJoint": "slide", "PivotJoint": "pivot",
 _ARRAY_MAX = 1 << 28
 #: Lowest address a live object can have (the first page is never mapped).
 _LOWEST = 4096
+#: Past the highest address a live object can have: 2**56 bytes covers every 64-bit
+#: process's user space (x86-64's five-level paging, arm64's 52-bit addresses).
+_TOP = 1 << 56
 
 
 #: Spaces -> the addresses of the ledgers' hooks in them (:mod:`._hook`): what a space's
@@ -262,6 +265,14 @@ def _alignment_problem() -> str | None:
         for name in names:
             if p.offsetof(struct, name) % step:
                 return f"{struct}.{name} is not aligned for the gathers on this platform"
+    # The contacts' reads take an arbiter's two bodies as one pair of words, and a contact's
+    # r1.x and r2.x (and their y) as one strided slice.
+    if p.offsetof("cpArbiter", "body_b") != p.offsetof("cpArbiter", "body_a") + ptr:
+        return "cpArbiter.body_b does not follow body_a"
+    if p.offsetof("cpContact", "r2") <= p.offsetof("cpContact", "r1"):
+        return "cpContact.r2 does not follow r1"
+    if p.offsetof("cpContact", "jtAcc") != p.offsetof("cpContact", "jnAcc") + 8:
+        return "cpContact.jtAcc does not follow jnAcc"
     return None
 
 
@@ -294,7 +305,7 @@ def size(kind: str) -> int:
 
 def _plausible(at: int) -> bool:
     """An address a live, pointer-aligned object can have."""
-    top = 1 << (8 * pointer_size())
+    top = min(1 << (8 * pointer_size()), _TOP)
     return _LOWEST <= at < top and at % pointer_size() == 0
 
 
@@ -365,6 +376,35 @@ class Span:
         return self.u32[self._index(at, off) >> np.uint64(2)]
 
 
+class Memory:
+    """The process's memory from :data:`_LOWEST` to :data:`_TOP` as one read-only numpy
+    array of 8-byte words (``u64``, ``i64``, ``f64``): making it reads nothing, and indexing
+    it reads only the words indexed. The word at address ``a`` is ``(a - LOWEST) >> 3``.
+
+    The contacts' structs move every step (Munk2D takes each step's contacts from fresh
+    buffers): indexed here, their reads need no span found first (two numpy calls fewer
+    each, and no view made again when they land outside the last one): one ``take`` reads
+    what a step needs of all its arbiters, another of all its contacts. Only 8-byte platforms get here
+    (:func:`platform_problem`)."""
+
+    LOWEST = _LOWEST
+
+    def __init__(self) -> None:
+        f = ffi()
+        words = (_TOP - _LOWEST) >> 3
+        raw = np.frombuffer(f.buffer(f.cast("char *", _LOWEST), words << 3), dtype=np.uint64)
+        raw.flags.writeable = False
+        self.u64 = raw
+        self.i64 = raw.view(np.int64)
+        self.f64 = raw.view(np.float64)
+
+
+@cache
+def memory() -> Memory:
+    """The process's memory as numpy views (see :class:`Memory`)."""
+    return Memory()
+
+
 class Reader:
     """Fields of structs of one kind at fixed addresses, read in one numpy gather each:
     ``floats()`` (fields, structs) float64, ``pointers()`` (fields, structs) uint64."""
@@ -390,7 +430,7 @@ class Reader:
     def floats(self) -> np.ndarray:
         if self.span is None:
             return np.zeros((self.shape[0], 0))
-        return self.span.f64[self.fi]
+        return self.span.f64.take(self.fi)
 
     def both(self) -> tuple[np.ndarray, np.ndarray]:
         """``floats()`` and ``pointers()``, in one gather where pointers are 8 bytes."""
@@ -398,14 +438,14 @@ class Reader:
             return self.floats(), self.pointers()
         if self._all is None:
             self._all = np.concatenate([self.fi, self.pi])
-        out = self.span.u64[self._all]
+        out = self.span.u64.take(self._all)
         nf = len(self.fi)
         return out[:nf].view(np.float64), out[nf:]
 
     def pointers(self) -> np.ndarray:
         if self.span is None:
             return np.zeros((self.shape[1], 0), dtype=np.uint64)
-        out = self.span.ptr[self.pi]
+        out = self.span.ptr.take(self.pi)
         return out if out.dtype == np.uint64 else out.astype(np.uint64)
 
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from . import _inventory as inventory
 from ._inventory import Build, Group, Table
 from ._records import Before, Energy, Move, Potentials, Snapshot, Step
 from ._terms import Sums
@@ -89,7 +90,8 @@ def field_energy(b: Build, pos: np.ndarray) -> np.ndarray:
 def snapshot(b: Build, pos: np.ndarray, vel: np.ndarray, bias: np.ndarray,
              sleeping: np.ndarray) -> Snapshot:
     """A snapshot at (pos, vel), with the potentials there."""
-    return Snapshot(pos, vel, bias, sleeping, spring_energy(b, pos), field_energy(b, pos))
+    return Snapshot(pos, vel, bias, sleeping, spring_energy(b, pos), field_energy(b, pos),
+                    bool(sleeping.any()), bool(bias.any()))
 
 
 def read_snapshot(b: Build) -> Snapshot:
@@ -166,11 +168,19 @@ def move_of(b: Build, s: Snapshot, pos: np.ndarray, vel: np.ndarray, dt: float) 
     if s.asleep:
         moving = moving.copy()
         moving[:n] &= ~s.sleeping
+        spans = np.where(moving, dt, 0.0)
+    else:
+        spans = inventory.spans(t, dt)
     start = s.pos
-    if not np.array_equal(pos, np.where(moving, start + (vel + s.bias) * dt, start)):
+    # Where each body would be: (v + v_bias) dt on from where it was for those that move,
+    # and as it was for the others (x + 0). Found the same bit for bit (as almost every
+    # step), that is the move; else the exact comparison decides (-0 against +0, ...).
+    ahead = start + (vel + s.bias if s.biased else vel) * spans
+    if ahead.tobytes() != pos.tobytes() and not np.array_equal(
+            pos, np.where(moving, start + (vel + s.bias) * dt, start)):
         moving, start = _moved_how(b, s, Move(pos, vel, start, dt), moving)
-    step = np.where(moving, dt, 0.0) if start is not s.pos or s.asleep else dt
-    return Move(pos, vel, start, step)
+        return Move(pos, vel, start, np.where(moving, dt, 0.0))
+    return Move(pos, vel, start, spans if s.asleep else dt)
 
 
 def _moved_how(b: Build, s: Snapshot, move: Move, moving: np.ndarray
@@ -358,13 +368,15 @@ def external(b: Build, step: Step, p: Before, damping: float, sums: Sums
     kicked, force = p.awake, p.force
     if b.any_custom:
         kicked = ~b.custom if kicked is None else kicked & ~b.custom
-    n, m, dt = t.n, t.m, step.dt
+    n, dt = t.n, step.dt
     gx, gy = b.gravity
     un = step.u[:, :n]
-    mk = m * dt if kicked is None else np.where(kicked, m * dt, 0.0)
+    mk = inventory.mass_dt(t, dt)
+    if kicked is not None:
+        mk = np.where(kicked, mk, 0.0)
     lin = mk * (gx * un[0] + gy * un[1])
     w_g = float(lin.sum())
-    ang: Any = 0.0
+    ang: Any = 0.0  # an array once a force or damping acts
     total = 0.0
     if force is not None:
         f = force * dt
@@ -404,7 +416,8 @@ def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, Any,
     # The work of what no source explains: of the impulse m (v1 - v0), less the sources'.
     K = t.mass3 * (step.vel1[:, :n] - step.vel0[:, :n]) * step.u[:, :n]
     w_r = K[0] + K[1] - lin - step.work[0, :n]
-    spin = K[2] - ang - step.work[1, :n]
+    # (without forces and damping ang is 0.0, and K - 0.0 is K bit for bit)
+    spin = (K[2] - ang if isinstance(ang, np.ndarray) else K[2]) - step.work[1, :n]
     w_r += spin if t.all_finite else np.where(t.finite, spin, 0.0)  # infinite: imposed
     total = 0.0
     if b.any_custom:
@@ -422,7 +435,7 @@ def unexplained(b: Build, step: Step, p: Before, outside: tuple[np.ndarray, Any,
     else:
         step_err = w_g + g_int
         sums.unattributed += w_r
-        total += float(np.sum(w_r))
+        total += float(w_r.sum())
         for j, f in enumerate(b.fields):
             own = float(np.sum(d_int[f.idx]))
             sums.field[j] += own

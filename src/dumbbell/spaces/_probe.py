@@ -69,6 +69,8 @@ PART_COST = 20
 MAX_UNKNOWNS = 120
 #: Relative agreement asked of a recovered impulse with pymunk's own magnitude.
 AGREE = 1e-6
+#: Impulses under this fraction of the probe's largest momentum are all alike: at rest.
+AT_REST = 1e-9
 
 #: Constraint kinds whose impulse is a torque, and the springs (the guard's own rows).
 ROTARY = ("DampedRotarySpring", "RotaryLimitJoint", "RatchetJoint", "GearJoint", "SimpleMotor")
@@ -205,6 +207,7 @@ class _Run:
         self.static = space.static_body
         self.work = np.zeros(len(cons))
         self.unsure: dict[int, str] = {}
+        self.peak = 0.0  # the largest momentum of a body so far
         self.parts = self._parts(cons, slot, by_slot, pymunk)
         self.kicks: dict[int, tuple[float, float, float]] = {}
         # Each contact's last step, and its impulse along and across its normal then.
@@ -390,6 +393,7 @@ class _Run:
         moving = after[:, 3:6].tolist()
         self.momentum = (self.mass[rows] * np.hypot(after[rows, 3], after[rows, 4])
                          + self.turns * np.abs(after[rows, 5]))
+        self.peak = max(self.peak, float(self.momentum.max(initial=0.0)))
         for part in self.parts:
             if not all(k in self.unsure for k in part.cons):
                 self._solve(part, rhs, use, (pose, mean, moving))
@@ -450,9 +454,13 @@ class _Run:
             solution, _, _, _ = np.linalg.lstsq(a_mat, values, rcond=None)
             if not all(k in self.unsure for k in part.cons):
                 self._underdetermined(a_mat, part)
-        # The size of the part's impulses: what it moved and the momentum of its bodies.
+        # The size of the part's impulses: what it moved and the momentum of its bodies,
+        # and at least a rounding of the largest momentum of the probe (a ball at rest on
+        # its friction joints holds impulses of 1e-17 that two roundings tell apart: they
+        # do no work the drift could show).
         rows = part.rows
-        scale = max(float(np.abs(values).max(initial=0.0)), self.momentum[rows].max(), 1e-300)
+        scale = max(float(np.abs(values).max(initial=0.0)), self.momentum[rows].max(),
+                    AT_REST * self.peak, 1e-300)
         sol = solution.tolist()
         for at, k in enumerate(part.cons):
             lo, hi = part.first[at], part.first[at + 1]

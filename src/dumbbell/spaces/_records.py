@@ -18,7 +18,8 @@ import numpy as np
 
 class Snapshot(NamedTuple):
     """The bodies' state (positions, velocities, the bias velocities the next move adds,
-    and which dynamic rows sleep), and the springs' and fields' potentials there."""
+    and which dynamic rows sleep), the springs' and fields' potentials there, and whether
+    any body sleeps and any bias velocity is not 0 (found once, read by every step)."""
 
     pos: np.ndarray
     vel: np.ndarray
@@ -26,14 +27,8 @@ class Snapshot(NamedTuple):
     sleeping: np.ndarray
     us: list[np.ndarray]
     ud: np.ndarray
-
-    @property
-    def asleep(self) -> bool:
-        return bool(self.sleeping.any())
-
-    @property
-    def biased(self) -> bool:
-        return bool(self.bias.any())
+    asleep: bool
+    biased: bool
 
 
 class Energy(NamedTuple):

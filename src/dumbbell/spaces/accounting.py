@@ -50,7 +50,31 @@ _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
 
 @dataclass(frozen=True)
 class Skipped:
-    """Something the accounting left out, and why in words."""
+    """Something the accounting left out, and why in words.
+
+    Parameters
+    ----------
+    subject : str
+        What (a body or a constraint, as the accounting labels it).
+    reason : str
+        Why it was left out.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> pin = pymunk.PinJoint(space.static_body, ball, (0.3, 1.5), (0.0, 0.0))
+    >>> space.add(pin)
+    >>> spaces.energy(space).skipped           # a pin stores no energy: nothing is left out
+    ()
+    """
 
     subject: str
     reason: str
@@ -649,7 +673,38 @@ class _Sampler:
 class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
     momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
-    space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not)."""
+    space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not).
+
+    Parameters
+    ----------
+    subject : str
+        Its label ('body 0').
+    mass, moment : float
+        kg and kg m².
+    K_trans, K_rot, U_g : float
+        Its energies (J).
+    momentum : tuple of float
+        (px, py) (kg m/s).
+    L_about : float
+        Angular momentum about the point asked for (kg m²/s).
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> e = spaces.energy(space, units="m")
+    >>> e.bodies[0]
+    BodyEnergy('body 0': K_trans = 0 J, K_rot = 0 J, U_g = 0.98 J, momentum = (0, 0) kg m/s)
+    """
 
     subject: str
     mass: float
@@ -669,7 +724,34 @@ class BodyEnergy:
 
 @dataclass(frozen=True, repr=False)
 class SpringEnergy:
-    """One spring: its label, kind and potential energy U (J; in the space's ``units``)."""
+    """One spring: its label, kind and potential energy U (J; in the space's ``units``).
+
+    Parameters
+    ----------
+    subject : str
+        Its label ('DampedSpring 0').
+    kind : str
+        Its pymunk class.
+    U : float
+        Its potential energy (J).
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> e = spaces.energy(space, units="m")
+    >>> e.springs[0]
+    SpringEnergy('DampedSpring 0', DampedSpring: U = 3.35238484 J)
+    """
 
     subject: str
     kind: str
@@ -690,7 +772,47 @@ class SpaceEnergy:
     K_trans, K_rot, K_cm, K_int (= K_trans + K_rot - K_cm), U_g, U_spring and E = K_trans +
     K_rot + U_g + U_spring in J; ``momentum`` (px, py) in kg m/s; ``L_cm`` and ``L_about`` in
     kg m^2/s about the centre of mass ``cm`` (m) and about ``about`` (m). ``bodies`` and
-    ``springs`` hold the parts; ``skipped``, ``unknown`` and ``notes`` what was left out."""
+    ``springs`` hold the parts; ``skipped``, ``unknown`` and ``notes`` what was left out.
+
+    Parameters
+    ----------
+    K_trans, K_rot, K_cm, K_int, U_g, U_spring, E : float
+        The energies (J).
+    momentum : tuple of float
+        (px, py) (kg m/s).
+    L_cm, L_about : float
+        Angular momentum (kg m²/s) about the centre of mass and about ``about``.
+    about, cm : tuple of float
+        The point asked for and the centre of mass (m).
+    bodies : tuple of BodyEnergy
+        One per dynamic body.
+    springs : tuple of SpringEnergy
+        One per spring.
+    skipped, unknown : tuple of Skipped
+        What was left out: bodies or constraints not counted, and constraints of a kind the
+        accounting does not know.
+    notes : tuple of str
+        What else to know.
+    units : tuple of str, default ('units', 'mass units', 's')
+        (length, mass, time), as :func:`energy` was told.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> e = spaces.energy(space, units="m")
+    >>> round(e.U_g, 6), round(e.U_spring, 6), round(e.E, 6)          # J
+    (0.98, 3.352385, 4.332385)
+    >>> e.momentum, e.skipped, e.unknown, e.notes
+    ((0.0, 0.0), (), (), ())
+    """
 
     K_trans: float
     K_rot: float
@@ -728,7 +850,45 @@ def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
     ``units`` names the space's units as the recorder takes them (the length unit alone,
     'px' or 'm', or (length, mass, time); None: not named, and the reprs say "energy units",
     never J for what may be pixels): the values are the same, their reprs carry them. See
-    the module docstring for what is counted."""
+    the module docstring for what is counted.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    about : tuple of float, default (0.0, 0.0)
+        The point (length units) the angular momentum ``L_about`` is taken about.
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
+
+    Returns
+    -------
+    SpaceEnergy
+        The energies, momenta and parts, frozen.
+
+    Raises
+    ------
+    UsageError
+        A ``space`` that is not a pymunk Space, or ``about`` or ``units`` not allowed.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> e = spaces.energy(space, units="m")
+    >>> e
+    SpaceEnergy(E = 4.33238484 J: K_trans = 0, K_rot = 0, U_g = 0.98, U_spring = 3.35238484 J; momentum = (0, 0) kg m/s, L_cm = 0 kg m²/s; 1 body, 1 spring, complete = True)
+    >>> spaces.energy(space).E          # units not named: the same number, no J in its repr
+    4.33238484...
+    """
     from ..model import args
     from .units import check_units
 

@@ -31,7 +31,39 @@ def shown(text: str, limit: int = TEXT_CHARS) -> str:
 class Term:
     """One source in the ledger: ``energy`` it put into the bodies over the run (negative
     when it took energy out, in ``unit``: J in SI), its ``kind`` (see
-    :mod:`dumbbell.spaces.ledger`) and a note."""
+    :mod:`dumbbell.spaces.ledger`) and a note.
+
+    Parameters
+    ----------
+    source : str
+        Who (a body, a spring, gravity, the program, ...).
+    kind : str
+        What kind of term.
+    energy : float
+        What it put in (negative: took out).
+    note : str, default ''
+        A note.
+    unit : str, default 'J'
+        The energy unit.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> ledger = spaces.Ledger(space, units="m")
+    >>> for _ in range(60):
+    ...     space.step(1 / 600)
+    >>> balance = ledger.balance()
+    >>> balance.sources()[0]
+    Term('DampedSpring 0', 'step error', +0.0563252 J)
+    """
 
     source: str
     kind: str
@@ -53,7 +85,64 @@ class Balance:
     is the largest kinetic energy and change of a potential seen, ``worst_step`` the largest
     closure of one step relative to it; ``complete`` is True when
     the closure and anything unattributed stay within ``tolerance`` of it and every source
-    is accounted for (``unaccounted`` names the others, with why)."""
+    is accounted for (``unaccounted`` names the others, with why).
+
+    Parameters
+    ----------
+    E0, E : float
+        The energy at the start and now.
+    terms : tuple of Term
+        The sources.
+    closure : float
+        E(t) - E(0) - the sum of the terms.
+    worst_step : float
+        The largest closure of one step, relative to ``scale``.
+    scale : float
+        The largest kinetic energy and change of a potential seen.
+    tolerance : float
+        What ``complete`` allows, relative to ``scale``.
+    unaccounted : tuple of (str, str)
+        Sources not accounted for, with why.
+    steps : int
+        Steps counted.
+    t : float
+        The time counted.
+    notes : tuple of str, default ()
+        What else to know.
+    unit : str, default 'J'
+        The energy unit.
+    time_unit : str, default 's'
+        The time unit.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> ledger = spaces.Ledger(space, units="m")
+    >>> for _ in range(60):
+    ...     space.step(1 / 600)
+    >>> balance = ledger.balance()
+    >>> balance.complete, balance.steps, round(balance.E0, 6)
+    (True, 60, 4.332385)
+    >>> round(balance.by_kind()["step error"], 4)      # J: pymunk's step put energy in
+    0.0623
+    >>> [term.source for term in balance.sources("step error")]
+    ['DampedSpring 0', 'gravity']
+    >>> print(balance.table(top=1))
+    energy ledger over 60 steps, t = 0.1 s, energies in J
+      E(0) = 4.33238484   E(t) = 4.39470941   scale = 3.352
+      step error       +0.0623246  (2 sources)
+          DampedSpring 0                           +0.0563252
+          ...
+      complete: True
+    """
 
     E0: float
     E: float
@@ -110,7 +199,13 @@ class Balance:
                     and abs(self.closure) <= self.tolerance * self.scale)
 
     def by_kind(self) -> dict[str, float]:
-        """Energy per kind of term."""
+        """Energy per kind of term.
+
+        Returns
+        -------
+        dict of str to float
+            Kind -> its terms' energy, summed.
+        """
         out: dict[str, float] = {}
         for t in self.terms:
             out[t.kind] = out.get(t.kind, 0.0) + t.energy
@@ -118,7 +213,20 @@ class Balance:
 
     def sources(self, kind: str | None = None, at_least: float = 0.0) -> list[Term]:
         """Terms (of ``kind``, all when None) with |energy| >= ``at_least``, largest
-        first."""
+        first.
+
+        Parameters
+        ----------
+        kind : str or None, default None
+            Only terms of this kind.
+        at_least : float, default 0.0
+            Only terms with at least this much energy.
+
+        Returns
+        -------
+        list of Term
+            Largest first.
+        """
         from ..model import args
 
         at_least = args.real(at_least, "at_least", self.unit, lo=0.0)
@@ -136,7 +244,18 @@ class Balance:
 
     def table(self, top: int = 4) -> str:
         """The ledger as text: totals per kind with the ``top`` largest sources of each,
-        then the check."""
+        then the check.
+
+        Parameters
+        ----------
+        top : int, default 4
+            Sources shown per kind.
+
+        Returns
+        -------
+        str
+            The text.
+        """
         from ..model import args
 
         top = args.whole(top, "top", "sources", lo=0)

@@ -86,7 +86,43 @@ class Reach:
     (``position . g / |g|``) its centre of gravity reaches after that fall (None without
     gravity): below it the estimate says nothing; ``held``: the joint holding it ('' if
     free); ``source``: what sets the estimate, in words; ``bound``: whether the estimate is an
-    upper bound (see the module docstring)."""
+    upper bound (see the module docstring).
+
+    Parameters
+    ----------
+    subject : str
+        The body's label.
+    speed : float
+        The estimate (length units per time unit).
+    now : float
+        The speed of its fastest point now.
+    point : bool
+        The estimate is of its farthest point, not its centre of gravity.
+    fall : float
+        How far its centre of gravity can drop along gravity (length units).
+    level : float or None
+        The depth along gravity it reaches after that fall.
+    held : str
+        The joint holding it ('' if free).
+    source : str
+        What sets the estimate, in words.
+    bound : bool
+        Whether the estimate is a bound (True) or a guess.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> spaces.reach(space, 1 / 60)[0].bound
+    True
+    """
 
     subject: str
     speed: float
@@ -102,7 +138,42 @@ class Reach:
 def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     """Each dynamic body's reach estimate (a :class:`Reach`, in the order of
     ``space.bodies``) for steps of ``dt`` (s); ``units`` names the space's length unit in
-    the ``source`` texts (e.g. 'm' or 'px'; None: 'units')."""
+    the ``source`` texts (e.g. 'm' or 'px'; None: 'units').
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit).
+    units : str or None, default None
+        The space's length unit, for the texts.
+
+    Returns
+    -------
+    tuple of Reach
+        One per dynamic body.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> (estimate,) = spaces.reach(space, 1 / 60)
+    >>> estimate.subject, round(estimate.speed, 3), estimate.source   # m/s: from the spring
+    ('body 0', 8.27, "its springs' energy")
+    """
     space = args.space(space)
     dt = args.real(dt, "dt", "s")
     unit = length_unit(units)

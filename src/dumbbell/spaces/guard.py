@@ -81,7 +81,29 @@ def energy_swing(w_dt: float) -> float:
 
     Why: positions first, then velocities from the new positions (symplectic Euler) keeps
     H = v^2/2 + w^2 x^2/2 - (w^2 dt/2) x v exactly for x'' = -w^2 x; the energy
-    E = v^2/2 + w^2 x^2/2 then runs between H / (1 + w dt / 2) and H / (1 - w dt / 2)."""
+    E = v^2/2 + w^2 x^2/2 then runs between H / (1 + w dt / 2) and H / (1 - w dt / 2).
+
+    Parameters
+    ----------
+    w_dt : float
+        w*dt, w the spring's angular frequency.
+
+    Returns
+    -------
+    float
+        The swing, a fraction (inf from w dt = 2).
+
+    Raises
+    ------
+    UsageError
+        A w*dt that is not a number >= 0.
+
+    Examples
+    --------
+    >>> from dumbbell import spaces
+    >>> spaces.energy_swing(1.0), spaces.energy_swing(0.01), spaces.energy_swing(2.0)
+    (2.0, 0.010050251256281407, inf)
+    """
     z = args.real(w_dt, "w_dt", "-", lo=0.0)
     return math.inf if z >= SPRING_LIMIT else 2.0 * z / (2.0 - z)
 
@@ -126,7 +148,37 @@ def _inverse_mass(body: Any) -> tuple[float, float]:
 
 def spring_omega(spring: Any) -> float:
     """Angular frequency (rad/s) of a ``DampedSpring`` or ``DampedRotarySpring`` on its two
-    bodies as they are now (0 if neither can move); see the module docstring."""
+    bodies as they are now (0 if neither can move); see the module docstring.
+
+    Parameters
+    ----------
+    spring : pymunk.DampedSpring or pymunk.DampedRotarySpring
+        The spring.
+
+    Returns
+    -------
+    float
+        w (rad per the space's time unit).
+
+    Raises
+    ------
+    UsageError
+        Anything but such a spring.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> round(spaces.spring_omega(spring), 4)         # sqrt(200 / 0.1)
+    44.7214
+    """
     import pymunk
 
     args.pymunk_object(spring, "spring", ("DampedSpring", "DampedRotarySpring"))
@@ -150,7 +202,30 @@ def spring_omega(spring: Any) -> float:
 
 def shape_size(shape: Any) -> float:
     """The thinnest extent of a shape (length units): a circle's diameter, a segment's
-    thickness (2 x radius), a polygon's least width across an edge plus 2 x radius."""
+    thickness (2 x radius), a polygon's least width across an edge plus 2 x radius.
+
+    Parameters
+    ----------
+    shape : pymunk.Shape
+        A circle, segment or polygon.
+
+    Returns
+    -------
+    float
+        The thinnest extent (length units).
+
+    Raises
+    ------
+    UsageError
+        Anything but a pymunk shape.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> spaces.shape_size(pymunk.Circle(None, 0.02))
+    0.04
+    """
     args.pymunk_object(shape, "shape", ("Shape",))
     return float(_shapes([shape], np.zeros(1, dtype=int), np.zeros((1, 2)))[1][0])
 
@@ -369,7 +444,45 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
     ``speeds``: 'state' (the present speeds), 'energy' (the reach estimates) or 'both' (the
     larger); ``tolerance``: the largest energy swing of a spring's step (a fraction;
-    math.inf for stability only); ``units``: the space's length unit for the messages."""
+    math.inf for stability only); ``units``: the space's length unit for the messages.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit, s in SI).
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        The speeds checked: the present ones, the reach estimates, or the larger.
+    tolerance : float, default 0.01
+        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
+    units : str or None, default None
+        The space's length unit, for the messages.
+
+    Returns
+    -------
+    list of (Finding, bool)
+        Every check, and whether it passes.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> [(f.kind, ok) for f, ok in spaces.survey(space, 1e-4)][:1]
+    [('spring', True)]
+    """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return [(f, f.ok) for f in _advise(space, dt, speeds, tolerance, unit).rows]
 
@@ -378,7 +491,47 @@ def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERA
           units: str | None = None) -> list[Finding]:
     """The checks that fail at step ``dt`` (s): each a :class:`Finding` with its fix (see
     :func:`survey` for the arguments; rows not checked are in :func:`survey` and
-    :func:`report`, not here)."""
+    :func:`report`, not here).
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit, s in SI).
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        The speeds checked: the present ones, the reach estimates, or the larger.
+    tolerance : float, default 0.01
+        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
+    units : str or None, default None
+        The space's length unit, for the messages.
+
+    Returns
+    -------
+    list of Finding
+        The checks that fail, each with its fix; [] when all pass.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> [(f.kind, f.subject) for f in spaces.check(space, 1 / 60)]   # stiff for 60 fps
+    [('spring', 'DampedSpring 0')]
+    >>> spaces.check(space, 1e-4)
+    []
+    """
     return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok and f.checked]
 
 
@@ -386,7 +539,47 @@ def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOL
              units: str | None = None) -> int:
     """The fewest whole sub-steps of ``dt`` (s) that clear every finding a step can clear (see
     :func:`survey` for the arguments). A space in a state no step fixes (a NaN, a body without
-    a mass) is refused."""
+    a mass) is refused.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit, s in SI).
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        The speeds checked: the present ones, the reach estimates, or the larger.
+    tolerance : float, default 0.01
+        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
+    units : str or None, default None
+        The space's length unit, for the messages.
+
+    Returns
+    -------
+    int
+        Sub-steps per step, at least 1.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+    DumbbellError
+        A space in a state no step fixes.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> spaces.substeps(space, 1 / 60)               # w dt under 0.00995 for a 1 % swing
+    75
+    """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return _refuse(_advise(space, dt, speeds, tolerance, unit))
 
@@ -395,7 +588,45 @@ def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = T
                units: str | None = None) -> float:
     """A step (s) that clears every finding a step can clear: ``dt`` divided into the fewest
     whole sub-steps (so frames at ``dt`` stay whole); ``dt`` itself when nothing fails. The
-    springs' energy swing at it is at most ``tolerance``; :func:`report` says what it is."""
+    springs' energy swing at it is at most ``tolerance``; :func:`report` says what it is.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit, s in SI).
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        The speeds checked: the present ones, the reach estimates, or the larger.
+    tolerance : float, default 0.01
+        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
+    units : str or None, default None
+        The space's length unit, for the messages.
+
+    Returns
+    -------
+    float
+        The sub-step (the space's time unit).
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> spaces.suggest_dt(space, 1 / 60) == 1 / 60 / spaces.substeps(space, 1 / 60)
+    True
+    """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return dt / _refuse(_advise(space, dt, speeds, tolerance, unit))
 
@@ -428,7 +659,47 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
            units: str | None = None) -> str:
     """The guard's report as text: every check with ok or its fix (a kind with many rows
     lists the first few and sums up the rest), the suggestion and its reason, and the springs'
-    energy swing at the suggested step."""
+    energy swing at the suggested step.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        Any space.
+    dt : float
+        The step (the space's time unit, s in SI).
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        The speeds checked: the present ones, the reach estimates, or the larger.
+    tolerance : float, default 0.01
+        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
+    units : str or None, default None
+        The space's length unit, for the messages.
+
+    Returns
+    -------
+    str
+        The report, one line per check.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> print(spaces.report(space, 1 / 60, units="m"))
+    step-size guard at dt = 0.0166667 s ...
+      FAIL spring         DampedSpring 0         w dt = 0.7454 >= 0.00995; w = 44.72 rad/s: ...
+      suggested: 75 sub-steps of each step, of 0.0002222 s, ...
+    """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     advice = _advise(space, dt, speeds, tolerance, unit)
     named = (f"lengths in {unit}" if units is not None

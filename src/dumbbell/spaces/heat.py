@@ -21,7 +21,9 @@ kick), so it shrinks with dt.
 The counters of a space listen on its wildcard handler (``on_collision(None, None)``)
 through one dispatcher (``pre_solve`` and ``post_solve``): callbacks already there are kept
 and called after the counters with their own data, handlers the user sets for particular
-collision types keep firing, and when the last counter detaches (in any order; dropping a
+collision types keep firing (their ``post_solve``, which pymunk calls before the wildcard
+one, runs after the counters too: a velocity it sets is the program's, not a contact's
+heat), and when the last counter detaches (in any order; dropping a
 counter detaches it) the handler's callbacks and data are as they were (a wildcard handler
 pymunk made for the counters stays, with no callbacks: pymunk offers no way to remove one).
 Setting another wildcard ``pre_solve`` or ``post_solve`` afterwards stops the counters: each
@@ -54,7 +56,40 @@ class HeatCounter:
     """Attach to ``space``: ``total`` (J) is the heat its contacts dissipated since, ``steps``
     the contact-steps counted. ``detach()`` stops counting; ``stopped`` says why counting
     stopped (None while it counts). ``units`` names the space's units as the recorder takes
-    them (its repr prints the total in them)."""
+    them (its repr prints the total in them).
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space to count.
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
+
+    Raises
+    ------
+    UsageError
+        A ``space`` that is not a pymunk Space, or units not allowed.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    >>> ball.position = (0.0, 1.0)
+    >>> floor = pymunk.Segment(space.static_body, (-1.0, 0.0), (1.0, 0.0), 0.01)
+    >>> ball_shape = pymunk.Circle(ball, 0.1)
+    >>> ball_shape.elasticity, floor.elasticity = 0.5, 1.0     # a bounce that loses energy
+    >>> space.add(ball, ball_shape, floor)
+    >>> heat = spaces.HeatCounter(space)
+    >>> for _ in range(1000):
+    ...     space.step(1e-3)
+    >>> heat.total > 0, heat.stopped                 # J, dissipated by the bounces
+    (True, None)
+    >>> heat.detach()
+    """
 
     def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
@@ -77,6 +112,10 @@ class HeatCounter:
         self._steps = 0
         self._stopped: str | None = None
         self._before: dict[int, list[tuple[float, float, float, float]]] = {}
+        # The bodies of each arbiter counted in the step, and their velocities at the
+        # solver's end (taken at the step's first post_solve, before any program's).
+        self._ends: dict[int, tuple[Any, Any]] = {}
+        self._after: dict[int, tuple[float, float, float]] | None = None
         self._last_dt: float | None = None
         _Dispatch.of(space).add(self)
 
@@ -126,7 +165,10 @@ class HeatCounter:
 
     def detach(self) -> None:
         """Stop counting. When the space's last counter detaches, its wildcard callbacks are
-        the ones it had before the first counter attached."""
+        the ones it had before the first counter attached.
+
+
+        """
         self._look()
         d = self._dispatch()
         if d is not None:
@@ -147,7 +189,7 @@ class HeatCounter:
         # it), and holds no space: a pickled space or state brings its own bodies, which a
         # second space would claim.
         state = dict(self.__dict__)
-        state["_before"] = {}
+        state["_before"], state["_ends"], state["_after"] = {}, {}, None
         state["space"] = None
         if state["_stopped"] is None:
             state["_stopped"] = "a copy: it does not count"
@@ -167,14 +209,23 @@ class HeatCounter:
         return raw, a.body, b.body
 
     @staticmethod
-    def _velocities(raw: Any, ba: Any, bb: Any) -> list[tuple[float, float]]:
-        va, wa, vb, wb = ba.velocity, ba.angular_velocity, bb.velocity, bb.angular_velocity
+    def _velocities(raw: Any, ba: Any, bb: Any,
+                    at: dict[int, tuple[float, float, float]] | None = None
+                    ) -> list[tuple[float, float]]:
+        """The relative velocity at each contact point of ``raw``: from the bodies' own
+        velocities, or from those taken in ``at`` (by id)."""
+        if at is None:
+            (vax, vay), wa = ba.velocity, ba.angular_velocity
+            (vbx, vby), wb = bb.velocity, bb.angular_velocity
+        else:
+            vax, vay, wa = at[id(ba)]
+            vbx, vby, wb = at[id(bb)]
         out = []
         for i in range(raw.count):
             c = raw.contacts[i]
             r1, r2 = c.r1, c.r2
-            out.append(((vb.x - wb * r2.y) - (va.x - wa * r1.y),
-                        (vb.y + wb * r2.x) - (va.y + wa * r1.x)))
+            out.append(((vbx - wb * r2.y) - (vax - wa * r1.y),
+                        (vby + wb * r2.x) - (vay + wa * r1.x)))
         return out
 
     def _pre_solve(self, arbiter: Any, space: Any) -> None:
@@ -187,16 +238,20 @@ class HeatCounter:
         # accumulator's growth from here plus the part applied at the start.
         carried = 0.0 if arbiter.is_first_contact else (
             space.current_time_step / self._last_dt if self._last_dt else 1.0)
-        self._before[int(ffi.cast("uintptr_t", raw))] = [
+        key = int(ffi.cast("uintptr_t", raw))
+        self._before[key] = [
             (ux, uy, raw.contacts[i].jnAcc * (1.0 - carried),
              raw.contacts[i].jtAcc * (1.0 - carried))
             for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb))
         ]
+        self._ends[key] = (ba, bb)
         # A contact whose post_solve never comes (the user rejected it) must not linger.
         space.add_post_step_callback(self._end_step, self)
 
     def _end_step(self, space: Any, key: Any) -> None:
         self._before.clear()
+        self._ends.clear()
+        self._after = None
         # Arbiters that carry impulses into the next step had contacts in this one, so this
         # is the 'previous dt' pymunk scales them by.
         self._last_dt = space.current_time_step
@@ -206,10 +261,15 @@ class HeatCounter:
 
         raw, ba, bb = self._relative(arbiter)
         before = self._before.pop(int(ffi.cast("uintptr_t", raw)), None)
+        if self._after is None:
+            # The step's first post_solve: every program's post_solve runs after it (the
+            # counters run first in every handler), so these are the solver's velocities.
+            self._after = {id(b): (*b.velocity, b.angular_velocity)
+                           for pair in self._ends.values() for b in pair}
         if before is not None and len(before) == raw.count:
             nx, ny = raw.n.x, raw.n.y
             work = 0.0
-            for i, (ux1, uy1) in enumerate(self._velocities(raw, ba, bb)):
+            for i, (ux1, uy1) in enumerate(self._velocities(raw, ba, bb, self._after)):
                 ux0, uy0, jn0, jt0 = before[i]
                 c = raw.contacts[i]
                 jn, jt = c.jnAcc - jn0, c.jtAcc - jt0
@@ -288,6 +348,26 @@ class _Dispatch:
         for phase, callback in self.phases.items():
             handler.data.setdefault(phase, None)
             setattr(handler, phase, callback)  # the property: data stays the user's
+        # The post_solve callbacks the program set for particular collision types, run
+        # after the counters (see :meth:`wrap`).
+        self.specific: list[tuple[weakref.ref[Any], _Phase]] = []
+        self.wrap()
+
+    def wrap(self) -> None:
+        """Run the counters before every post_solve the program set for particular
+        collision types (pymunk calls the most specific handler first, then the wildcard
+        one): a callback there that changes a velocity is the program's, not a contact's
+        heat. The handlers are read from ``Space._handlers``, as the wildcard one is."""
+        space = self._space()
+        if space is None:
+            return
+        for key, handler in list(getattr(space, "_handlers", {}).items()):
+            user = getattr(handler, "post_solve", None)
+            if key == (None, None) or user is None or isinstance(user, _Phase):
+                continue
+            phase = _Phase(self, "post_solve", user)
+            self.specific.append((weakref.ref(handler), phase))
+            handler.post_solve = phase
 
     @classmethod
     def of(cls, space: Any) -> _Dispatch:
@@ -321,6 +401,11 @@ class _Dispatch:
                 setattr(h, phase, callback.user)
                 if phase in self.no_data:
                     h.data.pop(phase, None)
+        for ref, callback in self.specific:
+            handler = ref()
+            if handler is not None and handler.post_solve is callback:
+                handler.post_solve = callback.user
+        self.specific = []
         if _DISPATCH.get(space) is self:
             del _DISPATCH[space]
 
@@ -330,6 +415,7 @@ class _Dispatch:
         handler = self._handler()
         if handler is None:
             return
+        self.wrap()
         for phase, mine in self.phases.items():
             new = getattr(handler, phase)
             if new is mine:

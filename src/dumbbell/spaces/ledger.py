@@ -120,7 +120,42 @@ class Ledger(Changes):
     units as the recorder takes them (the length unit alone, 'px', or (length, mass, time));
     energies are printed in them (J in SI; "energy units" when not named). See the module docstring for the terms. A copy
     or a pickle of a ledger holds its account so far and does not count; a copy of the
-    space has no ledger attached."""
+    space has no ledger attached.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space to count.
+    tolerance : float, default 1e-6
+        What ``complete`` allows, relative to the energy scale.
+    units : str or tuple of str or None, default None
+        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
+        or (length, mass, time); None: not named (reprs say "energy units", never J).
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, or a space being stepped or not finite.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> ledger = spaces.Ledger(space, units="m")      # counts every later space.step
+    >>> for _ in range(60):
+    ...     space.step(1 / 600)
+    >>> balance = ledger.balance()
+    >>> balance.complete, balance.steps
+    (True, 60)
+    >>> ledger.detach()
+    """
 
     def __new__(cls, space: Any = None, *args: Any, **kwargs: Any) -> Ledger:  # noqa: PYI034
         if cls is Ledger:
@@ -196,7 +231,10 @@ class Ledger(Changes):
     def detach(self) -> None:
         """Stop counting and take the hook out of the space: its constraints are back in
         the order they had. :meth:`balance` keeps the account up to here. Inside a step (a
-        callback), it stops counting at once and the hook is taken out after the step."""
+        callback), it stops counting at once and the hook is taken out after the step.
+
+
+        """
         hook = self.__dict__.get("_hook")
         if hook is None:
             return
@@ -216,7 +254,42 @@ class Ledger(Changes):
         -GM * m / np.hypot(x - 300, y - 300)``. Declare it before the first step the ledger
         counts: the field's energy joins E from E(0) on, and each step's kicks count as the
         field's step error instead of unaccounted work. ``name`` labels its term (at most
-        60 printable characters)."""
+        60 printable characters).
+
+        Parameters
+        ----------
+        target : pymunk.Body or list of pymunk.Body or callable
+            The bodies, or a velocity function (every body that uses it).
+        potential : callable
+            ``potential(x, y, m)``: the field's potential energy, numpy in and out.
+        name : str or None, default None
+            The term's label.
+
+        Raises
+        ------
+        UsageError
+            A target, potential or name that is not allowed, or a declaration after the first step
+            counted.
+
+        Examples
+        --------
+        >>> import pymunk
+        >>> from dumbbell import spaces
+        >>> def spring_to_origin(body, gravity, damping, dt):     # a field F = -k m r, k = 4 /s²
+        ...     pymunk.Body.update_velocity(body, -4.0 * body.position, damping, dt)
+        >>> space = pymunk.Space()
+        >>> body = pymunk.Body(1, 1)
+        >>> body.position, body.velocity = (1, 0), (0, 1)
+        >>> body.velocity_func = spring_to_origin
+        >>> space.add(body, pymunk.Circle(body, 0.1))
+        >>> ledger = spaces.Ledger(space)
+        >>> ledger.declare_potential(spring_to_origin, lambda x, y, m: 2.0 * m * (x**2 + y**2),
+        ...                          name="harmonic field")
+        >>> for _ in range(200):
+        ...     space.step(0.005)
+        >>> ledger.balance().complete
+        True
+        """
         from ..errors import UsageError
 
         if self._frozen is not None:
@@ -254,7 +327,18 @@ class Ledger(Changes):
     def balance(self) -> Balance:
         """The account from attaching until now (what the program changed since the last
         step counts as ``program``). Raises a :class:`~dumbbell.errors.DumbbellError` naming
-        the body once the space's state stopped being finite."""
+        the body once the space's state stopped being finite.
+
+        Returns
+        -------
+        Balance
+            The account, frozen.
+
+        Raises
+        ------
+        DumbbellError
+            The space's state stopped being finite (naming the body).
+        """
         if self._frozen is not None:
             return self._frozen
         if self._bad is not None:
@@ -407,9 +491,9 @@ class Ledger(Changes):
                            "potential energy the contacts' position correction adds (beyond "
                            "each pair's part through gravity)")
         force = F[6:9, :n]
-        awake = P[0, :n] == 0
+        roots = P[0, :n]
         self._before = Before(dt, coef, move, force if force.any() else None,
-                              None if awake.all() else awake, g_int, g_rows, pots,
+                              roots == 0 if roots.any() else None, g_int, g_rows, pots,
                               [g.before.floats() for g in b.groups.values()], contacts,
                               total + corr)
 
@@ -422,7 +506,7 @@ class Ledger(Changes):
         slots, work = self._push
         share = work * dt
         self._pairs.push += np.bincount(slots, weights=share, minlength=len(self._pairs.push))
-        pushed = float(np.sum(share))
+        pushed = float(share.sum())
         self._push = None
         return total + pushed, corr - pushed
 
@@ -465,11 +549,14 @@ class Ledger(Changes):
         """Snapshot the end of the step (``Q``: the post reader's floats, ``root`` its
         pointers), check it against the terms, track the scale."""
         t = self._b.table
-        bias = Q[3:6].copy()
-        bias[:, t.n:] = 0.0
-        sleeping = root[0, : t.n] != 0
-        snap = Snapshot(p.move.pos, Q[0:3].copy(), bias, sleeping, p.potentials.u_end,
-                        p.potentials.d_end)
+        # Q and the move's positions are this step's own reads: the snapshot keeps them.
+        bias = Q[3:6]
+        if t.rows > t.n:
+            bias[:, t.n:] = 0.0
+        roots = root[0, : t.n]
+        asleep = bool(roots.any())
+        snap = Snapshot(p.move.pos, Q[0:3], bias, roots != 0 if asleep else t.none_asleep,
+                        p.potentials.u_end, p.potentials.d_end, asleep, bool(bias.any()))
         E, K, Ug, Us, Ud = phys.totals(self._b, snap)
         if not (math.isfinite(E) and math.isfinite(total)):
             self._blown(snap)

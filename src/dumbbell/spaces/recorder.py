@@ -107,7 +107,26 @@ def _window_y_up(space: Any) -> tuple[bool, str]:
 
 
 def draw_options() -> Any:
-    """A new ``PaletteDrawOptions`` (a ``pymunk.SpaceDebugDrawOptions``)."""
+    """A new ``PaletteDrawOptions`` (a ``pymunk.SpaceDebugDrawOptions``).
+
+    Returns
+    -------
+    PaletteDrawOptions
+        Options for ``space.debug_draw``.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> space.debug_draw(spaces.draw_options())       # collects what the recorder draws
+    """
     return _options_class()()
 
 
@@ -259,6 +278,66 @@ class Recorder:
       After writing, :attr:`view` is the box shown and :attr:`note` says what the picture
       does not show as it is: which way y points and why (:attr:`orientation`), the bodies
       drawn larger than to scale, those outside the picture in some frames.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space.
+    path : str or pathlib.Path
+        The file (.gif; .mp4 with the ``[mp4]`` extra).
+    fps : int, default 25
+        Frames per second.
+    energy : bool, default True
+        Draw the energy bars and strip.
+    size : str or tuple of int, default '640x360'
+        The picture, 'WxH' (px).
+    strip : bool, default True
+        The energy strip over the whole recording.
+    heat : HeatCounter or None, default None
+        Add its total and E + heat.
+    world : tuple of float or None, default None
+        The view (x0, y0, x1, y1) in length units; None: the camera's.
+    camera : str or tuple, default 'auto'
+        How the view follows the bodies.
+    span : float or None, default None
+        The time the strip shows.
+    y_up : bool or None, default None
+        Which way y points on screen; None: as the program's window does.
+    units : str or tuple of str or None, default None
+        The space's units ('m', 'px' or (length, mass, time)); None: not named.
+    reference : str or float, default 'start'
+        Where the potentials are counted from.
+    t0 : float, default 0.0
+        The time of frame 0.
+    title : str, default ''
+        A title.
+    about : tuple of float, default (0.0, 0.0)
+        The point angular momentum is taken about.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, naming it, before any work.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> with spaces.Recorder(space, "ball.gif", fps=10, size="320x180") as rec:
+    ...     for frame in range(10):
+    ...         spaces.step(space, 1 / 10, substeps=500)
+    ...         rec.capture()
+    >>> len(rec.recording().t)                     # frame 0 and ten captures
+    11
+    >>> open("ball.gif", "rb").read(6)
+    b'GIF89a'
     """
 
     def __init__(self, space: Any, path: str | Path, fps: int = 25, energy: bool = True, *,
@@ -374,7 +453,18 @@ class Recorder:
     def capture(self, t: float | None = None) -> None:
         """Keep the space as it is now as the next frame, at time ``t`` (the space's time
         unit; default: 1/fps after the previous frame if the space was stepped since, else
-        the previous frame's time). Before any step, it replaces frame 0."""
+        the previous frame's time). Before any step, it replaces frame 0.
+
+        Parameters
+        ----------
+        t : float or None, default None
+            The frame's time (the space's time unit).
+
+        Raises
+        ------
+        UsageError
+            A time that is not a finite number within the allowed range.
+        """
         from ..model import args
 
         previous = self.t[-1]
@@ -460,7 +550,13 @@ class Recorder:
         return e, labels
 
     def recording(self) -> Any:
-        """The frozen :class:`dumbbell.animation.recorded.Recording` of what was captured."""
+        """The frozen :class:`dumbbell.animation.recorded.Recording` of what was captured.
+
+        Returns
+        -------
+        dumbbell.animation.recorded.Recording
+            What was captured, frozen.
+        """
         from ..animation.camera import item_box
         from ..animation.recorded import Recording
 
@@ -501,7 +597,31 @@ class Recorder:
         return []
 
     def write(self) -> Path:
-        """Draw and write the file (called when the ``with`` block ends)."""
+        """Draw and write the file (called when the ``with`` block ends).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+
+        Examples
+        --------
+        >>> import pymunk
+        >>> from dumbbell import spaces
+        >>> space = pymunk.Space()                     # a ball on a spring, SI units
+        >>> space.gravity = (0.0, -9.8)
+        >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+        >>> ball.position = (0.3, 1.0)
+        >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+        ...                              200.0, 0.0)
+        >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+        >>> rec = spaces.Recorder(space, "ball.gif", fps=10, size="320x180")
+        >>> for frame in range(5):
+        ...     spaces.step(space, 1 / 10, substeps=500)
+        ...     rec.capture()
+        >>> rec.write().name
+        'ball.gif'
+        """
         from ..animation import recording
 
         if not self._captured:

@@ -40,7 +40,39 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
     ``apply_force_at_world_point`` and ``apply_force_at_local_point`` added) act in every
     sub-step, as they act over the whole frame without sub-steps (pymunk clears them after
     each step). A state that is not finite is refused before the frame and named after it
-    (a DumbbellError)."""
+    (a DumbbellError).
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space.
+    dt : float
+        The frame's step (the space's time unit).
+    substeps : int, default 1
+        Equal sub-steps.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed.
+    DumbbellError
+        A state that is not finite, before the frame or after it.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> spaces.step(space, 1 / 60, substeps=spaces.substeps(space, 1 / 60))
+    >>> spaces.check(space, 1 / 60 / 75)
+    []
+    """
     space = args.space(space)
     substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
     h = _frame_step(dt, substeps)
@@ -173,7 +205,42 @@ def _push_again(pushes: list[_Push]) -> None:
 class Driver:
     """Steps a space at a fixed frame step ``dt`` (s) in whole sub-steps: ``substeps`` given,
     or None for the guard's suggestion at the start (``speeds`` and ``tolerance`` as in
-    :func:`survey`). ``t`` (s) counts whole frames, so it does not drift with rounding."""
+    :func:`survey`). ``t`` (s) counts whole frames, so it does not drift with rounding.
+
+    Parameters
+    ----------
+    space : pymunk.Space
+        The space.
+    dt : float
+        The frame step (the space's time unit).
+    substeps : int or None, default None
+        Sub-steps per frame; None: the guard's suggestion.
+    speeds : {'both', 'state', 'energy'}, default 'both'
+        As in :func:`survey`.
+    tolerance : float, default 0.01
+        As in :func:`survey`.
+
+    Raises
+    ------
+    UsageError
+        An argument that is not allowed, or an absurd step.
+
+    Examples
+    --------
+    >>> import pymunk
+    >>> from dumbbell import spaces
+    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space.gravity = (0.0, -9.8)
+    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
+    >>> ball.position = (0.3, 1.0)
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
+    ...                              200.0, 0.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> driver = spaces.Driver(space, 1 / 60)
+    >>> driver.step(5)
+    >>> driver
+    Driver(dt=0.0166667 s, substeps=75, frames=5, t=0.0833333 s)
+    """
 
     def __init__(self, space: Any, dt: float, substeps: int | None = None,
                  speeds: str = "both", tolerance: float = TOLERANCE) -> None:
@@ -195,7 +262,20 @@ class Driver:
                 f"t={self.t:.6g} s)")
 
     def step(self, frames: int = 1) -> None:
-        """Advance ``frames`` frames."""
+        """Advance ``frames`` frames.
+
+        Parameters
+        ----------
+        frames : int, default 1
+            How many.
+
+        Raises
+        ------
+        UsageError
+            A number of frames that is not allowed.
+        DumbbellError
+            A state that is not finite (naming the body).
+        """
         frames = args.whole(frames, "frames", "frames", lo=0, hi=MAX_STEPS // self.substeps)
         if frames:
             try:

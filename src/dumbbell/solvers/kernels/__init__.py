@@ -80,6 +80,32 @@ class Kernel(NamedTuple):
     computes must follow from the sampled state alone. ``through_at_radius``: a particle is
     through the floor once its centre is more than its radius below it and moving down (a
     circle that the floor catches while they overlap); otherwise at any depth.
+
+    Parameters
+    ----------
+    step : callable
+        The step, as the floor rule says.
+    floor : {'flip', 'end', 'locate'}, default 'flip'
+        The rule at the floor.
+    start : callable or None, default None
+        Extends the sampled state with what the step carries.
+    through_at_radius : bool, default False
+        When a particle counts as through the floor.
+
+    Examples
+    --------
+    A classic Euler-Cromer step of the 1D state ``s = (xA, vA, xB, vB)`` with the scalars
+    ``p`` (``p.dt``, ``p.mA``, ``p.mB``, ``p.k``, ``p.b``, ``p.g``):
+
+    >>> from dumbbell.solvers import Kernel
+    >>> def euler_cromer(s, p):
+    ...     xA, vA, xB, vB = s
+    ...     f = -p.k * (xA - xB - p.b)
+    ...     vA = vA + (f / p.mA - p.g) * p.dt
+    ...     vB = vB + (-f / p.mB - p.g) * p.dt
+    ...     return (xA + vA * p.dt, vA, xB + vB * p.dt, vB)
+    >>> Kernel(euler_cromer).floor
+    'flip'
     """
 
     step: Callable[..., Any]
