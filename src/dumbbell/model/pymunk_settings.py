@@ -3,7 +3,7 @@
 The scene reader hands the table to this class, which reads it: what its keys mean, their
 bounds and their defaults are kept here, beside the scene that holds them (the model imports
 nothing of the solvers). Why these defaults is explained in :mod:`dumbbell.solvers.engine`. The table's ``spin`` key is physics
-(whether the particles are spinning discs, :attr:`~dumbbell.model.scene.System.discs`), so the
+(whether the particles are spinning discs, :attr:`~dumbbell.model.system.System.discs`), so the
 scene reads that one itself.
 """
 
