@@ -26,6 +26,31 @@ def load_tool(name: str):
     return sys.modules[name]
 SCENES = ROOT / "scenes"
 
+
+@pytest.fixture(autouse=True)
+def _no_process_outlives_its_test():
+    """Kill what a test started and left running, pass or fail (a subprocess it gave up on,
+    that process's own children), so that one failed test does not make the next ones fail
+    on ``assert not own_children()``. A test that checks for leftovers checks before this
+    runs; processes that were there before the test (a module's fixture, multiprocessing's
+    resource tracker) are left alone."""
+    import psutil
+
+    me = psutil.Process()
+    before = {p.pid for p in me.children(recursive=True)}
+    yield
+    left = []
+    for p in me.children(recursive=True):
+        try:
+            if p.pid not in before and \
+                    "multiprocessing.resource_tracker" not in " ".join(p.cmdline()):
+                p.kill()
+                left.append(p)
+        except psutil.NoSuchProcess:
+            pass
+    psutil.wait_procs(left, timeout=60)
+
+
 #: The textbook's scene as a dict, for tests that vary it.
 TEXTBOOK = {
     "title": "textbook",

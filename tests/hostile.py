@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import io
 import os
+import select
 import signal
 import subprocess
 import sys
 import time
-from contextlib import redirect_stderr, redirect_stdout
+from collections.abc import Iterator
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 import psutil
@@ -44,12 +46,136 @@ def cli(*argv: object) -> tuple[int, str, str]:
     return status, out.getvalue(), err.getvalue()
 
 
-def spawn(*argv: object, cwd: Path | None = None) -> subprocess.Popen:
-    """Start ``dumbbell ARGV`` as a real process (stderr and stdout piped)."""
-    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1"}
-    code = "import sys; from dumbbell.cli import main; sys.exit(main())"
+def spawn(*argv: object, cwd: Path | None = None, prelude: str = "",
+          **popen: object) -> subprocess.Popen:
+    """Start ``dumbbell ARGV`` as a real process (stderr and stdout piped) in a session of
+    its own (:func:`started` ends the whole group); ``prelude``: Python run before
+    ``main`` (a test's hooks)."""
+    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", **popen.pop("env", {})}
+    code = f"{prelude}\nimport sys; from dumbbell.cli import main; sys.exit(main())"
+    popen = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE, "text": True, **popen}
+    popen["preexec_fn"] = interruptible(popen.get("preexec_fn"))
     return subprocess.Popen([sys.executable, "-c", code, *map(str, argv)], cwd=cwd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            start_new_session=True, **popen)
+
+
+def interruptible(then=None):
+    """A ``preexec_fn`` giving the child SIGINT's default action, then calling ``then``: a
+    test run in the background by a shell without job control (``pytest ... &`` in a
+    script) has SIGINT ignored, which its children inherit, and the command keeps an
+    ignored signal ignored, as it must under ``nohup``; the tests that send SIGINT mean a
+    process that has it."""
+    def child() -> None:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        if then is not None:
+            then()
+
+    return child
+
+
+#: Generous bound on one subprocess of a test (s): only a hang reaches it; the tests wait
+#: for events (a line, a marker, the process's end), never for a time, so a loaded 2-core
+#: machine makes them slower, not wrong.
+HANG_S = 600.0
+
+
+def end_group(proc: subprocess.Popen) -> None:
+    """Kill ``proc``'s whole process group (its pool workers, its forked figure process;
+    spawned in a session of its own), whatever state it is in, and reap it."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    try:
+        proc.wait(timeout=HANG_S)
+    except subprocess.TimeoutExpired:  # pragma: no cover - the kernel reaps a killed group
+        pass
+    for stream in (proc.stdin, proc.stdout, proc.stderr):
+        if stream is not None:
+            stream.close()
+
+
+@contextmanager
+def started(*argv: object, cwd: Path | None = None, prelude: str = "", **popen: object
+            ) -> Iterator[subprocess.Popen]:
+    """:func:`spawn` for the block; on the way out (a failed assertion too) its whole
+    process group is killed, so that no test leaves a process behind."""
+    proc = spawn(*argv, cwd=cwd, prelude=prelude, **popen)
+    try:
+        yield proc
+    finally:
+        end_group(proc)
+
+
+def run_group(cmd: list[object], *, input: bytes | str | None = None,
+              timeout: float = HANG_S, **popen: object) -> subprocess.CompletedProcess:
+    """``subprocess.run(cmd, capture_output=True)`` in a session of its own, bounded by
+    ``timeout`` only against a hang, and its whole process group killed on the way out, pass
+    or fail (``subprocess.run`` kills only the process it started, not what that forked)."""
+    popen.setdefault("stdout", subprocess.PIPE)
+    popen.setdefault("stderr", subprocess.PIPE)
+    if input is not None:
+        popen["stdin"] = subprocess.PIPE
+    proc = subprocess.Popen([str(c) for c in cmd], start_new_session=True, **popen)
+    try:
+        out, err = proc.communicate(input, timeout=timeout)
+        return subprocess.CompletedProcess(proc.args, proc.returncode, out, err)
+    finally:
+        end_group(proc)
+
+
+def group_left(proc: subprocess.Popen, timeout: float = HANG_S) -> list[int]:
+    """Processes of ``proc``'s process group (its session: pool workers, the forked figure
+    process) still running after it ended, once those that end by themselves have: the
+    multiprocessing resource tracker, say, which ends when it sees its parent gone. Waits
+    for them (the event), at most ``timeout`` s against a hang; none may be left."""
+    members = []
+    for p in psutil.process_iter(["pid"]):
+        try:
+            if os.getpgid(p.pid) == proc.pid and p.status() != psutil.STATUS_ZOMBIE:
+                members.append(p)
+        except (ProcessLookupError, psutil.NoSuchProcess):
+            pass
+    _, alive = psutil.wait_procs(members, timeout=timeout)
+    return [p.pid for p in alive]
+
+
+def finish(proc: subprocess.Popen, timeout: float = HANG_S) -> tuple[str, str]:
+    """``proc.communicate()``, bounded by ``timeout`` only against a hang."""
+    return proc.communicate(timeout=timeout)
+
+
+@contextmanager
+def marker_pipe() -> Iterator[tuple[int, int]]:
+    """(read end, write end) of a pipe: the write end goes to a child (``pass_fds``) that
+    writes a line when it reaches the state a test waits for; :func:`wait_mark` reads it."""
+    r, w = os.pipe()
+    try:
+        yield r, w
+    finally:
+        for fd in (r, w):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+
+def wait_mark(proc: subprocess.Popen, fd: int, timeout: float = HANG_S) -> bytes:
+    """The first line the child writes on the marker pipe ``fd``: waits for that event (the
+    child's end, or :data:`HANG_S`, fails the test instead)."""
+    got = b""
+    deadline = time.monotonic() + timeout
+    while not got.endswith(b"\n"):
+        ready, _, _ = select.select([fd], [], [], 1.0)
+        if ready:
+            chunk = os.read(fd, 4096)
+            assert chunk, "the marker pipe closed before the mark"
+            got += chunk
+        elif proc.poll() is not None:
+            raise AssertionError(f"the process ended ({proc.returncode}) before the mark: "
+                                 f"{proc.communicate()}")
+        assert time.monotonic() < deadline, "the process never reached the mark"
+    return got
 
 
 def one_line(err: str) -> str:
@@ -94,8 +220,9 @@ def processes_naming(marker: str) -> list[psutil.Process]:
     return found
 
 
-def wait_gone(marker: str, timeout: float = 10.0) -> list[psutil.Process]:
-    """Wait up to ``timeout`` s for every process naming ``marker`` to end; the survivors."""
+def wait_gone(marker: str, timeout: float = HANG_S) -> list[psutil.Process]:
+    """Wait for every process naming ``marker`` to end (at most ``timeout`` s, against a
+    hang: it returns as soon as they are gone); the survivors, killed."""
     deadline = time.monotonic() + timeout
     while (left := processes_naming(marker)) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -117,14 +244,3 @@ def refused(status: int, err: str, folder: Path | None = None, keep: tuple[str, 
         assert files_in(folder) == sorted(keep), files_in(folder)
     assert not own_children()
     return line
-
-
-def send_when(proc: subprocess.Popen, ready, sig: signal.Signals, timeout: float = 60.0
-              ) -> None:
-    """Send ``sig`` to ``proc`` as soon as ``ready()`` is true (polled)."""
-    deadline = time.monotonic() + timeout
-    while not ready():
-        assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() < deadline, "the run never reached the state to signal"
-        time.sleep(0.02)
-    proc.send_signal(sig)

@@ -18,25 +18,26 @@ import pytest
 from dumbbell.cli import main
 from dumbbell.cli.app import DEFAULT_OUT, build_parser, subcommands
 from tests.conftest import SCENES
+from tests.hostile import run_group
 
 HEAVY = ("numpy", "matplotlib", "pymunk", "numba", "scipy", "pandas", "PIL", "imageio", "dask")
 
 
 def _python(code: str, *flags: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, *flags, "-c", code], capture_output=True, text=True,
-                          timeout=120, check=True)
+    done = run_group([sys.executable, *flags, "-c", code], text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done
 
 
 def test_import_dumbbell_is_cheap_and_loads_nothing_heavy():
-    # -X importtime: microseconds per module, the cumulative time of `dumbbell` its whole
-    # import. Bounded with room for a busy machine; the library's own figure is ~0.02 s.
-    done = _python("import sys, dumbbell\n"
-                   f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))",
-                   "-X", "importtime")
-    assert done.stdout.strip() == "[]"
-    cumulative = [int(m.group(1)) for m in re.finditer(r"\|\s*(\d+) \| dumbbell$", done.stderr,
-                                                       re.MULTILINE)]
-    assert len(cumulative) == 1 and cumulative[0] < 200_000, done.stderr[-2000:]
+    # What `import dumbbell` loads, not how long it takes (a time is the machine's load: speed
+    # lives in the benchmarks): nothing heavy, and a handful of modules (7 today, 2 of them
+    # dumbbell's own).
+    done = _python("import sys\nbefore = set(sys.modules)\nimport dumbbell\n"
+                   f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))\n"
+                   "print(len(set(sys.modules) - before))")
+    heavy, count = done.stdout.splitlines()
+    assert heavy == "[]" and int(count) <= 20, done.stdout
 
 
 def test_submodules_load_on_first_use():
@@ -65,11 +66,9 @@ def test_submodules_load_on_first_use():
 
 def test_python_m_dumbbell_and_version():
     version = importlib.metadata.version("dumbbell")
-    done = subprocess.run([sys.executable, "-m", "dumbbell", "--version"], capture_output=True,
-                          text=True, timeout=120, check=False)
+    done = run_group([sys.executable, "-m", "dumbbell", "--version"], text=True)
     assert (done.returncode, done.stdout.strip()) == (0, f"dumbbell {version}")
-    done = subprocess.run([sys.executable, "-m", "dumbbell"], capture_output=True, text=True,
-                          timeout=120, check=False)
+    done = run_group([sys.executable, "-m", "dumbbell"], text=True)
     assert done.returncode == 2 and done.stderr.count("\n") == 1
     import dumbbell
 

@@ -13,10 +13,10 @@ import subprocess
 import sys
 import threading
 import tracemalloc
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-import psutil
 import pytest
 
 import dumbbell
@@ -27,13 +27,19 @@ from tests.hostile import (
     SHORT_SCENE,
     SRC,
     cli,
+    end_group,
     files_in,
+    finish,
+    group_left,
+    interruptible,
+    marker_pipe,
     own_children,
     refused,
-    send_when,
+    run_group,
     short_scene,
-    spawn,
+    started,
     wait_gone,
+    wait_mark,
 )
 
 
@@ -411,16 +417,65 @@ def test_a_rigid_scene_file_of_huge_length_is_one_line(tmp_path):
 # --- 3. signals -----------------------------------------------------------------------------
 
 
+#: Run before ``main`` in a child: at the point MARK names, the process writes a line on the
+#: marker pipe MARK_FD and, where the work would otherwise end soon, waits there until the
+#: test's signal comes. 'sweep': each pool worker, at its first point; 'frame': the GIF's
+#: second frame (its temporary file is there); 'stepping': the first chunk of steps done.
+AT_MARK = """
+import os, time
+def _mark(wait):
+    os.write(int(os.environ["MARK_FD"]), b"marked\\n")
+    if wait:
+        time.sleep(3600)
+_at = os.environ["MARK"]
+if _at == "sweep":
+    from dumbbell.analysis import sweep as _sweep
+    _evaluate = _sweep._evaluate
+    def _marked(*args):
+        _mark(True)
+        return _evaluate(*args)
+    _sweep._evaluate = _marked
+elif _at == "frame":
+    from dumbbell.animation import drawing as _drawing
+    _frame = _drawing.Painter.frame
+    def _marked(self, k):
+        if k == 1:
+            _mark(True)
+        return _frame(self, k)
+    _drawing.Painter.frame = _marked
+elif _at == "stepping":
+    from dumbbell import progress as _progress
+    _update = _progress._NoBar.update
+    def _marked(self, n=1):
+        if not self.n:
+            _mark(False)
+        return _update(self, n)
+    _progress._NoBar.update = _marked
+"""
+
+
+@contextmanager
+def at_mark(mark: str, *argv: object, cwd: Path | None = None):
+    """``dumbbell ARGV`` started with :data:`AT_MARK` at ``mark``; yields it once it got
+    there (its whole process group is killed on the way out, pass or fail)."""
+    with marker_pipe() as (r, w), started(*argv, cwd=cwd, prelude=AT_MARK, pass_fds=(w,),
+                                          env={"MARK": mark, "MARK_FD": str(w)}) as proc:
+        wait_mark(proc, r)
+        yield proc
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT])
 def test_a_signal_stops_a_sweep_and_its_workers(tmp_path, sig):
+    """Signalled once a worker is inside a point (each waits there for it): the run cannot
+    have ended before the signal, however slow the machine."""
     scene = short_scene(tmp_path, "sweep-signal.toml")
     out = tmp_path / "out"
-    proc = spawn("sweep", scene, "--grid", "k=log:1e2:1e3:16", "--t-end", "30",
-                 "--workers", "2", "--out", out)
-    workers = lambda: len(psutil.Process(proc.pid).children()) >= 2
-    send_when(proc, workers, sig)
-    _, err = proc.communicate(timeout=30)
-    assert not wait_gone(str(scene)), "pool workers outlived the sweep"
+    with at_mark("sweep", "sweep", scene, "--grid", "k=log:1e2:1e3:16", "--t-end", "30",
+                 "--workers", "2", "--out", out) as proc:
+        proc.send_signal(sig)
+        _, err = finish(proc)
+        assert not wait_gone(str(scene)), "pool workers outlived the sweep"
+        assert not group_left(proc)
     line = refused(proc.returncode, err, code=128 + sig)
     assert signal.Signals(sig).name in line
     assert not out.exists() or files_in(out) == []
@@ -431,9 +486,11 @@ def test_a_signal_while_the_gif_is_written_leaves_no_part_file(tmp_path, sig):
     scene = short_scene(tmp_path, "render-signal.toml")
     out = tmp_path / "out"
     out.mkdir()
-    proc = spawn("render", scene, "--t-end", "60", "--fps", "10", "-o", out / "x.gif")
-    send_when(proc, lambda: any(".part" in n for n in os.listdir(out)), sig)
-    _, err = proc.communicate(timeout=30)
+    with at_mark("frame", "render", scene, "--t-end", "60", "--fps", "10", "-o",
+                 out / "x.gif") as proc:
+        assert any(".part" in n for n in os.listdir(out))  # the GIF is being written
+        proc.send_signal(sig)
+        _, err = finish(proc)
     refused(proc.returncode, err, out, code=128 + sig)
 
 
@@ -443,10 +500,10 @@ def test_sigterm_while_stepping_writes_nothing(tmp_path):
     scene.write_text(SHORT_SCENE.replace("[floor]\nelasticity = 1.0\n", ""))
     out = tmp_path / "out"
     out.mkdir()
-    proc = spawn("simulate", scene, "--t-end", "1e5", "--every", "1000000", "-o", out / "x.csv",
-                 "--events", out / "e.csv")
-    send_when(proc, lambda: psutil.Process(proc.pid).cpu_times().user > 1.5, signal.SIGTERM)
-    _, err = proc.communicate(timeout=30)
+    with at_mark("stepping", "simulate", scene, "--t-end", "1e5", "--every", "1000000",
+                 "-o", out / "x.csv", "--events", out / "e.csv") as proc:
+        proc.send_signal(signal.SIGTERM)
+        _, err = finish(proc)
     refused(proc.returncode, err, out, code=128 + signal.SIGTERM)
 
 
@@ -655,8 +712,7 @@ def _piped(stdin: bytes, *argv: object, cwd: Path) -> subprocess.CompletedProces
     """``dumbbell ARGV`` as a real process reading ``stdin``."""
     env = {**os.environ, "PYTHONPATH": SRC, "CI": "1"}
     code = "import sys; from dumbbell.cli import main; sys.exit(main())"
-    return subprocess.run([sys.executable, "-c", code, *map(str, argv)], input=stdin, cwd=cwd,
-                          check=False, env=env, capture_output=True, timeout=120)
+    return run_group([sys.executable, "-c", code, *argv], input=stdin, cwd=cwd, env=env)
 
 
 def test_a_scene_from_stdin_runs_as_the_same_file_does(work):
@@ -845,9 +901,8 @@ def test_dev_stdout_is_written_not_replaced(tmp_path):
     link = os.readlink("/dev/stdout") if os.path.islink("/dev/stdout") else None
     code = "import sys; from dumbbell.cli import main; sys.exit(main())"
     with open(tmp_path / "out.txt", "w") as fh:
-        proc = subprocess.run([sys.executable, "-c", code, "simulate", scene, "-o", "/dev/stdout",
-                               "-q"], stdout=fh, stderr=subprocess.PIPE, text=True,
-                              env={**os.environ, "PYTHONPATH": SRC}, timeout=60, check=False)
+        proc = run_group([sys.executable, "-c", code, "simulate", scene, "-o", "/dev/stdout",
+                          "-q"], stdout=fh, text=True, env={**os.environ, "PYTHONPATH": SRC})
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "out.txt").read_text().startswith("t,xA,vA")
     assert (os.readlink("/dev/stdout") if link else None) == link
@@ -893,6 +948,7 @@ PLANNED = [
     ("run", ["--out", "OUT"], ["{name}.csv", "{name}-impacts.csv", "{name}.gif",
                                "{name}-positions.png"]),
     ("render", [], ["renders/{name}.gif"]),
+    ("play", [], ["renders/{name}.html"]),
     ("compare", ["--out", "OUT"], ["{name}-compare.csv", "{name}-compare-errors.csv",
                                    "{name}-compare-energy.png"]),
     ("bench", ["--out", "OUT", "--dts", "1e-3"], ["bench-{name}.json",
@@ -925,7 +981,7 @@ def test_a_folder_in_the_way_of_any_output_is_refused_before_the_run(tmp_path, m
     from dumbbell import load_scene
 
     blocked = name.format(name=load_scene(scene).name)
-    root = tmp_path if command == "render" else out
+    root = tmp_path if command in ("render", "play") else out
     (root / blocked).mkdir(parents=True)
     keep = set(files_in(tmp_path))
     monkeypatch.chdir(tmp_path)
@@ -975,6 +1031,7 @@ def test_a_dangling_link_as_the_output_file_writes_its_target(work):
     ["simulate", "SCENE", "-o", "-", "--events", "sub/e.csv"],
     ["run", "SCENE"],
     ["render", "SCENE"],
+    ["play", "SCENE"],
     ["sweep", "SCENE", "--grid", "k=100,200"],
 ])
 def test_a_deleted_working_folder_is_refused_naming_the_output(work, argv):
@@ -1026,12 +1083,11 @@ def test_another_users_file_in_a_sticky_folder_is_refused_before_the_run(work, h
     try:
         if how == "real":
             code = "import sys; from dumbbell.cli import main; sys.exit(main())"
-            proc = subprocess.run(
+            proc = run_group(
                 ["setpriv", "--reuid", "65534", "--regid", "65534", "--clear-groups",
                  sys.executable, "-c", code, "simulate", str(scene), "-o",
                  str(out / "a.csv"), "--events", str(sticky / "e.csv")],
-                env={**os.environ, "PYTHONPATH": SRC, "HOME": "/"}, capture_output=True,
-                text=True, timeout=120, check=False)
+                env={**os.environ, "PYTHONPATH": SRC, "HOME": "/"}, text=True)
             if proc.returncode not in (0, 2):
                 pytest.skip(f"the user nobody cannot run this Python: {proc.stderr[-200:]}")
             status, err = proc.returncode, proc.stderr
@@ -1129,6 +1185,7 @@ def test_every_output_a_command_writes_was_checked_before_the_work(tmp_path, mon
     short_scene(cases)
     monkeypatch.chdir(tmp_path)
     for argv in (["run", scene, "--out", "o1"], ["render", scene, "--t-end", "0.02"],
+                 ["play", scene, "--t-end", "0.02", "-o", "o7/x.html"],
                  ["compare", scene, "--out", "o2"], ["sweep", scene, "--grid", "k=100,200",
                                                      "--out", "o3", "--workers", "1"],
                  ["bench", scene, "--dts", "1e-3", "--t-end", "0.05", "--window", "0.05",
@@ -1161,7 +1218,7 @@ if how == "transaction":
         with atomic_output(out / "b.csv") as tmp:
             tmp.write_text("b")
             print("ready", flush=True)
-            time.sleep(60)
+            time.sleep(3600)
 elif how == "exit":
     manager = atomic_output(out / "a.csv")
     tmp = manager.__enter__()
@@ -1172,7 +1229,7 @@ else:
     with atomic_output(out / "a.csv") as tmp:
         tmp.write_text("a")
         print("ready", flush=True)
-        time.sleep(60)
+        time.sleep(3600)
 """
 
 
@@ -1189,12 +1246,17 @@ def test_no_temporary_file_survives_a_signal_in_a_users_script(tmp_path, how, si
     out.mkdir()
     proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, how, str(out)],
                             env={**os.environ, "PYTHONPATH": SRC}, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    assert proc.stdout.readline().strip() == "ready", proc.stderr.read()
-    assert _no_temporary(out) or how == "exit"
-    if sig is not None:
-        proc.send_signal(sig)
-    proc.communicate(timeout=30)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=interruptible())  # noqa: PLW1509 - no thread forks here
+    try:
+        # Waits for the line (an event); the script then sleeps until the signal comes.
+        assert proc.stdout.readline().strip() == "ready", proc.stderr.read()
+        assert _no_temporary(out) or how == "exit"
+        if sig is not None:
+            proc.send_signal(sig)
+        finish(proc)
+    finally:
+        end_group(proc)  # its sleep(60) must not outlive a failed test
     assert proc.returncode == code, proc.returncode
     assert files_in(out) == [], files_in(out)
 
@@ -1262,9 +1324,8 @@ def _as_user(argv: list[str], pkg: Path, home: Path, tmpdir: Path, cwd: Path,
     environment = {"PATH": os.environ.get("PATH", "/usr/bin:/bin"), "HOME": str(home),
                    "TMPDIR": str(tmpdir), "PYTHONPATH": os.pathsep.join([str(pkg), *site]),
                    "PYTHONDONTWRITEBYTECODE": "1", "CI": "1", **(env or {})}
-    return subprocess.run([*prefix, sys.executable, "-c", code, *argv], cwd=cwd,
-                          env=environment, capture_output=True, text=True, timeout=300,
-                          check=False)
+    return run_group([*prefix, sys.executable, "-c", code, *argv], cwd=cwd,
+                     env=environment, text=True)
 
 
 @pytest.fixture
@@ -1548,10 +1609,9 @@ def test_the_api_echoes_a_huge_value_short():
 
 def test_a_closed_stdin_is_one_line(tmp_path):
     code = "import sys; from dumbbell.cli import main; sys.exit(main())"
-    done = subprocess.run([sys.executable, "-c", code, "simulate", "-", "-o",
-                           str(tmp_path / "x.csv")], env={**os.environ, "PYTHONPATH": SRC},
-                          capture_output=True, text=True, timeout=60, check=False,
-                          preexec_fn=lambda: os.close(0))
+    done = run_group([sys.executable, "-c", code, "simulate", "-", "-o",
+                      str(tmp_path / "x.csv")], env={**os.environ, "PYTHONPATH": SRC},
+                     text=True, preexec_fn=lambda: os.close(0))
     line = refused(done.returncode, done.stderr, tmp_path)
     assert "stdin" in line and "closed" in line and "NoneType" not in line, line
 

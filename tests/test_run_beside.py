@@ -13,10 +13,20 @@ import threading
 from pathlib import Path
 
 import numpy as np
-import psutil
 import pytest
 
-from tests.hostile import SHORT_SCENE, SRC, files_in, refused, send_when
+from tests.hostile import (
+    SHORT_SCENE,
+    SRC,
+    files_in,
+    finish,
+    group_left,
+    marker_pipe,
+    refused,
+    run_group,
+    started,
+    wait_mark,
+)
 
 #: A short run of the textbook scene with every output: three figures, the CSVs, a GIF.
 SCENE = SHORT_SCENE.replace("t_end = 0.05\ndt = 1e-4", "t_end = 2.0\ndt = 1e-4") + """
@@ -46,9 +56,7 @@ def run(*argv: object, fork: bool | None = None, patch: str = "", check: str = "
         cwd: Path | None = None) -> subprocess.CompletedProcess:
     env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", "PATCH": patch, "CHECK": check,
            "FORK": "" if fork is None else str(int(fork))}
-    return subprocess.run([sys.executable, "-c", RUNNER, *map(str, argv)], env=env, cwd=cwd,
-                          check=False,
-                          capture_output=True, text=True, timeout=120)
+    return run_group([sys.executable, "-c", RUNNER, *argv], env=env, cwd=cwd, text=True)
 
 
 @pytest.fixture
@@ -128,20 +136,46 @@ def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
     assert outputs_of(tmp_path / "died") == outputs_of(tmp_path / "alone")
 
 
+#: The child waits in its first figure, the parent in the GIF's second frame, each after a
+#: line on the marker pipe MARK_FD: the test signals once both are there.
+BOTH_BUSY = """
+import os, time
+import dumbbell.cli.run as r, dumbbell.cli.beside as b
+from dumbbell.animation import drawing
+def _mark(who):
+    os.write(int(os.environ["MARK_FD"]), who.encode() + b"\\n")
+    time.sleep(3600)
+draw = r._draw_figures
+def waiting(files, traj, alive):
+    if b._IN_CHILD:
+        _mark("child")
+    return draw(files, traj, alive)
+r._draw_figures = waiting
+frame = drawing.Painter.frame
+def slow(self, k):
+    if k == 1 and not b._IN_CHILD:
+        _mark("parent")
+    return frame(self, k)
+drawing.Painter.frame = slow
+"""
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_a_stop_signal_stops_the_child_and_leaves_nothing(tmp_path, sig):
-    # A long GIF keeps the parent busy while the child waits to be reaped.
-    path = tmp_path / "long.toml"
-    path.write_text(SCENE.replace('t_end = 1.0 }', 't_end = 2.0 }').replace(
-        "fps = 10", "fps = 50").replace('"320x180"', '"1280x720"'))
+def test_a_stop_signal_stops_the_child_and_leaves_nothing(scene, tmp_path, sig):
+    """Signalled while the child draws a figure and the parent writes the GIF (each waits
+    there, after saying so): both stop, nothing is left, whatever the machine's load."""
     out = tmp_path / "out"
-    env = {**os.environ, "PYTHONPATH": SRC, "CI": "1", "FORK": "1", "PATCH": "", "CHECK": ""}
-    proc = subprocess.Popen([sys.executable, "-c", RUNNER, "run", str(path), "--out", str(out)],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    children = lambda: psutil.Process(proc.pid).children()
-    send_when(proc, lambda: bool(children()) and out.exists()
-              and any(n.endswith(".gif") for n in os.listdir(out)), sig)
-    _, err = proc.communicate(timeout=60)
+    forked = "import dumbbell.cli.beside as _b\n_b.side_by_side = lambda: True\n"
+    with marker_pipe() as (r, w), started("run", scene, "--out", out, pass_fds=(w,),
+                                          prelude=forked + BOTH_BUSY,
+                                          env={"MARK_FD": str(w)}) as proc:
+        marks = b""
+        while marks.count(b"\n") < 2:
+            marks += wait_mark(proc, r)
+        assert sorted(marks.split()) == [b"child", b"parent"]
+        proc.send_signal(sig)
+        _, err = finish(proc)
+        assert not group_left(proc), "the child outlived the command"
     line = refused(proc.returncode, err, out, code=128 + sig)
     assert signal.Signals(sig).name in line
 
@@ -211,31 +245,39 @@ def test_the_library_keeps_pyplot_and_the_command_does_without(tmp_path):
 
 def test_a_slow_first_use_says_it_compiles_once(monkeypatch, capsys):
     """The line shows when a kernel's first use outlasts a load from the cache, on a
-    terminal only, once per solver and process."""
-    import time
+    terminal only, once per solver and process. No clock: 'quick' is a block that ends
+    before a wait of 600 s does, 'slow' one that waits, inside, until the timer (set to
+    0 s) has done whatever it does."""
+    import threading
 
     from dumbbell import _install, progress
 
-    monkeypatch.setattr(_install, "COMPILE_NOTE_AFTER", 0.05)
+    def slow() -> None:
+        for thread in threading.enumerate():
+            if thread.name == "dumbbell-compiling":
+                thread.join()
+
     monkeypatch.setattr(_install, "_compiling_said", set())
     monkeypatch.delenv(_install._SAID, raising=False)
     watching = {"yes": True}
     monkeypatch.setattr(progress, "_progress_wanted", lambda quiet=False: watching["yes"]
                         and not quiet)
+    monkeypatch.setattr(_install, "COMPILE_NOTE_AFTER", 600.0)
     with _install.compiling("the test solver's kernels", quiet=False):
         pass  # a load from the cache: quick
     assert capsys.readouterr().err == ""
+    monkeypatch.setattr(_install, "COMPILE_NOTE_AFTER", 0.0)
     with _install.compiling("the test solver's kernels", quiet=True):
-        time.sleep(0.2)  # slow, but -q
+        slow()  # slow, but -q
     assert capsys.readouterr().err == ""
     watching["yes"] = False
     with _install.compiling("the test solver's kernels", quiet=False):
-        time.sleep(0.2)  # slow, but not on a terminal (or CI)
+        slow()  # slow, but not on a terminal (or CI)
     assert capsys.readouterr().err == ""
     watching["yes"] = True
     for _ in range(2):
         with _install.compiling("the test solver's kernels", quiet=False):
-            time.sleep(0.2)
+            slow()
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert err.startswith("dumbbell: compiling the test solver's kernels with numba (the first "

@@ -946,7 +946,7 @@ def test_sigterm_while_writing_leaves_no_part_file(tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     done = subprocess.run([sys.executable, str(script), str(out / "rec.gif")],
-                          capture_output=True, text=True, timeout=120, check=False)
+                          capture_output=True, text=True, timeout=600, check=False)
     assert done.returncode == -signal.SIGTERM  # ended as SIGTERM ends a script ...
     assert "not reached" not in done.stdout and list(out.iterdir()) == []  # ... cleanly
 

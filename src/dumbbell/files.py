@@ -83,6 +83,36 @@ def _under_system(path: Path) -> bool:
     return False
 
 
+def link_refusal(path: str | Path) -> str | None:
+    """Why the link at ``path`` (an output's name) may not be written through, or None when
+    it is no link or may be followed. Followed only: a link of the user's own (never
+    another user's, the rule the kernel's ``fs.protected_symlinks`` applies in sticky
+    folders, here everywhere) that names a file inside the folder holding it (a link to
+    nothing creates nothing outside it either), or names a device or a FIFO, which are
+    written, never created; and a system path the user named (``/dev/stdout``)."""
+    from .model.args import show_path
+
+    path = Path(path)
+    if not os.path.islink(path) or os.path.abspath(path).startswith(("/dev/", "/proc/")):
+        return None
+    try:
+        owner = os.lstat(path).st_uid
+        target = os.readlink(path)
+    except OSError as exc:
+        return f"is a link that cannot be read ({exc.strerror})"
+    if owner != os.geteuid():
+        return (f"is a link of another user's (uid {owner}) to {show_path(target)}: never "
+                "written through; remove the link or write into another folder")
+    if is_special(path):
+        return None
+    folder = os.path.realpath(path.parent)
+    if os.path.commonpath([os.path.realpath(path), folder]) != folder:
+        return (f"is a link to {show_path(target)}, outside {show_path(path.parent)}: an "
+                "output is written only inside the folder it names; remove the link or write "
+                "elsewhere")
+    return None
+
+
 # --- temporary files: registered while they exist, removed at exit or on a stop signal ----
 
 #: Temporary file -> the process that made it (a forked child must not remove its parent's).
@@ -185,6 +215,8 @@ class OutputTransaction:
         self.planned: set[str] = set()
         #: Outputs written that were not planned (a command that forgot one: a test finds it).
         self.unplanned: list[Path] = []
+        #: Real paths written so far (:func:`atomic_output`): none may be written twice.
+        self.written: set[str] = set()
         #: (finished temporary file, final path, the name the user gave): renamed at commit.
         self.pending: list[tuple[Path, Path, str]] = []
         self.created: list[Path] = []
@@ -219,7 +251,15 @@ class OutputTransaction:
         if what:
             self.claimed[key] = what
             self.planned.add(key)
-        elif key not in self.planned and not is_special(path) and not _under_system(path):
+            return
+        special = is_special(path) or _under_system(path)
+        if key in self.written and not special:
+            # Two writes of one file: the commit would rename the second over the first,
+            # whichever finished last (an empty one, say).
+            raise UsageError(f"{label}: written twice by one command; each output is one "
+                             "file")
+        self.written.add(key)
+        if key not in self.planned and not special:
             self.unplanned.append(path)
 
     def plan(self, paths: Iterable[str | Path], flag: str) -> list[Path]:
@@ -374,12 +414,19 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
         raise UsageError(f"path = {args.show(str(path))}: a path cannot hold a NUL character",
                          param="path")
     shown = path
+    refusal = link_refusal(path)
+    if refusal is not None:  # planted since the command checked its outputs, say
+        raise UsageError(f"{args.show_path(path)}: {refusal}", param="path")
     transaction = _active.get()
     if transaction is not None:
         transaction.claim(path)
     if is_special(path) or _under_system(path):
         try:
             yield path
+        except BrokenPipeError:
+            # A FIFO or a pipe (/dev/stdout) whose reader left: what it did not read is
+            # dropped, as for standard output (`| head`); the other outputs are written.
+            pass
         except OSError as exc:
             raise _user_error(exc, path, None) from None
         return
@@ -439,9 +486,17 @@ def _why_not(path: Path, text: str, folder: bool, within: bool) -> str | None:
     if why:
         return why
     if not folder and os.path.islink(path):
-        path = Path(os.path.realpath(path))  # the file the link names is written
+        why = link_refusal(path)
+        if why:
+            return why
+        if not is_special(path):  # a device or a pipe (/dev/stdout) is written through
+            path = Path(os.path.realpath(path))  # the file the link names is written
     if not folder and is_special(path):
         return None if os.access(path, os.W_OK) else "cannot write it (permission denied)"
+    if not folder and _under_system(path) and not os.path.exists(path) \
+            and not os.path.abspath(path).startswith("/dev/shm/"):
+        return ("is no entry of the system's /dev or /proc, where no file can be created; "
+                "write elsewhere")
     if folder and path.exists() and not path.is_dir():
         return "exists and is not a folder"
     if not folder and path.is_dir():
@@ -491,8 +546,27 @@ def _unwritable(path: Path, folder: bool) -> str | None:
         return f"{here} is a file, not a folder"
     if not os.access(here, os.W_OK | os.X_OK):
         return f"cannot write in {here} (permission denied)"
+    probe = _probe(here)
+    if probe:
+        return f"cannot write in {here} ({probe})"
     if not folder and path.exists():
         return _sticky(path)
+    return None
+
+
+def _probe(folder: Path) -> str | None:
+    """Make and remove a file in ``folder``: the one sure test that a file can be created
+    there (a read-only file system, /sys, a folder only root may write pass ``os.access``
+    for root). None when it can; else why not."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".dumbbell-", suffix=".probe", dir=folder)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(fd)
+    try:
+        os.unlink(name)
+    except OSError:
+        pass
     return None
 
 
@@ -534,5 +608,22 @@ def check_writable(path: str | Path, flag: str, folder: bool = False, *,
         text = os.fsdecode(text)
     why = _why_not(Path(text.replace("\0", "")), text, folder, within)
     if why is not None:
-        shown = args.show(text) if "\0" in text else text
+        shown = args.show(text) if "\0" in text else args.show_path(text, 200)
         raise UsageError(f"{flag} {shown}: {why}")
+
+
+def writable_path(value: object, name: str = "path") -> Path:
+    """The output path ``value`` a function of the Python API was given, checked before any
+    work as the command line checks its outputs (:func:`check_writable`: as spelt, so that
+    ``"newdir/"`` is a folder, not a file called ``newdir``), else a UsageError naming
+    ``name``; returns it as a Path."""
+    from .model import args
+
+    if not isinstance(value, str | os.PathLike) or not os.fspath(value):
+        raise UsageError(f"{name} = {args.show(value)}: must be a path (str or "
+                         "pathlib.Path)", param=name)
+    try:
+        check_writable(value, f"{name} =")
+    except UsageError as exc:
+        raise UsageError(str(exc), param=name) from None
+    return Path(os.fsdecode(value))

@@ -248,11 +248,12 @@ def default_cases() -> Path:
 def find_cases(folder: str | Path) -> list[Path]:
     """The scene files in ``folder``, sorted by name (UsageError if there are none)."""
     folder = args.path(folder, "folder")
-    if not folder.is_dir():
-        raise UsageError(f"cases {folder}: no such folder", param="cases")
+    if not os.path.isdir(folder):  # False for any error too (a name too long, a loop)
+        raise UsageError(f"cases {args.show_path(folder)}: no such folder", param="cases")
     paths = sorted(folder.glob("*.toml"))
     if not paths:
-        raise UsageError(f"cases {folder}: no scene files (*.toml) in it", param="cases")
+        raise UsageError(f"cases {args.show_path(folder)}: no scene files (*.toml) in it",
+                         param="cases")
     return paths
 
 

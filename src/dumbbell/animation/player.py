@@ -123,11 +123,9 @@ class Player:
         UsageError
             A path that cannot be written (one line saying why).
         """
-        from ..files import atomic_output, check_writable
-        from ..model import args
+        from ..files import atomic_output, writable_path
 
-        path = args.path(path, "path")
-        check_writable(path, "path")
+        path = writable_path(path, "path")  # as spelt: "newdir/" is a folder, not a file
         with atomic_output(path) as tmp:
             Path(tmp).write_text(self.html, encoding="utf-8")
         return path

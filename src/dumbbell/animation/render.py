@@ -266,12 +266,10 @@ class Gif(bytes):
         UsageError
             A path that cannot be written (one line saying why).
         """
-        from ..files import check_writable
-        from ..model import args
+        from ..files import writable_path
         from .writer import binary_output
 
-        path = args.path(path, "path")
-        check_writable(path, "path")
+        path = writable_path(path)
         with binary_output(path) as fh:
             fh.write(self)
         return path
@@ -347,11 +345,10 @@ def render_gif(
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
                          param="traj")
-    path = None if path is None else args.path(path, "path")
     if path is not None:
-        from ..files import check_writable
+        from ..files import writable_path
 
-        check_writable(path, "path")  # before the work: a folder, a file as a folder, ...
+        path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
     quiet = args.flag(quiet, "quiet")
     fps = check_fps(fps)
     width, height = check_size(size)

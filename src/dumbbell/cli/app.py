@@ -10,6 +10,7 @@ written, pool workers stopped).
 
 from __future__ import annotations
 
+import _thread
 import argparse
 import contextlib
 import dataclasses
@@ -19,7 +20,7 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from ..errors import DumbbellError, UsageError
@@ -228,11 +229,81 @@ class Stopped(KeyboardInterrupt):
         self.signum = signum
 
 
+class _StopState:
+    """The stop signals of the running command: the first one (``signum``, None before any),
+    kept until the command ends whatever swallowed the exception it raised."""
+
+    signum: int | None = None
+    #: The command is over (its handlers are being given back): a late signal is ignored.
+    closing = False
+    #: Inside :func:`_unraisable`'s hook, where an exception would only be printed.
+    in_hook = False
+    #: The timer that delivers a swallowed stop again.
+    retry: threading.Timer | None = None
+
+
+_stopping = _StopState()
+
+#: How soon (s) a stop that C code swallowed is delivered again.
+RETRY_STOP = 0.005
+
+
+def _handling_a_stop() -> bool:
+    """True while a :class:`Stopped` is being handled (an ``except`` or ``finally`` on its
+    way out, the command's own handler): its cleanup must not be broken by a second one."""
+    exc = sys.exc_info()[1]
+    seen = 0
+    while exc is not None and seen < 100:
+        if isinstance(exc, Stopped):
+            return True
+        exc, seen = exc.__context__, seen + 1
+    return False
+
+
 def _stop(signum: int, frame: object) -> None:
-    # Once is enough: a second signal must not break the cleanup the first one started.
-    for name in STOP_SIGNALS:
-        signal.signal(getattr(signal, name), signal.SIG_IGN)
-    raise Stopped(signum)
+    """A stop signal: raise :class:`Stopped` for the first one. Another one while the first
+    one's cleanup runs is ignored; any other time (the first one's exception was swallowed)
+    it raises again, for the first signal."""
+    if _stopping.closing or _handling_a_stop():
+        return
+    if _stopping.signum is None:
+        _stopping.signum = signum
+    if _stopping.in_hook:
+        _retry_stop()
+        return
+    raise Stopped(_stopping.signum)
+
+
+def _retry_stop() -> None:
+    """Deliver the stop again in :data:`RETRY_STOP` s (a thread simulates the signal: the
+    main thread runs :func:`_stop` at its next Python instruction), unless that is planned."""
+    if _stopping.retry is None or not _stopping.retry.is_alive():
+        _stopping.retry = threading.Timer(RETRY_STOP, _thread.interrupt_main,
+                                          (_stopping.signum,))
+        _stopping.retry.daemon = True
+        _stopping.retry.start()
+
+
+def _unraisable(previous: Callable[[Any], object]) -> Callable[[Any], object]:
+    """A ``sys.unraisablehook`` that takes back a :class:`Stopped` that C code swallowed: an
+    exception raised in a pymunk collision callback is printed by cffi ('Exception ignored
+    from cffi callback') and the step goes on. No message then, and the stop is delivered
+    again a moment later (:func:`_retry_stop`): in a later callback (swallowed again, and
+    retried) or, at the latest, once ``Space.step`` has returned. Anything else goes to
+    ``previous``."""
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, Stopped) and _stopping.signum is not None \
+                and threading.current_thread() is threading.main_thread():
+            _stopping.in_hook = True
+            try:
+                _retry_stop()
+            finally:
+                _stopping.in_hook = False
+            return
+        previous(unraisable)
+
+    return hook
 
 
 @contextlib.contextmanager
@@ -244,14 +315,24 @@ def _stop_signals() -> Iterator[None]:
         return
     numbers = [getattr(signal, n) for n in STOP_SIGNALS if hasattr(signal, n)]
     before = {n: signal.getsignal(n) for n in numbers}
+    hook = sys.unraisablehook
+    _stopping.signum, _stopping.closing = None, False
     for n in numbers:
         if before[n] is not signal.SIG_IGN:  # nohup's ignored SIGHUP stays ignored
             signal.signal(n, _stop)
+    sys.unraisablehook = _unraisable(hook)
     try:
         yield
     finally:
+        _stopping.closing = True
+        if _stopping.retry is not None:
+            _stopping.retry.cancel()
+            _stopping.retry.join()  # a stop it simulated is ignored now (closing)
+            _stopping.retry = None
         for n, handler in before.items():
             signal.signal(n, handler if handler is not None else signal.SIG_DFL)
+        sys.unraisablehook = hook
+        _stopping.signum, _stopping.closing = None, False
 
 
 #: How a scene read from standard input (SCENE ``-``) is named in messages and outputs.
@@ -355,7 +436,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     state: dict[str, object] = {}
     # Without argv, this is the process's own command (the console script, python -m):
     # it ends with the command.
-    with _stop_signals(), _file_backend(process_ends=argv is None):
+    with _stop_signals(), _standard_streams(process_ends=argv is None), \
+            _file_backend(process_ends=argv is None):
         try:
             argv = sys.argv[1:] if argv is None else list(argv)
             parser = _parser_for(argv)
@@ -369,6 +451,92 @@ def main(argv: Sequence[str] | None = None) -> int:
                              + ("its outputs were already written\n" if kept
                                 else "no output was kept\n"))
             return 128 + signum
+        finally:
+            # The command is over: a signal from now on (a second Ctrl-C) changes nothing.
+            if threading.current_thread() is threading.main_thread():
+                _stopping.closing = True
+
+
+class _Sturdy:
+    """A standard stream that cannot stop the command: a write or flush that fails because
+    the stream is gone (closed when the process started, ``>&-``, or a pipe whose reader
+    left) is dropped, and so is everything after it, so that the command still writes its
+    files and its exit status says how they went; text the stream's encoding cannot hold
+    (``PYTHONIOENCODING=ascii``) is written with backslash escapes instead of failing."""
+
+    def __init__(self, stream: Any):
+        self.stream = stream
+        #: The stream is gone: nothing more is written to it.
+        self.lost = stream is None
+
+    def write(self, text: str) -> int:
+        if not self.lost:
+            try:
+                return self.stream.write(text)
+            except UnicodeEncodeError:
+                encoding = getattr(self.stream, "encoding", None) or "ascii"
+                return self.write(text.encode(encoding, "backslashreplace").decode(encoding))
+            except (OSError, ValueError):  # EPIPE, EBADF; ValueError: a closed file
+                self._lose()
+        return len(text)
+
+    def flush(self) -> None:
+        if not self.lost:
+            try:
+                self.stream.flush()
+            except (OSError, ValueError):
+                self._lose()
+
+    def isatty(self) -> bool:
+        try:
+            return not self.lost and self.stream.isatty()
+        except (OSError, ValueError):
+            return False
+
+    def __getattr__(self, name: str) -> Any:  # encoding, errors, fileno, buffer, ...
+        if self.stream is None:
+            raise AttributeError(name)
+        return getattr(self.stream, name)
+
+    def _lose(self) -> None:
+        self.lost = True
+        # Python flushes the stream once more at exit: let that land in /dev/null rather
+        # than complain about the pipe (or end the process with status 120).
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, self.stream.fileno())
+            os.close(null)
+
+
+@contextlib.contextmanager
+def _standard_streams(process_ends: bool = False) -> Iterator[None]:
+    """Standard output and error as :class:`_Sturdy` streams for the command, given back
+    afterwards. ``process_ends`` (the process's own command): descriptors 0, 1 and 2 that
+    were closed when it started are opened on /dev/null first, so that no file the command
+    opens takes their number (a message to descriptor 2 would land in an output)."""
+    if process_ends:
+        for fd in (0, 1, 2):
+            try:
+                os.fstat(fd)
+            except OSError:
+                null = os.open(os.devnull, os.O_RDONLY if fd == 0 else os.O_WRONLY)
+                if null != fd:  # pragma: no cover - lower descriptors are open
+                    os.dup2(null, fd)
+                    os.close(null)
+    before = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = _Sturdy(before[0]), _Sturdy(before[1])
+    try:
+        yield
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            stream.flush()
+        sys.stdout, sys.stderr = before
+
+
+def stdout_closed() -> bool:
+    """Whether standard output was closed when the command started (``>&-``): a command
+    that writes its result there refuses before the work."""
+    return isinstance(sys.stdout, _Sturdy) and sys.stdout.stream is None
 
 
 @contextlib.contextmanager
@@ -409,15 +577,12 @@ def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> in
         with output_transaction() as transaction:
             state["outputs"] = args.outputs = transaction
             _check_paths(args, transaction)
-            return int(args.func(args) or 0)
+            status = int(args.func(args) or 0)
+            if _stopping.signum is not None:  # a stop something swallowed: keep nothing
+                raise Stopped(_stopping.signum)
+            return status
     except DumbbellError as exc:
         return error(as_flags(exc, args))
-    except BrokenPipeError:
-        # The reader closed the pipe (``dumbbell simulate ... | head``): stop quietly, and keep
-        # Python from complaining again when it flushes stdout at exit.
-        with contextlib.suppress(OSError, ValueError):
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
     except OSError as exc:
         # Backstop: a file that still cannot be written or read is one line, not a traceback.
         if exc.filename:

@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
                           max_frames=args.max_frames)
     from .app import plan_outputs
 
-    plan_outputs(args, list(outputs(scenes[0], Path(args.out)).values()))
+    plan_outputs(args, [path for _, path in outputs(scenes[0], Path(args.out))])
     return run_scene(scenes[0], Path(args.out), quiet=args.quiet,
                      max_samples=args.max_samples, max_frames=args.max_frames)
 
@@ -108,16 +108,17 @@ def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = Fa
                                  "fps": "outputs.gif.fps"}) from None
 
 
-def outputs(scene, out: Path) -> dict[str, Path]:
-    """Every file :func:`run_scene` writes for ``scene`` in ``out``, by what it is: each
-    figure's name, 'csv', 'impacts', 'gif'."""
-    names = {name: out / f"{scene.name}-{name}.png" for name in scene.outputs.figures}
+def outputs(scene, out: Path) -> list[tuple[str, Path]]:
+    """Every file :func:`run_scene` writes for ``scene`` in ``out``, with what it is (each
+    figure's name, 'csv', 'impacts', 'gif'), one pair per file written: a figure listed twice
+    would be two pairs on one path, which the plan refuses."""
+    names = [(name, out / f"{scene.name}-{name}.png") for name in scene.outputs.figures]
     if scene.outputs.csv:
-        names["csv"] = out / f"{scene.name}.csv"
+        names.append(("csv", out / f"{scene.name}.csv"))
         if scene.system.floor is not None:
-            names["impacts"] = out / f"{scene.name}-impacts.csv"
+            names.append(("impacts", out / f"{scene.name}-impacts.csv"))
     if scene.outputs.gif is not None:
-        names["gif"] = out / f"{scene.name}.gif"
+        names.append(("gif", out / f"{scene.name}.gif"))
     return names
 
 
@@ -134,7 +135,7 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     from .app import verdict_status
     from .beside import beside
 
-    names = outputs(scene, out)
+    names = dict(outputs(scene, out))
     with contextlib.ExitStack() as stack:
         # The figures' files first (the child writes them), then the child: leaving early
         # stops the child before the files are removed.

@@ -84,17 +84,10 @@ def measured() -> set[str]:
 
 def load_packaged(name: str):
     """The shipped scene ``name``, read from the package and named ``scenes/NAME.toml``."""
-    from ..model.scene import load_scene_bytes, packaged_scene
+    from ..model.scene import load_scene_file, packaged_scene
 
-    path = packaged_scene(name)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        from ..errors import SceneError
-
-        raise SceneError(f"scenes/{name}.toml: cannot read the packaged scene: "
-                         f"{exc.strerror or exc}") from None
-    return load_scene_bytes(data, f"scenes/{name}.toml")
+    # Read as any scene file is: no more than the size limit, whatever the file has become.
+    return load_scene_file(packaged_scene(name), f"scenes/{name}.toml")
 
 
 def parse(piece: Piece, out: Path, quiet: bool) -> argparse.Namespace:

@@ -6,8 +6,17 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..errors import UsageError
 from ..solvers.base import MAX_SAMPLES, MAX_STEPS
-from .app import add_quiet, add_scene, positive_float, positive_int, read_scene, verdict_status
+from .app import (
+    add_quiet,
+    add_scene,
+    positive_float,
+    positive_int,
+    read_scene,
+    stdout_closed,
+    verdict_status,
+)
 
 #: What ``dumbbell simulate --help`` says the command does.
 DESCRIPTION = """\
@@ -51,6 +60,9 @@ def run(args: argparse.Namespace) -> int:
     from ..io.trajectory import dump_csv, write_csv, write_events
     from ..solvers import simulate
 
+    if (not args.output or args.output == "-") and stdout_closed():
+        raise UsageError("-o -: standard output is closed, so the CSV has nowhere to go; "
+                         "give -o FILE")
     scene = read_scene(args.scene)
     traj = simulate(scene, args.solver, dt=args.dt, t_end=args.t_end, every=args.every,
                     quiet=args.quiet, max_samples=args.max_samples)

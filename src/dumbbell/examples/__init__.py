@@ -78,12 +78,17 @@ def check_argv(argv: Any) -> list[str] | None:
     return None if argv is None else list(argv)
 
 
-def arguments(name: str, doc: str, seconds: float, argv: list[str] | None) -> argparse.Namespace:
+def arguments(name: str, doc: str | None, seconds: float, argv: list[str] | None
+              ) -> argparse.Namespace:
     """The examples' command line: ``--out`` (``NAME.gif``), ``--seconds``, ``--fps``, ``--dt``
-    (s; each example also runs at dt / 10). Bad values: one line and exit status 2."""
+    (s; each example also runs at dt / 10). Bad values: one line and exit status 2. ``doc``:
+    the example's docstring, whose first line describes it (None under ``python -OO``, which
+    drops docstrings: the description then only names the example)."""
     argv = check_argv(argv)
+    summary = doc.strip().splitlines()[0] if doc and doc.strip() else \
+        f"The {name} example of dumbbell.spaces."
     parser = argparse.ArgumentParser(prog=f"python -m dumbbell.examples.{name}",
-                                     description=doc.splitlines()[0])
+                                     description=summary)
     parser.add_argument("--out", default=f"{name}.gif", help="GIF or MP4 to write")
     parser.add_argument("--seconds", type=float, default=seconds, help="simulated time (s)")
     parser.add_argument("--fps", type=int, default=25, help="frames per second (1..50)")

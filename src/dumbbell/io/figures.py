@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
-from ..files import atomic_output
+from ..files import atomic_output, writable_path
 from ..model import args
 
 #: No public names: the commands save the figures that :mod:`dumbbell.plot` draws.
@@ -23,7 +23,7 @@ def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
     """Write ``fig`` to ``path`` (format from its suffix) at ``dpi`` (dots per inch, or
     "figure" for the figure's own) and close it; returns the path."""
     fig = args.figure(fig)
-    path = args.path(path, "path")
+    path = writable_path(path)
     formats = fig.canvas.get_supported_filetypes()
     if path.suffix[1:].lower() not in formats:
         raise UsageError(f"path = {args.show(str(path))}: must end in a figure format: "

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
-from ..files import atomic_output
+from ..files import atomic_output, writable_path
 from ..model import args
 
 #: No public names: the table cells every writer shares.
@@ -51,7 +51,7 @@ def csv_text(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> str:
 
 def write_text(path: str | Path, text: str) -> Path:
     """Write ``text`` to ``path`` atomically (whole or not at all); returns the path."""
-    path = args.path(path, "path")
+    path = writable_path(path)
     text = args.text(text, "text", "the text to write (str)")
     with atomic_output(path) as tmp:
         tmp.write_text(text)

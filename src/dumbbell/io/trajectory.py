@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import IO, Any
 
+from ..files import writable_path
 from ..model import args
 from ..model.trajectory import Trajectory
 from .tables import csv_text, write_text
@@ -166,4 +167,5 @@ def write_events(traj: Trajectory, path: str | Path) -> Path:
     3
     """
     traj = _checked(traj)
-    return write_text(args.path(path, "path"), events_csv(traj))
+    path = writable_path(path)
+    return write_text(path, events_csv(traj))

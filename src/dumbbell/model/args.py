@@ -34,6 +34,14 @@ def show(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+def show_path(value: Any, limit: int = 120) -> str:
+    """A path for an error message: one line, at most ``limit`` characters, its start and
+    its end kept (the end names the file)."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in os.fsdecode(value)) \
+        if isinstance(value, str | bytes | os.PathLike) else show(value)
+    return text if len(text) <= limit else f"{text[:limit - 43]}...{text[-40:]}"
+
+
 def _range(unit: str, positive: bool, lo: float | None, hi: float | None) -> str:
     """What a number must be, in words: 'a finite number > 0 (s)', '... from 0 to 1 (-)'."""
     if lo is not None and hi is not None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any
+from typing import Any, Self
 
 from ..errors import SceneError
 
@@ -17,6 +17,28 @@ __all__: list[str] = []
 #: stay below 1e300, and positions stay far below the solvers' blow-up threshold (1e150).
 MAX_MAGNITUDE = 1e75
 MIN_MASS = 1e-75
+
+
+#: The least integer of more digits than Python converts to or from text by default.
+_UNREADABLE = 10**4300
+
+
+class _LongInteger(int):
+    """A TOML integer of more digits than Python reads (its value stands in: 10**4300 with
+    its sign, beyond every bound a scene has), shown in messages by its number of digits."""
+
+    digits: int | None
+
+    def __new__(cls, sign: str, digits: int | None) -> Self:
+        value = super().__new__(cls, -_UNREADABLE if sign == "-" else _UNREADABLE)
+        value.digits = digits
+        return value
+
+    def __str__(self) -> str:
+        size = "more than 4,300" if self.digits is None else f"{self.digits:,}"
+        return f"a {'negative ' if self < 0 else ''}whole number of {size} digits"
+
+    __repr__ = __str__
 
 
 class _Checker:
@@ -34,7 +56,7 @@ class _Checker:
         return f"{self.path}.{name}" if self.path else name
 
     def fail(self, dotted: str, value: Any, allowed: str) -> None:
-        raise SceneError(f"{self.source}: {dotted} = {_show(value)}: {allowed}")
+        raise SceneError(f"{_printable(self.source)}: {dotted} = {_show(value)}: {allowed}")
 
     def has(self, name: str) -> bool:
         return name in self.table
@@ -53,7 +75,8 @@ class _Checker:
         allowed = _range_text(lo, hi, lo_open, unit)
         if name not in self.table:
             if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: {allowed}")
+                raise SceneError(f"{_printable(self.source)}: "
+                                 f"{self.key(name)} is missing: {allowed}")
             return default
         raw = self.table[name]
         value = _finite(raw)
@@ -74,6 +97,12 @@ class _Checker:
         allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
         if isinstance(value, bool) or not isinstance(value, numbers.Integral):
             self.fail(self.key(name), value, allowed)
+        if isinstance(value, _LongInteger) or abs(value) >= _UNREADABLE:
+            # Past what Python converts to and from text: no message could print it.
+            shown = value if isinstance(value, _LongInteger) else \
+                _LongInteger("-" if value < 0 else "", None)
+            self.fail(self.key(name), shown,
+                      allowed if hi is not None else f"{allowed}, of at most 4,300 digits")
         if value < lo or (hi is not None and value > hi):
             self.fail(self.key(name), value, allowed)
         return int(value)
@@ -91,7 +120,8 @@ class _Checker:
         self.used.add(name)
         if name not in self.table:
             if default is None:
-                raise SceneError(f"{self.source}: {self.key(name)} is missing: must be a string")
+                raise SceneError(f"{_printable(self.source)}: "
+                                 f"{self.key(name)} is missing: must be a string")
             return default
         value = self.table[name]
         if choices is not None:
@@ -111,16 +141,25 @@ class _Checker:
         unknown = sorted(set(self.table) - self.used, key=str)
         if unknown:
             allowed = ", ".join(sorted(self.used)) or "nothing"
-            where = f"in [{self.path}]" if self.path else "at the top level"
+            where = f"in [{_printable(self.path)}]" if self.path else "at the top level"
             raise SceneError(
-                f"{self.source}: unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
+                f"{_printable(self.source)}: "
+                f"unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
                 f"allowed: {allowed}"
             )
 
 
+#: Most characters of a key, a table's name or a file's name an error message echoes.
+MAX_ECHO = 120
+
+
 def _printable(text: str) -> str:
-    """``text`` with control characters escaped, so that an error stays on one line."""
-    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+    """``text`` (a key, a table's name, the scene's source) for an error message: control
+    characters escaped, so that it stays on one line, and at most :data:`MAX_ECHO`
+    characters, its start and end kept (a key of 80,000 characters, spaces or not, is a
+    short line)."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+    return text if len(text) <= MAX_ECHO else f"{text[:MAX_ECHO - 43]}...{text[-40:]}"
 
 
 def _finite(value: Any) -> float | None:

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,7 +27,7 @@ from typing import Any
 from ..errors import SceneError, UsageError
 from .checker import MIN_MASS, _check_magnitude, _Checker, _finite, _printable, _show
 from .pymunk_settings import PymunkSettings
-from .scene_file import MAX_SCENE_BYTES, _read_scene_file
+from .scene_file import MAX_SCENE_BYTES, _read_scene_file, _toml
 from .sizes import SIZE_RULE, pixel_size
 from .system import (
     DEFAULT_INACCURATE_ENERGY,
@@ -194,7 +193,7 @@ class Scene:
             for part in parts[:-1]:
                 nxt = table.setdefault(part, {})
                 if not isinstance(nxt, dict):
-                    raise SceneError(f"{self.source}: {_printable(dotted)}: "
+                    raise SceneError(f"{_printable(self.source)}: {_printable(dotted)}: "
                                      f"'{_printable(part)}' is not a table")
                 table = nxt
             table[parts[-1]] = value
@@ -308,7 +307,7 @@ def scene_from_dict(data: dict[str, Any], source: str = "<scene>") -> Scene:
     try:
         return _scene_from_dict(data, source)
     except RecursionError:
-        raise SceneError(f"{source}: nested too deeply to be a scene") from None
+        raise SceneError(f"{_printable(source)}: nested too deeply to be a scene") from None
 
 
 def _scene_from_dict(data: dict[str, Any], source: str) -> Scene:
@@ -346,11 +345,13 @@ def _bodies_tables(top: _Checker, source: str) -> tuple[_Checker, _Checker]:
     """The checkers of [bodies.A] and [bodies.B], both required."""
     bodies = top.sub("bodies")
     if bodies is None:
-        raise SceneError(f"{source}: [bodies] is missing: needs [bodies.A] and [bodies.B]")
+        raise SceneError(f"{_printable(source)}: "
+                         "[bodies] is missing: needs [bodies.A] and [bodies.B]")
     cA, cB = bodies.sub("A"), bodies.sub("B")
     if cA is None or cB is None:
         missing = "bodies.A" if cA is None else "bodies.B"
-        raise SceneError(f"{source}: [{missing}] is missing: a dumbbell has particles A and B")
+        raise SceneError(f"{_printable(source)}: "
+                         f"[{missing}] is missing: a dumbbell has particles A and B")
     bodies.done()
     return cA, cB
 
@@ -388,7 +389,8 @@ def _particles(cA: _Checker, cB: _Checker, dims: int, tilt: float | None,
     A = _particle(cA, "A", dims, placed=tilt is not None)
     M = A.mass + B.mass
     if not (math.isfinite(M) and A.mass * B.mass / M > 0):
-        raise SceneError(f"{cB.source}: bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
+        raise SceneError(f"{_printable(cB.source)}: "
+                         f"bodies.A.mass = {_show(A.mass)}, bodies.B.mass = "
                          f"{_show(B.mass)}: their total and reduced mass must be finite and "
                          "> 0 (kg)")
     if tilt is not None:
@@ -421,12 +423,14 @@ def _check_placement(A: Particle, B: Particle, dims: int, floor: Floor | None,
         for p in (A, B):
             if p.height < 0:
                 raise SceneError(
-                    f"{source}: bodies.{p.name}.height = {_show(p.height)}: must be >= 0 "
+                    f"{_printable(source)}: "
+                    f"bodies.{p.name}.height = {_show(p.height)}: must be >= 0 "
                     "(the particle would start below the floor)"
                 )
     if dims == 1 and A.height < B.height:
         raise SceneError(
-            f"{source}: bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
+            f"{_printable(source)}: "
+            f"bodies.A.height = {_show(A.height)}: must be >= bodies.B.height = "
             f"{_show(B.height)} (A is the top particle in 1D)"
         )
 
@@ -437,7 +441,8 @@ def _check_rod(A: Particle, B: Particle, rigid: Rigid | None, source: str) -> No
         dist = math.hypot(A.x - B.x, A.height - B.height)
         if abs(dist - rigid.length) > 1e-9 * max(1.0, rigid.length):
             raise SceneError(
-                f"{source}: rigid.length = {_show(rigid.length)}: must equal the distance "
+                f"{_printable(source)}: "
+                f"rigid.length = {_show(rigid.length)}: must equal the distance "
                 f"from B to A ({dist:.6g} m)"
             )
 
@@ -456,7 +461,7 @@ def _run(top: _Checker, source: str) -> RunSettings:
     """[run]: t_end and dt (s), solver, every, unstable_energy, inaccurate_energy."""
     crun = top.sub("run")
     if crun is None:
-        raise SceneError(f"{source}: [run] is missing: needs t_end and dt (s)")
+        raise SceneError(f"{_printable(source)}: [run] is missing: needs t_end and dt (s)")
     t_end = crun.number("t_end", lo=0.0, lo_open=True, unit="s")
     dt = crun.number("dt", lo=0.0, lo_open=True, unit="s")
     if dt > t_end:
@@ -488,6 +493,11 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
         value = co.table["figures"]
         if not isinstance(value, list) or any(v not in FIGURE_NAMES for v in value):
             co.fail("outputs.figures", value, "must be a list of " + ", ".join(FIGURE_NAMES))
+        twice = next((v for i, v in enumerate(value) if v in value[:i]), None) \
+            if len(set(value)) < len(value) else None
+        if twice is not None:
+            co.fail("outputs.figures", value, f"names '{twice}' more than once: each figure "
+                    "is one file, list it once")
         if "rotation" in value and dims != 2:
             co.fail("outputs.figures", value, "'rotation' needs a 2D scene (dimensions = 2)")
         if "contact" in value and (dims != 2 or not has_floor):
@@ -570,16 +580,21 @@ def load_scene(path: str | Path) -> Scene:
     if not isinstance(path, str | os.PathLike) or str(path) == "":
         raise SceneError(f"path = {_show(path)}: must be the path of a scene file (str or "
                          "pathlib.Path)")
-    path = Path(path)
-    source = str(path)
+    return load_scene_file(Path(path), str(path))
+
+
+def load_scene_file(path: Path, source: str) -> Scene:
+    """:func:`load_scene` of the file ``path``, named ``source`` in messages and outputs
+    (the showcase names a packaged scene ``scenes/NAME.toml``, not by its place in the
+    installation). Reads at most :data:`MAX_SCENE_BYTES` + 1 bytes of it, whatever it is."""
     try:
-        data = _read_scene_file(path)
+        data = _read_scene_file(path, source)
     except FileNotFoundError:
-        raise SceneError(f"{source}: no such scene file") from None
+        raise SceneError(f"{_printable(source)}: no such scene file") from None
     except IsADirectoryError:
-        raise SceneError(f"{source}: is a directory, not a scene file") from None
+        raise SceneError(f"{_printable(source)}: is a directory, not a scene file") from None
     except OSError as exc:
-        raise SceneError(f"{source}: cannot read: {exc.strerror or exc}") from None
+        raise SceneError(f"{_printable(source)}: cannot read: {exc.strerror or exc}") from None
     return load_scene_bytes(data, source)
 
 
@@ -590,22 +605,23 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     if not isinstance(source, str):
         raise SceneError(f"source = {_show(source)}: must be a str naming the scene")
     if not isinstance(data, bytes | bytearray):
-        raise SceneError(f"{source}: data = {_show(data)}: must be the bytes of a TOML "
+        raise SceneError(f"{_printable(source)}: data = {_show(data)}: must be the bytes of a TOML "
                          "document")
     if len(data) > MAX_SCENE_BYTES:
-        raise SceneError(f"{source}: more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
+        raise SceneError(f"{_printable(source)}: "
+                         f"more than {MAX_SCENE_BYTES:,} bytes; a scene may be at "
                          "most 1 MB")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
-        raise SceneError(f"{source}: not UTF-8 text; a scene is a TOML file") from None
+        raise SceneError(f"{_printable(source)}: not UTF-8 text; a scene is a TOML file") from None
     try:
-        data = tomllib.loads(text)
-    except ValueError as exc:  # TOMLDecodeError, or an integer too long to convert
+        data = _toml(text)
+    except ValueError as exc:  # TOMLDecodeError
         message = " ".join(str(exc).split())[:200]
-        raise SceneError(f"{source}: not valid TOML: {message}") from None
+        raise SceneError(f"{_printable(source)}: not valid TOML: {message}") from None
     except RecursionError:
-        raise SceneError(f"{source}: not valid TOML: nested too deeply") from None
+        raise SceneError(f"{_printable(source)}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
 
 

@@ -504,9 +504,9 @@ class Trajectory:
         pathlib.Path
             The file written.
         """
-        from ..files import atomic_output
+        from ..files import atomic_output, writable_path
 
-        path = args.path(path, "path")
+        path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
         # One open of our own: given a name, numpy opens the file twice, and the first,
         # empty open would end a FIFO's reader.
         with atomic_output(path) as tmp, open(tmp, "w") as fh:

@@ -16,7 +16,16 @@ from .._display import counted
 from ..analysis.bench import FIT_MAX_ERROR, BenchResult, dt_label
 from ..model import args
 from ..solvers import solver_class
-from .style import _subplots, finish, legend, legend_below, legend_inside, solver_style, wrap_texts
+from .style import (
+    _subplots,
+    finish,
+    legend,
+    legend_below,
+    legend_inside,
+    plain,  # the user's text, drawn as text
+    solver_style,
+    wrap_texts,
+)
 
 __all__ = ["convergence", "work_precision"]
 
@@ -102,7 +111,7 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
     ax.margins(x=0.07, y=0.06)  # room for the labels of the outermost points
     ax.set_xlabel(f"run time [s], fastest of at least {counted(result.repeat, 'run')}")
     ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
-    ax.set_title(f"Work-precision: {result.scene}, {result.t_end:g} s simulated; "
+    ax.set_title(f"Work-precision: {plain(result.scene)}, {result.t_end:g} s simulated; "
                  f"labels: dt (s)", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     if own:
@@ -246,7 +255,7 @@ def convergence(result: BenchResult, ax: Any = None) -> Any:
     ax.set_yscale("log")
     ax.set_xlabel("time step dt [s]")
     ax.set_ylabel(f"largest position error over [0, {result.window:g} s] [m]")
-    ax.set_title(f"Convergence: {result.scene}, error over [0, {result.window:g} s]; "
+    ax.set_title(f"Convergence: {plain(result.scene)}, error over [0, {result.window:g} s]; "
                  "lines: least-squares fits", fontsize=10)
     ax.grid(True, which="major", alpha=0.3)
     legend(ax, own)

@@ -15,7 +15,7 @@ from ..analysis.compare import PART_FRACTION, Comparison
 from ..analysis.metrics import energy_error
 from ..model import args
 from ..solvers.advice import length as dumbbell_length
-from .style import ROW_COLOURS, ROW_DASHES, _subplots, finish, legend, wrap_texts
+from .style import ROW_COLOURS, ROW_DASHES, _subplots, finish, legend, plain, wrap_texts
 
 __all__ = ["compare", "compare_energy", "compare_positions"]
 
@@ -92,7 +92,7 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
     axes[-1].set_xlabel("t [s]")
     for panel, body in zip(axes, "AB", strict=True):
         _heights_panel(panel, result, body, own=True)
-    fig.suptitle(f"{result.scene.title}: heights, each solver over the truth", fontsize=10)
+    fig.suptitle(f"{plain(result.scene.title)}: heights, each solver over the truth", fontsize=10)
     finish(fig)
     return axes[-1]
 
@@ -163,7 +163,7 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     ax.grid(True, which="major", color="0.9", lw=0.6)
     # On the user's axes the scene's title is theirs to give (a figure's title): not repeated
     # over each axes.
-    ax.set_title(f"{scene.title}: position error against {truth.solver}" if own
+    ax.set_title(f"{plain(scene.title)}: position error against {truth.solver}" if own
                  else f"Position error against {truth.solver}", fontsize=9)
     _end(ax, own)
     return ax
@@ -238,7 +238,7 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
     ax.set_xlim(0, float(truth.t[-1]))
     ax.grid(True, color="0.9", lw=0.6)
     ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    ax.set_title((f"{scene.title}: total" if own else "Total")
+    ax.set_title((f"{plain(scene.title)}: total" if own else "Total")
                  + f" energy per solver, relative to E(0) = {E0:.4g} J", fontsize=9)
     _end(ax, own)
     return ax

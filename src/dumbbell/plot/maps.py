@@ -15,6 +15,7 @@ from ..analysis.sweep import Axis, PointResult, SweepResult
 from ..errors import UsageError
 from ..model import args
 from ..model.trajectory import COMPLETE
+from . import style
 from .style import FAIL_COLOURS, _subplots, finish, legend, legend_below, legend_inside, wrap_texts
 
 __all__ = ["stability_map", "sweep_map"]
@@ -102,7 +103,8 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     if own:
         _, ax = _subplots(figsize=(8.2, 6.2) if len(result.axes) == 2 else (8.2, 4.6))
     fig = ax.figure
-    title = (f"Sweep of {result.scene.name}: {result.solver}, t_end = {result.t_end:g} s, "
+    title = (f"Sweep of {style.plain(result.scene.name)}: {result.solver}, "
+             f"t_end = {result.t_end:g} s, "
              f"{counted(len(result.rows), 'run')}")
     if len(result.axes) == 2:
         mesh, handles = draw_map(ax, result.axes[0], result.axes[1], result.rows, title)

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..analysis.rotation import Series, mean_after_first_cluster
-from .style import COLOURS, _subplots, finish, legend_inside, legend_outside
+from .style import COLOURS, _subplots, finish, legend_inside, legend_outside, plain
 
 __all__ = ["rotation"]
 
@@ -144,7 +144,7 @@ def rotation(s: Series, ax: Any = None) -> Any:
     axes[-1].set_xlabel("t [s]")
     axes[-1].set_xlim(0, float(rigid.t[-1]))
     fig.suptitle(
-        f"{s.scene.title}: rotation preview ({s.runs[labels[0]].solver}, dt = {s.dt:g} s)\n"
+        f"{plain(s.scene.title)}: rotation preview ({s.runs[labels[0]].solver}, dt = {s.dt:g} s)\n"
         "Between impacts a stiffer spring turns more like the rigid body; the floor's push on "
         "one particle leaves it far less rotation", fontsize=9.5)
     finish(fig)

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import _subplots, finish, legend, wrap_texts
+from .style import _subplots, finish, legend, plain, wrap_texts
 
 if TYPE_CHECKING:
     from ..analysis.contact import ContactMomentum
@@ -181,7 +181,7 @@ def topple(cf: ToppleClosedForm, measured: ToppleMeasure, ax: Any = None,
     args.instance(measured, "measured", ToppleMeasure,
                   "a ToppleMeasure (from dumbbell.analysis.topple.measure)")
     ax = args.axes(ax, count=3)
-    solver = args.text(solver, "solver", "a str (the name in the legend)")
+    solver = plain(args.text(solver, "solver", "a str (the name in the legend)"))
     own = ax is None
     a1, a2, a3 = _axes(ax, 3, figsize=(10.5, 8.0), sharex=True)
     t, theta = cf.angle_curve()
@@ -272,7 +272,7 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
     args.instance(cm, "cm", ContactMomentum,
                   "a ContactMomentum (from dumbbell.analysis.contact.about_contact)")
     ax = args.axes(ax)
-    solver = args.text(solver, "solver", "a str (the name in the title)")
+    solver = plain(args.text(solver, "solver", "a str (the name in the title)"))
     own = ax is None
     ax = _axes(ax, 1, figsize=(10.5, 4.8))
     t = (cm.t - cm.impact.t) * 1e3

@@ -32,6 +32,14 @@ from ..colours import COLOURS  # noqa: F401  (re-exported)
 #: No public names: the colours every figure shares.
 __all__: list[str] = []
 
+def plain(text: str) -> str:
+    """``text`` of the user's (a scene's title or name) as matplotlib shows it letter for
+    letter: it reads text between two ``$`` as mathtext, which a title such as ``"price
+    $\\frac{ and $ end"`` breaks when the figure is drawn. The package's own labels use no
+    mathtext; tick labels (which do, on log axes) are not touched."""
+    return str(text).replace("$", r"\$")
+
+
 #: Colour of the angular momentum L_cm (kept out of COLOURS: the GIF's palette is built from
 #: those, and L_cm is text there, drawn in ink).
 MOMENTUM_COLOUR = "#17becf"

@@ -24,7 +24,17 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ..model.trajectory import Trajectory
-from .style import COLOURS, HEAT_COLOUR, LABELS, MOMENTUM_COLOUR, _figure, _subplots, finish, legend
+from .style import (
+    COLOURS,
+    HEAT_COLOUR,
+    LABELS,
+    MOMENTUM_COLOUR,
+    _figure,
+    _subplots,
+    finish,
+    legend,
+    plain,
+)
 
 __all__ = ["energy", "kinetic", "positions", "potential"]
 
@@ -117,7 +127,7 @@ def _title(fig: Any, axes: list[Any], traj: Trajectory, window: float, subtitle:
     # A solver without a step takes dt only as the sample spacing: not worth a title (a
     # stepping solver counts its steps in info).
     dt = f", dt = {traj.dt:g} s" if traj.dt and "steps" in traj.info else ""
-    fig.suptitle(f"{traj.scene.title}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
+    fig.suptitle(f"{plain(traj.scene.title)}\n{subtitle} ({traj.solver}{dt})", fontsize=10)
     finish(fig)
 
 

@@ -18,6 +18,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import UsageError
+from ..model import args
 from ..model.scene import Scene, System
 from ..model.trajectory import Impact, Trajectory, Verdict
 from .kernels import Params
@@ -619,7 +620,7 @@ def run_options(scene: Scene, dt: float | None = None, t_end: float | None = Non
     if dt > t_end:
         raise UsageError(f"dt = {dt:g}: must be <= t_end = {t_end:g} (s)", param="dt")
     if every > MAX_STEPS:
-        raise UsageError(f"every = {every}: must be a whole number from 1 to "
+        raise UsageError(f"every = {args.show(every)}: must be a whole number from 1 to "
                          f"{MAX_STEPS:,} (steps)", param="every")
     ratio = t_end / dt  # a float; inf when the quotient passes the largest float
     if not ratio <= MAX_STEPS:

@@ -23,9 +23,23 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from numba.cpython.unsafe.tuple import tuple_setitem
+from numba.core import config
 from numba.extending import register_jitable
-from numba.np.unsafe.ndarray import to_fixed_tuple
+
+if config.DISABLE_JIT:
+    # NUMBA_DISABLE_JIT=1 runs the loops as Python, where numba's two intrinsics below
+    # cannot run ("<intrinsic to_fixed_tuple> is not usable in pure-python"): their
+    # meaning, in Python. The floats are the same, so the runs give the same numbers.
+    def to_fixed_tuple(array: Any, n: int) -> tuple[float, ...]:
+        """The first ``n`` values of ``array`` as a tuple of floats."""
+        return tuple(float(x) for x in array[:n])
+
+    def tuple_setitem(tup: tuple[Any, ...], i: int, value: Any) -> tuple[Any, ...]:
+        """``tup`` with item ``i`` replaced by ``value``."""
+        return (*tup[:i], value, *tup[i + 1:])
+else:
+    from numba.cpython.unsafe.tuple import tuple_setitem
+    from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from ..._install import njit
 from ...errors import UsageError
