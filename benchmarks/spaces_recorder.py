@@ -55,7 +55,7 @@ def scene_area() -> tuple[int, int, int, int]:
     """Where the recorder draws the view on a W x H frame without the energy panel (px)."""
     if AREA is not None:
         return AREA
-    from dumbbell.animation.recording import scene_area as area
+    from dumbbell.animation.camera import scene_area as area
 
     return area(W, H, False)
 

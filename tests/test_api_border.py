@@ -409,11 +409,11 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "cases": f.scene_file.parent, "solvers": ["euler-cromer"], "workers": 1,
         "quiet": True},
     # dumbbell.analysis.bench
-    "dumbbell.analysis.bench.BenchResult": lambda f: fields(f.bench_result),
-    "dumbbell.analysis.bench.BenchResult.speedups": lambda f: {"target": 1e-3},
-    "dumbbell.analysis.bench.Fit": lambda f: {"solver": "verlet", "order": 2.0,
+    "dumbbell.analysis.bench_result.BenchResult": lambda f: fields(f.bench_result),
+    "dumbbell.analysis.bench_result.BenchResult.speedups": lambda f: {"target": 1e-3},
+    "dumbbell.analysis.bench_result.Fit": lambda f: {"solver": "verlet", "order": 2.0,
                                               "log10_c": 1.0, "dts": [1e-3, 1e-4]},
-    "dumbbell.analysis.bench.Point": lambda f: fields(f.bench_result.points[0]),
+    "dumbbell.analysis.bench_result.Point": lambda f: fields(f.bench_result.points[0]),
     # dumbbell.analysis.compare
     "dumbbell.analysis.compare.Comparison": lambda f: fields(f.comparison),
     "dumbbell.analysis.compare.Row": lambda f: fields(f.comparison.rows[0]),
@@ -516,7 +516,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.stepping.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
     "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
     "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
-    "dumbbell.spaces.guard.Finding": lambda f: fields(f.finding),
+    "dumbbell.spaces._finding.Finding": lambda f: fields(f.finding),
     "dumbbell.spaces.stepping.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
                                                "speeds": "both", "tolerance": math.inf},
     "dumbbell.spaces.stepping.Driver.step": lambda f: {"frames": 2},
@@ -537,9 +537,9 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
         "camera": "auto", "span": None, "y_up": None, "units": ("m", "kg", "s"),
         "reference": "start", "t0": 0.0, "title": "t", "about": (0.0, 0.0)},
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: {"t": None},
-    "dumbbell.spaces.recorder.PaletteDrawOptions": lambda f: {},
-    "dumbbell.spaces.recorder.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
-    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of": lambda f: {
+    "dumbbell.spaces._draw.PaletteDrawOptions": lambda f: {},
+    "dumbbell.spaces._draw.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
+    "dumbbell.spaces._draw.PaletteDrawOptions.ink_of": lambda f: {
         "body": next(iter(f.space().bodies))},
     "dumbbell.spaces.recorder.draw_options": lambda f: {},
 }
@@ -587,16 +587,16 @@ OWNER: dict[str, Callable[[Fixtures], Any]] = {
     "dumbbell.solvers.base.RunOptions.sample_times":
         lambda f: importlib.import_module("dumbbell.solvers").RunOptions(1e-3, 1.0, 10),
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: f.recorder(),
-    "dumbbell.spaces.recorder.PaletteDrawOptions.capture":
+    "dumbbell.spaces._draw.PaletteDrawOptions.capture":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
-    "dumbbell.spaces.recorder.PaletteDrawOptions.ink_of":
+    "dumbbell.spaces._draw.PaletteDrawOptions.ink_of":
         lambda f: importlib.import_module("dumbbell.spaces").draw_options(),
     "dumbbell.model.trajectory.Trajectory.first_impact": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.to_csv": lambda f: f.traj,
     "dumbbell.model.trajectory.Trajectory.__getitem__": lambda f: f.traj,
     "dumbbell.animation.render.Gif.save": lambda f: __import__("dumbbell").Gif(b"GIF89a"),
     "dumbbell.animation.player.Player.save": lambda f: __import__("dumbbell").Player("<p></p>"),
-    "dumbbell.analysis.bench.BenchResult.speedups": lambda f: f.bench_result,
+    "dumbbell.analysis.bench_result.BenchResult.speedups": lambda f: f.bench_result,
     "dumbbell.analysis.topple.ToppleClosedForm.alpha": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.angle_curve": lambda f: f.topple_cf,
     "dumbbell.analysis.topple.ToppleClosedForm.normal_force": lambda f: f.topple_cf,

@@ -54,7 +54,7 @@ def test_a_simulation_checks_its_arguments_once(textbook, call, most):
     found = checks(lambda: call(textbook))
     assert sum(found.values()) <= most, found
     # Each is the border's own: simulate's, and the run options' it was given.
-    assert {caller for _, caller in found} <= {"simulate", "make_options"}, found
+    assert {caller for _, caller in found} <= {"simulate", "make_options", "scene_options"}, found
 
 
 def test_a_comparison_checks_its_arguments_once(textbook):
@@ -78,3 +78,43 @@ def test_checks_do_not_grow_with_the_runs(textbook):
     bench = checks(lambda: dumbbell.bench(textbook, solvers=["euler-cromer"],
                                           dts=[1e-3, 5e-4], t_end=0.1, window=0.1, repeat=1))
     assert sum(bench.values()) <= 3, bench
+
+
+def test_dumbbell_run_checks_the_fps_and_the_scene_once_on_the_way_to_its_gif(tmp_path):
+    # Each value is checked where it enters: the scene (and its GIF's fps) when the file is
+    # read; from there to the GIF's bytes nothing checks them again (issue 32: the fps was
+    # checked 9 times on this path, the scene 4 times more).
+    import re
+
+    from dumbbell.animation import timing
+    from dumbbell.cli import main
+    from dumbbell.model import checker
+    from dumbbell.model import scene as scene_module
+
+    text = re.sub(r"\[outputs\][\s\S]*", "", TEXTBOOK.read_text())
+    path = tmp_path / "gif-only.toml"
+    path.write_text(text + '\n[outputs]\nfigures = []\ncsv = false\n[outputs.gif]\nfps = 10\n'
+                    'size = "160x90"\nt_end = 0.2\n')
+    counts: collections.Counter = collections.Counter()
+
+    def profile(frame: Any, event: str, _arg: Any) -> None:
+        if event != "call":
+            return
+        code = frame.f_code
+        if code.co_filename == timing.__file__ and code.co_name == "check_fps":
+            counts["fps"] += 1
+        elif (code.co_filename == checker.__file__ and code.co_name == "integer"
+              and frame.f_locals.get("name") == "fps"):
+            counts["fps"] += 1  # the scene reader's check of outputs.gif.fps
+        elif code.co_filename == args.__file__ and code.co_name in ("scene", "trajectory"):
+            counts["scene"] += 1
+        elif code.co_filename == scene_module.__file__ and code.co_name == "load_scene":
+            counts["scene"] += 1  # the scene read and checked from its file
+
+    sys.setprofile(profile)
+    try:
+        status = main(["run", str(path), "--out", str(tmp_path / "out"), "-q"])
+    finally:
+        sys.setprofile(None)
+    assert status == 0 and (tmp_path / "out" / "gif-only.gif").stat().st_size > 0
+    assert counts == {"fps": 1, "scene": 1}, counts

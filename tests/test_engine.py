@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from dumbbell.cli import main
+from dumbbell.model.pymunk_settings import PymunkSettings
 from dumbbell.model.scene import load_scene
 from dumbbell.solvers import simulate
 from dumbbell.solvers.engine import build
-from dumbbell.solvers.pymunk_settings import PymunkSettings
 from tests.conftest import SCENES, make_scene
 
 pymunk = pytest.importorskip("pymunk")

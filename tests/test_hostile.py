@@ -623,7 +623,7 @@ def test_a_failed_second_output_leaves_the_first_out_too(work, monkeypatch):
     import dumbbell.io.trajectory
 
     def fail(traj, path):
-        from dumbbell.io.files import atomic_output
+        from dumbbell.files import atomic_output
 
         with atomic_output(path) as tmp:
             raise PermissionError(13, "Permission denied", str(tmp))
@@ -1105,7 +1105,7 @@ def test_another_users_file_in_a_sticky_folder_is_refused_before_the_run(work, h
 
 def _fail_rename(monkeypatch, nth: int) -> list[str]:
     """Make the ``nth`` rename into place of a commit fail (0: the first); returns the log."""
-    from dumbbell.io import files
+    from dumbbell import files
 
     calls: list[str] = []
     real = os.replace
@@ -1139,7 +1139,7 @@ def test_a_failed_rename_while_committing_restores_every_output(work, monkeypatc
 
 
 def test_a_commit_without_hard_links_moves_the_old_file_aside_and_back(work, monkeypatch):
-    from dumbbell.io import files
+    from dumbbell import files
 
     scene, out = work
     for n in ("x.csv", "e.csv"):
@@ -1165,7 +1165,7 @@ def test_a_commit_without_hard_links_moves_the_old_file_aside_and_back(work, mon
 def test_every_output_a_command_writes_was_checked_before_the_work(tmp_path, monkeypatch):
     """The planned names are the written ones: an output the command forgot to check first
     would show up in the transaction's ``unplanned``."""
-    from dumbbell.io import files
+    from dumbbell import files
     from tests.test_fuzz_cli import SHORT_2D
 
     seen: list[files.OutputTransaction] = []
@@ -1205,7 +1205,7 @@ def test_every_output_a_command_writes_was_checked_before_the_work(tmp_path, mon
 _SCRIPT = """
 import os, signal, sys, time
 from pathlib import Path
-from dumbbell.io.files import atomic_output, output_transaction
+from dumbbell.files import atomic_output, output_transaction
 how, out = sys.argv[1], Path(sys.argv[2])
 if how == "handler":
     def handler(signum, frame):
@@ -1262,7 +1262,7 @@ def test_no_temporary_file_survives_a_signal_in_a_users_script(tmp_path, how, si
 
 
 def test_the_signal_handlers_come_back_after_a_write():
-    from dumbbell.io.files import atomic_output
+    from dumbbell.files import atomic_output
 
     before = {s: signal.getsignal(s) for s in (signal.SIGTERM, signal.SIGHUP)}
     signal.signal(signal.SIGTERM, signal.SIG_DFL)

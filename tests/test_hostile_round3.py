@@ -241,7 +241,7 @@ def test_the_output_plan_refuses_two_outputs_on_one_path(tmp_path, monkeypatch):
 
     from dumbbell import DumbbellError, load_scene
     from dumbbell.cli import run as run_command
-    from dumbbell.io.files import OutputTransaction, atomic_output, output_transaction
+    from dumbbell.files import OutputTransaction, atomic_output, output_transaction
     from tests.hostile import cli
 
     out = tmp_path / "r"

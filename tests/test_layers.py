@@ -4,21 +4,22 @@ the ones below it, so data flows one way, and no two files import each other."""
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import dumbbell
 
 ROOT = Path(dumbbell.__file__).parent
 
-#: The one kind of upward import allowed: a convenience method that delegates to the layer
-#: above, imported inside the method (never at module level), as the brief allows for
-#: ``traj.to_csv(path)``. (importer, imported) pairs.
-DELEGATES = {("dumbbell.model.trajectory", "dumbbell.io.trajectory")}
 #: Layer of each package: ``spaces`` (any pymunk space: energy, heat, step guard) sits with
-#: the model; its recorder is the user's API above the animation that paints the recording
+#: the model; its recorder (and ``_draw``, what it collects of a space as the recording's
+#: primitives) is the user's API above the animation that paints the recording
 #: (``animation/recording.py``), as the commands are. The modules directly in the package
-#: (errors, progress, parallel, frames, _lazy, _display, ...) serve every layer: layer 0.
-LAYERS = {"model": 1, "spaces": 1, "spaces.recorder": 5, "solvers": 2,
+#: (errors, progress, parallel, frames, _lazy, _display, ...) serve every layer: layer 0;
+#: ``files`` (the one way a file is written, ``atomic_output``) with the model, below every
+#: writer (it checks paths with ``model.args``).
+LAYERS = {"model": 1, "files": 1, "spaces": 1, "spaces.recorder": 5, "spaces._draw": 5,
+          "solvers": 2,
           "analysis": 3, "io": 4, "plot": 4, "animation": 4, "cli": 5, "examples": 5,
           "__main__": 5}
 
@@ -59,7 +60,13 @@ def imports(path: Path, local: bool = True, root: Path = ROOT) -> tuple[str, lis
     for node in ast.walk(tree):
         if not local and id(node) in inside:
             continue
-        if isinstance(node, ast.Import):
+        if isinstance(node, ast.Call):
+            target = _dynamic(node, module)
+            if target == "?":  # a name computed at run time: every module the file names
+                found += [t for t in _named(tree) if _exists(t, root)]
+            elif target and _exists(target, root):
+                found.append(target)
+        elif isinstance(node, ast.Import):
             found += [a.name for a in node.names if a.name.split(".")[0] == "dumbbell"]
         elif isinstance(node, ast.ImportFrom):
             if node.level:
@@ -74,23 +81,60 @@ def imports(path: Path, local: bool = True, root: Path = ROOT) -> tuple[str, lis
     return module, found
 
 
+def _dynamic(call: ast.Call, module: str) -> str | None:
+    """The dumbbell module a call ``importlib.import_module(NAME)``, ``import_module(NAME)``
+    or ``__import__(NAME)`` loads, when NAME is a string or an f-string that starts with
+    one (``f"dumbbell.cli.{name}"`` loads a module of ``dumbbell.cli``; ``f"{__name__}.x"``
+    one of this package); '?' when NAME is computed at run time; None for any other call."""
+    func = call.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+    if name not in ("import_module", "__import__") or not call.args:
+        return None
+    arg = call.args[0]
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        target = arg.value
+    elif isinstance(arg, ast.JoinedStr) and arg.values:
+        head = arg.values[0]
+        if isinstance(head, ast.Constant) and isinstance(head.value, str):
+            target = head.value.rstrip(".")
+        elif (isinstance(head, ast.FormattedValue) and isinstance(head.value, ast.Name)
+              and head.value.id == "__name__"):
+            target = module
+        else:
+            return "?"
+    else:
+        return "?"
+    return target if target.split(".")[0] == "dumbbell" else None
+
+
+def _named(tree: ast.AST) -> list[str]:
+    """The dumbbell modules a file names in its strings (``"dumbbell.x.y"`` or
+    ``"dumbbell.x.y:Class"``, docstrings left out): what a name computed at run time may
+    load."""
+    docs = {id(n.value) for n in ast.walk(tree) if isinstance(n, ast.Expr)}
+    return [n.value.partition(":")[0] for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs
+            and re.fullmatch(r"dumbbell(\.\w+)+(:\w+)?", n.value)]
+
+
 def upward_imports(root: Path = ROOT) -> list[str]:
-    """Every import that reaches up a layer, but a listed delegate's import inside a function."""
+    """Every import that reaches up a layer: at module level, inside a function, or by name
+    through importlib."""
     upward = []
     for path in sorted(root.rglob("*.py")):
         module, targets = imports(path, root=root)
-        _, top = imports(path, local=False, root=root)
-        upward += [f"{module} -> {t}" for t in targets if layer(t) > layer(module)
-                   and ((module, t) not in DELEGATES or t in top)]
+        upward += [f"{module} -> {t}" for t in targets if layer(t) > layer(module)]
     return upward
 
 
 def _graph(root: Path = ROOT) -> dict[str, set[str]]:
-    """Who imports whom, but a listed delegate's import (it goes one way by design)."""
+    """Who imports whom (at module level, inside a function or by name)."""
     graph = {}
     for path in sorted(root.rglob("*.py")):
         module, targets = imports(path, root=root)
-        graph[module] = {t for t in targets if t != module and (module, t) not in DELEGATES}
+        # (A module that loads a module of its own package by name, ``f"{__name__}.x"`` or
+        # ``f"dumbbell.cli.{name}"`` in the package, names the package: no circle.)
+        graph[module] = {t for t in targets if t != module and not module.startswith(t + ".")}
     return graph
 
 
@@ -121,18 +165,18 @@ def test_no_files_import_each_other():
     assert circles(_graph()) == []
 
 
-def test_a_delegate_may_import_up_only_inside_a_function(tmp_path):
+def test_an_import_inside_a_function_reaches_up_as_one_at_the_top_does(tmp_path):
     model = tmp_path / "dumbbell" / "model"
     model.mkdir(parents=True)
+    (tmp_path / "dumbbell" / "io").mkdir()
+    (tmp_path / "dumbbell" / "io" / "trajectory.py").write_text("")
     (model / "trajectory.py").write_text(
         "def to_csv(self, path):\n    from ..io.trajectory import write_csv\n")
-    assert upward_imports(tmp_path / "dumbbell") == []
+    assert upward_imports(tmp_path / "dumbbell") == [
+        "dumbbell.model.trajectory -> dumbbell.io.trajectory"]
     (model / "trajectory.py").write_text("from ..io.trajectory import write_csv\n")
     assert upward_imports(tmp_path / "dumbbell") == [
         "dumbbell.model.trajectory -> dumbbell.io.trajectory"]
-    (model / "scene.py").write_text("def f():\n    from ..io.trajectory import write_csv\n")
-    assert "dumbbell.model.scene -> dumbbell.io.trajectory" in upward_imports(
-        tmp_path / "dumbbell")
 
 
 def test_the_layer_rule_sees_an_upward_import():
@@ -141,8 +185,8 @@ def test_the_layer_rule_sees_an_upward_import():
     assert layer("dumbbell.spaces.recorder") > layer("dumbbell.solvers.engine")
     # The recorder may use the painter in animation/, never the other way round.
     assert layer("dumbbell.animation.recording") < layer("dumbbell.spaces.recorder")
-    assert layer("dumbbell.errors") == 0 < layer("dumbbell.model.trajectory") < layer(
-        "dumbbell.io.files")
+    assert layer("dumbbell.errors") == 0 < layer("dumbbell.model.trajectory") == layer(
+        "dumbbell.files") < layer("dumbbell.io.trajectory")
     assert layer("dumbbell.frames") == 0 and layer("dumbbell") == 5
     # Writing files is io's: a model module that wrote its own would be caught.
     assert layer("dumbbell.io.trajectory") > layer("dumbbell.model.trajectory")
@@ -162,3 +206,28 @@ def test_absolute_imports_and_circles_are_seen(tmp_path):
     assert imports(path, local=False, root=root)[1] == ["dumbbell.plot.style",
                                                          "dumbbell.io.files"]
     assert circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [{"a", "b", "c"}]
+
+
+def test_importlib_calls_are_seen(tmp_path):
+    # A module loaded by name reaches up as an import does: the rule reads those calls too.
+    root = tmp_path / "dumbbell"
+    for name in ("model/x.py", "solvers/settings.py", "cli/run.py", "cli/__init__.py"):
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text("")
+    (root / "model" / "x.py").write_text(
+        "import importlib\n"
+        "def f(name):\n"
+        "    importlib.import_module('dumbbell.solvers.settings')\n"
+        "    return importlib.import_module(f'dumbbell.cli.{name}')\n")
+    assert imports(root / "model" / "x.py", root=root)[1] == [
+        "dumbbell.solvers.settings", "dumbbell.cli"]
+    assert upward_imports(root) == ["dumbbell.model.x -> dumbbell.solvers.settings",
+                                    "dumbbell.model.x -> dumbbell.cli"]
+    # A name computed at run time: the modules the file names in its strings count.
+    (root / "model" / "x.py").write_text(
+        "import importlib\n"
+        "OWNED = {'t': 'dumbbell.solvers.settings:Settings'}\n"
+        "def owner(t):\n"
+        "    module, _, name = OWNED[t].partition(':')\n"
+        "    return getattr(importlib.import_module(module), name)\n")
+    assert upward_imports(root) == ["dumbbell.model.x -> dumbbell.solvers.settings"]

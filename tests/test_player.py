@@ -325,6 +325,7 @@ def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium,
     2 px of where the recording's GIF painter draws it in frame k."""
     from dumbbell.animation import recording as R
     from dumbbell.animation.palette import blend
+    from dumbbell.animation.pens import BODY_INKS
 
     path = tmp_path / "space.html"
     rec = _space_recording(path)
@@ -333,7 +334,7 @@ def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium,
     o = B.open_player(chromium, path)
     try:
         assert o.console == [] and o.refused == [] and o.requests == [o.url]
-        fill = np.array(blend(R.BODY_INKS[0], 0.33))
+        fill = np.array(blend(BODY_INKS[0], 0.33))
         gif_frames = [np.asarray(painter.frame(k).convert("RGB")) for k in range(r.n)]
         for k in (0, 9, 21):
             before = o.shown()

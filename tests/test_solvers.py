@@ -64,11 +64,11 @@ def test_a_class_that_breaks_the_contract_is_refused_by_name():
         name = "half"
 
         @staticmethod
-        def supports(scene):
+        def _supports(scene):
             return None
 
     problems = contract_problems(Half)
-    assert "order is not declared" in problems and "solve is not written" in problems
+    assert "order is not declared" in problems and "_solve is not written" in problems
     scene = load_scene(SCENES / "textbook-1d.toml")
     with pytest.raises(UsageError, match=r"solver = .*Half: does not keep the solver contract"):
         simulate(scene, Half)
@@ -83,11 +83,23 @@ def test_a_contract_method_called_on_the_class_checks_its_arguments():
         cls.supports(None)
     with pytest.raises(UsageError, match="options"):
         cls.solve(SCENES / "textbook-1d.toml", None)
-    # ... and shows the parameters as written.
+    # ... and shows its parameters.
     import inspect
 
-    assert list(inspect.signature(cls.solve).parameters) == ["scene", "options"]
+    assert list(inspect.signature(cls.solve).parameters)[:2] == ["scene", "options"]
     assert list(inspect.signature(cls.supports).parameters) == ["scene"]
+
+
+def test_a_solver_that_writes_the_public_method_in_place_of_its_impl_is_refused():
+    class Old(METHODS["euler-cromer"]):
+        @classmethod
+        def solve(cls, scene, options):  # the checks of Solver.solve would be bypassed
+            return None
+
+    assert contract_problems(Old) == [(
+        "solve is written in place of _solve (Solver.solve checks the arguments and calls "
+        "_solve)")]
+    assert contract_problems(METHODS["euler-cromer"]) == []
 
 
 def test_every_truth_solver_is_step_free_and_the_truth_exists_in_1d_and_2d():
@@ -121,11 +133,11 @@ class Still(Solver):
     estimates_error = False
 
     @classmethod
-    def supports(cls, scene):
+    def _supports(cls, scene):
         return None if scene.system.dimensions == 1 else "still is 1D only"
 
     @classmethod
-    def solve(cls, scene, options: RunOptions) -> Trajectory:
+    def _solve(cls, scene, options: RunOptions) -> Trajectory:
         t = options.sample_times()
         state = {"xA": np.full_like(t, scene.system.A.height), "vA": np.zeros_like(t),
                  "xB": np.full_like(t, scene.system.B.height), "vB": np.zeros_like(t)}

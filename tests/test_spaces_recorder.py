@@ -289,7 +289,7 @@ def _ball_and_floor(g: float, floor_y: float, ball_y: float) -> pymunk.Space:
 def _ink_mask(frame: np.ndarray, k: int = 0) -> np.ndarray:
     """Where a frame (from row 30) shows the colour of body k (its outline or its fill)."""
     from dumbbell.animation.palette import blend
-    from dumbbell.animation.recording import BODY_INKS
+    from dumbbell.animation.pens import BODY_INKS
 
     f = frame[30:].astype(int)
     near = [np.abs(f - np.array(c)).sum(axis=2) < 30 for c in (BODY_INKS[k],
@@ -825,12 +825,12 @@ def _boxes_space(n: int) -> pymunk.Space:
 
 @pytest.mark.parametrize("n, flat", [(99, False), (100, True)])
 def test_many_small_bodies_are_drawn_flat(tmp_path, n, flat):
-    # The rule (recording.FLAT_MANY, FLAT_PX): 100 moving shapes or more, each drawn within
+    # The rule (pens.FLAT_MANY, FLAT_PX): 100 moving shapes or more, each drawn within
     # 20 px, are drawn flat: the bodies' pixels are their fill or outline exactly, no blend
     # of an ink with white in between (the static floor stays smooth). 99 are drawn smooth:
     # blends at their edges.
     from dumbbell.animation.palette import blend
-    from dumbbell.animation.recording import BODY_INKS, FLAT_MANY, FLAT_PX
+    from dumbbell.animation.pens import BODY_INKS, FLAT_MANY, FLAT_PX
 
     assert (FLAT_MANY, FLAT_PX) == (100, 20)
     space = _boxes_space(n)
@@ -892,9 +892,9 @@ def test_a_read_only_folder_is_refused_up_front(tmp_path):
 
 
 def test_mp4_without_the_extra_is_refused_up_front(tmp_path, monkeypatch):
-    from dumbbell.animation import recording
+    from dumbbell.animation import writer
 
-    monkeypatch.setattr(recording, "mp4_problem", lambda: "MP4 needs the optional extra")
+    monkeypatch.setattr(writer, "mp4_problem", lambda: "MP4 needs the optional extra")
     assert "optional extra" in _refused(tmp_path / "a.mp4", "optional extra")
     assert list(tmp_path.iterdir()) == []
 

@@ -153,6 +153,11 @@ def _numba_target() -> None:
     skip = (COMMAND_LINE.get() and "scipy.linalg" not in sys.modules
             and _BLAS_PROBE not in sys.modules)
     if skip:
+        # Kept on purpose (issue 32): a None in sys.modules makes numba's one import of the
+        # probe fail at once, the only way to skip it that numba leaves open. Measured with
+        # `python benchmarks/blas_probe.py`: readying numba's target took a median of 1.12 s
+        # without the probe against 2.10 s with it (5 rounds interleaved, load average 14 on
+        # the shared 2-core machine): about 1 s of every command that runs a compiled solver.
         sys.modules[_BLAS_PROBE] = None  # type: ignore[assignment]  # the import fails at once
     try:
         cpu_target.target_context.refresh()

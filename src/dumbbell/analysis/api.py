@@ -295,6 +295,11 @@ def _signature(fn: Any, kind: type) -> None:
     fn.__signature__ = inspect.signature(fn).replace(parameters=params)
 
 
+# Kept on purpose (issue 32): each function takes its record's fields as ``**options`` (one
+# list of options, checked once, the record's), so without this help() and a notebook's
+# completion would show ``**options`` in place of the 23 keywords of the four functions
+# (`python -c "import inspect, dumbbell; print(inspect.signature(dumbbell.bench))"` lists
+# bench's 8); writing them out again in each signature would be a second list to keep in step.
 for _fn, _kind in ((compare, CompareOptions), (bench, BenchOptions), (sweep, SweepOptions),
                    (stability, StabilityOptions)):
     _signature(_fn, _kind)

@@ -80,7 +80,8 @@ class Painter(Backdrop):
         fr = self.frames
         img = self.bg.copy()
         self.world.draw_dumbbell(fr, k, k in self.impact_frames,
-                                 lambda box: self.patch(img, box, SS), self.letters, self.small)
+                                 lambda box: self.patch(img, box, SS),
+                                 (self.letters, self.small))
         flat = lambda box: self.patch(img, box, 1)
         self.world.draw_time(fr, k, flat, self.time, self.note)
         self.bars.draw(img, fr, k, flat, self.values)

@@ -7,7 +7,10 @@ import math
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
 from PIL import Image, ImageDraw, ImageFont
+
+from .palette import INK, WHITE, to_palette
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
 __all__: list[str] = []
@@ -100,3 +103,50 @@ def fmt_tick(v: float) -> str:
     """A tick label: 6 significant digits at most, and never "-0"."""
     text = f"{v:.6g}"
     return "0" if text in ("-0", "0") else text
+
+
+class PaletteText:
+    """Text pasted on a palette image from glyphs drawn once: each character drawn by
+    ``stamps`` in ink on white at a whole pixel, mapped to the palette, pasted through the
+    mask of the pixels it inks. For text on a white background: the same pixels as the
+    stamps give there, without drawing in RGB and mapping back every frame."""
+
+    #: White margin (px) around each glyph's cell.
+    MARGIN = 4
+
+    def __init__(self, stamps: Stamps) -> None:
+        self.st = stamps
+        self.glyphs: dict[str, tuple[Image.Image, Image.Image, int, int, float]] = {}
+
+    def _glyph(self, ch: str) -> tuple[Image.Image, Image.Image, int, int, float]:
+        g = self.glyphs.get(ch)
+        if g is None:
+            ascent, descent = self.st.font.getmetrics()
+            m = self.MARGIN
+            advance = self.st.width(ch)
+            x0, _, x1, _ = self.st.font.getbbox(ch, anchor="ls")
+            left = m + max(0, -x0)
+            tile = Image.new("RGB", (left + max(x1, math.ceil(advance)) + m,
+                                     ascent + descent + 2 * m), WHITE)
+            self.st.draw(tile, (left, m + ascent), ch, INK, "ls")
+            inked = (np.asarray(tile) != 255).any(axis=2)
+            sprite, mask = to_palette(tile), Image.fromarray(inked)
+            sprite.load()
+            mask.load()
+            g = self.glyphs[ch] = (sprite, mask, left, m + ascent, advance)
+        return g
+
+    def draw(self, img: Image.Image, xy: tuple[float, float], text: str, anchor: str) -> None:
+        """Paste ``text`` on the palette image ``img`` at ``xy`` (px), anchored as
+        :meth:`Stamps.draw` anchors it."""
+        x, y = xy
+        glyphs = [self._glyph(ch) for ch in text]
+        if anchor[0] in "rm":
+            x -= sum(g[4] for g in glyphs) / (1 if anchor[0] == "r" else 2)
+        base = round({"m": y + self.st.cap / 2, "t": y + self.st.cap, "s": y}[anchor[1]])
+        img.load()
+        core = img.im  # pasted through Pillow's core: no per-call checks, both are "P"
+        for sprite, mask, left, top, advance in glyphs:
+            X, Y = round(x) - left, base - top
+            core.paste(sprite.im, (X, Y, X + sprite.width, Y + sprite.height), mask.im)
+            x += advance

@@ -123,7 +123,7 @@ class Player:
         UsageError
             A path that cannot be written (one line saying why).
         """
-        from ..io.files import atomic_output, writable_path
+        from ..files import atomic_output, writable_path
 
         path = writable_path(path, "path")  # as spelt: "newdir/" is a folder, not a file
         with atomic_output(path) as tmp:

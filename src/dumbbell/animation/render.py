@@ -32,10 +32,9 @@ import numpy as np
 
 from .._display import counted
 from ..errors import UsageError
-from ..io.files import atomic_output
 from ..model.scene import GifSettings
 from ..model.trajectory import Trajectory
-from .timing import check_fps, check_size, delays_cs
+from .timing import _delays, check_fps, check_size, delays_cs  # noqa: F401 - delays_cs re-exported
 
 if TYPE_CHECKING:
     from .frames import Frames
@@ -57,8 +56,11 @@ def frame_count(t_end: float, fps: int) -> int:
     """Frames of an animation of ``t_end`` s at ``fps``: times 0, 1/fps, ... below t_end."""
     from ..model import args
 
-    t_end = args.real(t_end, "t_end", "s")
-    fps = check_fps(fps)
+    return _frame_count(args.real(t_end, "t_end", "s"), check_fps(fps))
+
+
+def _frame_count(t_end: float, fps: int) -> int:
+    """:func:`frame_count` of values checked already."""
     if not t_end * fps <= 1e15:
         raise UsageError(f"t_end = {t_end:g} s at {fps} fps: more than 1e15 frames", param="t_end")
     return max(1, math.ceil(t_end * fps - 1e-9))
@@ -70,11 +72,14 @@ def check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") 
     from ..model import args
 
     where = args.text(where, "where", "the argument's name for the message (str)")
-    t_end = args.real(t_end, "t_end", "s")
-    fps = check_fps(fps)
-    max_frames = args.whole(max_frames, "max_frames", "frames")
+    return _check_frames(args.real(t_end, "t_end", "s"), check_fps(fps),
+                         args.whole(max_frames, "max_frames", "frames"), where)
+
+
+def _check_frames(t_end: float, fps: int, max_frames: int, where: str = "t_end") -> int:
+    """:func:`check_frames` of values checked already (a scene's GIF settings, say)."""
     if t_end * fps <= max_frames + 1:
-        n = frame_count(t_end, fps)
+        n = _frame_count(t_end, fps)
         if n <= max_frames:
             return n
         count = counted(n, "frame", grouped=True)
@@ -106,10 +111,12 @@ def sample_every(dt: float, fps: int, t_end: float, every: int | None = None) ->
     bytes."""
     from ..model import args
 
-    dt = args.real(dt, "dt", "s")
-    fps = check_fps(fps)
-    t_end = args.real(t_end, "t_end", "s")
-    every = None if every is None else args.whole(every, "every", "steps")
+    return _sample_every(args.real(dt, "dt", "s"), check_fps(fps), args.real(t_end, "t_end", "s"),
+                         None if every is None else args.whole(every, "every", "steps"))
+
+
+def _sample_every(dt: float, fps: int, t_end: float, every: int | None = None) -> int:
+    """:func:`sample_every` of values checked already."""
     steps = max(1.0, t_end / dt)  # inf only past the step cap, which a run checks first
     # At most the run's steps, so that a subnormal dt cannot make it overflow.
     target = min(steps, max(1.0, 1.0 / (dt * STRIP_RATE), t_end / dt / STRIP_SAMPLES))
@@ -137,9 +144,11 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
     """The frames of ``traj`` up to ``t_end`` (s): nearest samples at times k/fps."""
     from ..model import args
 
-    traj = args.trajectory(traj)
-    fps = check_fps(fps)
-    t_end = args.real(t_end, "t_end", "s")
+    return _frames_of(args.trajectory(traj), check_fps(fps), args.real(t_end, "t_end", "s"))
+
+
+def _frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
+    """:func:`frames_of` of values checked already."""
     from .frames import Frames
 
     t = traj.t
@@ -147,7 +156,7 @@ def frames_of(traj: Trajectory, fps: int, t_end: float) -> Frames:
         raise UsageError(f"{traj.scene.source}: the trajectory has no samples to render")
     half = float(t[1] - t[0]) / 2 if len(t) > 1 else 0.0
     end = min(t_end, float(t[-1]) + half + 1e-12)
-    ft = np.arange(frame_count(end, fps)) / fps
+    ft = np.arange(_frame_count(end, fps)) / fps
     ft = ft[ft <= float(t[-1]) + half + 1e-12]
     i = np.clip(np.searchsorted(t, ft), 1, max(1, len(t) - 1))
     idx = np.where(np.abs(t[i - 1] - ft) <= np.abs(t[np.minimum(i, len(t) - 1)] - ft), i - 1,
@@ -257,11 +266,12 @@ class Gif(bytes):
         UsageError
             A path that cannot be written (one line saying why).
         """
-        from ..io.files import writable_path
+        from ..files import writable_path
+        from .writer import binary_output
 
         path = writable_path(path)
-        with atomic_output(path) as tmp:
-            Path(tmp).write_bytes(self)
+        with binary_output(path) as fh:
+            fh.write(self)
         return path
 
 
@@ -330,17 +340,13 @@ def render_gif(
     ...
     dumbbell.errors.UsageError: fps = 100: ...
     """
-    from .. import progress
     from ..model import args
-    from .drawing import Painter
-    from .gif import write_frames
-    from .picture import describe
 
     if not isinstance(traj, Trajectory):
         raise UsageError(f"traj = {args.show(traj)}: must be a Trajectory (from simulate)",
                          param="traj")
     if path is not None:
-        from ..io.files import writable_path
+        from ..files import writable_path
 
         path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
     quiet = args.flag(quiet, "quiet")
@@ -352,19 +358,34 @@ def render_gif(
     max_frames = args.whole(max_frames, "max_frames", "frames")
     t_end = float(traj.t[-1]) if t_end is None and len(traj.t) else t_end
     t_end = args.real(t_end, "t_end", "s")
-    check_frames(t_end, fps, max_frames)
+    _check_frames(t_end, fps, max_frames)
+    gif = GifSettings(t_end, fps, f"{width}x{height}", strip)
+    return _render_gif(traj, path, gif, quiet, timing)
+
+
+def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bool,
+                timing: dict[str, float] | None) -> Path | Gif:
+    """:func:`render_gif` of values checked already (its frame count too): the scene's GIF
+    settings on the way from ``dumbbell run``, checked when the scene was read."""
+    from .. import progress
+    from ..model.sizes import pixel_size
+    from .drawing import Painter
+    from .gif import write_frames
+    from .picture import describe
+    from .writer import binary_output
+
+    (width, height), fps, strip, t_end = pixel_size(gif.size), gif.fps, gif.strip, gif.t_end
     t0 = time.perf_counter()
-    frames = frames_of(traj, fps, t_end)
+    frames = _frames_of(traj, fps, t_end)
     painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
-    delays = delays_cs(len(frames.t), fps)
+    delays = _delays(len(frames.t), fps)
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"
     with contextlib.ExitStack() as stack:
         if path is None:
             fh = stack.enter_context(io.BytesIO())
         else:
-            tmp = stack.enter_context(atomic_output(path))
-            fh = stack.enter_context(open(tmp, "wb"))
+            fh = stack.enter_context(binary_output(path))
         pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
         stats["draw"], stats["encode"] = write_frames(fh, (width, height), painter.frame, delays,
                                                       on_frame=lambda: pbar.update(1))

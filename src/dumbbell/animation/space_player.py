@@ -16,32 +16,34 @@ from typing import Any
 
 import numpy as np
 
-from ..io.files import atomic_output
+from ..files import atomic_output
 from . import recording as R
+from .backdrop import SS
+from .palette import GREY, INK, LIGHT, SPRING, WHITE, blend
+from .pens import COILS, FLAT_MANY, SHAPE_COLOURS, SPRING_WIDTH
 from .picture import hex_colour
 from .player import b64_array, energy_array, page
+from .recorded import Recording
+from .strip import GRID
+from .world import LEAD
 
 #: No public names: the page behind :class:`dumbbell.spaces.Recorder` for a path ending in
 #: .html.
 __all__: list[str] = []
 
 
-def write(path: Path, rec: R.Recording, timing: dict[str, float] | None = None) -> R.Painter:
+def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) -> R.Painter:
     """Write the player page of ``rec`` to ``path`` (atomically); ``timing`` receives the
     seconds spent. Returns the painter (its ``view``), as :func:`.recording.write` does."""
     t0 = time.perf_counter()
     painter = R.Painter(rec)
-    with R._signals_end_cleanly():
-        text = space_page(painter)
-        # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
-        # for the recorder's note), counted without drawing.
-        panel = (painter.scene_w, painter.H)
-        for k in range(painter.n):
-            view = painter.views[k]
-            painter._count(R.Layer(rec, k, view, painter.u, panel, painter._flat,
-                                   painter._shapes(rec.shape_of[k], view)))
-        with atomic_output(path) as tmp:
-            Path(tmp).write_text(text, encoding="utf-8")
+    text = space_page(painter)
+    # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
+    # for the recorder's note), counted without drawing.
+    for k in range(painter.n):
+        painter._count(painter.layer(k))
+    with atomic_output(path) as tmp:
+        Path(tmp).write_text(text, encoding="utf-8")
     if timing is not None:
         timing.update(frames=painter.n, total=time.perf_counter() - t0)
     return painter
@@ -84,7 +86,7 @@ def space_document(painter: Any) -> dict[str, Any]:
     counts = [len(p) for p in rec.poses]
     poses = np.concatenate([np.asarray(p, dtype=float).reshape(-1, 3) for p in rec.poses]
                            + [np.zeros((0, 3))])
-    shape_colours = [[hex_colour(out), hex_colour(fill)] for out, fill in R.SHAPE_COLOURS]
+    shape_colours = [[hex_colour(out), hex_colour(fill)] for out, fill in SHAPE_COLOURS]
     doc: dict[str, Any] = {
         "size": [painter.W, painter.H], "u": u, "title": rec.title,
         "time_unit": rec.time_unit, "t_decimals": painter.t_decimals,
@@ -95,12 +97,12 @@ def space_document(painter: Any) -> dict[str, Any]:
         "shapes": shape_sets, "shape_of": list(rec.shape_of),
         "counts": counts, "poses": b64_array(poses, "f4"),
         "extras": [[list(it) for it in items] for items in rec.extras],
-        "shape_colours": shape_colours, "spring": hex_colour(R.SPRING), "ink": hex_colour(R.INK),
-        "light": hex_colour(R.LIGHT), "grey": hex_colour(R.GREY), "grid": hex_colour(R.GRID),
-        "white": hex_colour(R.WHITE),
-        "factors": {"COILS": R.COILS, "SPRING_WIDTH": R.SPRING_WIDTH, "LEAD": R.LEAD,
-                    "SS": R.SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
-                    "FLAT_MANY": R.FLAT_MANY},
+        "shape_colours": shape_colours, "spring": hex_colour(SPRING), "ink": hex_colour(INK),
+        "light": hex_colour(LIGHT), "grey": hex_colour(GREY), "grid": hex_colour(GRID),
+        "white": hex_colour(WHITE),
+        "factors": {"COILS": COILS, "SPRING_WIDTH": SPRING_WIDTH, "LEAD": LEAD,
+                    "SS": SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
+                    "FLAT_MANY": FLAT_MANY},
         "label_box": list(painter.label_box), "colours": colours(),
     }
     if painter.energy:
@@ -114,7 +116,7 @@ def space_document(painter: Any) -> dict[str, Any]:
             "left": painter.bar_left, "right": painter.bar_right, "zero": painter.bar_zero,
             "px_per_j": painter.bar_scale, "heat": rec.heat,
             "inks": {n: hex_colour(R.TERM_INKS[n]) for n in painter.names},
-            "heat_ink": hex_colour(R.blend(R.TERM_INKS["heat"], 0.6)),
+            "heat_ink": hex_colour(blend(R.TERM_INKS["heat"], 0.6)),
         }
         if painter.strip:
             from .glyphs import fmt_tick, nice_step

@@ -247,6 +247,17 @@ class Tape:
             if -S <= x <= (c1 - c0 + 1) * S:
                 d.line([(x, 0), (x, edge)], fill=IMPACT, width=S)
                 d.line([(x, edge - IMPACT_TICK * u * S), (x, edge)], fill=GREY, width=S)
+        self._curves(img, d, c0, c1)
+        for y, colour, t0, t1 in self.contacts:  # resting or rolling on the floor: a bar
+            x0, x1 = (t0 * p - c0) * S, (t1 * p - c0) * S
+            if x1 >= -S and x0 <= (c1 - c0 + 1) * S:
+                d.rectangle([x0, y, x1, y + self.bar - 1], fill=colour)
+        return to_palette(img)
+
+    def _curves(self, img: Image.Image, d: ImageDraw.ImageDraw, c0: int, c1: int) -> None:
+        """The series over columns ``c0`` to ``c1`` on the piece ``img``: fast terms as pale
+        bands, the others as lines, E on top."""
+        S, u, p = 1, self.strip.u, self.strip.px_per_s
         lo_t, hi_t = (c0 - 2) / p, (c1 + 2) / p
         lines = []
         for name, (ts, c, y) in self.series.items():
@@ -271,11 +282,6 @@ class Tape:
         width = max(1, round(LINE * u))
         for name, pts in lines:
             d.line(pts, fill=TERM_RGB.get(name, GREY), width=width, joint="curve")
-        for y, colour, t0, t1 in self.contacts:  # resting or rolling on the floor: a bar
-            x0, x1 = (t0 * p - c0) * S, (t1 * p - c0) * S
-            if x1 >= -S and x0 <= (c1 - c0 + 1) * S:
-                d.rectangle([x0, y, x1, y + self.bar - 1], fill=colour)
-        return to_palette(img)
 
     def crop(self, box: tuple[int, int, int, int]) -> Image.Image:
         """The tape's columns ``box[0]`` to ``box[2]`` (rows ``box[1]`` to ``box[3]``), as

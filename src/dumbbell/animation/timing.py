@@ -49,7 +49,10 @@ def check_size(size: str | tuple[int, int], where: str = "size") -> tuple[int, i
 def delays_cs(n: int, fps: int) -> list[int]:
     """Delay of each of ``n`` frames in GIF units (10 ms): frame k starts at
     round(k * 100 / fps) units, so the animation keeps real time."""
-    n = args.whole(n, "n", "frames", lo=0, hi=10**7)
-    fps = check_fps(fps)
+    return _delays(args.whole(n, "n", "frames", lo=0, hi=10**7), check_fps(fps))
+
+
+def _delays(n: int, fps: int) -> list[int]:
+    """:func:`delays_cs` of values checked already."""
     starts = [math.floor(k * 100 / fps + 0.5) for k in range(n + 1)]
     return [b - a for a, b in itertools.pairwise(starts)]

@@ -185,11 +185,12 @@ class World:
 
     def draw_dumbbell(self, frames: Frames, k: int, impact: bool,
                       patch: Callable[[tuple[float, float, float, float]], Patch],
-                      letters: Stamps, small: Stamps) -> None:
+                      stamps: tuple[Stamps, Stamps]) -> None:
         """Frame ``k``'s dumbbell (``impact``: with the mark of an impact since the previous
-        frame) on a crop from ``patch`` at :data:`SS` times the size; ``letters`` and
-        ``small`` are fonts at that size."""
+        frame) on a crop from ``patch`` at :data:`SS` times the size; ``stamps`` (the letters,
+        the small text) are fonts at that size."""
         L, u, S = self.layout, self.layout.u, SS
+        letters, small = stamps
         (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
         if not all(math.isfinite(v) for v in (ax, ay, bx, by)):
             return
@@ -222,13 +223,8 @@ class World:
             d.line([(x - IMPACT_MARK * u * S, y), (x + IMPACT_MARK * u * S, y)], fill=BLACK,
                    width=round(IMPACT_LINE * u * S))
             small.draw(crop, (x, y + IMPACT_GAP * u * S), IMPACT_WORD_TEXT, INK, "mt")
-        if self.link == "rod":
-            d.line([P(pa), P(pb)], fill=SPRING, width=round(ROD_LINE * u * S))
-        elif self.link == "spring":
-            d.line([P(p) for p in zigzag(pb, pa, amp, COILS)], fill=SPRING,
-                   width=max(2, round(ZIGZAG_LINE * u * S)), joint="curve")
-        else:
-            d.line([P(pa), P(pb)], fill=LIGHT, width=S)
+        self._link(d, [P(pa), P(pb)],
+                   [P(p) for p in zigzag(pb, pa, amp, COILS)] if self.link == "spring" else [])
         # Labels sit beyond each particle along the axis, clear of the spring; in 2D at least
         # LABEL_CLEAR from the centre of mass (clear of the angle's arc and vertical line when
         # the spring is compressed) and above the floor; in 1D (and when the particles
@@ -249,14 +245,29 @@ class World:
                 letters.draw(crop, P((lx, ly)), name, INK, "mm")
             else:
                 letters.draw(crop, (x + (r + LETTER_GAP_1D * u) * S, y), name, INK, "lm")
-        # Centre of mass: the quartered-disc symbol, narrower than the spring's zig-zag so
-        # the coils still show beside it when the spring is fully compressed.
-        (x, y), rc = P(pc), CM_RADIUS * u * S
+        self._centre(d, P(pc), outline)
+        done()
+
+    def _centre(self, d: ImageDraw.ImageDraw, xy: tuple[float, float], outline: int) -> None:
+        """Centre of mass at ``xy`` (px on the crop): the quartered-disc symbol, narrower than
+        the spring's zig-zag so the coils still show beside it when the spring is fully
+        compressed."""
+        (x, y), rc = xy, CM_RADIUS * self.layout.u * SS
         bb = [x - rc, y - rc, x + rc, y + rc]
         d.ellipse(bb, fill=WHITE, outline=BLACK, width=outline)
         d.pieslice(bb, 180, 270, fill=BLACK)
         d.pieslice(bb, 0, 90, fill=BLACK)
-        done()
+
+    def _link(self, d: ImageDraw.ImageDraw, ends: list, coils: list) -> None:
+        """The rod, the spring (its zig-zag ``coils``) or a faint line between the particles
+        (``ends``, px on the crop)."""
+        u, S = self.layout.u, SS
+        if self.link == "rod":
+            d.line(ends, fill=SPRING, width=round(ROD_LINE * u * S))
+        elif self.link == "spring":
+            d.line(coils, fill=SPRING, width=max(2, round(ZIGZAG_LINE * u * S)), joint="curve")
+        else:
+            d.line(ends, fill=LIGHT, width=S)
 
     def _angle(self, d: ImageDraw.ImageDraw, P, pa, pb, pc) -> None:
         """The axis through B and A, a vertical reference at the centre of mass and the arc

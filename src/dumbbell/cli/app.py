@@ -366,7 +366,7 @@ def plan_outputs(args: argparse.Namespace, paths, flag: str | None = None) -> li
     """Before the work: check and reserve every output ``paths`` the command will write
     (each can be created or replaced, none is an input or another output), else a
     UsageError naming ``flag`` (default ``--out DIR``) and the file. Returns the paths."""
-    from ..io.files import OutputTransaction
+    from ..files import OutputTransaction
 
     flag = flag or f"--out {args.out}"
     transaction = getattr(args, "outputs", None) or OutputTransaction()
@@ -376,7 +376,7 @@ def plan_outputs(args: argparse.Namespace, paths, flag: str | None = None) -> li
 def _check_paths(args: argparse.Namespace, transaction) -> None:
     """Before any work: every output can be written, none is an input or another output
     (UsageError naming the flags)."""
-    from ..io.files import check_writable
+    from ..files import check_writable
 
     for dest, what in INPUT_FLAGS.items():
         value = getattr(args, dest, None)
@@ -567,7 +567,7 @@ def _file_backend(process_ends: bool = False) -> Iterator[None]:
 
 
 def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> int:
-    from ..io.files import output_transaction
+    from ..files import output_transaction
 
     def error(text: str) -> int:
         sys.stderr.write(one_line(f"{command}: error: {text}") + "\n")

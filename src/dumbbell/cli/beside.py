@@ -6,7 +6,7 @@ other, most of it imports. On a machine with more than one CPU for this process,
 :func:`figures_beside` forks a child before the run: it imports matplotlib while this process
 loads the solver, receives the trajectory through a pipe (pickled, its arrays sent as they lie
 in memory), and draws each figure into the temporary file that this process made for it
-(:func:`~dumbbell.io.files.atomic_output`). This process renames those with its other outputs
+(:func:`~dumbbell.files.atomic_output`). This process renames those with its other outputs
 once the whole command has succeeded, all or none, as before. The child runs the same code on
 the same data with matplotlib's same defaults, so the figures are the same bytes.
 

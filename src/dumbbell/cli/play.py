@@ -7,16 +7,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..animation.render import MAX_FRAMES
 from .app import (
     DEFAULT_OUT,
     EXIT_VERDICT,
-    add_quiet,
     add_scene,
-    positive_float,
     positive_int,
     read_scene,
 )
+from .render import add_length_flags
 
 #: What ``dumbbell play --help`` says the command does.
 DESCRIPTION = """\
@@ -47,33 +45,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--size", metavar="WxH",
                    help="the picture's width x height in pixels (default 640x360; the page "
                         "scales it to the window)")
-    p.add_argument("--t-end", type=positive_float("s"), metavar="T",
-                   help="length in s (default: the scene's run.t_end)")
-    p.add_argument("--max-frames", type=positive_int("frames"), metavar="N",
-                   default=MAX_FRAMES,
-                   help=f"refuse, before anything runs, more than N frames (t_end x fps; "
-                        f"default {MAX_FRAMES:,})")
-    p.add_argument("--no-strip", dest="strip", action="store_false", default=None,
-                   help="leave out the strip of the energy time series")
-    add_quiet(p)
+    add_length_flags(p, "length in s", "more than N frames")
     p.set_defaults(func=run, names={"dt": "run.dt"})
 
 
 def run(args: argparse.Namespace) -> int:
     from ..animation.player import player
-    from ..animation.render import check_fps, check_frames, check_size
     from ..errors import UsageError
-    from ..model.scene import GifSettings
     from ..solvers import runnable, solver_class
-    from .render import gif_trajectory
+    from .render import check_gif_frames, gif_flags, gif_trajectory
 
     scene = read_scene(args.scene)
-    gif = scene.outputs.gif or GifSettings(scene.run.t_end)
-    fps = check_fps(args.fps if args.fps is not None else gif.fps,
-                    "--fps" if args.fps is not None else "outputs.gif.fps")
-    size = check_size(args.size or gif.size, "--size" if args.size else "outputs.gif.size")
-    strip = args.strip if args.strip is not None else gif.strip
-    t_end = args.t_end or gif.t_end
+    gif = gif_flags(args, scene)
     out = Path(args.output) if args.output else Path(DEFAULT_OUT) / f"{scene.name}.html"
     if out.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"-o {out}: must end in .html")
@@ -91,12 +74,10 @@ def run(args: argparse.Namespace) -> int:
 
     if not args.output:  # -o itself was checked with the other flags
         plan_outputs(args, [out], "the default -o")
-    check_frames(t_end, fps, args.max_frames,
-                 "--t-end" if args.t_end else "outputs.gif.t_end" if scene.outputs.gif
-                 else "run.t_end")
-    trajs = [gif_trajectory(scene, fps, t_end, name, quiet=args.quiet) for name in solvers]
-    player(trajs if len(trajs) > 1 else trajs[0], fps=fps, size=size, strip=strip,
-           t_end=t_end).save(out)
+    check_gif_frames(args, scene, gif)
+    trajs = [gif_trajectory(scene, gif, name, quiet=args.quiet) for name in solvers]
+    player(trajs if len(trajs) > 1 else trajs[0], fps=gif.fps, size=gif.size, strip=gif.strip,
+           t_end=gif.t_end).save(out)
     if not args.quiet:
         sys.stderr.write(f"wrote {out}\n")
     bad = [x for x in trajs if not x.verdict.ok]

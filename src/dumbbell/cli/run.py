@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import gc
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -80,9 +81,9 @@ def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = Fa
     message offers only the flags."""
     import string
 
-    from ..animation.render import check_frames
+    from ..animation.render import _check_frames
     from ..errors import UsageError
-    from ..solvers import make_options
+    from ..solvers.base import scene_options
 
     def in_scene(exc: UsageError, keys: dict[str, str]) -> UsageError:
         if not packaged:
@@ -94,13 +95,13 @@ def _check_budgets(scene, max_samples: int, max_frames: int, packaged: bool = Fa
         return UsageError(f"the packaged scene {scene.name}: {exc.reason}", fixes=flags)
 
     try:
-        make_options(scene, max_samples=max_samples)
+        scene_options(scene, max_samples=max_samples)
     except UsageError as exc:
         raise in_scene(exc, {}) from None
     if scene.outputs.gif is not None:
         gif = scene.outputs.gif
         try:
-            check_frames(gif.t_end, gif.fps, max_frames,
+            _check_frames(gif.t_end, gif.fps, max_frames,
                          "the GIF's length" if packaged else "outputs.gif.t_end")
         except UsageError as exc:
             raise in_scene(exc, {"t_end": "outputs.gif.t_end",
@@ -128,8 +129,9 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
     exit status (0, 3 or 4: :func:`~.app.verdict_status`). The figures are drawn beside the CSVs and the GIF, in a forked
     process, where there is a CPU for it (:mod:`.beside`); the bytes are the same either
     way."""
-    from ..io.files import atomic_output
-    from ..solvers import simulate
+    from ..files import atomic_output
+    from ..solvers import run_scene
+    from ..solvers.base import scene_options
     from .app import verdict_status
     from .beside import beside
 
@@ -142,7 +144,8 @@ def run_scene(scene, out: Path, quiet: bool = False, max_samples: int = MAX_SAMP
         figures = stack.enter_context(beside(
             lambda traj, alive: _draw_figures(files, traj, alive), _figure_imports,
             fork=None if files else False))
-        traj = simulate(scene, quiet=quiet, max_samples=max_samples)
+        options = scene_options(scene, max_samples=max_samples)
+        traj = run_scene(scene, None, replace(options, quiet=quiet))
         # numba, its kernels and whatever else the run imported stay until the command ends:
         # the garbage collector need not look at them again.
         gc.freeze()
@@ -173,14 +176,14 @@ def _write_rest(scene, traj: Any, names: dict[str, Path], quiet: bool, max_frame
         if "impacts" in names:
             write_events(traj, names["impacts"])
     if scene.outputs.gif is not None:
-        from ..animation.render import render_gif
+        from ..animation.render import _render_gif
         from .render import gif_trajectory
 
         gif = scene.outputs.gif
-        # The samples `dumbbell render` would draw from: one scene, one GIF's bytes.
-        drawn = gif_trajectory(scene, gif.fps, gif.t_end, quiet=quiet, traj=traj)
-        render_gif(drawn, names["gif"], quiet=quiet, fps=gif.fps, size=gif.size,
-                   strip=gif.strip, t_end=gif.t_end, max_frames=max_frames)
+        # The samples `dumbbell render` would draw from: one scene, one GIF's bytes. Its
+        # settings were checked when the scene was read, its frames by _check_budgets.
+        drawn = gif_trajectory(scene, gif, quiet=quiet, traj=traj)
+        _render_gif(drawn, names["gif"], gif, quiet, None)
 
 
 def _figure_imports() -> None:

@@ -107,7 +107,7 @@ def run_pieces(out: Path, quiet: bool = False, max_samples: int | None = None,
     """Run every piece into ``out``; returns the worst exit status. Every piece's command
     line and scene are read before the first one runs. ``max_samples`` and ``max_frames``
     are the budgets of the ``run`` pieces (their defaults when None)."""
-    from ..io.files import check_writable
+    from ..files import check_writable
     from .app import worst_status
 
     pieces = [(piece, parse(piece, out, quiet)) for piece in PIECES]

@@ -21,13 +21,11 @@ __all__ = ["newtons_cradle", "pendulum", "slope"]
 MAX_STEPS = 10**8
 
 
-def check_run(dt: Any, seconds: Any, fps: Any, space: Any, recorder: Any = None,
-              heat: Any = None) -> tuple[float, float, int]:
-    """The arguments of an example's ``measure`` checked at the border (UsageError naming
+def check_run(dt: Any, seconds: Any, fps: Any) -> tuple[float, float, int]:
+    """The times of an example's ``measure`` checked at the border (UsageError naming
     the one that is not valid): ``dt`` (s) > 0 and at most one frame 1/``fps`` (fps 1..50),
-    ``seconds`` (s) > 0 with at most :data:`MAX_STEPS` steps, ``space`` None or a
-    pymunk.Space with a dynamic body, ``recorder`` None or a Recorder, ``heat`` None or a
-    HeatCounter. Returns (dt, seconds, fps)."""
+    ``seconds`` (s) > 0 with at most :data:`MAX_STEPS` steps. Returns (dt, seconds, fps);
+    :func:`check_tools` checks the rest."""
     from ..animation.render import check_fps
     from ..errors import UsageError
     from ..model import args
@@ -41,6 +39,16 @@ def check_run(dt: Any, seconds: Any, fps: Any, space: Any, recorder: Any = None,
     if seconds / dt > MAX_STEPS:
         raise UsageError(f"seconds = {seconds:g}: {seconds:g} s / dt {dt:g} s is more than "
                          f"{MAX_STEPS:,} steps; lower seconds or raise dt", param="seconds")
+    return dt, seconds, fps
+
+
+def check_tools(space: Any, recorder: Any = None, heat: Any = None) -> None:
+    """The objects an example's ``measure`` is given, checked at the border: ``space`` None
+    or a pymunk.Space with a dynamic body, ``recorder`` None or a Recorder, ``heat`` None or
+    a HeatCounter."""
+    from ..errors import UsageError
+    from ..model import args
+
     if space is not None:
         import pymunk
 
@@ -56,7 +64,6 @@ def check_run(dt: Any, seconds: Any, fps: Any, space: Any, recorder: Any = None,
         from ..spaces.heat import HeatCounter
 
         args.instance(heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
-    return dt, seconds, fps
 
 
 def check_argv(argv: Any) -> list[str] | None:
@@ -107,3 +114,26 @@ def print_guard(space: Any, args: argparse.Namespace) -> None:
 
     print(spaces.report(space, 1.0 / args.fps, units="m"))
     print(spaces.report(space, args.dt, units="m"))
+
+
+def record_and_compare(args: argparse.Namespace, space: Any, measure: Any, line: Any,
+                       header: str = "", **recorder: Any) -> int:
+    """An example's run: ``measure(dt, seconds, fps, space, rec)`` measures ``space`` at
+    ``args.dt`` while a Recorder ``rec`` (with the keywords ``recorder``; its ``heat`` counter
+    is given to ``measure`` too) captures each frame into ``args.out``, then a new space again
+    at dt / 10; then ``header`` (if any), a ``line(dt, measured)`` for each run and the file
+    written. Returns the exit status, 0."""
+    from .. import spaces
+    from .._display import counted
+
+    tools = {"heat": recorder["heat"]} if "heat" in recorder else {}
+    with spaces.Recorder(space, args.out, fps=args.fps, units="m", **recorder) as rec:
+        rec.capture()
+        measured = measure(args.dt, args.seconds, args.fps, space, rec, **tools)
+    if header:
+        print(header)
+    again = measure(args.dt / 10, args.seconds, args.fps)
+    for dt, m in ((args.dt, measured), (args.dt / 10, again)):
+        print(line(dt, m))
+    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
+    return 0

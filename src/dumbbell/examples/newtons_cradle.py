@@ -16,8 +16,7 @@ import math
 import sys
 from typing import Any
 
-from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard, record_and_compare
 
 #: No public names: a program, run as ``python -m dumbbell.examples.newtons_cradle``.
 __all__: list[str] = []
@@ -62,7 +61,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     run (default: a new one); ``recorder`` captures each frame."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder)
     space = build() if space is None else space
     balls = [b for b in space.bodies]
     e0 = spaces.energy(space).E
@@ -95,21 +95,16 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .. import spaces
 
     args = arguments("newtons_cradle", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Newton's cradle", units="m") as rec:
-        rec.capture()
-        first = measure(args.dt, args.seconds, args.fps, space, rec)
-    results = [(args.dt, first), (args.dt / 10, measure(args.dt / 10, args.seconds, args.fps))]
-    for dt, m in results:
-        print(f"dt = {dt:.3g} s over {args.seconds:g} s: energy drift max "
-              f"{m['energy_drift_max']:.2e}, at the end {m['energy_drift_end']:.2e}; momentum "
-              f"change across an impact max {m['momentum_change_max']:.2e}")
-    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
-    return 0
+    return record_and_compare(
+        args, space, measure,
+        lambda dt, m: (f"dt = {dt:.3g} s over {args.seconds:g} s: energy drift max "
+                       f"{m['energy_drift_max']:.2e}, at the end {m['energy_drift_end']:.2e}; "
+                       f"momentum change across an impact max {m['momentum_change_max']:.2e}"),
+        title="Newton's cradle")
 
 
 if __name__ == "__main__":

@@ -20,8 +20,7 @@ import math
 import sys
 from typing import Any
 
-from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard, record_and_compare
 
 #: No public names: a program, run as ``python -m dumbbell.examples.pendulum``.
 __all__: list[str] = []
@@ -74,7 +73,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
     of the rod's angle (s) and the largest |E - E0| / E0."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder)
     space = build() if space is None else space
     rod = next(iter(space.bodies))
     e0 = spaces.energy(space).E
@@ -99,24 +99,19 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None,
 
 
 def main(argv: list[str] | None = None) -> int:
-    from .. import spaces
 
     args = arguments("pendulum", __doc__, 10.0, argv)
     space = build()
     print_guard(space, args)
-    with spaces.Recorder(space, args.out, fps=args.fps, title="Pendulum on a rotary spring", units="m",
-                         world=(-0.45, 0.45, -0.55, 0.55)) as rec:
-        rec.capture()
-        first = measure(args.dt, args.seconds, args.fps, space, rec)
     T0, T1 = small_angle_period(), amplitude_corrected_period()
-    print(f"small-angle period {T0:.6f} s; with the amplitude correction {T1:.6f} s")
-    for dt, m in ((args.dt, first), (args.dt / 10, measure(args.dt / 10, args.seconds, args.fps))):
-        print(f"dt = {dt:.3g} s: period {m['period']:.6f} s over {m['periods']} swings, "
-              f"{(m['period'] - T0) / T0:+.3%} from the small-angle formula, "
-              f"{(m['period'] - T1) / T1:+.1e} from the corrected one; energy drift max "
-              f"{m['energy_drift_max']:.2e}")
-    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
-    return 0
+    return record_and_compare(
+        args, space, measure,
+        lambda dt, m: (f"dt = {dt:.3g} s: period {m['period']:.6f} s over {m['periods']} "
+                       f"swings, {(m['period'] - T0) / T0:+.3%} from the small-angle formula, "
+                       f"{(m['period'] - T1) / T1:+.1e} from the corrected one; energy drift "
+                       f"max {m['energy_drift_max']:.2e}"),
+        f"small-angle period {T0:.6f} s; with the amplitude correction {T1:.6f} s",
+        title="Pendulum on a rotary spring", world=(-0.45, 0.45, -0.55, 0.55))
 
 
 if __name__ == "__main__":

@@ -16,8 +16,7 @@ import math
 import sys
 from typing import Any
 
-from .._display import counted
-from . import arguments, check_run, print_guard
+from . import arguments, check_run, check_tools, print_guard, record_and_compare
 
 #: No public names: a program, run as ``python -m dumbbell.examples.slope``.
 __all__: list[str] = []
@@ -59,7 +58,8 @@ def measure(dt: float, seconds: float, fps: int = 25, space: Any = None, recorde
     box travelled (m)."""
     from .. import spaces
 
-    dt, seconds, fps = check_run(dt, seconds, fps, space, recorder, heat)
+    dt, seconds, fps = check_run(dt, seconds, fps)
+    check_tools(space, recorder, heat)
     space = build() if space is None else space
     heat = spaces.HeatCounter(space, units="m") if heat is None else heat
     box = next(iter(space.bodies))
@@ -83,17 +83,16 @@ def main(argv: list[str] | None = None) -> int:
     print_guard(space, args)
     heat = spaces.HeatCounter(space, units="m")
     c, s = math.cos(ANGLE), math.sin(ANGLE)
-    with spaces.Recorder(space, args.out, fps=args.fps, heat=heat, title="Box on a slope", units="m",
-                         world=(-0.1, RAMP * c + 0.05, -0.15, RAMP * s + 0.45)) as rec:
-        rec.capture()
-        first = measure(args.dt, args.seconds, args.fps, space, rec, heat)
-    for dt, m in ((args.dt, first), (args.dt / 10, measure(args.dt / 10, args.seconds, args.fps))):
+
+    def line(dt: float, m: dict[str, float]) -> str:
         left = m["E0"] - m["E"] - m["heat"]
-        print(f"dt = {dt:.3g} s: E(0) = {m['E0']:.5f} J, E(t) = {m['E']:.5f} J, heat "
-              f"{m['heat']:.5f} J over {m['distance']:.3f} m; E(0) - E(t) - heat = {left:+.2e} J "
-              f"({left / m['heat']:+.2e} of the heat)")
-    print(f"wrote {args.out} ({counted(rec.frames, 'frame')})")
-    return 0
+        return (f"dt = {dt:.3g} s: E(0) = {m['E0']:.5f} J, E(t) = {m['E']:.5f} J, heat "
+                f"{m['heat']:.5f} J over {m['distance']:.3f} m; E(0) - E(t) - heat = "
+                f"{left:+.2e} J ({left / m['heat']:+.2e} of the heat)")
+
+    return record_and_compare(
+        args, space, measure, line, heat=heat, title="Box on a slope",
+        world=(-0.1, RAMP * c + 0.05, -0.15, RAMP * s + 0.45))
 
 
 if __name__ == "__main__":

@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 
 from ..analysis.compare import MAX_TIMED_RUNS, TIME_AGAIN_BELOW, Comparison
+from ..files import atomic_output
 from ..model import args
-from .files import atomic_output
 from .tables import csv_text, write_text
 
 __all__ = ["text", "write"]

@@ -7,8 +7,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
+from ..files import atomic_output, writable_path
 from ..model import args
-from .files import atomic_output, writable_path
 
 #: No public names: the commands save the figures that :mod:`dumbbell.plot` draws.
 __all__: list[str] = []
@@ -41,7 +41,7 @@ def save_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> Path:
 def write_figure(fig: Any, path: str | Path, dpi: float | str = DPI) -> None:
     """Write the checked figure ``fig`` to the file ``path`` itself (format from its suffix),
     then close it: :func:`save_figure` past its checks, for a caller that already holds the
-    file to write (a temporary file of :func:`~.files.atomic_output`)."""
+    file to write (a temporary file of :func:`~dumbbell.files.atomic_output`)."""
     from matplotlib.layout_engine import ConstrainedLayoutEngine, PlaceHolderLayoutEngine
 
     engine = fig.get_layout_engine()

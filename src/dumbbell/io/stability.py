@@ -103,18 +103,9 @@ def markdown(result: StabilityResult) -> str:
                      "`run.inaccurate_energy` "
                      f"({' or '.join(f'{v:g}' for v in thresholds)}); `inaccurate`: stable "
                      "to the end, but past it, dated where it first passed it.")]
-    notes = [r for r in rows if r.verdict != "ok" or not r.agrees]
+    notes = [_note(r) for r in rows if r.verdict != "ok" or not r.agrees]
     if notes:
-        out += ["", "Runs that did not end ok, or disagree with the theory:", ""]
-        for r in notes:
-            line = f"- {r.case}, {r.solver}: {r.verdict}"
-            if r.t_fail is not None:
-                line += f" at t = {r.t_fail:.4g} s"
-            if r.reason:
-                line += f": {r.reason}"
-            if not r.agrees:
-                line += f". {r.agreement} ({r.theory})"
-            out.append(line)
+        out += ["", "Runs that did not end ok, or disagree with the theory:", "", *notes]
     if guard:
         out += ["", ("Step-size guard (`dumbbell.spaces.check` on the space the pymunk solver "
                      "builds, at the case's dt):"), ""]
@@ -123,6 +114,18 @@ def markdown(result: StabilityResult) -> str:
         out += ["", "Not run (the solver cannot run the scene):", ""]
         out += [f"- {s}" for s in skipped]
     return "\n".join(out) + "\n"
+
+
+def _note(r: Any) -> str:
+    """The line of a run that did not end ok or disagrees with the theory."""
+    line = f"- {r.case}, {r.solver}: {r.verdict}"
+    if r.t_fail is not None:
+        line += f" at t = {r.t_fail:.4g} s"
+    if r.reason:
+        line += f": {r.reason}"
+    if not r.agrees:
+        line += f". {r.agreement} ({r.theory})"
+    return line
 
 
 def csv_text(result: StabilityResult) -> str:

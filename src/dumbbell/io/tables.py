@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UsageError
+from ..files import atomic_output, writable_path
 from ..model import args
-from .files import atomic_output, writable_path
 
 #: No public names: the table cells every writer shares.
 __all__: list[str] = []

@@ -12,17 +12,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import IO, Any
 
+from ..files import writable_path
 from ..model import args
 from ..model.trajectory import Trajectory
-from .files import atomic_output, writable_path
 from .tables import csv_text, write_text
 
 __all__ = ["dump_csv", "events_csv", "write_csv", "write_events"]
 
 #: Columns of the impacts' CSV (s, -, m/s, m/s).
 EVENT_COLUMNS = ("t", "body", "v_before", "v_after")
-#: Rows of the samples' CSV formatted at once (a few MB of text).
-CSV_BLOCK = 8192
 
 
 def _checked(traj: Any) -> Trajectory:
@@ -63,14 +61,7 @@ def dump_csv(traj: Trajectory, stream: IO[str]) -> None:
 
         raise UsageError(f"stream = {args.show(stream)}: must be an open text file "
                          "(with a write method)", param="stream")
-    table = traj.table()
-    stream.write(",".join(traj.columns) + "\n")
-    # np.savetxt's text (fmt "%.17g", "," between cells), formatted a block of rows at a time
-    # rather than row by row.
-    row = ",".join(["%.17g"] * table.shape[1]) + "\n"
-    for start in range(0, len(table), CSV_BLOCK):
-        block = table[start:start + CSV_BLOCK]
-        stream.write((row * len(block)) % tuple(block.ravel().tolist()))
+    traj._write_csv(stream)
 
 
 def write_csv(traj: Trajectory, path: str | Path) -> Path:
@@ -105,13 +96,7 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
     >>> write_csv(traj, "exact.csv").read_text().splitlines()[0]
     't,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E'
     """
-    traj = _checked(traj)
-    path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
-    # One open of our own: given a name, numpy opens the file twice, and the first,
-    # empty open would end a FIFO's reader.
-    with atomic_output(path) as tmp, open(tmp, "w") as fh:
-        dump_csv(traj, fh)
-    return path
+    return _checked(traj).to_csv(path)
 
 
 def events_csv(traj: Trajectory) -> str:

@@ -120,7 +120,7 @@ def column_unit(name: str) -> str:
 
 def spins(scene: Scene) -> bool:
     """True when the particles are spinning discs (:attr:`System.discs
-    <dumbbell.model.scene.System.discs>`, 2D only)."""
+    <dumbbell.model.system.System.discs>`, 2D only)."""
     return _scene(scene).system.discs
 
 

@@ -19,16 +19,28 @@ allowed.
 from __future__ import annotations
 
 import math
-import numbers
 import os
-import stat
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Self
+from typing import Any
 
 from ..errors import SceneError, UsageError
+from .checker import MIN_MASS, _check_magnitude, _Checker, _finite, _printable, _show
+from .pymunk_settings import PymunkSettings
+from .scene_file import MAX_SCENE_BYTES, _read_scene_file, _toml
 from .sizes import SIZE_RULE, pixel_size
+from .system import (
+    DEFAULT_INACCURATE_ENERGY,
+    DEFAULT_UNSTABLE_ENERGY,
+    Floor,
+    GifSettings,
+    OutputSettings,
+    Particle,
+    Rigid,
+    RunSettings,
+    Spring,
+    System,
+)
 
 __all__ = ["Scene", "load_scene", "scene_from_dict", "scenes_dir"]
 
@@ -37,182 +49,6 @@ FIGURE_NAMES = ("positions", "kinetic", "potential", "energy", "rotation", "topp
 #: What a GIF size must be.
 #: Radius given to particles that do not state one (m); only pymunk and drawings use it.
 DEFAULT_RADIUS = 0.02
-#: Largest magnitude of any number in a scene (m, kg, m/s, N/m, ...), and the smallest mass
-#: (kg): the energy formulas multiply up to four of them (1/2 I w^2 = 1/4 m r^2 w^2), which then
-#: stay below 1e300, and positions stay far below the solvers' blow-up threshold (1e150).
-MAX_MAGNITUDE = 1e75
-MIN_MASS = 1e-75
-#: Largest scene file read (bytes).
-MAX_SCENE_BYTES = 1_000_000
-#: Relative energy error above which a run is called unstable, unless ``[run]`` says otherwise.
-DEFAULT_UNSTABLE_ENERGY = 10.0
-#: Default ``run.inaccurate_energy``: past a relative energy error of 0.1 a run that stays
-#: stable is ``inaccurate`` (docs/stability.md says why 0.1).
-DEFAULT_INACCURATE_ENERGY = 0.1
-
-
-@dataclass(frozen=True)
-class Particle:
-    """One particle. Positions in m, velocities in m/s, spin in rad/s, mass in kg."""
-
-    name: str
-    mass: float
-    x: float
-    height: float
-    vx: float
-    vy: float
-    radius: float
-    spin: float
-
-
-@dataclass(frozen=True)
-class Spring:
-    """A Hooke spring between A and B: stiffness in N/m, rest length in m."""
-
-    stiffness: float
-    rest_length: float
-
-
-@dataclass(frozen=True)
-class Rigid:
-    """A massless rigid rod between A and B (2D only): length in m."""
-
-    length: float
-
-
-@dataclass(frozen=True)
-class Floor:
-    """The floor at height 0 for the particle centres. ``elasticity`` is the restitution
-    coefficient (1: elastic), ``friction`` the Coulomb coefficient (2D only)."""
-
-    elasticity: float
-    friction: float
-
-
-@dataclass(frozen=True)
-class RunSettings:
-    """Default run options: ``t_end`` and ``dt`` in s, ``every`` in steps (keep every N-th),
-    ``unstable_energy`` the relative energy error that makes a run ``unstable``, and
-    ``inaccurate_energy`` the one past which a run that stays stable is ``inaccurate``."""
-
-    t_end: float
-    dt: float
-    solver: str
-    every: int
-    unstable_energy: float
-    inaccurate_energy: float = DEFAULT_INACCURATE_ENERGY
-
-
-#: The scene tables a solver owns, by table name: where the owner's settings class lives
-#: ("module:class"), loaded when a scene is read. The model names no solver's settings: they
-#: stay on their owner, as pymunk keeps a space's settings on the space. The class reads its
-#: table (``_read(table)``, the table's checker, or None for a scene without it) and writes
-#: it back (``_table()``, the keys the scene gave) for :meth:`Scene.to_dict`.
-OWNED_TABLES: dict[str, str] = {"pymunk": "dumbbell.solvers.pymunk_settings:PymunkSettings"}
-
-
-def _owner(table: str) -> Any:
-    """The settings class that owns the scene table ``table`` (:data:`OWNED_TABLES`)."""
-    import importlib
-
-    module, _, name = OWNED_TABLES[table].partition(":")
-    return getattr(importlib.import_module(module), name)
-
-
-@dataclass(frozen=True)
-class GifSettings:
-    """[outputs.gif]: the animation ``dumbbell run`` writes. ``t_end`` (s) is the scene's
-    ``run.t_end`` unless the table says otherwise; the other defaults are written only here."""
-
-    t_end: float
-    fps: int = 25
-    size: str = "640x360"  # WIDTHxHEIGHT in px
-    strip: bool = True
-
-
-@dataclass(frozen=True)
-class OutputSettings:
-    """[outputs]: what ``dumbbell run`` makes for the scene (figure names, a CSV, a GIF)."""
-
-    figures: tuple[str, ...]
-    csv: bool
-    gif: GifSettings | None
-
-
-@dataclass(frozen=True)
-class System:
-    """The physics of a scene: the dumbbell, its spring or rod, the floor and gravity.
-
-    ``dimensions`` is 1 (vertical line) or 2; ``g`` in m/s^2 (downward, 0 without gravity);
-    ``tilt`` in degrees.
-    Solvers, energy formulas and closed forms need only this, not the run or output settings.
-    """
-
-    dimensions: int
-    A: Particle
-    B: Particle
-    spring: Spring | None
-    rigid: Rigid | None
-    floor: Floor | None
-    g: float
-    #: The axis's angle from vertical (degrees) that placed A from B, or None when the scene
-    #: gives A's position. Kept so that changing the length moves A, as in the file.
-    tilt: float | None = None
-    #: The particles are discs that spin (moment 1/2 m r^2, a ``K_spin`` energy term, 2D
-    #: only) rather than points of infinite moment (the textbook's particles). Physics, not
-    #: an engine option: every solver and the energy terms follow it. A file sets it with the
-    #: ``[pymunk]`` key ``spin``, where it was first introduced.
-    discs: bool = False
-
-    @property
-    def M(self) -> float:
-        """Total mass (kg)."""
-        return self.A.mass + self.B.mass
-
-    @property
-    def mu(self) -> float:
-        """Reduced mass mA*mB/M (kg)."""
-        return self.A.mass * self.B.mass / (self.A.mass + self.B.mass)
-
-    @property
-    def omega(self) -> float:
-        """Angular frequency of the spring's vibration sqrt(k/mu) (rad/s); 0 without spring."""
-        return math.sqrt(self.spring.stiffness / self.mu) if self.spring else 0.0
-
-    @property
-    def k(self) -> float:
-        """Spring stiffness (N/m); 0 without a spring."""
-        return self.spring.stiffness if self.spring else 0.0
-
-    @property
-    def b(self) -> float:
-        """Spring rest length (m); 0 without a spring."""
-        return self.spring.rest_length if self.spring else 0.0
-
-    @property
-    def elasticity(self) -> float:
-        """Floor restitution coefficient; 1 without a floor (it is then never used)."""
-        return self.floor.elasticity if self.floor else 1.0
-
-    @property
-    def dissipative(self) -> bool:
-        """True when energy can leave the system (elasticity below 1, or friction in 2D)."""
-        if self.floor is None:
-            return False
-        return self.floor.elasticity < 1.0 or (self.dimensions == 2 and self.floor.friction > 0)
-
-    def resting_contact(self) -> str | None:
-        """None, or why a particle starts in resting contact: on the floor (height 0), not
-        moving up, pressed down by gravity. Solvers that model the floor only by impacts
-        cannot run such a scene (it would bounce on the spot forever)."""
-        if self.floor is None or self.g <= 0:
-            return None
-        for p in (self.A, self.B):
-            if p.height == 0 and p.vy <= 0:
-                return (f"bodies.{p.name} starts at rest on the floor (height 0): resting "
-                        "contact needs a contact solver such as pymunk; impacts alone cannot "
-                        "hold it")
-        return None
 
 
 @dataclass(frozen=True)
@@ -256,7 +92,7 @@ class Scene:
     system: System
     run: RunSettings
     outputs: OutputSettings
-    pymunk: Any
+    pymunk: PymunkSettings
     source: str = "<scene>"
 
     @property
@@ -365,166 +201,6 @@ class Scene:
 
 
 # --- validation -----------------------------------------------------------------------------
-
-
-class _Checker:
-    """Reads one TOML table, remembering which keys were used, and raises SceneError."""
-
-    def __init__(self, source: str, table: Any, path: str):
-        self.source = source
-        self.path = path
-        if not isinstance(table, dict):
-            self.fail(path, table, "must be a table")
-        self.table = table
-        self.used: set[str] = set()
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def fail(self, dotted: str, value: Any, allowed: str) -> None:
-        raise SceneError(f"{_printable(self.source)}: {dotted} = {_show(value)}: {allowed}")
-
-    def has(self, name: str) -> bool:
-        return name in self.table
-
-    def number(
-        self,
-        name: str,
-        default: float | None = None,
-        *,
-        lo: float | None = None,
-        hi: float | None = None,
-        lo_open: bool = False,
-        unit: str = "",
-    ) -> float:
-        self.used.add(name)
-        allowed = _range_text(lo, hi, lo_open, unit)
-        if name not in self.table:
-            if default is None:
-                raise SceneError(f"{_printable(self.source)}: "
-                                 f"{self.key(name)} is missing: {allowed}")
-            return default
-        raw = self.table[name]
-        value = _finite(raw)
-        if value is None:
-            self.fail(self.key(name), raw, allowed)
-        if lo is not None and (value < lo or (lo_open and value == lo)):
-            self.fail(self.key(name), value, allowed)
-        if hi is not None and value > hi:
-            self.fail(self.key(name), value, allowed)
-        _check_magnitude(self, self.key(name), value, unit)
-        return value
-
-    def integer(self, name: str, default: int, *, lo: int, hi: int | None = None) -> int:
-        self.used.add(name)
-        if name not in self.table:
-            return default
-        value = self.table[name]
-        allowed = f"must be a whole number >= {lo}" + (f" and <= {hi}" if hi is not None else "")
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-            self.fail(self.key(name), value, allowed)
-        if isinstance(value, _LongInteger) or abs(value) >= _UNREADABLE:
-            # Past what Python converts to and from text: no message could print it.
-            shown = value if isinstance(value, _LongInteger) else \
-                _LongInteger("-" if value < 0 else "", None)
-            self.fail(self.key(name), shown,
-                      allowed if hi is not None else f"{allowed}, of at most 4,300 digits")
-        if value < lo or (hi is not None and value > hi):
-            self.fail(self.key(name), value, allowed)
-        return int(value)
-
-    def boolean(self, name: str, default: bool | None) -> bool | None:
-        self.used.add(name)
-        if name not in self.table:
-            return default
-        value = self.table[name]
-        if not isinstance(value, bool):
-            self.fail(self.key(name), value, "must be true or false")
-        return value
-
-    def string(self, name: str, default: str | None, choices: tuple[str, ...] | None = None) -> str:
-        self.used.add(name)
-        if name not in self.table:
-            if default is None:
-                raise SceneError(f"{_printable(self.source)}: "
-                                 f"{self.key(name)} is missing: must be a string")
-            return default
-        value = self.table[name]
-        if choices is not None:
-            if value not in choices:
-                self.fail(self.key(name), value, "must be one of " + ", ".join(choices))
-        elif not isinstance(value, str):
-            self.fail(self.key(name), value, "must be a string")
-        return value
-
-    def sub(self, name: str) -> _Checker | None:
-        self.used.add(name)
-        if name not in self.table:
-            return None
-        return _Checker(self.source, self.table[name], self.key(name))
-
-    def done(self) -> None:
-        unknown = sorted(set(self.table) - self.used, key=str)
-        if unknown:
-            allowed = ", ".join(sorted(self.used)) or "nothing"
-            where = f"in [{_printable(self.path)}]" if self.path else "at the top level"
-            raise SceneError(
-                f"{_printable(self.source)}: "
-                f"unknown key '{_printable(self.key(str(unknown[0])))}' {where}; "
-                f"allowed: {allowed}"
-            )
-
-
-#: Most characters of a key, a table's name or a file's name an error message echoes.
-MAX_ECHO = 120
-
-
-def _printable(text: str) -> str:
-    """``text`` (a key, a table's name, the scene's source) for an error message: control
-    characters escaped, so that it stays on one line, and at most :data:`MAX_ECHO`
-    characters, its start and end kept (a key of 80,000 characters, spaces or not, is a
-    short line)."""
-    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
-    return text if len(text) <= MAX_ECHO else f"{text[:MAX_ECHO - 43]}...{text[-40:]}"
-
-
-def _finite(value: Any) -> float | None:
-    """``value`` as a finite float, or None if it is not a finite number (a bool, a string, an
-    integer too large for a float, nan or inf)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        return None
-    try:
-        number = float(value)
-    except (OverflowError, ValueError, TypeError):
-        return None
-    return number if math.isfinite(number) else None
-
-
-def _check_magnitude(c: _Checker, dotted: str, value: float, unit: str) -> None:
-    if abs(value) > MAX_MAGNITUDE:
-        c.fail(dotted, value, f"must be at most {MAX_MAGNITUDE:g} in magnitude"
-                              + (f" ({unit})" if unit else "")
-                              + ": larger values overflow the energies")
-
-
-def _show(value: Any) -> str:
-    try:
-        text = repr(value) if isinstance(value, str) else str(value)
-    except ValueError:  # an integer with more digits than Python will print
-        text = "a whole number too large to read"
-    if isinstance(value, bool):
-        text = "true" if value else "false"
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _range_text(lo: float | None, hi: float | None, lo_open: bool, unit: str) -> str:
-    parts = []
-    if lo is not None:
-        parts.append(f"{'>' if lo_open else '>='} {lo:g}")
-    if hi is not None:
-        parts.append(f"<= {hi:g}")
-    text = "must be a finite number" + (" " + " and ".join(parts) if parts else "")
-    return text + (f" ({unit})" if unit else "")
 
 
 def _velocity(c: _Checker, dims: int) -> tuple[float, float]:
@@ -848,10 +524,10 @@ def _outputs(top: _Checker, dims: int, has_floor: bool, has_rigid: bool, t_end: 
 
 
 def _pymunk(top: _Checker) -> tuple[Any, bool]:
-    """[pymunk]: the engine's settings, as their owner reads them (:data:`OWNED_TABLES`), and
+    """[pymunk]: the engine's settings, as :class:`~.pymunk_settings.PymunkSettings` reads them, and
     the table's ``spin`` key, which says whether the particles are spinning discs
     (:attr:`System.discs`)."""
-    owner = _owner("pymunk")
+    owner = PymunkSettings
     cp = top.sub("pymunk")
     if cp is None:
         return owner._read(None), False
@@ -947,102 +623,6 @@ def load_scene_bytes(data: bytes, source: str) -> Scene:
     except RecursionError:
         raise SceneError(f"{_printable(source)}: not valid TOML: nested too deeply") from None
     return scene_from_dict(data, source=source)
-
-
-#: A decimal integer of more digits than Python converts from text (sys.int_info's default
-#: limit, 4,300 digits), in a TOML document: a number's sign and digits, '_' between them.
-_LONG_INTEGER = r"(?<![\w.+-])([+-]?)([0-9](?:_?[0-9]){4300,})(?![\w.])"
-
-
-#: The least integer of more digits than Python converts to or from text by default.
-_UNREADABLE = 10**4300
-
-
-class _LongInteger(int):
-    """A TOML integer of more digits than Python reads (its value stands in: 10**4300 with
-    its sign, beyond every bound a scene has), shown in messages by its number of digits."""
-
-    digits: int | None
-
-    def __new__(cls, sign: str, digits: int | None) -> Self:
-        value = super().__new__(cls, -_UNREADABLE if sign == "-" else _UNREADABLE)
-        value.digits = digits
-        return value
-
-    def __str__(self) -> str:
-        size = "more than 4,300" if self.digits is None else f"{self.digits:,}"
-        return f"a {'negative ' if self < 0 else ''}whole number of {size} digits"
-
-    __repr__ = __str__
-
-
-def _toml(text: str) -> dict[str, Any]:
-    """``tomllib.loads(text)``, except that a decimal integer too long for Python to read
-    ('Exceeds the limit (4300 digits) for integer string conversion', naming no key) is
-    read as a :class:`_LongInteger` at its key, which the scene's checks then name."""
-    import re
-
-    try:
-        return tomllib.loads(text)
-    except ValueError as exc:
-        if isinstance(exc, tomllib.TOMLDecodeError) or "integer string" not in str(exc):
-            raise
-    longs: dict[int, _LongInteger] = {}
-
-    def stand_in(match: re.Match[str]) -> str:
-        # A hexadecimal integer (no limit on those) marks the place.
-        marker = 0x5CE7E << 64 | len(longs)
-        longs[marker] = _LongInteger(match[1], len(match[2].replace("_", "")))
-        return hex(marker)
-
-    data = tomllib.loads(re.sub(_LONG_INTEGER, stand_in, text))
-
-    def swap(node: Any) -> Any:
-        if isinstance(node, dict):
-            return {k: swap(v) for k, v in node.items()}
-        if isinstance(node, list):
-            return [swap(v) for v in node]
-        return longs.get(node, node) if type(node) is int else node
-
-    return swap(data)
-
-
-def _read_scene_file(path: Path, source: str) -> bytes:
-    """The bytes of ``path`` (named ``source``) if it is a regular file of at most
-    MAX_SCENE_BYTES; SceneError for a device, a FIFO, a socket or a larger file, before
-    reading (a 3 GB sparse file is refused from its size). Opened without blocking, so that
-    a FIFO with no writer is refused rather than waited on."""
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    try:
-        info = os.fstat(fd)
-        if stat.S_ISDIR(info.st_mode):
-            raise IsADirectoryError
-        if not stat.S_ISREG(info.st_mode):
-            raise SceneError(f"{_printable(source)}: "
-                             f"is {_file_kind(info.st_mode)}, not a regular file; a "
-                             "scene is a TOML file")
-        if info.st_size > MAX_SCENE_BYTES:
-            raise SceneError(f"{_printable(source)}: "
-                             f"is {info.st_size:,} bytes; a scene file may be at most "
-                             f"{MAX_SCENE_BYTES:,} bytes (1 MB)")
-        with os.fdopen(fd, "rb", closefd=False) as fh:
-            data = fh.read(MAX_SCENE_BYTES + 1)
-    finally:
-        os.close(fd)
-    if len(data) > MAX_SCENE_BYTES:  # it grew while we read it
-        raise SceneError(f"{_printable(source)}: "
-                         f"more than {MAX_SCENE_BYTES:,} bytes; a scene file may be at "
-                         "most 1 MB")
-    return data
-
-
-def _file_kind(mode: int) -> str:
-    """'a character device', 'a FIFO', ... for an ``st_mode``."""
-    for test, kind in ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-                       (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket")):
-        if test(mode):
-            return kind
-    return "not a regular file"
 
 
 def packaged_scene(name: str = "textbook-1d") -> Path:

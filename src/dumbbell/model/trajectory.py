@@ -62,6 +62,10 @@ def _number(value: Any, name: str, unit: str) -> None:
     raise UsageError(f"{name} = {args.show(value)}: must be a number ({unit})", param=name)
 
 
+#: Rows of the samples' CSV formatted at once (a few MB of text).
+CSV_BLOCK = 8192
+
+
 @dataclass(frozen=True)
 class Impact:
     """One impact with the floor, as a run's ``events`` hold them.
@@ -487,8 +491,8 @@ class Trajectory:
 
     def to_csv(self, path: str | Path) -> Path:
         """Write the samples as ``dumbbell simulate -o FILE`` does (the :attr:`columns`,
-        atomically): a convenience over :func:`dumbbell.io.trajectory.write_csv`, which
-        writes it (a trajectory itself writes no file).
+        atomically, through :func:`dumbbell.files.atomic_output`; what
+        :func:`dumbbell.io.trajectory.write_csv` writes).
 
         Parameters
         ----------
@@ -500,9 +504,26 @@ class Trajectory:
         pathlib.Path
             The file written.
         """
-        from ..io.trajectory import write_csv
+        from ..files import atomic_output, writable_path
 
-        return write_csv(self, path)
+        path = writable_path(path)  # before the work: a folder, /proc, 'newdir/', ...
+        # One open of our own: given a name, numpy opens the file twice, and the first,
+        # empty open would end a FIFO's reader.
+        with atomic_output(path) as tmp, open(tmp, "w") as fh:
+            self._write_csv(fh)
+        return path
+
+    def _write_csv(self, stream: Any) -> None:
+        """The samples with a header row on the open text ``stream``: one row per sample,
+        the :attr:`columns`, each float with 17 significant digits (read back exactly)."""
+        table = self.table()
+        stream.write(",".join(self.columns) + "\n")
+        # np.savetxt's text (fmt "%.17g", "," between cells), formatted a block of rows at a
+        # time rather than row by row.
+        row = ",".join(["%.17g"] * table.shape[1]) + "\n"
+        for start in range(0, len(table), CSV_BLOCK):
+            block = table[start:start + CSV_BLOCK]
+            stream.write((row * len(block)) % tuple(block.ravel().tolist()))
 
     def to_pandas(self) -> pandas.DataFrame:
         """The CSV's columns as a pandas DataFrame with ``t`` (s) as its index and every

@@ -175,18 +175,7 @@ class _Band:
         import numpy as np
 
         legend = self.legend
-        room = 0.98 * width
-        for ncol in range(self.count, 0, -1):
-            legend.set_ncols(ncol)
-            if legend.get_window_extent(renderer).width <= room:
-                break
-        else:
-            # Too wide in one column: its entries wrapped to the room left beside the keys.
-            texts = legend.get_texts()
-            widest = max(t.get_window_extent(renderer).width for t in texts)
-            keys = legend.get_window_extent(renderer).width - widest
-            for t in texts:
-                wrap_text(t, max(room - keys, 0.3 * room))
+        self._columns(0.98 * width, renderer)
         dpi = self.ax.figure.dpi
         pad = (legend.borderaxespad * legend.prop.get_size_in_points() + _BAND_GAP) * dpi / 72
         band = min((legend.get_window_extent(renderer).height + pad) / max(height, 1.0), most)
@@ -210,6 +199,20 @@ class _Band:
             elif tuple(text.get_position()) != (x, y * keep):
                 text.set_position((x, y * keep))
         return band
+
+    def _columns(self, room: float, renderer: Any) -> None:
+        """The most columns whose legend fits in ``room`` px; in one column still too wide,
+        its entries wrapped to the room left beside the keys."""
+        legend = self.legend
+        for ncol in range(self.count, 0, -1):
+            legend.set_ncols(ncol)
+            if legend.get_window_extent(renderer).width <= room:
+                return
+        texts = legend.get_texts()
+        widest = max(t.get_window_extent(renderer).width for t in texts)
+        keys = legend.get_window_extent(renderer).width - widest
+        for t in texts:
+            wrap_text(t, max(room - keys, 0.3 * room))
 
     def keep(self) -> None:
         """Keep the band at each draw (as the axes' locator), free of y ticks and grid lines

@@ -25,7 +25,8 @@ from .base import (
     RunOptions,
     Solver,
     contract_problems,
-    make_options,
+    make_options,  # noqa: F401 - the analyses import it from here
+    scene_options,
 )
 from .engine import Pymunk
 from .euler_cromer import EulerCromer
@@ -212,9 +213,18 @@ def simulate(
     scene = args.scene(scene)
     cls = scene_class(scene) if solver is None else solver_class(solver)
     runnable(cls, scene)
-    options = make_options(scene, dt, t_end, every, max_samples)
+    options = scene_options(scene, dt, t_end, every, max_samples)
     if quiet is not True:
         options = replace(options, quiet=args.flag(quiet, "quiet"))
+    return cls._solve(scene, options)
+
+
+def run_scene(scene: Scene, solver: str | type[Solver] | None, options: RunOptions
+              ) -> Trajectory:
+    """:func:`simulate` of a Scene and its run options (both checked already: the commands'
+    path, from the scene file they read)."""
+    cls = scene_class(scene) if solver is None else solver_class(solver)
+    runnable(cls, scene)
     return cls._solve(scene, options)
 
 

@@ -9,11 +9,10 @@ registry costs nothing to load.
 
 from __future__ import annotations
 
-import functools
-import inspect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from os import PathLike
 from typing import Any, ClassVar
 
 import numpy as np
@@ -166,10 +165,11 @@ class Solver:
     - ``estimates_error``: ``solve`` takes ``estimate_error=False`` to skip measuring its own
       error with a second, tighter run.
 
-    The methods a subclass writes (:data:`CHECKED`) are wrapped when the class is made: called
-    on the class they check their arguments first, while the package, which has checked them
-    at its border, calls the method as written, under the same name with a leading
-    underscore (``cls._solve(scene, options)``).
+    A subclass writes :meth:`_supports` and :meth:`_solve` (and optionally
+    :meth:`_check_work`, :meth:`_truth_for`, :meth:`_catch_depth`), as scipy's ``OdeSolver``
+    subclasses write ``_step_impl``: the public methods (:data:`CHECKED`) check their
+    arguments and call them; the package, which has checked them at its border, calls them
+    directly (``cls._solve(scene, options)``).
 
     Examples
     --------
@@ -217,58 +217,62 @@ class Solver:
         "is_truth": (bool,), "estimates_error": (bool,),
     }
 
-    def __init_subclass__(cls, **kwargs: Any) -> None:
-        super().__init_subclass__(**kwargs)
-        for name in CHECKED:
-            fn = vars(cls).get(name)
-            if isinstance(fn, staticmethod | classmethod):
-                setattr(cls, f"_{name}", fn)
-                setattr(cls, name, _checked(name, fn.__func__, isinstance(fn, staticmethod)))
+    # The contract's methods, as scipy's OdeSolver.step calls the _step_impl its subclass
+    # writes: each public one checks its arguments (the scene, or a scene file's path; for
+    # solve and check_work also RunOptions and a scene the solver supports), then calls the
+    # method of the same name with a leading underscore, which the subclass writes and the
+    # package calls directly, having checked at its border.
 
     @classmethod
-    def supports(cls, scene: Scene) -> str | None:
-        """Whether this solver can run a scene.
+    def supports(cls, scene: Scene | str | PathLike) -> str | None:
+        """Whether this solver can run a scene (the subclass's :meth:`_supports`, the scene
+        checked first).
 
         Parameters
         ----------
         scene : Scene
-            The scene (or a scene file's path, called on the class).
+            The scene (or a scene file's path).
 
         Returns
         -------
         str or None
             None if it can; else why not, in one sentence.
         """
-        raise NotImplementedError
+        return cls._supports(_scene(scene))
 
     @classmethod
-    def solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
-        """Run a scene.
+    def solve(cls, scene: Scene | str | PathLike, options: RunOptions, **keywords: Any
+              ) -> Trajectory:
+        """Run a scene (the subclass's :meth:`_solve`, the arguments checked first).
 
         Parameters
         ----------
         scene : Scene
-            A scene this solver supports.
+            A scene this solver supports (or a scene file's path).
         options : RunOptions
             The step, the end, the samples kept.
+        **keywords
+            What the solver's own ``_solve`` takes besides (``estimate_error`` of the
+            reference solver).
 
         Returns
         -------
         Trajectory
             The run; its ``verdict`` says how it ended.
         """
-        raise NotImplementedError
+        scene = cls._runnable(scene, options)
+        return cls._solve(scene, options, **keywords)
 
     @classmethod
-    def _check_work(cls, scene: Scene, options: RunOptions) -> None:
+    def check_work(cls, scene: Scene | str | PathLike, options: RunOptions) -> None:
         """Refuse, before any work, a run known to exceed this solver's work budget (the
-        default: no such estimate). :meth:`solve` calls it first; callers that plan several
-        runs call it for each before the first.
+        subclass's :meth:`_check_work`; the default: no such estimate). :meth:`solve` calls
+        it first; callers that plan several runs call it for each before the first.
 
         Parameters
         ----------
         scene : Scene
-            A scene this solver supports.
+            A scene this solver supports (or a scene file's path).
         options : RunOptions
             The run planned.
 
@@ -277,39 +281,71 @@ class Solver:
         UsageError
             The run is past the budget; the message says what would do.
         """
+        cls._check_work(cls._runnable(scene, options), options)
 
     @classmethod
-    def _truth_for(cls, scene: Scene) -> bool:
+    def truth_for(cls, scene: Scene | str | PathLike) -> bool:
         """Whether this (``is_truth``) solver is the truth for scenes of a scene's kind,
-        whether or not it can run this one.
+        whether or not it can run this one (the subclass's :meth:`_truth_for`).
 
         Parameters
         ----------
         scene : Scene
-            The scene.
+            The scene (or a scene file's path).
 
         Returns
         -------
         bool
             False for every solver that is not a truth.
         """
-        return False
+        return cls._truth_for(_scene(scene))
 
     @classmethod
-    def _catch_depth(cls, scene: Scene) -> float | None:
+    def catch_depth(cls, scene: Scene | str | PathLike) -> float | None:
         """How far a particle may move in one step and still be caught by a floor that is a
-        body of finite thickness (beyond it, it passes through).
+        body of finite thickness (beyond it, it passes through); the subclass's
+        :meth:`_catch_depth`.
 
         Parameters
         ----------
         scene : Scene
-            The scene.
+            The scene (or a scene file's path).
 
         Returns
         -------
         float or None
             The depth (m); None when the floor is not such a body.
         """
+        return cls._catch_depth(_scene(scene))
+
+    @classmethod
+    def _runnable(cls, scene: Any, options: Any) -> Scene:
+        """``scene`` checked, with ``options`` a RunOptions and a scene this solver runs."""
+        from ..model import args
+
+        scene = _scene(scene)
+        args.instance(options, "options", RunOptions,
+                      "RunOptions (from dumbbell.solvers.make_options)")
+        reason = cls._supports(scene)
+        if reason is not None:
+            raise UsageError(f"scene = {scene.name}: {cls.name} cannot run it: {reason}",
+                             param="scene")
+        return scene
+
+    # What a subclass writes: _supports and _solve (both required), and optionally the rest.
+
+    @classmethod
+    def _check_work(cls, scene: Scene, options: RunOptions) -> None:
+        """The work budget's check as the subclass writes it (the default: none)."""
+
+    @classmethod
+    def _truth_for(cls, scene: Scene) -> bool:
+        """Whether this solver is the truth for ``scene``'s kind, as written (default False)."""
+        return False
+
+    @classmethod
+    def _catch_depth(cls, scene: Scene) -> float | None:
+        """A floor's catch depth (m) as written (default None: no floor of finite thickness)."""
         return None
 
     @classmethod
@@ -379,6 +415,19 @@ class ExplicitSpring:
         return ratio / (2.0 - ratio) if ratio < 2.0 else math.inf
 
 
+class Truth(Solver):
+    """The facts the truth solvers share (the exact solution, the reference integrator): no
+    step (``dt`` only spaces the samples, so no order and no step limit), a floor that reverses
+    velocities at impacts, and an error far below any stepping solver's, so that analysis may
+    take them as the truth for the scenes they claim (:meth:`Solver.truth_for`)."""
+
+    order = None
+    has_step = False
+    step_limit = None
+    flip_floor = True
+    is_truth = True
+
+
 #: The registered solvers by name: :data:`dumbbell.solvers.METHODS` is this dict, filled
 #: there; kept here so that the solvers' own modules can read it without importing the
 #: package that imports them.
@@ -387,8 +436,8 @@ REGISTRY: dict[str, type[Solver]] = {}
 
 def contract_problems(cls: Any) -> list[str]:
     """What keeps ``cls`` from being a solver: not a :class:`Solver` subclass, a fact left out
-    or of the wrong type (:attr:`Solver.CAPABILITIES`) or out of its range, ``supports`` or
-    ``solve`` not written. Empty for a solver that keeps the contract."""
+    or of the wrong type (:attr:`Solver.CAPABILITIES`) or out of its range, ``_supports`` or
+    ``_solve`` not written, a public contract method written over the base's. Empty for a solver that keeps the contract."""
     if not (isinstance(cls, type) and issubclass(cls, Solver)) or cls is Solver:
         return ["not a subclass of dumbbell.solvers.Solver"]
     problems = []
@@ -399,8 +448,11 @@ def contract_problems(cls: Any) -> list[str]:
         elif isinstance(value, bool) and bool not in kinds or not isinstance(value, kinds):
             problems.append(f"{fact} = {value!r} must be {' or '.join(k.__name__ for k in kinds)}")
     problems += [] if problems else _range_problems(cls)
-    problems += [f"{method[1:]} is not written" for method in ("_supports", "_solve")
+    problems += [f"{method} is not written" for method in ("_supports", "_solve")
                  if not hasattr(cls, method)]
+    problems += [f"{name} is written in place of _{name} (Solver.{name} checks the arguments "
+                 f"and calls _{name})" for name in CHECKED
+                 if any(name in vars(k) for k in cls.__mro__[:cls.__mro__.index(Solver)])]
     return problems
 
 
@@ -495,41 +547,11 @@ def check_impacts(scene: Scene, options: RunOptions, vertical_energy: float,
         f"air between two), past the budget of {limit:,} per run", param="t_end",
         fixes=("lower {t_end}",))
 
-def _checked(name: str, fn: Callable[..., Any], static: bool) -> classmethod:
-    """The contract method ``name`` (``fn`` as written, a static method if ``static``, its
-    first argument after ``cls`` the scene) as a class method that checks its arguments first:
-    the scene (or a scene file's path), and for ``solve`` and ``check_work`` also RunOptions
-    and a scene the solver supports. It then calls ``cls._NAME``, the method as written."""
+def _scene(scene: Any) -> Scene:
+    """``scene`` checked: a Scene, or a scene file's path loaded."""
+    from ..model import args
 
-    @functools.wraps(fn)
-    def method(cls: type[Solver], scene: Any, *rest: Any, **kwargs: Any) -> Any:
-        from ..model import args
-
-        scene = args.scene(scene)
-        if name in ("solve", "check_work"):
-            options = rest[0] if rest else kwargs.pop("options", None)
-            args.instance(options, "options", RunOptions,
-                          "RunOptions (from dumbbell.solvers.make_options)")
-            reason = cls._supports(scene)
-            if reason is not None:
-                raise UsageError(f"scene = {scene.name}: {cls.name} cannot run it: {reason}",
-                                 param="scene")
-            rest = (options, *rest[1:])
-        return getattr(cls, f"_{name}")(scene, *rest, **kwargs)
-
-    # Its signature is the method's as written (a static one gains ``cls``, which the class
-    # binds), so that help() and inspect show the real parameters.
-    signature = inspect.signature(fn)
-    if static:
-        cls_param = inspect.Parameter("cls", inspect.Parameter.POSITIONAL_OR_KEYWORD)
-        signature = signature.replace(parameters=[cls_param, *signature.parameters.values()])
-    method.__signature__ = signature  # type: ignore[attr-defined]
-    return classmethod(method)
-
-
-# The contract's optional methods, public and checked on every solver that keeps the default.
-for _name in ("check_work", "truth_for", "catch_depth"):
-    setattr(Solver, _name, _checked(_name, vars(Solver)[f"_{_name}"].__func__, static=False))
+    return args.scene(scene)
 
 
 def kernel_params(system: System, dt: float) -> Params:
@@ -564,7 +586,14 @@ def make_options(
     the samples kept against it, both as exact integers before anything is allocated."""
     from ..model import args
 
-    scene = args.scene(scene)
+    return scene_options(args.scene(scene), dt, t_end, every, max_samples)
+
+
+def scene_options(scene: Scene, dt: float | None = None, t_end: float | None = None,
+                  every: int | None = None, max_samples: int | None = None) -> RunOptions:
+    """:func:`make_options` of a Scene (checked already, when it was read)."""
+    from ..model import args
+
     if dt is not None:
         dt = args.real(dt, "dt", "s")
     if t_end is not None:

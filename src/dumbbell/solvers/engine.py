@@ -80,7 +80,7 @@ _PARTICLE_TYPE = {"A": 2, "B": 3}
 
 def settings(scene: Scene) -> dict[str, Any]:
     """The engine settings used for ``scene``: the scene's ``[pymunk]`` values, else the
-    defaults declared on :class:`~dumbbell.solvers.pymunk_settings.PymunkSettings`."""
+    defaults declared on :class:`~dumbbell.model.pymunk_settings.PymunkSettings`."""
     return scene.pymunk.resolved()
 
 
@@ -481,11 +481,11 @@ class Pymunk(ExplicitSpring, Solver):
     relative_cost = 30.0
     is_truth = False
     estimates_error = False
-    supports = staticmethod(supports)
-    solve = staticmethod(solve)
+    _supports = staticmethod(supports)
+    _solve = staticmethod(solve)
 
     @staticmethod
-    def catch_depth(scene: Scene) -> float:
+    def _catch_depth(scene: Scene) -> float:
         """How far (m) a circle may travel in one step and still be caught by the floor: the
         floor box's thickness plus the smaller circle's diameter."""
         return 2.0 * min(scene.system.A.radius, scene.system.B.radius) + FLOOR_THICKNESS

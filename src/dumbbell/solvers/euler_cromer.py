@@ -34,7 +34,7 @@ class EulerCromer(ExplicitSpring, Stepper):
     chunk = 4_000_000
 
     @staticmethod
-    def supports(scene: Scene) -> str | None:
+    def _supports(scene: Scene) -> str | None:
         """None if this solver can run ``scene``, else why not."""
         if scene.system.dimensions != 1:
             return ("euler-cromer is the 1D textbook method; use euler-cromer-2d or pymunk in "

@@ -37,7 +37,7 @@ class EulerCromer2D(ExplicitSpring, Stepper):
     chunk = 4_000_000
 
     @staticmethod
-    def supports(scene: Scene) -> str | None:
+    def _supports(scene: Scene) -> str | None:
         """None if this solver can run ``scene``, else why not."""
         if scene.system.dimensions != 2:
             return "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"

@@ -35,7 +35,7 @@ from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
 from . import base
 from ._closed_form import MIN_SPLIT, REST_SPEED, ROOT_XTOL, at_rest, search_failed
-from .base import RunOptions, SearchBudget, Solver, check_impacts, impact_budget_reason
+from .base import RunOptions, SearchBudget, Truth, check_impacts, impact_budget_reason
 from .verdicts import RawRun, conclude
 
 #: No public names: the class is ``dumbbell.solvers.METHODS[name]``.
@@ -213,24 +213,19 @@ def _solve_rigid(scene: Scene, options: RunOptions) -> Trajectory:
                                                    "moment": rigid_moment(scene)}))
 
 
-class Exact(Solver):
+class Exact(Truth):
     """The closed-form 1D solution with impacts found by root search (see the module
     docstring)."""
 
     name = NAME
-    order = None
-    has_step = False
-    step_limit = None
-    flip_floor = True
     relative_cost = 0.01
-    is_truth = True
     estimates_error = False
-    supports = staticmethod(supports)
-    solve = staticmethod(solve)
-    check_work = staticmethod(check_work)
+    _supports = staticmethod(supports)
+    _solve = staticmethod(solve)
+    _check_work = staticmethod(check_work)
     warm_up = staticmethod(warm_up)
 
     @staticmethod
-    def truth_for(scene: Scene) -> bool:
+    def _truth_for(scene: Scene) -> bool:
         """The truth for 1D scenes and the rigid 2D dumbbell."""
         return scene.system.dimensions == 1 or scene.system.rigid is not None

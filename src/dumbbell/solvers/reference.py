@@ -55,7 +55,7 @@ from ..model.energy import (
 )
 from ..model.scene import Scene
 from ..model.trajectory import Impact, Trajectory, Verdict
-from .base import RunOptions, Solver, impact_budget_reason
+from .base import RunOptions, Truth, impact_budget_reason
 from .kernels import REST_SPEED
 from .verdicts import RawRun, head, judge, rest_reason
 
@@ -368,23 +368,18 @@ def _estimate_error(
     return est
 
 
-class Reference(Solver):
+class Reference(Truth):
     """RK8 on d = rA - rB with a curvature-bounded floor search (2D spring), or scipy's DOP853
     at tight tolerance with impacts as events (1D, rigid); see the module docstring."""
 
     name = NAME
-    order = None
-    has_step = False
-    step_limit = None
-    flip_floor = True
     relative_cost = 100.0
-    is_truth = True
     estimates_error = True
-    supports = staticmethod(supports)
-    solve = staticmethod(solve)
+    _supports = staticmethod(supports)
+    _solve = staticmethod(solve)
     warm_up = staticmethod(warm_up)
 
     @staticmethod
-    def truth_for(scene: Scene) -> bool:
+    def _truth_for(scene: Scene) -> bool:
         """The truth for the 2D spring dumbbell."""
         return scene.system.dimensions == 2 and scene.system.rigid is None

@@ -107,7 +107,7 @@ class Stepper(Solver):
         raise NotImplementedError
 
     @classmethod
-    def supports(cls, scene: Scene) -> str | None:
+    def _supports(cls, scene: Scene) -> str | None:
         """Whether this solver has a step for the scene's dimensions (in 2D: two point
         particles, a spring and a frictionless floor).
 
@@ -126,7 +126,7 @@ class Stepper(Solver):
         return point_particle_limits(scene, cls.name) if scene.system.dimensions == 2 else None
 
     @classmethod
-    def solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
+    def _solve(cls, scene: Scene, options: RunOptions) -> Trajectory:
         """Run a scene at step ``options.dt``. ``wall_time`` covers the kernel calls and the
         impact list, not the compiling, the array set-up, the verdict or the energy.
 

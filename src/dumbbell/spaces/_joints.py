@@ -7,28 +7,11 @@ dt/2, to give the step that clears it or to say that no step changes it. See
 from __future__ import annotations
 
 import math
-from typing import Any, NamedTuple
+from dataclasses import replace
+from typing import Any
 
+from ._finding import Finding
 from .estimates import energy_units, percent
-
-
-class Row(NamedTuple):
-    """A joint's row, field for field the guard's ``Finding`` (which it becomes)."""
-
-    kind: str
-    subject: str
-    value: float
-    limit: float
-    fix: str
-    dt_max: float | None = None
-    relation: str = "<"
-    unit: str = ""
-    note: str = ""
-
-    @property
-    def ok(self) -> bool:
-        return self.relation == "measured" or (self.relation == "<=" and
-                                               self.value <= self.limit)
 
 #: A drift that falls by less than this factor at half the step does not shrink with it.
 SHRINKS = 0.75
@@ -37,7 +20,7 @@ DRIVES = ("SimpleMotor",)
 
 
 def joint_rows(space: Any, dt: float, tolerance: float, unit: str
-               ) -> tuple[list[Row], str]:
+               ) -> tuple[list[Finding], str]:
     """A row for each constraint that is not a spring, from the probe (:mod:`._probe`): its
     energy drift per second at ``dt`` against ``tolerance`` of the energy scale a second;
     and what the probe cost, in words ('' when no constraint needed it)."""
@@ -54,14 +37,14 @@ def joint_rows(space: Any, dt: float, tolerance: float, unit: str
     found = probe(space, dt, wanted)
     if found.problem or not found.steps:
         why = f"not checked: {found.problem}; spaces.Ledger measures it on your own run"
-        return [Row("joint", f"{type(constraints[j]).__name__} {j}", math.nan, math.nan,
+        return [Finding("joint", f"{type(constraints[j]).__name__} {j}", math.nan, math.nan,
                         why, None, "unchecked") for j in wanted], ""
     limit = tolerance * found.scale
-    rows: dict[int, Row] = {}
+    rows: dict[int, Finding] = {}
     rates: dict[int, float] = {}
     for j, d in found.drifts.items():
         if d.work is None:
-            rows[j] = Row("joint", d.label, math.nan, math.nan,
+            rows[j] = Finding("joint", d.label, math.nan, math.nan,
                               f"not checked: {d.why}; spaces.Ledger measures it on your own "
                               "run",
                               None, "unchecked")
@@ -73,13 +56,13 @@ def joint_rows(space: Any, dt: float, tolerance: float, unit: str
         note = (f"{verb} {share}" if share and rate != 0 else
                 "no energy in or out" if share else "nothing moved in the probe")
         if type(constraints[j]).__name__ in DRIVES:
-            rows[j] = Row("joint", d.label, abs(rate), math.nan,
+            rows[j] = Finding("joint", d.label, abs(rate), math.nan,
                               f"{verb} {abs(rate):.4g} {power}: a motor's work is its drive, "
                               "not the step's error", None, "measured", power,
                               f"{note}: a motor's drive, not the step's error")
             continue
         fix = f"{note}, at this step: more than {percent(tolerance)}/s"
-        rows[j] = Row("joint", d.label, abs(rate), limit, fix, None, "<=", power, note)
+        rows[j] = Finding("joint", d.label, abs(rate), limit, fix, None, "<=", power, note)
     failing = [j for j, f in rows.items() if f.relation == "<=" and not f.ok]
     bodies = len(space.bodies)
     cost = (f"  joints measured on a copy of the space over {found.seconds:.4g} s: "
@@ -93,7 +76,7 @@ def joint_rows(space: Any, dt: float, tolerance: float, unit: str
     return [rows[j] for j in wanted], cost
 
 
-def _at_half(row: Row, rate: float, half: Any, j: int, dt: float) -> Row:
+def _at_half(row: Finding, rate: float, half: Any, j: int, dt: float) -> Finding:
     """A failing joint row judged again from its drift at ``dt / 2`` (``half``, a probe):
     the step that clears it when the drift shrinks with the step (as dt^p, p measured), a
     measured row (no step changes it) when it does not."""
@@ -102,16 +85,16 @@ def _at_half(row: Row, rate: float, half: Any, j: int, dt: float) -> Row:
         dt_max = dt * row.limit / row.value
         fix = (f"{row.fix}; dt < {dt_max:.4g} s keeps it under (if it shrinks in proportion "
                "to dt, as a joint's error does; not measured at dt/2 here)")
-        return row._replace(fix=fix, dt_max=dt_max)
+        return replace(row, fix=fix, dt_max=dt_max)
     slower = abs(d.work / half.seconds)
     ratio = slower / row.value
     if ratio > SHRINKS:
         note = (f"{row.note}; about as much at dt/2, {slower:.4g} {row.unit}: the joint's "
                 "own loss (a stop, a snap, a slip), which no step changes")
-        return row._replace(relation="measured", limit=math.nan, note=note,
+        return replace(row, relation="measured", limit=math.nan, note=note,
                        fix=f"{row.fix}; at dt/2, {slower:.4g} {row.unit}: no step changes it")
     order = min(3.0, max(0.5, math.log2(1.0 / ratio))) if ratio > 0 else 3.0
     dt_max = dt * (row.limit / row.value) ** (1.0 / order)
     fix = (f"{row.fix}; at dt/2, {slower:.4g} {row.unit} (it goes as dt^{order:.2g}): "
            f"dt < {dt_max:.4g} s keeps it under")
-    return row._replace(fix=fix, dt_max=dt_max)
+    return replace(row, fix=fix, dt_max=dt_max)

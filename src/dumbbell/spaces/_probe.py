@@ -226,6 +226,34 @@ class _Run:
         """The constraints in parts tied together through dynamic bodies, those with a
         wanted constraint kept; the ends of every constraint (``ends``) and the rows'
         bodies (``rows``: their batch rows, ``row_bodies``, ``row_ends``)."""
+        tied, root = self._tie(cons, slot, pymunk)
+        groups: dict[int, list[int]] = {}
+        for k, j in enumerate(tied):
+            if j is None:
+                if k in self.wanted:
+                    self.unsure[k] = "it joins no dynamic body: there is no motion to measure"
+                continue
+            groups.setdefault(root(j), []).append(k)
+        wanted = set(self.wanted)
+        self.row_slots: list[int] = []
+        row_of: dict[int, int] = {}
+        parts = []
+        for members in groups.values():
+            if wanted & set(members):
+                part = self._part(members, wanted, row_of)
+                if part is not None:
+                    parts.append(part)
+        self.rows = np.array(self.row_slots, dtype=int)
+        self.row_bodies = [by_slot[j] for j in self.row_slots]
+        self.row_ends = [_End(j, i, False, (0.0, 0.0), tuple(self.cog[j]))
+                         for i, j in enumerate(self.row_slots)]
+        return parts
+
+    def _tie(self, cons: list[Any], slot: dict[int, int], pymunk: Any
+             ) -> tuple[list[int | None], Any]:
+        """The ends of every constraint (``ends``), a dynamic body each is tied to (None: it
+        joins none), and the function that names the group of such a body (constraints
+        joined through dynamic bodies are one group)."""
         parent: dict[int, int] = {}
 
         def root(j: int) -> int:
@@ -251,45 +279,33 @@ class _Run:
                 parent[root(moving[0])] = root(moving[1])
             tied.append(moving[0] if moving else None)
             self.ends.append((pair[0], pair[1]))
-        groups: dict[int, list[int]] = {}
-        for k, j in enumerate(tied):
-            if j is None:
-                if k in self.wanted:
-                    self.unsure[k] = "it joins no dynamic body: there is no motion to measure"
-                continue
-            groups.setdefault(root(j), []).append(k)
-        wanted = set(self.wanted)
-        self.row_slots: list[int] = []
-        row_of: dict[int, int] = {}
-        parts = []
-        for members in groups.values():
-            if not wanted & set(members):
-                continue
-            first = [0]
-            for k in members:
-                first.append(first[-1] + self.width[k])
-            if first[-1] > MAX_UNKNOWNS:
-                for k in wanted & set(members):
-                    self.unsure[k] = (f"it is tied to {len(members)} constraints through the "
-                                      f"bodies they join, more than the probe solves together "
-                                      f"({MAX_UNKNOWNS} impulse components)")
-                continue
-            rows = []
-            for k in members:
-                for e, end in enumerate(self.ends[k]):
-                    if end.slot >= 0 and self.dynamic[end.slot]:
-                        if end.slot not in row_of:
-                            row_of[end.slot] = len(self.row_slots)
-                            self.row_slots.append(end.slot)
-                        self.ends[k] = _replace_end(self.ends[k], e, row_of[end.slot])
-                        if row_of[end.slot] not in rows:
-                            rows.append(row_of[end.slot])
-            parts.append(_Part(members, first, rows))
-        self.rows = np.array(self.row_slots, dtype=int)
-        self.row_bodies = [by_slot[j] for j in self.row_slots]
-        self.row_ends = [_End(j, i, False, (0.0, 0.0), tuple(self.cog[j]))
-                         for i, j in enumerate(self.row_slots)]
-        return parts
+        return tied, root
+
+    def _part(self, members: list[int], wanted: set[int], row_of: dict[int, int]
+              ) -> _Part | None:
+        """The part of the constraints ``members`` (one group, some wanted), its bodies given
+        rows (``row_of``, ``row_slots``); None, with the wanted ones unsure, when it has more
+        unknowns than the probe solves together."""
+        first = [0]
+        for k in members:
+            first.append(first[-1] + self.width[k])
+        if first[-1] > MAX_UNKNOWNS:
+            for k in wanted & set(members):
+                self.unsure[k] = (f"it is tied to {len(members)} constraints through the "
+                                  f"bodies they join, more than the probe solves together "
+                                  f"({MAX_UNKNOWNS} impulse components)")
+            return None
+        rows = []
+        for k in members:
+            for e, end in enumerate(self.ends[k]):
+                if end.slot >= 0 and self.dynamic[end.slot]:
+                    if end.slot not in row_of:
+                        row_of[end.slot] = len(self.row_slots)
+                        self.row_slots.append(end.slot)
+                    self.ends[k] = _replace_end(self.ends[k], e, row_of[end.slot])
+                    if row_of[end.slot] not in rows:
+                        rows.append(row_of[end.slot])
+        return _Part(members, first, rows)
 
     def _wrap(self, body: Any, i: int) -> None:
         """Record the kick ``body``'s velocity update gives it each step."""
@@ -380,11 +396,14 @@ class _Run:
         self.peak = max(self.peak, float(self.momentum.max(initial=0.0)))
         for part in self.parts:
             if not all(k in self.unsure for k in part.cons):
-                self._solve(part, rhs, use, pose, mean, moving)
+                self._solve(part, rhs, use, (pose, mean, moving))
 
-    def _solve(self, part: _Part, rhs: np.ndarray, use: np.ndarray, pose: list[list[float]],
-               mean: list[list[float]], moving: list[list[float]]) -> None:
-        """Recover the impulses of one part's constraints and add up their work."""
+    def _columns_of(self, part: _Part, pose: list[list[float]], mean: list[list[float]],
+                    moving: list[list[float]]
+                    ) -> tuple[np.ndarray, list[float], list[int], set[int]]:
+        """The part's matrix (a column per impulse component, three rows per body), the mean
+        relative velocity each component acts on, the components pymunk sets to 0 this step
+        and the constraints that apply nothing whatever they report."""
         cons = self.copy.constraints
         m = part.first[-1]
         local = {r: i for i, r in enumerate(part.rows)}
@@ -416,6 +435,15 @@ class _Run:
                     velocity[col] += vec[0] * u[0] + vec[1] * u[1] + vec[2] * u[2]
         mat = np.zeros((3 * len(part.rows), m))
         mat[where_r, where_c] = value          # each (row, column) once: a body per end
+        return mat, velocity, idle, silent
+
+    def _solve(self, part: _Part, rhs: np.ndarray, use: np.ndarray,
+               motion: tuple[list[list[float]], list[list[float]], list[list[float]]]) -> None:
+        """Recover the impulses of one part's constraints and add up their work (``motion``:
+        the bodies' pose, mean velocity and moving velocity over the step)."""
+        cons = self.copy.constraints
+        m = part.first[-1]
+        mat, velocity, idle, silent = self._columns_of(part, *motion)
         keep = use[part.rows].reshape(-1)
         a_mat, values = mat[keep], rhs[part.rows].reshape(-1)[keep]
         if idle:

@@ -51,6 +51,7 @@ import numpy as np
 
 from ..errors import UsageError
 from ..model import args
+from ._finding import _FAILS, Finding
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from .accounting import settings_problem
 from .estimates import Estimates, estimate, length_unit, percent, state_problem
@@ -72,124 +73,6 @@ MAX_STEPS = 10**9
 SLOP_SUGGESTED = 0.01
 #: Rows of one kind a report lists before it sums up the rest.
 SHOWN = 6
-
-#: The relation a good value keeps to its limit, and the one a failing value shows.
-_FAILS = {"<": ">=", "<=": ">", ">=": "<"}
-#: What a kind's value is, where its number alone would not say.
-_QUANTITY = {"spring": "w dt = ", "rotary-spring": "w dt = ", "spring-network": "w dt = "}
-
-
-@dataclass(frozen=True)
-class Finding:
-    """One check: ``kind`` (spring, rotary-spring, spring-network, tunnelling, slop, bias,
-    state), the ``subject`` it is about, the measured ``value`` and its ``limit`` (w*dt for
-    springs, length units moved per step for tunnelling, length units for slop, the bias for
-    bias), the ``relation`` a good value keeps to the limit ('<', '<=' or '>='; 'finite' for a
-    state no step fixes), the ``fix`` with its reason in words, the largest step that clears it,
-    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none).
-    A constraint's row (kind ``joint``) may instead be ``relation`` 'measured' (a number
-    with no limit: a motor's work, a loss the step does not change; ok) or 'unchecked' (not
-    measured: ``fix`` says why; not ok, and not a failure :func:`check` lists); ``note`` says
-    in words what the number is.
-
-    Parameters
-    ----------
-    kind : str
-        What is checked.
-    subject : str
-        What it is about.
-    value, limit : float
-        The measured value and its limit.
-    fix : str
-        The fix, with its reason in words.
-    dt_max : float or None, default None
-        The largest step that clears it (None when no step can).
-    relation : str, default '<'
-        What a good value keeps to the limit.
-    unit : str, default ''
-        The unit of value and limit.
-    note : str, default ''
-        What else the row says.
-
-    Examples
-    --------
-    >>> import pymunk
-    >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> finding = spaces.check(space, 1 / 60)[0]
-    >>> finding.kind, round(finding.value, 4), finding.comparison()
-    ('spring', 0.7454, 'w dt = 0.7454 >= 0.00995')
-    >>> round(finding.dt_max, 7)                    # s
-    0.0002225
-    """
-
-    kind: str
-    subject: str
-    value: float
-    limit: float
-    fix: str
-    dt_max: float | None = None
-    relation: str = "<"
-    unit: str = ""
-    note: str = ""
-
-    @property
-    def checked(self) -> bool:
-        """Whether the row was measured (False: 'unchecked')."""
-        return self.relation != "unchecked"
-
-    @property
-    def ok(self) -> bool:
-        """Whether the value keeps its relation to the limit."""
-        if self.relation == "measured":
-            return True
-        if self.relation == "<":
-            return self.value < self.limit
-        if self.relation == "<=":
-            return self.value <= self.limit
-        if self.relation == ">=":
-            return self.value >= self.limit
-        return False
-
-    def comparison(self) -> str:
-        """'value relation limit' with the relation that holds, the numbers printed with
-        enough digits to show it.
-
-        Returns
-        -------
-        str
-            'value relation limit', e.g. ``'w dt = 0.7454 >= 0.00995'``.
-        """
-        unit = f" {self.unit}" if self.unit else ""
-        if self.relation == "measured":
-            return f"{self.value:.4g}{unit}"
-        if self.relation not in _FAILS:
-            return ""
-        rel = self.relation if self.ok else _FAILS[self.relation]
-        a, b = _distinct(self.value, self.limit, rel)
-        return f"{_QUANTITY.get(self.kind, '')}{a}{unit} {rel} {b}{unit}"
-
-    def __str__(self) -> str:
-        shown = self.comparison()
-        return f"{self.kind}: {self.subject}: {shown + '; ' if shown else ''}{self.fix}"
-
-
-def _distinct(a: float, b: float, rel: str) -> tuple[str, str]:
-    """``a`` and ``b`` printed with the fewest digits (4 or more) that keep ``rel`` true of
-    the printed numbers."""
-    holds = {"<": float.__lt__, "<=": float.__le__, ">=": float.__ge__, ">": float.__gt__}[rel]
-    for digits in range(4, 18):
-        x, y = f"{a:.{digits}g}", f"{b:.{digits}g}"
-        if holds(float(x), float(y)):
-            return x, y
-    return repr(a), repr(b)
-
 
 def energy_swing(w_dt: float) -> float:
     """The energy swing of pymunk's step of an undamped spring at ``w_dt`` = w*dt: the largest
@@ -526,7 +409,7 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
     from ._joints import joint_rows
 
     rows_of_joints, probed = joint_rows(space, dt, tolerance, unit)
-    joints = [Finding(*r) for r in rows_of_joints]
+    joints = rows_of_joints
     rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance) + joints
             + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
     failing = [f for f in rows if not f.ok and f.dt_max is not None]
@@ -844,28 +727,31 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
                          f"{_listed([f.subject for f in rest])}")
         if kind == "joint" and advice.probe:
             lines.append(advice.probe)
+    lines.append(_suggestion(advice, dt))
+    return "\n".join(lines)
+
+
+def _suggestion(advice: Any, dt: float) -> str:
+    """The report's last line: the sub-steps suggested and why, or why none."""
     unchecked = [f.subject for f in advice.rows if not f.checked]
     n = advice.substeps
     swing = ("" if advice.swing is None else
              f"; the springs' energy swing at it: at most {percent(advice.swing)}")
     if any(f.kind == "state" for f in advice.rows):
-        lines.append("  no step is suggested: fix the state first")
-    elif n is None:
+        return "  no step is suggested: fix the state first"
+    if n is None:
         t = advice.tightest
-        lines.append(f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
-                     f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of a step")
-    elif n > 1:
+        return (f"  no step is suggested: {t.kind} of {t.subject} needs dt < "
+                f"{t.dt_max:.3g} s, more than {MAX_STEPS:,} sub-steps of a step")
+    if n > 1:
         t = advice.tightest
-        lines.append(f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
-                     f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
-    elif any(not f.ok and f.checked for f in advice.rows):
-        lines.append(f"  the step is fine; the failures are settings{swing}")
-    elif unchecked:
-        lines.append(f"  nothing to fix in what was checked{swing}; not checked: "
-                     f"{_listed(unchecked)}")
-    else:
-        lines.append(f"  nothing to fix{swing}")
-    return "\n".join(lines)
+        return (f"  suggested: {n} sub-steps of each step, of {dt / n:.4g} s, for {t.kind} of "
+                f"{t.subject} (needs dt < {t.dt_max:.4g} s){swing}")
+    if any(not f.ok and f.checked for f in advice.rows):
+        return f"  the step is fine; the failures are settings{swing}"
+    if unchecked:
+        return f"  nothing to fix in what was checked{swing}; not checked: {_listed(unchecked)}"
+    return f"  nothing to fix{swing}"
 
 
 def _listed(names: list[str]) -> str:

@@ -35,7 +35,8 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from pathlib import Path
 
-from ..errors import UsageError
+from .errors import UsageError
+from .parallel import STOP_SIGNALS
 
 #: No public names: the one way every writer of the package writes a file.
 __all__: list[str] = []
@@ -43,7 +44,7 @@ __all__: list[str] = []
 
 def _inputs(inputs: object) -> list[tuple[str | Path, str]]:
     """``inputs`` as (path, how the user named it) pairs, else a UsageError."""
-    from ..model import args
+    from .model import args
 
     allowed = "must be (path, name) pairs, e.g. [('x.toml', 'the scene x.toml')]"
     if isinstance(inputs, str | bytes) or not isinstance(inputs, Iterable):
@@ -63,7 +64,7 @@ def _key(path: Path) -> str:
 def is_special(path: str | Path) -> bool:
     """True when ``path`` exists and is neither a regular file nor a folder (a device, a FIFO,
     a socket): such an output is written directly, never replaced."""
-    from ..model import args
+    from .model import args
 
     path = args.path(path, "path")
     try:
@@ -89,7 +90,7 @@ def link_refusal(path: str | Path) -> str | None:
     folders, here everywhere) that names a file inside the folder holding it (a link to
     nothing creates nothing outside it either), or names a device or a FIFO, which are
     written, never created; and a system path the user named (``/dev/stdout``)."""
-    from ..model.args import show_path
+    from .model.args import show_path
 
     path = Path(path)
     if not os.path.islink(path) or os.path.abspath(path).startswith(("/dev/", "/proc/")):
@@ -119,7 +120,7 @@ _temporary: dict[str, int] = {}
 _lock = threading.Lock()
 #: Signals given :func:`_remove_and_resend` while temporary files exist.
 _armed: set[int] = set()
-_STOP = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP", "SIGINT") if hasattr(signal, n))
+_STOP = tuple(getattr(signal, n) for n in STOP_SIGNALS if hasattr(signal, n))
 
 
 def _remove_temporary() -> None:
@@ -237,7 +238,7 @@ class OutputTransaction:
     def claim(self, path: str | Path, what: str | None = None) -> None:
         """Check that the output ``path`` is no input; with ``what`` (how the user named it,
         e.g. '-o x.csv') also reserve it, refusing a second output on the same file."""
-        from ..model import args
+        from .model import args
 
         path = args.path(path, "path")
         if what is not None:
@@ -266,7 +267,7 @@ class OutputTransaction:
         created or replaced, :func:`check_writable`) and reserve it, refusing one that is an
         input or another output. ``flag`` is how the user set them (``'--out r'``): a
         refusal names it, then the file. Returns the paths."""
-        from ..model import args
+        from .model import args
 
         flag = args.text(flag, "flag", "how the user set these outputs (str), e.g. '--out r'")
         if isinstance(paths, str | bytes | os.PathLike) or not isinstance(paths, Iterable):
@@ -406,7 +407,7 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     >>> with atomic_output("out.csv") as tmp:        # doctest: +SKIP
     ...     tmp.write_text("t,x\\n")
     """
-    from ..model import args
+    from .model import args
 
     path = args.path(path, "path")
     if "\0" in str(path):
@@ -594,7 +595,7 @@ def check_writable(path: str | Path, flag: str, folder: bool = False, *,
     write permission; an existing file another user owns in a sticky folder that is not ours.
     With ``within``, ``flag`` is a prefix (``'--out r:'``) and the message names ``path``
     after it."""
-    from ..model import args
+    from .model import args
 
     args.text(flag, "flag", "the flag or argument that names the path (str)")
     if not isinstance(path, str | os.PathLike):
@@ -616,7 +617,7 @@ def writable_path(value: object, name: str = "path") -> Path:
     work as the command line checks its outputs (:func:`check_writable`: as spelt, so that
     ``"newdir/"`` is a folder, not a file called ``newdir``), else a UsageError naming
     ``name``; returns it as a Path."""
-    from ..model import args
+    from .model import args
 
     if not isinstance(value, str | os.PathLike) or not os.fspath(value):
         raise UsageError(f"{name} = {args.show(value)}: must be a path (str or "

@@ -1,10 +1,9 @@
-"""The settings of the ``pymunk`` solver, on their owner: the scene's ``[pymunk]`` table.
+"""The settings of the ``pymunk`` solver: the scene's ``[pymunk]`` table.
 
-The scene reader knows only that the table belongs to a solver
-(:data:`dumbbell.model.scene.OWNED_TABLES` names this class, which the scene loads when it
-reads a scene); what its keys mean, their bounds and their defaults are the solver's. Why these
-defaults is explained in :mod:`dumbbell.solvers.engine`. The table's ``spin`` key is physics
-(whether the particles are spinning discs, :attr:`~dumbbell.model.scene.System.discs`), so the
+The scene reader hands the table to this class, which reads it: what its keys mean, their
+bounds and their defaults are kept here, beside the scene that holds them (the model imports
+nothing of the solvers). Why these defaults is explained in :mod:`dumbbell.solvers.engine`. The table's ``spin`` key is physics
+(whether the particles are spinning discs, :attr:`~dumbbell.model.system.System.discs`), so the
 scene reads that one itself.
 """
 
@@ -13,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
-#: The public API: the settings record.
 #: No public names: the pymunk solver's settings are ``scene.pymunk``.
 __all__: list[str] = []
 
