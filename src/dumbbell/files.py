@@ -407,29 +407,12 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     >>> with atomic_output("out.csv") as tmp:        # doctest: +SKIP
     ...     tmp.write_text("t,x\\n")
     """
-    from .model import args
-
-    path = args.path(path, "path")
-    if "\0" in str(path):
-        raise UsageError(f"path = {args.show(str(path))}: a path cannot hold a NUL character",
-                         param="path")
-    shown = path
-    refusal = link_refusal(path)
-    if refusal is not None:  # planted since the command checked its outputs, say
-        raise UsageError(f"{args.show_path(path)}: {refusal}", param="path")
-    transaction = _active.get()
-    if transaction is not None:
-        transaction.claim(path)
+    path, transaction = _claimed(path)
     if is_special(path) or _under_system(path):
-        try:
+        with _written_through(path):
             yield path
-        except BrokenPipeError:
-            # A FIFO or a pipe (/dev/stdout) whose reader left: what it did not read is
-            # dropped, as for standard output (`| head`); the other outputs are written.
-            pass
-        except OSError as exc:
-            raise _user_error(exc, path, None) from None
         return
+    shown = path
     if path.is_symlink():
         # Write the file the link names; a rename onto the link would replace the link.
         path = Path(os.path.realpath(path))
@@ -453,6 +436,38 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     finally:
         if tmp is not None and not deferred:
             _unlink(tmp)
+
+
+def _claimed(path: str | Path) -> tuple[Path, OutputTransaction | None]:
+    """``path`` checked as an output (no NUL, no link planted since the command checked
+    it) and claimed in the running :func:`output_transaction`, if any; with that
+    transaction."""
+    from .model import args
+
+    path = args.path(path, "path")
+    if "\0" in str(path):
+        raise UsageError(f"path = {args.show(str(path))}: a path cannot hold a NUL character",
+                         param="path")
+    refusal = link_refusal(path)
+    if refusal is not None:  # planted since the command checked its outputs, say
+        raise UsageError(f"{args.show_path(path)}: {refusal}", param="path")
+    transaction = _active.get()
+    if transaction is not None:
+        transaction.claim(path)
+    return path, transaction
+
+
+@contextmanager
+def _written_through(path: Path) -> Iterator[None]:
+    """The block writes a device, a FIFO or a pipe itself (no temporary file)."""
+    try:
+        yield
+    except BrokenPipeError:
+        # A FIFO or a pipe (/dev/stdout) whose reader left: what it did not read is
+        # dropped, as for standard output (`| head`); the other outputs are written.
+        pass
+    except OSError as exc:
+        raise _user_error(exc, path, None) from None
 
 
 def _part_file(path: Path, transaction: OutputTransaction | None) -> Path:
