@@ -200,6 +200,17 @@ def _spring_kicks(b: Build, pos: np.ndarray, dt: float) -> np.ndarray:
     return out
 
 
+def start(self: Any) -> None:
+    """The first snapshot of a ledger ``self`` (either kind), just built: E(0), the
+    potentials' reference and the energy scale."""
+    self._snap = phys.read_snapshot(self._b)
+    self._snap_uid = self._b.table.uid.copy()
+    e = phys.energy(self._b, self._snap)
+    self._E0 = self._E = e.E
+    self._Uref = np.array([e.Ug, e.Us, e.Ud])
+    self._scale = e.K
+
+
 def attach(self: Any, calls: Any) -> None:
     """Attach the fallback ledger ``self`` (a :class:`.ledger.PublicLedger`): its hook
     is added last and never rotated."""
@@ -209,12 +220,7 @@ def attach(self: Any, calls: Any) -> None:
 
     self._touching = np.zeros(0, dtype=bool)
     self._rebuild()
-    self._snap = phys.read_snapshot(self._b)
-    self._snap_uid = self._b.table.uid.copy()
-    e = phys.energy(self._b, self._snap)
-    self._E0 = self._E = e.E
-    self._Uref = np.array([e.Ug, e.Us, e.Ud])
-    self._scale = e.K
+    start(self)
     self._hook = _hook.Hook(self.space, *calls, first=False)
     self._finalizer = weakref.finalize(self, self._hook.release)
 

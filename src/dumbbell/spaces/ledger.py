@@ -212,12 +212,7 @@ class Ledger(Changes):
         self._space_at = layout.check_space(self.space)
         self._contacts = Contacts(arbiters_address(self._space_at))
         self._rebuild()
-        self._snap = phys.read_snapshot(self._b)
-        self._snap_uid = self._b.table.uid.copy()
-        e = phys.energy(self._b, self._snap)
-        self._E0 = self._E = e.E
-        self._Uref = np.array([e.Ug, e.Us, e.Ud])
-        self._scale = e.K
+        _public.start(self)
         self._hook = _hook.Hook(self.space, *_calls(self), first=True)
         self._finalizer = weakref.finalize(self, self._hook.release)
 
