@@ -25,10 +25,10 @@ print(time.perf_counter() - t)
 def main(rounds: int = 5) -> None:
     times: dict[str, list[float]] = {"skip": [], "probe": []}
     for _ in range(rounds):
-        for way in times:
+        for way, seconds in times.items():
             out = subprocess.run([sys.executable, "-c", ONE, way], capture_output=True,
                                  text=True, check=True).stdout
-            times[way].append(float(out))
+            seconds.append(float(out))
     for way, seconds in times.items():
         print(f"{way:5s}: median {statistics.median(seconds):.2f} s of {rounds} "
               f"({', '.join(f'{s:.2f}' for s in seconds)})")

@@ -37,8 +37,9 @@ FRAME = 0.05
 
 
 def forces() -> None:
-    from dumbbell import spaces
     from tests.guard_cases import PUSHES, car, pushed
+
+    from dumbbell import spaces
 
     print("per-frame push, one frame of 0.05 s: largest |v_n - v_1| / |v_1| over vx, vy, w")
     print(f"{'push':16s} {'through':8s} {'n = 7':>10s} {'n = 80':>10s}")
@@ -82,9 +83,10 @@ def forces() -> None:
 
 
 def joints() -> None:
+    from tests.guard_cases import pendulum
+
     from dumbbell import spaces
     from dumbbell.spaces._probe import probe
-    from tests.guard_cases import pendulum
 
     cases = [("PinJoint, L = 200 px, from level", lambda: pendulum()),
              ("PinJoint, L = 100 px, from level", lambda: pendulum(length=100.0)),
