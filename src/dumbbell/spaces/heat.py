@@ -231,6 +231,10 @@ class HeatCounter:
     def _pre_solve(self, arbiter: Any, space: Any) -> None:
         from pymunk._chipmunk_cffi import ffi
 
+        if self._after is not None:
+            # A post_solve ran and this step is another: the last one's end (_end_step) was
+            # cut short by an exception raised inside a callback (a stop signal's handler).
+            self._forget()
         raw, ba, bb = self._relative(arbiter)
         # pymunk starts a step from the impulse accumulated in the last one, applied scaled by
         # dt / previous dt ("warm starting"); on a first contact it keeps an impulse cached
@@ -252,10 +256,14 @@ class HeatCounter:
         # A contact whose post_solve never comes (the user rejected it) must not linger.
         space.add_post_step_callback(self._end_step, self)
 
-    def _end_step(self, space: Any, key: Any) -> None:
+    def _forget(self) -> None:
+        """Drop what the counter took of the step (its pairs and the solver's velocities)."""
         self._after = None
         self._before.clear()
         self._ends.clear()
+
+    def _end_step(self, space: Any, key: Any) -> None:
+        self._forget()
         # Arbiters that carry impulses into the next step had contacts in this one, so this
         # is the 'previous dt' pymunk scales them by.
         self._last_dt = space.current_time_step
@@ -270,12 +278,6 @@ class HeatCounter:
             # counters run first in every handler), so these are the solver's velocities.
             self._after = {id(b): (*b.velocity, b.angular_velocity)
                            for pair in self._ends.values() for b in pair}
-        for b in (ba, bb):
-            # A body the snapshot lacks had its pre_solve cut short by an exception raised
-            # inside it (a stop signal's handler runs inside whatever callback is running):
-            # its velocities now are the solver's unless a later callback changed them.
-            if id(b) not in self._after:
-                self._after[id(b)] = (*b.velocity, b.angular_velocity)
         if before is not None and len(before) == raw.count:
             nx, ny = raw.n.x, raw.n.y
             work = 0.0
