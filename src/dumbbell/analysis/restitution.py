@@ -349,6 +349,8 @@ class RestitutionResult:
 
     Examples
     --------
+    Two tilts, the rigid dumbbell only (no spring runs):
+
     >>> import dumbbell
     >>> from dumbbell.analysis.restitution import restitution
     >>> from dumbbell.model.scene import scenes_dir
@@ -527,6 +529,8 @@ def restitution(scene: Scene, thetas: np.ndarray | list[float],
 
     Examples
     --------
+    The formula and the exact runs agree at three tilts (at 60°, e_eff = 1/7):
+
     >>> import dumbbell
     >>> from dumbbell.analysis.restitution import restitution
     >>> from dumbbell.model.scene import scenes_dir

@@ -90,7 +90,7 @@ def write(result: Comparison, out: Path) -> list[Path]:
     Raises
     ------
     UsageError
-        A ``result`` that is not a Comparison, or an ``out`` where no folder can be made.
+        A ``result`` that is not a Comparison; an ``out`` where no folder can be made.
 
     Examples
     --------
@@ -129,7 +129,7 @@ def text(result: Comparison) -> str:
     Raises
     ------
     UsageError
-        A ``result`` that is not a Comparison (from :func:`dumbbell.compare`).
+        Any ``result`` but a Comparison.
 
     Examples
     --------
