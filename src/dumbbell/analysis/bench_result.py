@@ -115,7 +115,8 @@ class Point:
 
     @property
     def ok(self) -> bool:
-        """The run ended ``ok``: stable, and within its scene's ``run.inaccurate_energy``."""
+        """The run ended ``ok``: stable, and its energy error within its scene's
+        ``run.inaccurate_energy``."""
         return self.verdict == "ok"
 
     @property

@@ -58,7 +58,8 @@ MAX_AXIS_VALUES = 10_000
 
 @dataclass(frozen=True)
 class Axis:
-    """One axis of a sweep's grid.
+    """One axis of a sweep's grid: a dotted scene key and the values it takes, in the order
+    the grid runs them.
 
     Parameters
     ----------
