@@ -138,9 +138,10 @@ class Bounce:
     def __repr__(self) -> str:
         from .._display import one_line
 
+        impacts = counted(self.impacts, "impact")
         return one_line(f"<Bounce e_first={self.e_first:.6g}, e_cluster={self.e_cluster:.6g} "
-                        f"after {counted(self.impacts, 'impact')}, K_rot share {self.share_first:.3g} "
-                        f"after the first, {self.share_cluster:.3g} after the cluster>")
+                        f"after {impacts}, K_rot share {self.share_first:.3g} after the first, "
+                        f"{self.share_cluster:.3g} after the cluster>")
 
     def _repr_html_(self) -> str:
         from .._display import html_table

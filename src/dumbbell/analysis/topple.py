@@ -145,7 +145,7 @@ class ToppleClosedForm:
 
         Parameters
         ----------
-        theta
+        theta : float or array_like
             As for :meth:`omega`.
 
         Returns
@@ -414,6 +414,8 @@ def measure(traj: Trajectory) -> ToppleMeasure:
 
     Examples
     --------
+    pymunk's fall, against the closed form's:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.topple import closed_form, measure
     >>> from dumbbell.model.scene import scenes_dir

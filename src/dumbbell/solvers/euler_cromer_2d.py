@@ -20,8 +20,7 @@ Frictionless 2D spring (or free) dumbbells without spin only.
 
 from __future__ import annotations
 
-from ..model.scene import Scene
-from .base import ExplicitSpring, point_particle_limits
+from .base import ExplicitSpring
 from .kernels import Kernel
 from .stepping import Stepper
 
@@ -35,13 +34,7 @@ class EulerCromer2D(ExplicitSpring, Stepper):
     name = "euler-cromer-2d"
     order = 1
     chunk = 4_000_000
-
-    @staticmethod
-    def _supports(scene: Scene) -> str | None:
-        """None if this solver can run ``scene``, else why not."""
-        if scene.system.dimensions != 2:
-            return "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
-        return point_particle_limits(scene, "euler-cromer-2d")
+    no_step = "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
 
     @staticmethod
     def kernel(dimensions: int) -> Kernel | None:
