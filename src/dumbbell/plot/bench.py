@@ -45,7 +45,7 @@ def work_precision(result: BenchResult, ax: Any = None) -> Any:
         What :func:`dumbbell.bench` measured.
     ax : matplotlib.axes.Axes or None, default None
         Draw on these axes (the legend inside them); None: a new figure of its own, the
-        legend outside on the right.
+        legend below the plot.
 
     Returns
     -------
