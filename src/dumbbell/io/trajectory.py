@@ -73,7 +73,7 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
     traj : Trajectory
         The run.
     path : str or pathlib.Path
-        The CSV file (its folder must exist).
+        The CSV file (missing folders are made).
 
     Returns
     -------

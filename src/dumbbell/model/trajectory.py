@@ -69,7 +69,7 @@ CSV_BLOCK = 8192
 @dataclass(frozen=True)
 class Impact:
     """One impact with the floor, as a run's ``events`` hold them: when, which particle,
-    its vertical velocity before and after, and the heat it made.
+    its vertical velocity before and after, and the energy it dissipated.
 
     Parameters
     ----------
