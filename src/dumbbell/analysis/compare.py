@@ -270,7 +270,7 @@ class Comparison:
 
     Examples
     --------
-    Its one-line summary, and its table's rows: the run and the truth.
+    Its one-line summary, and its table's rows: the truth, then the run.
 
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
