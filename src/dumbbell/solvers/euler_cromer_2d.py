@@ -31,6 +31,10 @@ __all__: list[str] = []
 class EulerCromer2D(ExplicitSpring, Stepper):
     """A 2D Euler-Cromer in pymunk's step order (see the module docstring)."""
 
+    # Declared as euler_cromer.EulerCromer is (`duplicates` pairs the two by shape): a solver
+    # is one class with its own facts, and the steps are two algorithms (the listing's
+    # operation order, bit for bit, against pymunk's), so no class branches on dimensions.
+
     name = "euler-cromer-2d"
     order = 1
     chunk = 4_000_000
