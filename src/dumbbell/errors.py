@@ -146,6 +146,8 @@ class ColumnError(UsageError, KeyError):
 
     Examples
     --------
+    A 1D run asked for a column only 2D runs have:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")

@@ -94,8 +94,8 @@ def bench(scene: Scene | str | Path, **options: Any) -> BenchResult:
 
     Parameters
     ----------
-    scene : Scene or str or pathlib.Path
-        The scene, or its file.
+    scene
+        As for :func:`dumbbell.compare`: a Scene, or its file.
     solvers : list of str or Solver classes, optional
         Default: every one that runs the scene.
     dts : sequence of float, default 1e-3 down to 1e-6

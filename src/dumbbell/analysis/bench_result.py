@@ -77,12 +77,12 @@ class Point:
 
     Examples
     --------
+    The first point: the hand-written method at the longest step, against the exact truth.
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
-    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
-    >>> point = result.points[0]
+    >>> point = dumbbell.bench(scenes_dir() / "textbook-1d.toml", solvers=["euler-cromer"],
+    ...                        dts=[1e-3, 1e-4], window=1.0, t_end=1.0, repeat=1).points[0]
     >>> point.solver, point.dt, point.steps, point.verdict, point.truth
     ('euler-cromer', 0.001, 1000, 'ok', 'exact')
     """
@@ -115,7 +115,8 @@ class Point:
 
     @property
     def ok(self) -> bool:
-        """The run ended ``ok``: stable, and within its scene's ``run.inaccurate_energy``."""
+        """The run ended ``ok``: stable, and its energy error within its scene's
+        ``run.inaccurate_energy``."""
         return self.verdict == "ok"
 
     @property
@@ -148,12 +149,13 @@ class Fit:
 
     Examples
     --------
+    Verlet's method is of second order, as it declares:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.bench(scene, solvers=["euler-cromer", "verlet"],
-    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
-    >>> fit = result.fits["verlet"]
+    >>> fit = dumbbell.bench(scene, solvers=["verlet"], dts=[1e-3, 1e-4, 1e-5], window=1.0,
+    ...                      t_end=1.0, repeat=1).fits["verlet"]
     >>> round(fit.order, 2), fit.expected, fit.dts
     (2.0, 2, [1e-05, 0.0001, 0.001])
     """
@@ -200,6 +202,8 @@ class BenchResult:
 
     Examples
     --------
+    Two solvers at three steps, and the truth: seven points, one fit.
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")

@@ -156,12 +156,12 @@ class Timing:
 
     Examples
     --------
+    The hand-written method's run time, timed after a warm-up run:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
-    >>> timing = result.rows[0].timing
+    >>> timing = dumbbell.compare(scenes_dir() / "textbook-1d.toml", solvers=["euler-cromer"],
+    ...                           dts=[1e-4], t_end=1.0, window=1.0).rows[0].timing
     >>> timing.seconds > 0, timing.runs >= 1
     (True, True)
     """
@@ -202,12 +202,13 @@ class Row:
 
     Examples
     --------
+    One run measured against the exact truth; the runs do not part within the window:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
-    >>> row = result.rows[0]
+    >>> row = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
+    ...                        window=1.0).rows[0]
     >>> row.label, round(row.window_error, 5), row.error_until, row.parted
     ('euler-cromer', 0.00151, 1.0, None)
     """
@@ -269,6 +270,8 @@ class Comparison:
 
     Examples
     --------
+    Its one-line summary, and its table's rows: the truth, then the run.
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")

@@ -46,16 +46,14 @@ class ContactMomentum:
 
     Examples
     --------
+    What :func:`about_contact` finds at the rigid dumbbell's first impact, in one line:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.contact import about_contact
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
-    >>> about = about_contact(traj)
-    >>> round(about.before, 6), round(about.after, 6), abs(about.change) < 1e-12   # kg m²/s
-    (-0.044272, -0.044272, True)
-    >>> round(about.L_cm_before, 6), round(about.L_cm_after, 6)   # the spin jumps
-    (0.0, -0.070835)
+    >>> about_contact(dumbbell.simulate(dumbbell.load_scene(scenes_dir() / "rigid-2d.toml"),
+    ...                                 solver="exact", t_end=0.6, dt=1e-4))
+    <ContactMomentum B's impact at t = 0.451754 s, P = (..., 0) m: L_P -0.04427189 -> -0.04427189 (change ...), L_cm ... -> -0.07083502 kg m^2/s>
     """
 
     impact: Impact
@@ -118,6 +116,8 @@ def about_contact(traj: Trajectory, index: int = 0, window: float = 0.02) -> Con
 
     Examples
     --------
+    The rigid dumbbell's first impact: L_P is kept while the spin jumps.
+
     >>> import dumbbell
     >>> from dumbbell.analysis.contact import about_contact
     >>> from dumbbell.model.scene import scenes_dir

@@ -104,15 +104,15 @@ class Series:
 
     Examples
     --------
+    Each run is a Trajectory, by label; in 2D each carries L_cm:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.rotation import series
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
-    >>> runs = series(scene, dt=1e-4, t_end=0.3, stiffnesses=(200.0,))
-    >>> runs
-    <Series tilted-2d: 2 runs (k = 200 N/m, rigid), pymunk at dt = 0.0001 s>
-    >>> runs.runs["rigid"].columns[-3:]
-    ['U_g', 'E', 'L_cm']
+    >>> runs = series(dumbbell.load_scene(scenes_dir() / "tilted-2d.toml"), dt=1e-4, t_end=0.3,
+    ...               stiffnesses=(200.0,)).runs
+    >>> list(runs), runs["rigid"].columns[-3:]
+    (['k = 200 N/m', 'rigid'], ['U_g', 'E', 'L_cm'])
     """
 
     runs: dict[str, Trajectory]
@@ -156,24 +156,23 @@ def series(scene: Scene, solver: str = "pymunk", dt: float = 1e-5, t_end: float 
     Returns
     -------
     Series
-        The runs by label.
+        The runs by label, the rigid one last.
 
     Raises
     ------
     UsageError
-        An argument that is not allowed.
+        A scene that is not 2D, or another argument that is not allowed.
 
     Examples
     --------
+    A short preview, one spring beside the rigid body:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.rotation import series
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
-    >>> runs = series(scene, dt=1e-4, t_end=0.3, stiffnesses=(200.0,))
-    >>> runs
+    >>> series(scene, dt=1e-4, t_end=0.3, stiffnesses=(200.0,))
     <Series tilted-2d: 2 runs (k = 200 N/m, rigid), pymunk at dt = 0.0001 s>
-    >>> runs.runs["rigid"].columns[-3:]
-    ['U_g', 'E', 'L_cm']
     """
     from ..solvers import available, simulate, solver_class
 

@@ -103,22 +103,17 @@ class StabilityRow:
 
     Examples
     --------
+    One case of the shipped catalogue, just past the explicit step's limit w·dt = 2:
+
+    >>> import shutil
     >>> from pathlib import Path
     >>> import dumbbell
+    >>> from dumbbell.analysis.stability import default_cases
     >>> Path("cases").mkdir()
-    >>> _ = Path("cases/stiff.toml").write_text('''
-    ... dimensions = 1
-    ... bodies.A = { mass = 0.1, height = 1.2 }
-    ... bodies.B = { mass = 0.1, height = 1.0 }
-    ... spring = { stiffness = 1e8, rest_length = 0.2 }
-    ... floor = { elasticity = 1.0 }
-    ... gravity = { g = 9.8 }
-    ... run = { t_end = 0.5, dt = 1e-4 }
-    ... ''')
-    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
-    >>> row = result.rows[0]
-    >>> row.verdict, row.predicted, round(row.w_dt, 2)
-    ('unstable', 'unstable', 4.47)
+    >>> _ = shutil.copy(default_cases() / "stiff-wdt-2.1.toml", "cases")
+    >>> row = dumbbell.stability("cases", solvers=["verlet"], workers=1).rows[0]
+    >>> row.case, row.verdict, row.predicted, round(row.w_dt, 2)
+    ('stiff-wdt-2.1', 'unstable', 'unstable', 2.1)
     """
 
     case: str
@@ -165,21 +160,19 @@ class StabilityResult:
 
     Examples
     --------
+    The shipped case just inside the limit (w·dt = 1.9): stable, but its energy error past
+    the case's bound, as the theory expects.
+
+    >>> import shutil
     >>> from pathlib import Path
     >>> import dumbbell
-    >>> Path("cases").mkdir()
-    >>> _ = Path("cases/stiff.toml").write_text('''
-    ... dimensions = 1
-    ... bodies.A = { mass = 0.1, height = 1.2 }
-    ... bodies.B = { mass = 0.1, height = 1.0 }
-    ... spring = { stiffness = 1e8, rest_length = 0.2 }
-    ... floor = { elasticity = 1.0 }
-    ... gravity = { g = 9.8 }
-    ... run = { t_end = 0.5, dt = 1e-4 }
-    ... ''')
-    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> from dumbbell.analysis.stability import default_cases
+    >>> inside = Path("inside")
+    >>> inside.mkdir()
+    >>> _ = shutil.copy(default_cases() / "stiff-wdt-1.9.toml", inside)
+    >>> result = dumbbell.stability("inside", solvers=["euler-cromer", "verlet"], workers=1)
     >>> result.to_pandas()[["case", "solver", "verdict", "agreement"]].values.tolist()
-    [['stiff', 'verlet', 'unstable', 'agrees']]
+    [['stiff-wdt-1.9', 'euler-cromer', 'inaccurate', 'agrees'], ['stiff-wdt-1.9', 'verlet', 'inaccurate', 'agrees']]
     """
 
     rows: tuple[StabilityRow, ...]

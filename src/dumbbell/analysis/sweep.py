@@ -58,7 +58,8 @@ MAX_AXIS_VALUES = 10_000
 
 @dataclass(frozen=True)
 class Axis:
-    """One axis of a sweep's grid.
+    """One axis of a sweep's grid: a dotted scene key and the values it takes, in the order
+    the grid runs them.
 
     Parameters
     ----------
@@ -74,11 +75,12 @@ class Axis:
 
     Examples
     --------
+    A list of values makes an axis spaced ``list``:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
-    ...                         workers=1)
+    >>> result = dumbbell.sweep(scenes_dir() / "textbook-1d.toml",
+    ...                         {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5, workers=1)
     >>> result.axes[0]
     Axis(key='spring.stiffness', text='k=200.0,2000000.0', values=(200.0, 2000000.0), spacing='list')
     """
@@ -280,12 +282,13 @@ class PointResult:
 
     Examples
     --------
+    The stiffest spring at the longest step, past the explicit step's limit:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
-    ...                         workers=1)
-    >>> point = result.rows[-1]
+    >>> point = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
+    ...                        workers=1).rows[-1]
     >>> point.values, round(point.w_dt, 2), point.verdict
     ((('spring.stiffness', 2000000.0), ('run.dt', 0.001)), 6.32, 'unstable')
     >>> print(point.reason)
@@ -377,6 +380,8 @@ class SweepResult:
 
     Examples
     --------
+    Four points; one is unstable:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")

@@ -146,7 +146,7 @@ class ToppleClosedForm:
         Parameters
         ----------
         theta : float or array_like
-            The angle from vertical (rad).
+            As for :meth:`omega`.
 
         Returns
         -------
@@ -156,7 +156,7 @@ class ToppleClosedForm:
         Raises
         ------
         UsageError
-            Angles that are not finite numbers.
+            As for :meth:`omega`.
         """
         th = args.array(theta, "theta", "rad")
         M, a, g = self.M, self.a, self.g
@@ -172,17 +172,17 @@ class ToppleClosedForm:
         Parameters
         ----------
         theta : float or array_like
-            The angle from vertical (rad).
+            The angle from vertical (rad), as for :meth:`omega`.
 
         Returns
         -------
         numpy.ndarray
-            The normal force (N).
+            The normal force (N), one per angle.
 
         Raises
         ------
         UsageError
-            Angles that are not finite numbers.
+            An angle that is not a finite number.
         """
         th = args.array(theta, "theta", "rad")
         w, al = self.omega(th), self.alpha(th)
@@ -298,10 +298,12 @@ def closed_form(scene: Scene) -> ToppleClosedForm:
     Raises
     ------
     UsageError
-        A scene that does not fit, naming what does not.
+        A scene that does not fit (one line naming what does not).
 
     Examples
     --------
+    The shipped topple scene's fall time (s), and a scene that does not fit:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.topple import closed_form
     >>> from dumbbell.model.scene import scenes_dir
@@ -356,6 +358,8 @@ class ToppleMeasure:
 
     Examples
     --------
+    pymunk's run of the shipped topple, sampled every step:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.topple import measure
     >>> from dumbbell.model.scene import scenes_dir
@@ -410,6 +414,8 @@ def measure(traj: Trajectory) -> ToppleMeasure:
 
     Examples
     --------
+    pymunk's fall, against the closed form's:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.topple import closed_form, measure
     >>> from dumbbell.model.scene import scenes_dir

@@ -144,10 +144,13 @@ def positive_int(what: str, hi: int = MAX_COUNT):
 DEFAULT_OUT = "renders"
 
 
-def add_scene(parser: argparse.ArgumentParser) -> None:
-    """The SCENE argument: a scene file, or - for standard input."""
+def add_scene(parser: argparse.ArgumentParser, solver: str | None = None) -> None:
+    """The SCENE argument: a scene file, or - for standard input; with ``solver`` (its help
+    text), the ``--solver NAME`` flag after it (None: the scene's ``run.solver``)."""
     parser.add_argument("scene", metavar="SCENE",
                         help="scene file (TOML); - reads it from standard input")
+    if solver is not None:
+        parser.add_argument("--solver", metavar="NAME", help=solver)
 
 
 def add_out(parser: argparse.ArgumentParser, what: str) -> None:

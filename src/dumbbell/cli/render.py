@@ -36,9 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "render", help="animate a scene as a GIF with live energy bars",
         description=DESCRIPTION,
     )
-    add_scene(p)
-    p.add_argument("--solver", metavar="NAME",
-                   help="solver (default: the scene's run.solver)")
+    add_scene(p, solver="solver (default: the scene's run.solver)")
     p.add_argument("-o", "--output", metavar="FILE.gif",
                    help=f"GIF to write (default: {DEFAULT_OUT}/<scene>.gif)")
     p.add_argument("--fps", metavar="N", type=_whole,

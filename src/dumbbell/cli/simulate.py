@@ -33,9 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "simulate", help="run one scene and write its trajectory as CSV",
         description=DESCRIPTION,
     )
-    add_scene(p)
-    p.add_argument("--solver", metavar="NAME",
-                   help="solver: euler-cromer, exact, pymunk, ... (default: the scene's "
+    add_scene(p, solver="solver: euler-cromer, exact, pymunk, ... (default: the scene's "
                         "run.solver)")
     p.add_argument("--dt", type=positive_float("s"), metavar="DT",
                    help="time step in s (default: the scene's run.dt)")

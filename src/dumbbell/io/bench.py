@@ -90,20 +90,22 @@ def markdown(result: BenchResult) -> str:
     Parameters
     ----------
     result : BenchResult
-        What :func:`dumbbell.bench` measured.
+        The benchmark, from :func:`dumbbell.bench`.
 
     Returns
     -------
     str
-        The Markdown text.
+        The Markdown text: the run's settings, the table, the fitted orders.
 
     Raises
     ------
     UsageError
-        A result that is not a BenchResult.
+        A ``result`` that is not a BenchResult (from :func:`dumbbell.bench`).
 
     Examples
     --------
+    The table's header, below the line that says how the run was timed:
+
     >>> from dumbbell.io.bench import markdown
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
@@ -198,27 +200,26 @@ def write_all(result: BenchResult, out: Path) -> list[Path]:
     result : BenchResult
         What :func:`dumbbell.bench` measured.
     out : pathlib.Path
-        The folder (made if missing).
+        As for :func:`dumbbell.io.compare.write`: the folder, made if missing.
 
     Returns
     -------
     list of pathlib.Path
-        The files written, each whole or not at all.
+        The CSV, JSON and Markdown files, in that order.
 
     Raises
     ------
     UsageError
-        A result that is not a BenchResult, or a folder that cannot be written.
+        A ``result`` that is not a BenchResult, or an ``out`` that cannot be written.
 
     Examples
     --------
     >>> from pathlib import Path
-    >>> from dumbbell.io.bench import write_all
     >>> import dumbbell
+    >>> from dumbbell.io.bench import write_all
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.bench(scene, solvers=["verlet"], dts=[1e-3, 1e-4, 1e-5], window=1.0,
-    ...                         t_end=1.0, repeat=1)
+    >>> result = dumbbell.bench(scenes_dir() / "textbook-1d.toml", solvers=["verlet"],
+    ...                         dts=[1e-3, 1e-4, 1e-5], window=1.0, t_end=1.0, repeat=1)
     >>> [path.name for path in write_all(result, Path("bench"))]
     ['bench-textbook-1d.csv', 'bench-textbook-1d.json', 'bench-textbook-1d.md']
     """

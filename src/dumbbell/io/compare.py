@@ -90,7 +90,7 @@ def write(result: Comparison, out: Path) -> list[Path]:
     Raises
     ------
     UsageError
-        A result that is not a Comparison, or a folder that cannot be written.
+        A ``result`` that is not a Comparison; an ``out`` where no folder can be made.
 
     Examples
     --------
@@ -119,7 +119,7 @@ def text(result: Comparison) -> str:
     Parameters
     ----------
     result : Comparison
-        What :func:`dumbbell.compare` measured.
+        What :func:`dumbbell.compare` measured (its rows, impacts and notes).
 
     Returns
     -------
@@ -129,16 +129,17 @@ def text(result: Comparison) -> str:
     Raises
     ------
     UsageError
-        A result that is not a Comparison.
+        Any ``result`` but a Comparison.
 
     Examples
     --------
-    >>> from dumbbell.io.compare import text
+    Its first line names the scene and its file:
+
     >>> import dumbbell
+    >>> from dumbbell.io.compare import text
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
+    >>> result = dumbbell.compare(scenes_dir() / "textbook-1d.toml", solvers=["euler-cromer"],
+    ...                           dts=[1e-4], t_end=1.0, window=1.0)
     >>> print(text(result).splitlines()[0])
     Bouncing dumbbell, textbook section 13.5.1  (...textbook-1d.toml)
     """

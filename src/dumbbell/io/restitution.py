@@ -29,26 +29,29 @@ def write_csv(result: RestitutionResult, path: str | Path) -> Path:
     result : RestitutionResult
         What :func:`~dumbbell.analysis.restitution.restitution` measured.
     path : str or pathlib.Path
-        The file.
+        The CSV file, one row per tilt.
 
     Returns
     -------
     pathlib.Path
-        The file written.
+        The path written.
 
     Raises
     ------
     UsageError
-        A result that is not a RestitutionResult, or a path that cannot be written.
+        A ``result`` not from :func:`~dumbbell.analysis.restitution.restitution`, or a
+        ``path`` that cannot be written.
 
     Examples
     --------
-    >>> from dumbbell.io.restitution import write_csv
+    The header row:
+
     >>> import dumbbell
+    >>> from dumbbell.io.restitution import write_csv
     >>> from dumbbell.analysis.restitution import restitution
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
-    >>> result = restitution(scene, [0.0, 30.0], stiffnesses=(), dt=1e-4)
+    >>> result = restitution(dumbbell.load_scene(scenes_dir() / "rigid-2d.toml"), [0.0, 30.0],
+    ...                      stiffnesses=(), dt=1e-4)
     >>> write_csv(result, "restitution.csv").read_text().splitlines()[0]
     'theta,formula,truth,pymunk,rigid_impacts,rigid_K_rot_share'
     """
@@ -72,12 +75,12 @@ def markdown(result: RestitutionResult) -> str:
     Returns
     -------
     str
-        The Markdown table.
+        The Markdown table: a header, a rule, a row per tilt.
 
     Raises
     ------
     UsageError
-        A result that is not a RestitutionResult.
+        A ``result`` that :func:`write_csv` would refuse too.
 
     Examples
     --------

@@ -49,33 +49,28 @@ def markdown(result: StabilityResult) -> str:
     Returns
     -------
     str
-        The Markdown text.
+        The report, in Markdown.
 
     Raises
     ------
     UsageError
-        A result that is not a StabilityResult.
+        A ``result`` that :func:`dumbbell.stability` did not return.
 
     Examples
     --------
+    The report of one shipped case, just past the limit w·dt = 2:
+
+    >>> import shutil
     >>> from pathlib import Path
-    >>> from dumbbell.io.stability import markdown
     >>> import dumbbell
+    >>> from dumbbell.analysis.stability import default_cases
+    >>> from dumbbell.io.stability import markdown
     >>> Path("cases").mkdir()
-    >>> _ = Path("cases/stiff.toml").write_text('''
-    ... dimensions = 1
-    ... bodies.A = { mass = 0.1, height = 1.2 }
-    ... bodies.B = { mass = 0.1, height = 1.0 }
-    ... spring = { stiffness = 1e8, rest_length = 0.2 }
-    ... floor = { elasticity = 1.0 }
-    ... gravity = { g = 9.8 }
-    ... run = { t_end = 0.5, dt = 1e-4 }
-    ... ''')
-    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
-    >>> print(markdown(result))
+    >>> _ = shutil.copy(default_cases() / "stiff-wdt-2.1.toml", "cases")
+    >>> print(markdown(dumbbell.stability("cases", solvers=["verlet"], workers=1)))
     | case | what it tests (the scene's title) | solver | dt [s] | w*dt | verdict | ...
     |---|...
-    | stiff | stiff | verlet | 0.0001 | 4.47 | unstable | 0.0011 | ...
+    | stiff-wdt-2.1 | Stiff spring just outside the limit, w*dt = 2.1 | verlet | 0.0021 | 2.1 | unstable | 0.0105 | ...
     ...
     """
     result = _checked(result)
@@ -142,34 +137,33 @@ def write(result: StabilityResult, out: Path) -> list[Path]:
     result : StabilityResult
         What :func:`dumbbell.stability` ran.
     out : pathlib.Path
-        The folder (made if missing).
+        The folder for both files (made if missing).
 
     Returns
     -------
     list of pathlib.Path
-        The files written, each whole or not at all.
+        stability.md then stability.csv, each written whole or not at all.
 
     Raises
     ------
     UsageError
-        A result that is not a StabilityResult, or a folder that cannot be written.
+        A ``result`` not from :func:`dumbbell.stability`, or a folder that cannot be written.
 
     Examples
     --------
+    A folder of one case of the user's own, the report written beside it:
+
     >>> from pathlib import Path
-    >>> from dumbbell.io.stability import write
     >>> import dumbbell
-    >>> Path("cases").mkdir()
-    >>> _ = Path("cases/stiff.toml").write_text('''
+    >>> from dumbbell.io.stability import write
+    >>> Path("mine").mkdir()
+    >>> _ = Path("mine/stiff.toml").write_text('''
     ... dimensions = 1
-    ... bodies.A = { mass = 0.1, height = 1.2 }
-    ... bodies.B = { mass = 0.1, height = 1.0 }
+    ... bodies = { A = { mass = 0.1, height = 1.2 }, B = { mass = 0.1, height = 1.0 } }
     ... spring = { stiffness = 1e8, rest_length = 0.2 }
-    ... floor = { elasticity = 1.0 }
-    ... gravity = { g = 9.8 }
     ... run = { t_end = 0.5, dt = 1e-4 }
     ... ''')
-    >>> result = dumbbell.stability("cases", solvers=["verlet"], workers=1)
+    >>> result = dumbbell.stability("mine", solvers=["verlet"], workers=1)
     >>> [path.name for path in write(result, Path("stability"))]
     ['stability.md', 'stability.csv']
     """

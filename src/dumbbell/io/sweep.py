@@ -44,26 +44,27 @@ def write_csv(result: SweepResult, path: str | Path) -> Path:
     result : SweepResult
         What :func:`dumbbell.sweep` ran.
     path : str or pathlib.Path
-        The file.
+        Where the sweep's CSV goes.
 
     Returns
     -------
     pathlib.Path
-        The file written.
+        The file written, whole.
 
     Raises
     ------
     UsageError
-        A result that is not a SweepResult, or a path that cannot be written.
+        A ``result`` that is not a SweepResult, or a ``path`` where no file can be written.
 
     Examples
     --------
-    >>> from dumbbell.io.sweep import write_csv
+    Two stiffnesses by two steps; the stiff spring at the long step is unstable:
+
     >>> import dumbbell
+    >>> from dumbbell.io.sweep import write_csv
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.sweep(scene, {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5,
-    ...                         workers=1)
+    >>> result = dumbbell.sweep(scenes_dir() / "textbook-1d.toml",
+    ...                         {"k": [200.0, 2e6], "dt": [1e-5, 1e-3]}, t_end=0.5, workers=1)
     >>> print(write_csv(result, "sweep.csv").read_text())
     spring.stiffness,run.dt,w_dt,verdict,t_fail,max_rel_energy_error,reason
     200.0,1e-05,0.0006324555320336759,ok,,0.00030916674793161035,

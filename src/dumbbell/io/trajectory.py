@@ -73,12 +73,12 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
     traj : Trajectory
         The run.
     path : str or pathlib.Path
-        The file.
+        The CSV file (missing folders are made).
 
     Returns
     -------
     pathlib.Path
-        The file written.
+        ``path``, now holding the samples.
 
     Raises
     ------
@@ -88,11 +88,13 @@ def write_csv(traj: Trajectory, path: str | Path) -> Path:
 
     Examples
     --------
+    The header row of the file written:
+
     >>> from dumbbell.io.trajectory import write_csv
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> traj = dumbbell.simulate(dumbbell.load_scene(scenes_dir() / "textbook-1d.toml"),
+    ...                          solver="exact", t_end=1.0, dt=0.1)
     >>> write_csv(traj, "exact.csv").read_text().splitlines()[0]
     't,xA,vA,xB,vB,K_cm,K_int,U_g,U_spring,E'
     """
@@ -106,12 +108,12 @@ def events_csv(traj: Trajectory) -> str:
     Parameters
     ----------
     traj : Trajectory
-        The run.
+        The run (its ``events``).
 
     Returns
     -------
     str
-        The CSV text.
+        The CSV text, a header line first.
 
     Raises
     ------
@@ -120,12 +122,13 @@ def events_csv(traj: Trajectory) -> str:
 
     Examples
     --------
-    >>> from dumbbell.io.trajectory import events_csv
+    The textbook's first two impacts, both of particle B:
+
     >>> import dumbbell
+    >>> from dumbbell.io.trajectory import events_csv
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
-    >>> print(events_csv(traj))
+    >>> print(events_csv(dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)))
     t,body,v_before,v_after
     0.4517539514526256,B,-4.42718872423573,4.42718872423573
     0.49895130056316217,B,-4.835568954040384,4.835568954040384
@@ -141,28 +144,26 @@ def write_events(traj: Trajectory, path: str | Path) -> Path:
 
     Parameters
     ----------
-    traj : Trajectory
-        The run.
-    path : str or pathlib.Path
-        The file.
+    traj, path
+        As for :func:`write_csv`.
 
     Returns
     -------
     pathlib.Path
-        The file written.
+        The impacts' file, written.
 
     Raises
     ------
     UsageError
-        A ``traj`` that is not a Trajectory, or a path that cannot be written.
+        As for :func:`write_csv`.
 
     Examples
     --------
-    >>> from dumbbell.io.trajectory import write_events
     >>> import dumbbell
+    >>> from dumbbell.io.trajectory import write_events
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=0.1)
+    >>> traj = dumbbell.simulate(dumbbell.load_scene(scenes_dir() / "textbook-1d.toml"),
+    ...                          solver="exact", t_end=1.0)
     >>> len(write_events(traj, "impacts.csv").read_text().splitlines())   # header, 2 impacts
     3
     """

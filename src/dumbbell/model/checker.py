@@ -58,6 +58,14 @@ class _Checker:
     def fail(self, dotted: str, value: Any, allowed: str) -> None:
         raise SceneError(f"{_printable(self.source)}: {dotted} = {_show(value)}: {allowed}")
 
+    def _missing(self, name: str, default: Any, allowed: str) -> Any:
+        """A key the table lacks: ``default``, or (None) a SceneError saying it is missing and
+        what is ``allowed``."""
+        if default is None:
+            raise SceneError(f"{_printable(self.source)}: "
+                             f"{self.key(name)} is missing: {allowed}")
+        return default
+
     def has(self, name: str) -> bool:
         return name in self.table
 
@@ -74,10 +82,7 @@ class _Checker:
         self.used.add(name)
         allowed = _range_text(lo, hi, lo_open, unit)
         if name not in self.table:
-            if default is None:
-                raise SceneError(f"{_printable(self.source)}: "
-                                 f"{self.key(name)} is missing: {allowed}")
-            return default
+            return self._missing(name, default, allowed)
         raw = self.table[name]
         value = _finite(raw)
         if value is None:
@@ -119,10 +124,7 @@ class _Checker:
     def string(self, name: str, default: str | None, choices: tuple[str, ...] | None = None) -> str:
         self.used.add(name)
         if name not in self.table:
-            if default is None:
-                raise SceneError(f"{_printable(self.source)}: "
-                                 f"{self.key(name)} is missing: must be a string")
-            return default
+            return self._missing(name, default, "must be a string")
         value = self.table[name]
         if choices is not None:
             if value not in choices:

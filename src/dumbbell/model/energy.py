@@ -386,6 +386,8 @@ def partition(
 
     Examples
     --------
+    The textbook's energy terms at the first three samples:
+
     >>> import dumbbell
     >>> from dumbbell.model.energy import partition
     >>> from dumbbell.model.scene import scenes_dir
@@ -438,6 +440,8 @@ def angular_momentum_cm(scene: Scene, state: Columns) -> np.ndarray:
 
     Examples
     --------
+    The rigid dumbbell: no spin before its first impact, then a steady one.
+
     >>> import dumbbell
     >>> from dumbbell.model.energy import angular_momentum_cm
     >>> from dumbbell.model.scene import scenes_dir

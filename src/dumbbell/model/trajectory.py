@@ -68,7 +68,8 @@ CSV_BLOCK = 8192
 
 @dataclass(frozen=True)
 class Impact:
-    """One impact with the floor, as a run's ``events`` hold them.
+    """One impact with the floor, as a run's ``events`` hold them: when, which particle,
+    its vertical velocity before and after, and the energy it dissipated.
 
     Parameters
     ----------
@@ -90,6 +91,8 @@ class Impact:
 
     Examples
     --------
+    The textbook's first impact, and a body the dumbbell does not have:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
@@ -297,6 +300,8 @@ class Trajectory:
 
     Examples
     --------
+    The exact run's summary, then its columns:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")

@@ -25,6 +25,16 @@ def _checked(result: Any, ax: Any) -> tuple[Comparison, Any]:
             args.axes(ax))
 
 
+def _one_panel(result: Any, ax: Any) -> tuple[Comparison, Any, bool]:
+    """The checked arguments of a one-panel figure: the result, the axes to draw on (a new
+    figure's when ``ax`` is None) and whether the figure is the package's own."""
+    result, ax = _checked(result, ax)
+    own = ax is None
+    if own:
+        _, ax = _subplots(figsize=(11, 4.6))
+    return result, ax, own
+
+
 def _shown(result: Comparison) -> float:
     """The time shown in the heights figure (s): twice the window, at most the whole run."""
     return min(float(result.truth.t[-1]), 2.0 * result.window)
@@ -57,30 +67,28 @@ def compare_positions(result: Comparison, ax: Any = None) -> Any:
 
     Parameters
     ----------
-    result : Comparison
-        What :func:`dumbbell.compare` measured.
-    ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+    result, ax
+        As for :func:`dumbbell.plot.compare`; on ``ax`` particle B only.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The axes drawn on (the last panel of a new figure).
+        The axes drawn on: ``ax``, or the lower panel (B) of the new figure.
 
     Raises
     ------
     UsageError
-        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+        A bad ``result`` or ``ax``, as for :func:`dumbbell.plot.compare`.
 
     Examples
     --------
+    Each run's heights over the truth's, past the window where the runs part:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
-    >>> ax = dumbbell.plot.compare_positions(result)
-    >>> ax.get_ylabel()
+    >>> result = dumbbell.compare(scenes_dir() / "textbook-1d.toml", solvers=["euler-cromer"],
+    ...                           dts=[1e-4], t_end=1.0, window=1.0)
+    >>> dumbbell.plot.compare_positions(result).get_ylabel()
     'x_B [m]'
     """
     result, ax = _checked(result, ax)
@@ -106,33 +114,34 @@ def compare(result: Comparison, ax: Any = None) -> Any:
     result : Comparison
         What :func:`dumbbell.compare` measured.
     ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+        Draw on these axes (the legend inside them, above the data); None: a new figure,
+        the legend outside on the right.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The axes drawn on.
+        The axes drawn on, ``ax`` or the new figure's.
 
     Raises
     ------
     UsageError
-        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+        A ``result`` that is not a Comparison (what :func:`dumbbell.compare` gives), or an
+        ``ax`` that is not one Axes.
 
     Examples
     --------
+    On the user's own axes:
+
+    >>> import matplotlib.pyplot as plt
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
-    >>> ax = dumbbell.plot.compare(result)
-    >>> ax.get_yscale()
+    >>> fig, ax = plt.subplots(figsize=(8, 4), layout="constrained")
+    >>> result = dumbbell.compare(scenes_dir() / "textbook-1d.toml", solvers=["verlet"],
+    ...                           dts=[1e-4], t_end=1.0, window=1.0)
+    >>> dumbbell.plot.compare(result, ax=ax).get_yscale()
     'log'
     """
-    result, ax = _checked(result, ax)
-    own = ax is None
-    if own:
-        _, ax = _subplots(figsize=(11, 4.6))
+    result, ax, own = _one_panel(result, ax)
     scene, truth = result.scene, result.truth
     # Each entry says the span its maximum covers (up to where the runs part); on the user's
     # axes on one line.
@@ -193,36 +202,31 @@ def compare_energy(result: Comparison, ax: Any = None) -> Any:
 
     Parameters
     ----------
-    result : Comparison
-        What :func:`dumbbell.compare` measured.
-    ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+    result, ax
+        The comparison and the axes, as for :func:`dumbbell.plot.compare`.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The axes drawn on.
+        The axes drawn on (without ``ax``, the one axes of the new figure).
 
     Raises
     ------
     UsageError
-        A ``result`` that is not a Comparison, or an ``ax`` that is not one Axes.
+        A bad ``result`` or ``ax`` (:func:`dumbbell.plot.compare` says which).
 
     Examples
     --------
-    >>> import dumbbell
+    The energy each run gains or loses, beside the truth's own drift:
+
+    >>> from dumbbell import compare, plot
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> result = dumbbell.compare(scene, solvers=["euler-cromer"], dts=[1e-4], t_end=1.0,
-    ...                           window=1.0)
-    >>> ax = dumbbell.plot.compare_energy(result)
+    >>> ax = plot.compare_energy(compare(scenes_dir() / "textbook-1d.toml",
+    ...                                  solvers=["euler-cromer"], dts=[1e-4], t_end=1.0))
     >>> ax.get_ylabel()
     'E(t) / E(0) - 1 [1]'
     """
-    result, ax = _checked(result, ax)
-    own = ax is None
-    if own:
-        _, ax = _subplots(figsize=(11, 4.6))
+    result, ax, own = _one_panel(result, ax)
     scene, truth = result.scene, result.truth
     E0 = float(truth["E"][0]) or 1.0
     for colour, row in zip(ROW_COLOURS, result.rows, strict=False):

@@ -74,20 +74,22 @@ def sweep_map(result: SweepResult, ax: Any = None) -> Any:
     result : SweepResult
         What :func:`dumbbell.sweep` ran.
     ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+        Draw on these axes (their colour bar takes its room from them); None: a new figure.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The axes drawn on.
+        The map's axes (not the colour bar's).
 
     Raises
     ------
     UsageError
-        A ``result`` that is not a SweepResult, or an ``ax`` that is not one Axes.
+        ``result`` not a SweepResult (from :func:`dumbbell.sweep`), or ``ax`` not one Axes.
 
     Examples
     --------
+    Three stiffnesses by three steps: the stiff, long steps blow up.
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
@@ -297,10 +299,12 @@ def stability_map(maps: dict[str, list[PointResult]]) -> list[Any]:
     Raises
     ------
     UsageError
-        Maps that are not such a dict of rows.
+        A ``maps`` that is not such a dict of rows.
 
     Examples
     --------
+    One solver's map, its points run in this process:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.stability import map_rows
     >>> panels = dumbbell.plot.stability_map({"euler-cromer": map_rows("euler-cromer",

@@ -77,7 +77,7 @@ def rotation(s: Series, ax: Any = None) -> Any:
     s : Series
         The runs of :func:`dumbbell.analysis.rotation.series`.
     ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+        Draw on these axes (the spring runs' K_rot over the rigid one's); None: a new figure.
 
     Returns
     -------
@@ -87,15 +87,17 @@ def rotation(s: Series, ax: Any = None) -> Any:
     Raises
     ------
     UsageError
-        An ``s`` that is not a Series, or an ``ax`` that is not one Axes.
+        An ``s`` that is not a Series of runs, or an ``ax`` that is not one Axes.
 
     Examples
     --------
+    Two spring dumbbells and the rigid one, half a second each:
+
     >>> import dumbbell
     >>> from dumbbell.analysis.rotation import series
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")
-    >>> runs = series(scene, dt=1e-4, t_end=0.5, stiffnesses=(200.0, 2000.0))
+    >>> runs = series(dumbbell.load_scene(scenes_dir() / "tilted-2d.toml"), dt=1e-4,
+    ...               t_end=0.5, stiffnesses=(200.0, 2000.0))
     >>> ax = dumbbell.plot.rotation(runs)
     >>> ax.get_ylabel()
     'E [J]'

@@ -50,12 +50,13 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
     result : RestitutionResult
         What :func:`~dumbbell.analysis.restitution.restitution` measured.
     ax : sequence of three matplotlib.axes.Axes or None, default None
-        Draw on these; None: a new figure.
+        Draw on these (top to bottom: e_eff, the impacts, the rotation share); None: a new
+        figure.
 
     Returns
     -------
     list of matplotlib.axes.Axes
-        The three axes.
+        The three axes, top to bottom.
 
     Raises
     ------
@@ -64,11 +65,13 @@ def restitution(result: RestitutionResult, ax: Any = None) -> Any:
 
     Examples
     --------
+    The rigid dumbbell only (no spring runs), at three tilts:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> from dumbbell.analysis.restitution import restitution
-    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
-    >>> result = restitution(scene, [0.0, 30.0, 60.0], stiffnesses=(), dt=1e-4)
+    >>> result = restitution(dumbbell.load_scene(scenes_dir() / "rigid-2d.toml"),
+    ...                      [0.0, 30.0, 60.0], stiffnesses=(), dt=1e-4)
     >>> len(dumbbell.plot.restitution(result))
     3
     """
@@ -241,27 +244,30 @@ def contact_momentum(cm: ContactMomentum, ax: Any = None, solver: str = "") -> A
     cm : ContactMomentum
         What :func:`~dumbbell.analysis.contact.about_contact` measured.
     ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
+        Draw on these axes (the numbers in a smaller title); None: a new figure.
     solver : str, default ""
         The run's solver, for the title.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The axes drawn on.
+        The one axes drawn on.
 
     Raises
     ------
     UsageError
-        A ``cm`` that is not a ContactMomentum, or an ``ax`` that is not one Axes.
+        A ``cm`` not from :func:`~dumbbell.analysis.contact.about_contact`, an ``ax`` that
+        is not one Axes, or a ``solver`` that is not a str.
 
     Examples
     --------
+    The rigid dumbbell's first impact, solved exactly:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> from dumbbell.analysis.contact import about_contact
-    >>> scene = dumbbell.load_scene(scenes_dir() / "rigid-2d.toml")
-    >>> run = dumbbell.simulate(scene, solver="exact", t_end=0.6, dt=1e-4)
+    >>> run = dumbbell.simulate(dumbbell.load_scene(scenes_dir() / "rigid-2d.toml"),
+    ...                         solver="exact", t_end=0.6, dt=1e-4)
     >>> ax = dumbbell.plot.contact_momentum(about_contact(run), solver="exact")
     >>> ax.get_ylabel()
     'angular momentum [kg m²/s]'

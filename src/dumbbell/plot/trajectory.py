@@ -156,6 +156,8 @@ def positions(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 
     Examples
     --------
+    The textbook's run, solved exactly, on a figure of its own:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
@@ -196,12 +198,8 @@ def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 
     Parameters
     ----------
-    traj : Trajectory
-        The run.
-    ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure (see below).
-    window : float, default 2.0
-        The span [0, window] (s) drawn.
+    traj, ax, window
+        As for :func:`dumbbell.plot.positions` (``ax`` None: a new figure, see above).
 
     Returns
     -------
@@ -211,11 +209,12 @@ def kinetic(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     Raises
     ------
     UsageError
-        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
-        that is not a positive number.
+        As for :func:`dumbbell.plot.positions`.
 
     Examples
     --------
+    The kinetic and the potential energy side by side, on the user's own figure:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
@@ -239,31 +238,27 @@ def potential(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 
     Parameters
     ----------
-    traj : Trajectory
-        The run.
-    ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure (see below).
-    window : float, default 2.0
-        The span [0, window] (s) drawn.
+    traj, ax, window
+        As for :func:`dumbbell.plot.kinetic`.
 
     Returns
     -------
     matplotlib.axes.Axes
-        The energy panel.
+        The energy panel: ``ax``, or the lower panel of the new figure.
 
     Raises
     ------
     UsageError
-        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
-        that is not a positive number.
+        The arguments' faults that :func:`dumbbell.plot.positions` names.
 
     Examples
     --------
+    The exact run of the textbook's scene, straight from its file:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=2.0, dt=1e-3)
-    >>> ax = dumbbell.plot.potential(traj)
+    >>> ax = dumbbell.plot.potential(dumbbell.simulate(
+    ...     dumbbell.load_scene(scenes_dir() / "textbook-1d.toml"), solver="exact", t_end=2.0))
     >>> len(ax.figure.axes)                          # the positions above it
     2
     """
@@ -334,12 +329,9 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
 
     Parameters
     ----------
-    traj : Trajectory
-        The run.
-    ax : matplotlib.axes.Axes or None, default None
-        Draw on these axes; None: a new figure.
-    window : float, default 2.0
-        The span [0, window] (s) drawn.
+    traj, ax, window
+        The run, the axes (None: the figure described above) and the span [0, window] (s),
+        as for :func:`dumbbell.plot.positions`.
 
     Returns
     -------
@@ -349,11 +341,12 @@ def energy(traj: Trajectory, ax: Any = None, window: float = WINDOW) -> Any:
     Raises
     ------
     UsageError
-        A ``traj`` that is not a Trajectory, an ``ax`` that is not one Axes, or a window
-        that is not a positive number.
+        A bad ``traj``, ``ax`` or ``window`` (:func:`dumbbell.plot.positions` says which).
 
     Examples
     --------
+    A tilted dumbbell in the plane, whose impacts set it spinning:
+
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
     >>> scene = dumbbell.load_scene(scenes_dir() / "tilted-2d.toml")

@@ -59,7 +59,7 @@ class RunOptions:
     Raises
     ------
     UsageError
-        A field that is not allowed, naming it.
+        A field that is not allowed (the message names it and what is).
 
     Examples
     --------
@@ -290,8 +290,8 @@ class Solver:
 
         Parameters
         ----------
-        scene : Scene
-            The scene (or a scene file's path).
+        scene
+            As for :meth:`supports`.
 
         Returns
         -------
@@ -309,7 +309,7 @@ class Solver:
         Parameters
         ----------
         scene : Scene
-            The scene (or a scene file's path).
+            The scene whose floor is asked about (or a scene file's path).
 
         Returns
         -------

@@ -17,7 +17,6 @@ Only every ``every``-th step is kept, so memory follows the samples, not the ste
 
 from __future__ import annotations
 
-from ..model.scene import Scene
 from .base import ExplicitSpring
 from .kernels import Kernel
 from .stepping import Stepper
@@ -32,14 +31,7 @@ class EulerCromer(ExplicitSpring, Stepper):
     name = "euler-cromer"
     order = 1
     chunk = 4_000_000
-
-    @staticmethod
-    def _supports(scene: Scene) -> str | None:
-        """None if this solver can run ``scene``, else why not."""
-        if scene.system.dimensions != 1:
-            return ("euler-cromer is the 1D textbook method; use euler-cromer-2d or pymunk in "
-                    "2D")
-        return None
+    no_step = "euler-cromer is the 1D textbook method; use euler-cromer-2d or pymunk in 2D"
 
     @staticmethod
     def kernel(dimensions: int) -> Kernel | None:

@@ -20,8 +20,7 @@ Frictionless 2D spring (or free) dumbbells without spin only.
 
 from __future__ import annotations
 
-from ..model.scene import Scene
-from .base import ExplicitSpring, point_particle_limits
+from .base import ExplicitSpring
 from .kernels import Kernel
 from .stepping import Stepper
 
@@ -32,16 +31,14 @@ __all__: list[str] = []
 class EulerCromer2D(ExplicitSpring, Stepper):
     """A 2D Euler-Cromer in pymunk's step order (see the module docstring)."""
 
+    # Declared as euler_cromer.EulerCromer is (`duplicates` pairs the two by shape): a solver
+    # is one class with its own facts, and the steps are two algorithms (the listing's
+    # operation order, bit for bit, against pymunk's), so no class branches on dimensions.
+
     name = "euler-cromer-2d"
     order = 1
     chunk = 4_000_000
-
-    @staticmethod
-    def _supports(scene: Scene) -> str | None:
-        """None if this solver can run ``scene``, else why not."""
-        if scene.system.dimensions != 2:
-            return "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
-        return point_particle_limits(scene, "euler-cromer-2d")
+    no_step = "euler-cromer-2d is the 2D method; use euler-cromer (the textbook's) in 1D"
 
     @staticmethod
     def kernel(dimensions: int) -> Kernel | None:

@@ -326,7 +326,7 @@ def first_impact_state(
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
+        A tilt, height or other argument that is not allowed, named in the message.
 
     Examples
     --------

@@ -46,8 +46,8 @@ REPLAY_BLOCK = 1 << 16
 class Stepper(Solver):
     """A solver that advances by a fixed step with a compiled kernel. A subclass declares
     ``name``, ``order`` and ``step_limit`` and writes :meth:`kernel`; ``supports`` and
-    ``solve`` are written here, from the kernels it has (a subclass may say more in its own
-    ``supports``). Its floor reverses velocities (``flip_floor``), and its step costs about
+    ``solve`` are written here, from the kernels it has (``no_step`` says what to use where it
+    has none; a subclass may say more in its own ``_supports``). Its floor reverses velocities (``flip_floor``), and its step costs about
     Euler-Cromer's (``relative_cost``; a costlier step says so).
 
     Examples
@@ -88,6 +88,9 @@ class Stepper(Solver):
     estimates_error = False
     #: Steps per kernel call: the progress bar moves between calls.
     chunk: ClassVar[int] = 2_000_000
+    #: What :meth:`supports` says of a scene whose dimensions it has no step for (None: "NAME
+    #: has no step for ND scenes").
+    no_step: ClassVar[str | None] = None
 
     @classmethod
     def kernel(cls, dimensions: int) -> Kernel | None:
@@ -122,7 +125,7 @@ class Stepper(Solver):
             None if it can run it; else why not.
         """
         if cls.kernel(scene.system.dimensions) is None:
-            return f"{cls.name} has no step for {scene.system.dimensions}D scenes"
+            return cls.no_step or f"{cls.name} has no step for {scene.system.dimensions}D scenes"
         return point_particle_limits(scene, cls.name) if scene.system.dimensions == 2 else None
 
     @classmethod
