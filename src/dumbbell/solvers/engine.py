@@ -385,7 +385,8 @@ class _Watch:
     def verdict(self, row: tuple[float, ...], t: float, dt: float) -> Verdict | None:
         """The verdict of the sample ``row`` at ``t`` (s) of a run at step ``dt`` (s), or
         None when the run goes on."""
-        if not all(abs(v) < _BIG for v in row):
+        # abs(v) < _BIG for every v (False for a NaN), the loop in C: this runs per sample.
+        if not all(map(_BIG.__gt__, map(abs, row))):
             return Verdict("unstable", t, nonfinite_reason(self.scene, dt, Pymunk.step_limit))
         if not self.floors:
             return None
@@ -423,10 +424,10 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
     # Heat of the contacts, from their impulses step by step (friction included).
     from ..spaces.heat import HeatCounter
 
-    counter = HeatCounter._on(space)
-    heat = np.zeros(options.n_samples)
     i = 0  # step index; the floor log reads it (a closure cell), so the loop pays nothing
     log = _FloorLog(world, dt, scene.system.g, lambda: i) if world.floors else None
+    counter = HeatCounter._on(space)  # after the log: every handler is made by now
+    heat = np.zeros(options.n_samples)
     watch = _Watch.of(scene, world, names)
     step = space.step
     verdict: Verdict | None = None
@@ -442,7 +443,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                 j += 1
                 row = read()
                 out[j] = row
-                heat[j] = counter.total
+                heat[j] = counter._total  # no program here replaces its callbacks: no look
                 verdict = watch.verdict(row, j * every * dt, dt)
                 if verdict is not None:
                     if verdict.status == "unstable":
