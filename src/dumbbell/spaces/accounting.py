@@ -93,7 +93,6 @@ class Spring:
     stiffness: float
     rest: float
     damping: float
-    constraint: Any = None
 
 
 @dataclass(frozen=True)
@@ -415,7 +414,7 @@ def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped
         rest = c.rest_length
     return Spring(label, "DampedRotarySpring" if rotary else "DampedSpring",
                   ia, ib, anchors[0], anchors[1], float(c.stiffness),
-                  float(rest), float(c.damping), c)
+                  float(rest), float(c.damping))
 
 
 @dataclass(frozen=True)
@@ -666,8 +665,17 @@ class _Sampler:
         return out
 
 
+class _Shown:
+    """The energy records' one repr: every value with its unit (:func:`.units.shown`)."""
+
+    def __repr__(self) -> str:
+        from .units import shown
+
+        return shown(self)
+
+
 @dataclass(frozen=True, repr=False)
-class BodyEnergy:
+class BodyEnergy(_Shown):
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
     momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
     space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not).
@@ -710,14 +718,9 @@ class BodyEnergy:
     L_about: float
     units: tuple[str, str, str] = UNNAMED
 
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
-
 
 @dataclass(frozen=True, repr=False)
-class SpringEnergy:
+class SpringEnergy(_Shown):
     """One spring: its label, kind and potential energy U (J; in the space's ``units``).
 
     Parameters
@@ -729,7 +732,7 @@ class SpringEnergy:
     U : float
         Its potential energy (J).
     units : tuple of str, default ('units', 'mass units', 's')
-        As for :class:`BodyEnergy`.
+        (length, mass, time), as for :class:`BodyEnergy`.
 
     Examples
     --------
@@ -748,14 +751,9 @@ class SpringEnergy:
     U: float
     units: tuple[str, str, str] = UNNAMED
 
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
-
 
 @dataclass(frozen=True, repr=False)
-class SpaceEnergy:
+class SpaceEnergy(_Shown):
     """Energy and momentum of a space's dynamic bodies (in the ``units``
     :func:`energy` was given: (length, mass, time)).
 
@@ -784,7 +782,7 @@ class SpaceEnergy:
     notes : tuple of str
         What else to know.
     units : tuple of str, default ('units', 'mass units', 's')
-        As for :class:`BodyEnergy`.
+        As :func:`energy` was told (see :class:`BodyEnergy`).
 
     Examples
     --------
@@ -825,11 +823,6 @@ class SpaceEnergy:
     def complete(self) -> bool:
         """True when nothing holding energy was left out (no unknown constraints)."""
         return not self.unknown
-
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
 
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
