@@ -50,19 +50,16 @@ class Term:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> space = pymunk.Space()
+    >>> space.damping = 0.5                       # each second keeps half of every velocity
+    >>> ball = pymunk.Body(1.0, 1.0)
+    >>> ball.velocity = (2.0, 0.0)                # m/s: 2 J
+    >>> space.add(ball)
     >>> ledger = spaces.Ledger(space, units="m")
-    >>> for _ in range(60):
-    ...     space.step(1 / 600)
-    >>> balance = ledger.balance()
-    >>> balance.sources()[0]
-    Term('DampedSpring 0', 'step error', +0.0563252 J)
+    >>> for _ in range(100):
+    ...     space.step(0.01)
+    >>> ledger.balance().sources()[0]             # after 1 s, 1 m/s: 1.5 of the 2 J taken out
+    Term('space.damping', 'damping', -1.5 J)
     """
 
     source: str
