@@ -157,7 +157,8 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     Raises
     ------
     UsageError
-        An argument that is not allowed.
+        ``space`` not a pymunk Space, ``dt`` not a number > 0 or ``units`` not a unit; or a
+        space in a state no estimate holds for (a NaN, a body without a mass), naming it.
 
     Examples
     --------

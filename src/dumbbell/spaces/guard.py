@@ -168,15 +168,11 @@ def spring_omega(spring: Any) -> float:
     Examples
     --------
     >>> import pymunk
-    >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> round(spaces.spring_omega(spring), 4)         # sqrt(200 / 0.1)
+    >>> from dumbbell.spaces import spring_omega
+    >>> space = pymunk.Space()
+    >>> ball = pymunk.Body(0.1, 1e-4)                 # 0.1 kg, hung 1 m below the anchor
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0, 1), (0, 0), 1, 200, 0)
+    >>> round(spring_omega(spring), 4)   # sqrt(k / m): the line runs through the centre
     44.7214
     """
     import pymunk

@@ -63,8 +63,8 @@ class HeatCounter:
     space : pymunk.Space
         The space to count.
     units : str or tuple of str or None, default None
-        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
-        or (length, mass, time); None: not named (reprs say "energy units", never J).
+        The space's units, as :func:`dumbbell.spaces.energy` takes them; the total's repr
+        is in them.
 
     Raises
     ------

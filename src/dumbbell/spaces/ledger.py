@@ -129,8 +129,8 @@ class Ledger(Changes):
     tolerance : float, default 1e-6
         What ``complete`` allows, relative to the energy scale.
     units : str or tuple of str or None, default None
-        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
-        or (length, mass, time); None: not named (reprs say "energy units", never J).
+        The space's units, as :func:`dumbbell.spaces.energy` takes them; the balance prints
+        its energies in them.
 
     Raises
     ------
