@@ -223,7 +223,9 @@ class Driver:
     Raises
     ------
     UsageError
-        An argument that is not allowed, or an absurd step.
+        An argument :func:`survey` refuses, a ``dt`` over :data:`MAX_DT` (no step a space can
+        take), ``substeps`` not a whole number >= 1, or (``substeps`` None) a space the
+        guard suggests no step for.
 
     Examples
     --------
