@@ -64,7 +64,7 @@ class Skipped:
     >>> import pymunk
     >>> from dumbbell import spaces
     >>> wheel = pymunk.Body(1.0, 0.1)
-    >>> space = pymunk.Space()
+    >>> space = pymunk.Space()                     # a wheel driven by a motor
     >>> space.add(wheel, pymunk.SimpleMotor(space.static_body, wheel, 2.0))
     >>> e = spaces.energy(space)
     >>> e.unknown                      # a motor's work is not counted, so E is not complete
@@ -738,7 +738,7 @@ class SpringEnergy(_Shown):
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()
+    >>> space = pymunk.Space()                     # a rod twisted half a radian on a rotary spring
     >>> rod = pymunk.Body(1.0, pymunk.moment_for_segment(1.0, (-0.5, 0), (0.5, 0), 0.01))
     >>> rod.angle = 0.5                           # rad, twisted from its rest angle 0
     >>> space.add(rod, pymunk.DampedRotarySpring(space.static_body, rod, 0.0, 8.0, 0.0))

@@ -75,7 +75,7 @@ class HeatCounter:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()
+    >>> space = pymunk.Space()                     # a ball dropped from 1 m onto a floor
     >>> space.gravity = (0.0, -9.8)
     >>> ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
     >>> ball.position = (0.0, 1.0)
