@@ -48,7 +48,7 @@ class Finding:
 
     Examples
     --------
-    >>> from dumbbell.spaces import Finding        # as the guard makes them
+    >>> from dumbbell.spaces import Finding        # a row of the guard's, made by hand
     >>> f = Finding("spring", "DampedSpring 0", 0.7454, 0.00995, "take dt < 0.0002225 s",
     ...             0.0002225)
     >>> f.ok, f.checked, f.comparison()

@@ -39,7 +39,7 @@ from ..model.energy import (
     spring_potential,
     translational_ke,
 )
-from .units import UNNAMED
+from .units import UNNAMED, shown
 
 __all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
@@ -665,17 +665,8 @@ class _Sampler:
         return out
 
 
-class _Shown:
-    """The energy records' one repr: every value with its unit (:func:`.units.shown`)."""
-
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
-
-
 @dataclass(frozen=True, repr=False)
-class BodyEnergy(_Shown):
+class BodyEnergy:
     """One dynamic body: its label, mass (kg), moment (kg m^2), K_trans, K_rot, U_g (J),
     momentum (kg m/s) and angular momentum about the point asked for (kg m^2/s); in the
     space's ``units`` (length, mass, time), as :func:`energy` was told (not named when not).
@@ -699,7 +690,7 @@ class BodyEnergy(_Shown):
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                    # a wheel rolling at 3 m/s and 4 rad/s
+    >>> space = pymunk.Space()                    # a wheel moving at 3 m/s, spinning at 4 rad/s
     >>> wheel = pymunk.Body(2.0, 0.5)             # kg, kg m^2
     >>> wheel.velocity, wheel.angular_velocity = (3.0, 0.0), 4.0
     >>> space.add(wheel)
@@ -718,9 +709,11 @@ class BodyEnergy(_Shown):
     L_about: float
     units: tuple[str, str, str] = UNNAMED
 
+    __repr__ = shown
+
 
 @dataclass(frozen=True, repr=False)
-class SpringEnergy(_Shown):
+class SpringEnergy:
     """One spring: its label, kind and potential energy U (J; in the space's ``units``).
 
     Parameters
@@ -751,9 +744,11 @@ class SpringEnergy(_Shown):
     U: float
     units: tuple[str, str, str] = UNNAMED
 
+    __repr__ = shown
+
 
 @dataclass(frozen=True, repr=False)
-class SpaceEnergy(_Shown):
+class SpaceEnergy:
     """Energy and momentum of a space's dynamic bodies (in the ``units``
     :func:`energy` was given: (length, mass, time)).
 
@@ -824,6 +819,7 @@ class SpaceEnergy(_Shown):
         """True when nothing holding energy was left out (no unknown constraints)."""
         return not self.unknown
 
+    __repr__ = shown
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
            units: Any = None) -> SpaceEnergy:

@@ -438,9 +438,6 @@ def _refuse(advice: _Advice) -> int:
 def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
            units: str | None = None) -> list[tuple[Finding, bool]]:
     """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
-    ``speeds``: 'state' (the present speeds), 'energy' (the reach estimates) or 'both' (the
-    larger); ``tolerance``: the largest energy swing of a spring's step (a fraction;
-    math.inf for stability only); ``units``: the space's length unit for the messages.
 
     Parameters
     ----------
@@ -449,7 +446,8 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     dt : float
         The step (the space's time unit, s in SI).
     speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
+        The speeds checked: 'state' the present ones, 'energy' the reach estimates
+        (:func:`reach`), 'both' the larger.
     tolerance : float, default 0.01
         The largest energy swing of a spring's step (a fraction; math.inf for stability only).
     units : str or None, default None

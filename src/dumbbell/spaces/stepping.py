@@ -68,8 +68,10 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
     >>> ball.velocity = (0.0, 5.0)                  # thrown up at 5 m/s
     >>> space.add(ball)
     >>> spaces.step(space, 0.1, substeps=10)        # 10 steps of 0.01 s
-    >>> round(ball.velocity.y, 6), round(ball.position.y, 6)   # 5 - 9.8 * 0.1 m/s
-    (4.02, 0.4559)
+    >>> round(ball.velocity.y, 6)                   # m/s: 5 - 9.8 * 0.1
+    4.02
+    >>> round(ball.position.y, 6)      # m: each 0.01 s moves at the speed it starts with
+    0.4559
     """
     space = args.space(space)
     substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
@@ -221,9 +223,9 @@ class Driver:
     Raises
     ------
     UsageError
-        An argument :func:`survey` refuses, a ``dt`` over :data:`MAX_DT` (no step a space can
-        take), ``substeps`` not a whole number >= 1, or (``substeps`` None) a space the
-        guard suggests no step for.
+        An argument :func:`survey` refuses, a ``dt`` over 1e6 s (no step a space can take),
+        ``substeps`` not a whole number >= 1, or (``substeps`` None) a space the guard
+        suggests no step for.
 
     Examples
     --------
