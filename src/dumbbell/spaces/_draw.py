@@ -32,17 +32,14 @@ class PaletteDrawOptions(pymunk.SpaceDebugDrawOptions):
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> space = pymunk.Space()                     # a rod on a pivot
+    >>> rod = pymunk.Body(1.0, 0.1)
+    >>> pivot = pymunk.PivotJoint(space.static_body, rod, (0, 0))
+    >>> space.add(rod, pymunk.Segment(rod, (-0.5, 0.0), (0.5, 0.0), 0.02), pivot)
     >>> options = spaces.draw_options()
-    >>> isinstance(options, pymunk.SpaceDebugDrawOptions), options.ink_of(ball)
+    >>> isinstance(options, pymunk.SpaceDebugDrawOptions), options.ink_of(rod)
     (True, 0)
-    >>> len(options.capture(space))                 # the ball and the spring
+    >>> len(options.capture(space))                 # the rod and the pivot
     2
     """
 

@@ -48,20 +48,13 @@ class Finding:
 
     Examples
     --------
-    >>> import pymunk
-    >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> finding = spaces.check(space, 1 / 60)[0]
-    >>> finding.kind, round(finding.value, 4), finding.comparison()
-    ('spring', 0.7454, 'w dt = 0.7454 >= 0.00995')
-    >>> round(finding.dt_max, 7)                    # s
-    0.0002225
+    >>> from dumbbell.spaces import Finding        # a row of the guard's, made by hand
+    >>> f = Finding("spring", "DampedSpring 0", 0.7454, 0.00995, "take dt < 0.0002225 s",
+    ...             0.0002225)
+    >>> f.ok, f.checked, f.comparison()
+    (False, True, 'w dt = 0.7454 >= 0.00995')
+    >>> print(f)
+    spring: DampedSpring 0: w dt = 0.7454 >= 0.00995; take dt < 0.0002225 s
     """
 
     kind: str

@@ -306,10 +306,9 @@ def post(self: Any) -> None:
     everything else the solver did, one lumped term."""
     from ._records import Step
 
-    p = self._before
+    p, self._before = self._before, None
     if p is None:
         return
-    self._before = None
     b = self._b
     t = b.table
     n = t.n

@@ -39,7 +39,7 @@ from ..model.energy import (
     spring_potential,
     translational_ke,
 )
-from .units import UNNAMED
+from .units import UNNAMED, shown
 
 __all__ = ["BodyEnergy", "Skipped", "SpaceEnergy", "SpringEnergy", "energy"]
 
@@ -63,17 +63,14 @@ class Skipped:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> pin = pymunk.PinJoint(space.static_body, ball, (0.3, 1.5), (0.0, 0.0))
-    >>> space.add(pin)
-    >>> spaces.energy(space).skipped           # a pin stores no energy: nothing is left out
-    ()
+    >>> wheel = pymunk.Body(1.0, 0.1)
+    >>> space = pymunk.Space()                     # a wheel driven by a motor
+    >>> space.add(wheel, pymunk.SimpleMotor(space.static_body, wheel, 2.0))
+    >>> e = spaces.energy(space)
+    >>> e.unknown                      # a motor's work is not counted, so E is not complete
+    (Skipped(subject='SimpleMotor 0', reason='motor: puts energy in (its work is not counted)'),)
+    >>> e.complete
+    False
     """
 
     subject: str
@@ -96,7 +93,6 @@ class Spring:
     stiffness: float
     rest: float
     damping: float
-    constraint: Any = None
 
 
 @dataclass(frozen=True)
@@ -418,7 +414,7 @@ def _spring(c: Any, label: str, index: Callable[[Any], int]) -> Spring | Skipped
         rest = c.rest_length
     return Spring(label, "DampedRotarySpring" if rotary else "DampedSpring",
                   ia, ib, anchors[0], anchors[1], float(c.stiffness),
-                  float(rest), float(c.damping), c)
+                  float(rest), float(c.damping))
 
 
 @dataclass(frozen=True)
@@ -694,16 +690,13 @@ class BodyEnergy:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space, units="m")
-    >>> e.bodies[0]
-    BodyEnergy('body 0': K_trans = 0 J, K_rot = 0 J, U_g = 0.98 J, momentum = (0, 0) kg m/s)
+    >>> space = pymunk.Space()                    # a wheel moving at 3 m/s, spinning at 4 rad/s
+    >>> wheel = pymunk.Body(2.0, 0.5)             # kg, kg m^2
+    >>> wheel.velocity, wheel.angular_velocity = (3.0, 0.0), 4.0
+    >>> space.add(wheel)
+    >>> b = spaces.energy(space, units="m").bodies[0]
+    >>> b.K_trans, b.K_rot, b.momentum           # 1/2 m v^2, 1/2 I w^2 (J), m v (kg m/s)
+    (9.0, 4.0, (6.0, 0.0))
     """
 
     subject: str
@@ -716,10 +709,7 @@ class BodyEnergy:
     L_about: float
     units: tuple[str, str, str] = UNNAMED
 
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
+    __repr__ = shown
 
 
 @dataclass(frozen=True, repr=False)
@@ -735,22 +725,18 @@ class SpringEnergy:
     U : float
         Its potential energy (J).
     units : tuple of str, default ('units', 'mass units', 's')
-        (length, mass, time), as :func:`energy` was told.
+        (length, mass, time), as for :class:`BodyEnergy`.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> e = spaces.energy(space, units="m")
-    >>> e.springs[0]
-    SpringEnergy('DampedSpring 0', DampedSpring: U = 3.35238484 J)
+    >>> space = pymunk.Space()                     # a rod twisted half a radian on a rotary spring
+    >>> rod = pymunk.Body(1.0, pymunk.moment_for_segment(1.0, (-0.5, 0), (0.5, 0), 0.01))
+    >>> rod.angle = 0.5                           # rad, twisted from its rest angle 0
+    >>> space.add(rod, pymunk.DampedRotarySpring(space.static_body, rod, 0.0, 8.0, 0.0))
+    >>> spaces.energy(space, units="m").springs[0]   # 1/2 k theta^2 = 1/2 8 0.5^2
+    SpringEnergy('DampedRotarySpring 0', DampedRotarySpring: U = 1 J)
     """
 
     subject: str
@@ -758,10 +744,7 @@ class SpringEnergy:
     U: float
     units: tuple[str, str, str] = UNNAMED
 
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
+    __repr__ = shown
 
 
 @dataclass(frozen=True, repr=False)
@@ -794,24 +777,22 @@ class SpaceEnergy:
     notes : tuple of str
         What else to know.
     units : tuple of str, default ('units', 'mass units', 's')
-        (length, mass, time), as :func:`energy` was told.
+        As :func:`energy` was told (see :class:`BodyEnergy`).
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> space = pymunk.Space()                  # a dumbbell: two 1 kg balls on a 1 m rod
+    >>> a, b = pymunk.Body(1.0, 1e-3), pymunk.Body(1.0, 1e-3)
+    >>> b.position = (1.0, 0.0)
+    >>> a.velocity, b.velocity = (2.0, 1.0), (2.0, -1.0)     # m/s: flying and spinning
+    >>> space.add(a, b, pymunk.PinJoint(a, b))
     >>> e = spaces.energy(space, units="m")
-    >>> round(e.U_g, 6), round(e.U_spring, 6), round(e.E, 6)          # J
-    (0.98, 3.352385, 4.332385)
-    >>> e.momentum, e.skipped, e.unknown, e.notes
-    ((0.0, 0.0), (), (), ())
+    >>> e.K_trans, e.K_cm, e.K_int              # J: the centre of mass's share, the rest
+    (5.0, 4.0, 1.0)
+    >>> e.momentum, e.L_cm, e.cm                # kg m/s, kg m^2/s about cm (m)
+    ((4.0, 0.0), -1.0, (0.5, 0.0))
     """
 
     K_trans: float
@@ -838,11 +819,7 @@ class SpaceEnergy:
         """True when nothing holding energy was left out (no unknown constraints)."""
         return not self.unknown
 
-    def __repr__(self) -> str:
-        from .units import shown
-
-        return shown(self)
-
+    __repr__ = shown
 
 def energy(space: Any, about: tuple[float, float] = (0.0, 0.0),
            units: Any = None) -> SpaceEnergy:

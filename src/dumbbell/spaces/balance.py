@@ -50,19 +50,16 @@ class Term:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> space = pymunk.Space()                     # a ball slowed by the space's damping
+    >>> space.damping = 0.5                       # each second keeps half of every velocity
+    >>> ball = pymunk.Body(1.0, 1.0)
+    >>> ball.velocity = (2.0, 0.0)                # m/s: 2 J
+    >>> space.add(ball)
     >>> ledger = spaces.Ledger(space, units="m")
-    >>> for _ in range(60):
-    ...     space.step(1 / 600)
-    >>> balance = ledger.balance()
-    >>> balance.sources()[0]
-    Term('DampedSpring 0', 'step error', +0.0563252 J)
+    >>> for _ in range(100):
+    ...     space.step(0.01)
+    >>> ledger.balance().sources()[0]             # after 1 s, 1 m/s: 1.5 of the 2 J taken out
+    Term('space.damping', 'damping', -1.5 J)
     """
 
     source: str
@@ -118,28 +115,28 @@ class Balance:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a ball on a damped spring, SI units
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> ball = pymunk.Body(0.2, 1e-4)
+    >>> ball.position = (0.0, -0.5)                # 0.2 m past the rest length, 0.3 m
+    >>> damped = pymunk.DampedSpring(space.static_body, ball, (0, 0), (0, 0), 0.3, 50.0, 0.5)
+    >>> space.add(ball, damped)
     >>> ledger = spaces.Ledger(space, units="m")
     >>> for _ in range(60):
     ...     space.step(1 / 600)
     >>> balance = ledger.balance()
     >>> balance.complete, balance.steps, round(balance.E0, 6)
-    (True, 60, 4.332385)
-    >>> round(balance.by_kind()["step error"], 4)      # J: pymunk's step put energy in
-    0.0623
+    (True, 60, 0.02)
+    >>> round(balance.by_kind()["spring damping"], 4)  # J: the damper's heat
+    -0.138
     >>> [term.source for term in balance.sources("step error")]
     ['DampedSpring 0', 'gravity']
     >>> print(balance.table(top=1))
     energy ledger over 60 steps, t = 0.1 s, energies in J
-      E(0) = 4.33238484   E(t) = 4.39470941   scale = 3.352
-      step error       +0.0623246  (2 sources)
-          DampedSpring 0                           +0.0563252
+      E(0) = 0.02   E(t) = -0.116817533   scale = 0.9329
+      spring damping   -0.137998  (1 source)
+          DampedSpring 0 damping                   -0.137998
+      step error       +0.0011808  (2 sources)
           ...
       complete: True
     """

@@ -113,15 +113,14 @@ class Reach:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a ball thrown at 5 m/s, nothing under it
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> spaces.reach(space, 1 / 60)[0].bound
-    True
+    >>> ball = pymunk.Body(1.0, 1.0)
+    >>> ball.velocity = (3.0, 4.0)                  # m/s: thrown, nothing to fall onto
+    >>> space.add(ball, pymunk.Circle(ball, 0.1))
+    >>> (r,) = spaces.reach(space, 1 / 60)
+    >>> r.now, round(r.speed, 4), r.source, r.bound  # 5 m/s, and what gravity adds in a step
+    (5.0, 5.1633, 'its kinetic energy now', True)
     """
 
     subject: str
@@ -157,22 +156,22 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     Raises
     ------
     UsageError
-        An argument that is not allowed.
+        ``space`` not a pymunk Space, ``dt`` not a number > 0 or ``units`` not a unit; or a
+        space in a state no estimate holds for (a NaN, a body without a mass), naming it.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a ball 2 m above a floor
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> (estimate,) = spaces.reach(space, 1 / 60)
-    >>> estimate.subject, round(estimate.speed, 3), estimate.source   # m/s: from the spring
-    ('body 0', 8.27, "its springs' energy")
+    >>> ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
+    >>> ball.position = (0.0, 2.0)
+    >>> space.add(ball, pymunk.Circle(ball, 0.1), pymunk.Segment(space.static_body, (-1, 0),
+    ...                                                          (1, 0), 0.0))
+    >>> (estimate,) = spaces.reach(space, 1 / 60, units="m")
+    >>> estimate.subject, round(estimate.speed, 3), estimate.source   # m/s
+    ('body 0', 6.185, 'falls 1.9 m to the floor under it')
     """
     space = args.space(space)
     dt = args.real(dt, "dt", "s")

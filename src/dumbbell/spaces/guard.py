@@ -168,15 +168,11 @@ def spring_omega(spring: Any) -> float:
     Examples
     --------
     >>> import pymunk
-    >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> round(spaces.spring_omega(spring), 4)         # sqrt(200 / 0.1)
+    >>> from dumbbell.spaces import spring_omega
+    >>> space = pymunk.Space()                     # no gravity, no shapes: the spring alone
+    >>> ball = pymunk.Body(0.1, 1e-4)                 # 0.1 kg, hung 1 m below the anchor
+    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0, 1), (0, 0), 1, 200, 0)
+    >>> round(spring_omega(spring), 4)   # sqrt(k / m): the line runs through the centre
     44.7214
     """
     import pymunk
@@ -442,9 +438,6 @@ def _refuse(advice: _Advice) -> int:
 def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERANCE,
            units: str | None = None) -> list[tuple[Finding, bool]]:
     """Every check at step ``dt`` (s) as (finding, ok) pairs, passed ones included.
-    ``speeds``: 'state' (the present speeds), 'energy' (the reach estimates) or 'both' (the
-    larger); ``tolerance``: the largest energy swing of a spring's step (a fraction;
-    math.inf for stability only); ``units``: the space's length unit for the messages.
 
     Parameters
     ----------
@@ -453,7 +446,8 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     dt : float
         The step (the space's time unit, s in SI).
     speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
+        The speeds checked: 'state' the present ones, 'energy' the reach estimates
+        (:func:`reach`), 'both' the larger.
     tolerance : float, default 0.01
         The largest energy swing of a spring's step (a fraction; math.inf for stability only).
     units : str or None, default None
@@ -467,21 +461,22 @@ def survey(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
+        ``space`` not a pymunk Space, ``dt`` not a number > 0, ``speeds`` not one of the
+        three, ``tolerance`` not > 0, or ``units`` not None, a length unit or three names;
+        the message names which.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a box at rest on a floor, SI units
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> [(f.kind, ok) for f, ok in spaces.survey(space, 1e-4)][:1]
-    [('spring', True)]
+    >>> box = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (0.2, 0.1)))
+    >>> box.position = (0.0, 0.05)
+    >>> floor = pymunk.Segment(space.static_body, (-2.0, 0.0), (2.0, 0.0), 0.0)
+    >>> space.add(box, pymunk.Poly.create_box(box, (0.2, 0.1)), floor)
+    >>> [(f.kind, ok) for f, ok in spaces.survey(space, 1 / 60)]    # passed rows too
+    [('tunnelling', True), ('slop', False)]
     """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return [(f, f.ok) for f in _advise(space, dt, speeds, tolerance, unit).rows]
@@ -495,16 +490,8 @@ def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERA
 
     Parameters
     ----------
-    space : pymunk.Space
-        Any space.
-    dt : float
-        The step (the space's time unit, s in SI).
-    speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
-    tolerance : float, default 0.01
-        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
-    units : str or None, default None
-        The space's length unit, for the messages.
+    space, dt, speeds, tolerance, units
+        As for :func:`survey`, whose failing rows these are.
 
     Returns
     -------
@@ -514,22 +501,21 @@ def check(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLERA
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
+        An argument :func:`survey` refuses.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> [(f.kind, f.subject) for f in spaces.check(space, 1 / 60)]   # stiff for 60 fps
-    [('spring', 'DampedSpring 0')]
-    >>> spaces.check(space, 1e-4)
+    >>> space = pymunk.Space()                  # a ball falling at 20 m/s onto a thin floor
+    >>> ball = pymunk.Body(1.0, 1.0)
+    >>> ball.position, ball.velocity = (0.0, 1.0), (0.0, -20.0)
+    >>> floor = pymunk.Segment(space.static_body, (-1.0, 0.0), (1.0, 0.0), 0.01)
+    >>> space.add(ball, pymunk.Circle(ball, 0.05), floor)
+    >>> [(f.kind, f.subject) for f in spaces.check(space, 1 / 60)]
+    [('tunnelling', 'body 0'), ('slop', 'space.collision_slop')]
+    >>> space.collision_slop = 1e-4             # a setting: no step size fixes it
+    >>> spaces.check(space, 1 / 600)            # 20 m/s * dt under 0.06 m, the half-widths
     []
     """
     return [f for f, ok in survey(space, dt, speeds, tolerance, units) if not ok and f.checked]
@@ -543,16 +529,9 @@ def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOL
 
     Parameters
     ----------
-    space : pymunk.Space
-        Any space.
-    dt : float
-        The step (the space's time unit, s in SI).
-    speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
-    tolerance : float, default 0.01
-        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
-    units : str or None, default None
-        The space's length unit, for the messages.
+    space, dt, speeds, tolerance, units
+        As for :func:`survey`; the springs' energy swing at the sub-step stays under
+        ``tolerance``.
 
     Returns
     -------
@@ -562,23 +541,18 @@ def substeps(space: Any, dt: float, speeds: str = "both", tolerance: float = TOL
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
-    DumbbellError
-        A space in a state no step fixes.
+        An argument :func:`survey` refuses; a space in a state no step fixes (naming the
+        body and the value), or a ``dt`` that would need more than 10**9 sub-steps.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> spaces.substeps(space, 1 / 60)               # w dt under 0.00995 for a 1 % swing
-    75
+    >>> space = pymunk.Space()                     # a wheel on a stiff rotary spring
+    >>> wheel = pymunk.Body(1.0, 0.1)               # kg, kg m^2
+    >>> space.add(wheel, pymunk.DampedRotarySpring(space.static_body, wheel, 0.0, 1000.0, 0.0))
+    >>> spaces.substeps(space, 1 / 60)    # w = sqrt(1000 / 0.1) = 100 rad/s; w dt < 0.00995
+    168
     """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return _refuse(_advise(space, dt, speeds, tolerance, unit))
@@ -592,16 +566,8 @@ def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = T
 
     Parameters
     ----------
-    space : pymunk.Space
-        Any space.
-    dt : float
-        The step (the space's time unit, s in SI).
-    speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
-    tolerance : float, default 0.01
-        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
-    units : str or None, default None
-        The space's length unit, for the messages.
+    space, dt, speeds, tolerance, units
+        As for :func:`substeps`.
 
     Returns
     -------
@@ -611,21 +577,18 @@ def suggest_dt(space: Any, dt: float, speeds: str = "both", tolerance: float = T
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
+        As for :func:`substeps`.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> spaces.suggest_dt(space, 1 / 60) == 1 / 60 / spaces.substeps(space, 1 / 60)
-    True
+    >>> space = pymunk.Space()                     # a bob on a spring, no gravity
+    >>> bob = pymunk.Body(0.1, 1e-4)                # 0.1 kg on a 200 N/m spring: w = 44.7 rad/s
+    >>> space.add(bob, pymunk.DampedSpring(bob, space.static_body, (0, 0), (0, 0), 0, 200, 0))
+    >>> dt = spaces.suggest_dt(space, 1 / 60)       # 1/60 s in 75 whole sub-steps
+    >>> round(dt, 10), dt == 1 / 60 / spaces.substeps(space, 1 / 60)
+    (0.0002222222, True)
     """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     return dt / _refuse(_advise(space, dt, speeds, tolerance, unit))
@@ -663,16 +626,9 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
 
     Parameters
     ----------
-    space : pymunk.Space
-        Any space.
-    dt : float
-        The step (the space's time unit, s in SI).
-    speeds : {'both', 'state', 'energy'}, default 'both'
-        The speeds checked: the present ones, the reach estimates, or the larger.
-    tolerance : float, default 0.01
-        The largest energy swing of a spring's step (a fraction; math.inf for stability only).
-    units : str or None, default None
-        The space's length unit, for the messages.
+    space, dt, speeds, tolerance, units
+        As for :func:`survey`; ``units`` names the lengths in the lines (else they say
+        'units').
 
     Returns
     -------
@@ -682,23 +638,23 @@ def report(space: Any, dt: float, speeds: str = "both", tolerance: float = TOLER
     Raises
     ------
     UsageError
-        An argument that is not allowed, naming it.
+        An argument :func:`survey` refuses (a state no step fixes is reported, not
+        refused).
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a pendulum: a bob on a 0.6 m pin
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> bob = pymunk.Body(0.5, pymunk.moment_for_circle(0.5, 0, 0.05))
+    >>> bob.position = (0.6, 0.0)
+    >>> space.add(bob, pymunk.Circle(bob, 0.05), pymunk.PinJoint(space.static_body, bob))
     >>> print(spaces.report(space, 1 / 60, units="m"))
-    step-size guard at dt = 0.0166667 s ...
-      FAIL spring         DampedSpring 0         w dt = 0.7454 >= 0.00995; w = 44.72 rad/s: ...
-      suggested: 75 sub-steps of each step, of 0.0002222 s, ...
+    step-size guard at dt = 0.0166667 s (lengths in m; energy swing of springs under 1 %, ...
+      FAIL joint          PinJoint 0             0.1416 W > 0.03026 W; takes out 4.68 %/s ...
+      joints measured on a copy of the space over 2 s: 120 steps of this dt (1 body), ...
+      suggested: 6 sub-steps of each step, of 0.002778 s, for joint of PinJoint 0 ...
     """
     space, dt, speeds, tolerance, unit = _check(space, dt, speeds, tolerance, units)
     advice = _advise(space, dt, speeds, tolerance, unit)

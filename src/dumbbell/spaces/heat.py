@@ -63,8 +63,8 @@ class HeatCounter:
     space : pymunk.Space
         The space to count.
     units : str or tuple of str or None, default None
-        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
-        or (length, mass, time); None: not named (reprs say "energy units", never J).
+        The space's units, as :func:`dumbbell.spaces.energy` takes them; the total's repr
+        is in them.
 
     Raises
     ------
@@ -75,7 +75,7 @@ class HeatCounter:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()
+    >>> space = pymunk.Space()                     # a ball dropped from 1 m onto a floor
     >>> space.gravity = (0.0, -9.8)
     >>> ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.1))
     >>> ball.position = (0.0, 1.0)

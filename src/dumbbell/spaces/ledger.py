@@ -129,8 +129,8 @@ class Ledger(Changes):
     tolerance : float, default 1e-6
         What ``complete`` allows, relative to the energy scale.
     units : str or tuple of str or None, default None
-        The space's units as the recorder takes them: the length unit alone ('px' or 'm'),
-        or (length, mass, time); None: not named (reprs say "energy units", never J).
+        The space's units, as :func:`dumbbell.spaces.energy` takes them; the balance prints
+        its energies in them.
 
     Raises
     ------
@@ -141,19 +141,20 @@ class Ledger(Changes):
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a box sliding to a stop on a rough floor
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
+    >>> floor = pymunk.Segment(space.static_body, (-5.0, 0.0), (5.0, 0.0), 0.0)
+    >>> box = pymunk.Body(1.0, pymunk.moment_for_box(1.0, (0.2, 0.1)))
+    >>> box.position, box.velocity = (0.0, 0.05), (2.0, 0.0)     # m, m/s: 2 J to lose
+    >>> shape = pymunk.Poly.create_box(box, (0.2, 0.1))
+    >>> shape.friction = floor.friction = 1.0          # pymunk multiplies them
+    >>> space.add(box, shape, floor)
     >>> ledger = spaces.Ledger(space, units="m")      # counts every later space.step
-    >>> for _ in range(60):
-    ...     space.step(1 / 600)
+    >>> for _ in range(100):
+    ...     space.step(0.005)
     >>> balance = ledger.balance()
-    >>> balance.complete, balance.steps
-    (True, 60)
+    >>> balance.complete, balance.steps, round(balance.by_kind()["contact"], 3)   # J: all 2
+    (True, 100, -2.0)
     >>> ledger.detach()
     """
 

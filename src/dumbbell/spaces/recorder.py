@@ -118,14 +118,10 @@ def draw_options() -> Any:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> space.debug_draw(spaces.draw_options())       # collects what the recorder draws
+    >>> options = spaces.draw_options()
+    >>> isinstance(options, pymunk.SpaceDebugDrawOptions)
+    True
+    >>> pymunk.Space().debug_draw(options)         # collects what the recorder draws
     """
     return _options_class()()
 
@@ -323,20 +319,20 @@ class Recorder:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a rod thrown up, tumbling, SI units
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> with spaces.Recorder(space, "ball.gif", fps=10, size="320x180") as rec:
-    ...     for frame in range(10):
-    ...         spaces.step(space, 1 / 10, substeps=500)
-    ...         rec.capture()
+    >>> rod = pymunk.Body(1.0, pymunk.moment_for_segment(1.0, (-0.3, 0), (0.3, 0), 0.02))
+    >>> rod.velocity, rod.angular_velocity = (0.5, 4.0), 6.0
+    >>> space.add(rod, pymunk.Segment(rod, (-0.3, 0), (0.3, 0), 0.02))
+    >>> rec = spaces.Recorder(space, "rod.gif", fps=10, size="320x180", units="m")
+    >>> for frame in range(10):
+    ...     spaces.step(space, 1 / 10, substeps=10)
+    ...     rec.capture()
     >>> len(rec.recording().t)                     # frame 0 and ten captures
     11
-    >>> open("ball.gif", "rb").read(6)
+    >>> rec.write().name            # a ``with`` block (``with Recorder(...) as rec:``) writes
+    'rod.gif'
+    >>> open("rod.gif", "rb").read(6)
     b'GIF89a'
     """
 
@@ -603,24 +599,6 @@ class Recorder:
         -------
         pathlib.Path
             The file written.
-
-        Examples
-        --------
-        >>> import pymunk
-        >>> from dumbbell import spaces
-        >>> space = pymunk.Space()                     # a ball on a spring, SI units
-        >>> space.gravity = (0.0, -9.8)
-        >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-        >>> ball.position = (0.3, 1.0)
-        >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-        ...                              200.0, 0.0)
-        >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-        >>> rec = spaces.Recorder(space, "ball.gif", fps=10, size="320x180")
-        >>> for frame in range(5):
-        ...     spaces.step(space, 1 / 10, substeps=500)
-        ...     rec.capture()
-        >>> rec.write().name
-        'ball.gif'
         """
         from ..animation import recording
 

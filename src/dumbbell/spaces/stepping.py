@@ -62,16 +62,16 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
+    >>> space = pymunk.Space()                     # a ball thrown straight up
     >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> spaces.step(space, 1 / 60, substeps=spaces.substeps(space, 1 / 60))
-    >>> spaces.check(space, 1 / 60 / 75)
-    []
+    >>> ball = pymunk.Body(1.0, 1.0)
+    >>> ball.velocity = (0.0, 5.0)                  # thrown up at 5 m/s
+    >>> space.add(ball)
+    >>> spaces.step(space, 0.1, substeps=10)        # 10 steps of 0.01 s
+    >>> round(ball.velocity.y, 6)                   # m/s: 5 - 9.8 * 0.1
+    4.02
+    >>> round(ball.position.y, 6)      # m: each 0.01 s moves at the speed it starts with
+    0.4559
     """
     space = args.space(space)
     substeps = args.whole(substeps, "substeps", "sub-steps", hi=MAX_STEPS)
@@ -223,23 +223,22 @@ class Driver:
     Raises
     ------
     UsageError
-        An argument that is not allowed, or an absurd step.
+        An argument :func:`survey` refuses, a ``dt`` over 1e6 s (no step a space can take),
+        ``substeps`` not a whole number >= 1, or (``substeps`` None) a space the guard
+        suggests no step for.
 
     Examples
     --------
     >>> import pymunk
     >>> from dumbbell import spaces
-    >>> space = pymunk.Space()                     # a ball on a spring, SI units
-    >>> space.gravity = (0.0, -9.8)
-    >>> ball = pymunk.Body(0.1, pymunk.moment_for_circle(0.1, 0, 0.02))
-    >>> ball.position = (0.3, 1.0)
-    >>> spring = pymunk.DampedSpring(space.static_body, ball, (0.0, 1.5), (0.0, 0.0), 0.4,
-    ...                              200.0, 0.0)
-    >>> space.add(ball, pymunk.Circle(ball, 0.02), spring)
-    >>> driver = spaces.Driver(space, 1 / 60)
+    >>> space = pymunk.Space()                     # two 1 kg balls on a 400 N/m spring
+    >>> a, b = pymunk.Body(1.0, 1e-3), pymunk.Body(1.0, 1e-3)
+    >>> b.position = (1.0, 0.0)
+    >>> space.add(a, b, pymunk.DampedSpring(a, b, (0, 0), (0, 0), 0.8, 400.0, 0.0))
+    >>> driver = spaces.Driver(space, 1 / 60)       # the guard's sub-steps: w = sqrt(800)
     >>> driver.step(5)
     >>> driver
-    Driver(dt=0.0166667 s, substeps=75, frames=5, t=0.0833333 s)
+    Driver(dt=0.0166667 s, substeps=48, frames=5, t=0.0833333 s)
     """
 
     def __init__(self, space: Any, dt: float, substeps: int | None = None,
