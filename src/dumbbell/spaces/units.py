@@ -72,7 +72,8 @@ def angular_unit(units: tuple[str, str, str]) -> str:
 
 
 def _g(value: float) -> str:
-    return f"{value:.9g}"
+    # + 0.0 turns a -0.0 (U_g = -m g y at y = 0, or with no gravity) into 0.
+    return f"{value + 0.0:.9g}"
 
 
 def shown(record: Any) -> str:
