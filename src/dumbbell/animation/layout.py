@@ -113,3 +113,27 @@ def layout(scene: Scene, runs: Sequence[Frames], size: tuple[int, int], strip: b
                  W - round(STRIP_RIGHT * u), H - round(STRIP_BOTTOM * u))
     return Layout(W, H, u, s, ox, oy, (x0, x1, y0, y1), round(ruler - RULER_INSET * u), scene_w,
                   bars_box, strip_box)
+
+
+#: A recorded space's frame, in units of u or shares of W and H: the picture panel takes
+#: this share of W when there are energy bars; the bars' panel ends at this share of H when
+#: a strip follows, which starts at this share of H, this far right of the bars' panel and
+#: this far from the right edge.
+SPACE_SCENE_SHARE = 0.56
+SPACE_BARS_SHARE = 0.55
+SPACE_STRIP_TOP_SHARE = 0.62
+SPACE_STRIP_RIGHT = 12
+
+
+def space_layout(W: int, H: int, energy: bool, strip: bool
+                 ) -> tuple[int, tuple[int, int, int, int], tuple[int, int, int, int]]:
+    """Where the panels of a recorded space's ``W`` x ``H`` frame go (px): the picture
+    panel's width, the energy bars' box and the strip's box (left, top, right, bottom)."""
+    u = unit(W, H)
+    scene_w = round(SPACE_SCENE_SHARE * W) if energy else W
+    right = scene_w + round(PANEL_GAP * u)
+    bars_box = (right, round(EDGE * u), W - round(EDGE * u),
+                round(SPACE_BARS_SHARE * H) if strip else H - round(EDGE * u))
+    strip_box = (right + round(STRIP_LEFT * u), round(SPACE_STRIP_TOP_SHARE * H),
+                 W - round(SPACE_STRIP_RIGHT * u), H - round(STRIP_BOTTOM * u))
+    return scene_w, bars_box, strip_box

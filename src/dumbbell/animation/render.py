@@ -369,16 +369,14 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
     settings on the way from ``dumbbell run``, checked when the scene was read."""
     from .. import progress
     from ..model.sizes import pixel_size
-    from .drawing import Painter
-    from .gif import write_frames
     from .picture import describe
+    from .world import scene_painter
     from .writer import binary_output
 
     (width, height), fps, strip, t_end = pixel_size(gif.size), gif.fps, gif.strip, gif.t_end
     t0 = time.perf_counter()
     frames = _frames_of(traj, fps, t_end)
-    painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
-    delays = _delays(len(frames.t), fps)
+    painter = scene_painter(describe(traj.scene, (frames,), (width, height), strip))
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"
     with contextlib.ExitStack() as stack:
@@ -387,8 +385,7 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
         else:
             fh = stack.enter_context(binary_output(path))
         pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
-        stats["draw"], stats["encode"] = write_frames(fh, (width, height), painter.frame, delays,
-                                                      on_frame=lambda: pbar.update(1))
+        stats["draw"], stats["encode"] = painter.write_gif(fh, fps, on_frame=lambda: pbar.update(1))
         result = Gif(fh.getvalue()) if path is None else Path(path)
     stats["frames"] = len(frames.t)
     if timing is not None:
