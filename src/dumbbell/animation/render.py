@@ -211,13 +211,12 @@ class Gif(bytes):
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj = dumbbell.simulate(scenes_dir() / "tilted-2d.toml", t_end=0.5)
     >>> gif = dumbbell.render_gif(traj, fps=10, size="320x180", quiet=True)
     >>> gif[:6], type(gif).__name__
     (b'GIF89a', 'Gif')
-    >>> gif.save("textbook.gif").name
-    'textbook.gif'
+    >>> dumbbell.Gif(gif.data) == gif, gif.save("tilted.gif").name
+    (True, 'tilted.gif')
     """
 
     def __new__(cls, data: bytes | bytearray | memoryview = b"") -> Self:
@@ -249,22 +248,23 @@ class Gif(bytes):
         return out.getvalue()
 
     def save(self, path: str | Path) -> Path:
-        """Write the GIF, whole or not at all.
+        """Write the GIF to a file, whole or not at all: a stop signal or a full disk leaves
+        no partial file behind.
 
         Parameters
         ----------
         path : str or pathlib.Path
-            The file.
+            The GIF file (``.gif`` is usual), replaced only once the whole GIF is written.
 
         Returns
         -------
-        pathlib.Path
-            The file written.
+        written : pathlib.Path
+            ``path``, as a ``Path``.
 
         Raises
         ------
         UsageError
-            A path that cannot be written (one line saying why).
+            A folder, or a path that cannot be written, said in one line.
         """
         from ..files import writable_path
         from .writer import binary_output
@@ -331,8 +331,7 @@ def render_gif(
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj = dumbbell.simulate(scenes_dir() / "textbook-1d.toml", solver="exact", t_end=1.0)
     >>> dumbbell.render_gif(traj, "textbook.gif", fps=10, size=(320, 180), quiet=True).name
     'textbook.gif'
     >>> dumbbell.render_gif(traj, fps=100)

@@ -46,20 +46,18 @@ __all__: list[str] = []
 #: terms oscillate at 20 Hz: over 1 s and ~390 px each oscillation is ~20 px wide and reads
 #: as a line (over 2 s they merge into a hatched band; over the whole run, a pale band).
 WINDOW = 1.0
-#: Fraction of the strip's window after the cursor (what comes next).
-AHEAD = 0.25
-#: Opacity of what lies after the cursor (over white): it has not happened yet at the
-#: frame's time, so it is drawn faded.
-FUTURE = 0.25
+#: The share of the strip's window after the cursor (what comes next), and the opacity of
+#: what lies there (over white): it has not happened yet at the frame's time, so it is
+#: drawn faded.
+AHEAD, FUTURE = 0.25, 0.25
 #: Width (px) of the pieces the strip's tape is drawn in.
 TAPE_CHUNK = 1024
 #: Time ticks per window (about).
 TIME_TICKS = 5
-#: A term whose range within one pixel column is mostly wider than this (px) changes faster
-#: than a column can show: it is drawn as a pale band of that range, not as a line.
-BAND_PX = 3
-#: Opacity of such a band.
-BAND_ALPHA = 0.45
+#: A term whose range within one pixel column is mostly wider than BAND_PX (px) changes
+#: faster than a column can show: it is drawn as a pale band of that range, at opacity
+#: BAND_ALPHA, not as a line.
+BAND_PX, BAND_ALPHA = 3, 0.45
 GRID = (238, 238, 238)     # the energy grid lines
 IMPACT = (216, 216, 216)   # the impacts' faint lines
 #: The names of the strip's axes: energy (left) and time (under it).
