@@ -14,15 +14,19 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from PIL import Image, ImageDraw
 
 from ..model.energy import BOOKKEEPING
 from .glyphs import SMALL_PX, TEXT_PX, TITLE_PX, Stamps, font, nice_step
+from .layout import unit
 from .painter import SS, Painter, Patch, Rect
 from .palette import GREY, INK, TERM_RGB, blend, ink_index
+
+if TYPE_CHECKING:  # for the annotations only
+    from .recorded import Recording
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
 #: and :class:`dumbbell.spaces.Recorder`.
@@ -205,17 +209,18 @@ class Bars:
                    value_gap=round(VALUE_GAP * u))
 
     @classmethod
-    def of_space(cls, box: tuple[int, int, int, int], u: float, energy: Mapping[str, Any],
-                 labels: Mapping[str, str], title: str, heat: bool, values: Stamps) -> Bars:
-        """A recorded space's panel in ``box`` for the rows ``energy`` (name -> values per
-        frame) with their ``labels`` and ``title``, on the scale of all of them (and of
-        E + heat with ``heat``), room left for the widest value printed with ``values``."""
-        names = tuple(energy)
-        e = {k: np.asarray(v, dtype=float) for k, v in energy.items()}
-        vals = [e[n] for n in names] + ([e["E"] + e["heat"]] if heat else [])
+    def of_space(cls, box: tuple[int, int, int, int], rec: Recording, readings: Readings
+                 ) -> Bars:
+        """A recorded space's panel in ``box`` for the rows of ``rec`` (their ``readings``),
+        with their labels and title, on the scale of all of them (and of E + heat with a
+        heat counter)."""
+        u = unit(*rec.size)
+        e, names, labels = readings.energy, tuple(readings.energy), rec.labels or {}
+        vals = [e[n] for n in names] + ([e["E"] + e["heat"]] if rec.heat else [])
         scale = EnergyScale.of(vals, plain=True)
         bx0, _, bx1, _ = box
         widest = max(abs(scale.lo), scale.hi)
+        values = Stamps(font(max(8, round(TEXT_PX * u))))
         value_w = round(values.width(f"-{widest:.{scale.decimals}f}") + SPACE_VALUE_PAD * u)
         # The bars start right of the longest name (a negative bar reaching the scale's
         # low end must not paint over it: issue 29), and at least SPACE_LABEL_ROOM from
@@ -227,8 +232,9 @@ class Bars:
         right = bx1 - value_w
         px_per_j = (right - left) / scale.span
         return cls(box, u, names, names, scale, left, right, left - scale.lo * px_per_j,
-                   px_per_j, bar_rows(names, box, u, row_max=SPACE_ROW_MAX), None, title,
-                   dict(labels), SPACE_INKS, False, heat, SPACE_VALUE_GAP)
+                   px_per_j, bar_rows(names, box, u, row_max=SPACE_ROW_MAX), None,
+                   rec.energy_title, dict(labels), SPACE_INKS, False, rec.heat,
+                   SPACE_VALUE_GAP)
 
     def px(self, value: float) -> float:
         """Pixel x of energy ``value`` (J) on the fixed scale."""

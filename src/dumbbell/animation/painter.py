@@ -30,7 +30,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from .glyphs import NOTE_PX, TEXT_PX, TIME_PX, PaletteText, Stamps, font
-from .layout import EDGE
+from .layout import EDGE, unit
 from .palette import GREY, INK, LIGHT, WHITE, ink_index, to_palette
 
 #: No public names: the painter behind :func:`dumbbell.animation.render.render_gif` and
@@ -68,9 +68,12 @@ class Panel(Protocol):
     """The picture panel of a frame: what differs between a scene and a recorded space."""
 
     #: Frames drawn, and whether each starts from the whole background (a scene's: all of
-    #: it changes anyway) or from the frame before (a space's: only what moved is drawn).
+    #: it changes anyway) or from the frame before (a space's: only what moved is drawn);
+    #: the panel's width (px: the energy panel, if any, starts there) and its time label.
     n: int
     fresh_every_frame: bool
+    width: int
+    clock: Clock
 
     def draw_base(self, d: ImageDraw.ImageDraw, S: int) -> None:
         """What lies under everything else, on the background ``S`` times the size."""
@@ -106,19 +109,19 @@ ANGLE_AT = 24
 
 
 class Painter:
-    """Draws the frames of one animation in the fixed palette (see the module notes): the
-    ``panel`` (a scene's world or a space's view), the ``bars`` and the ``strip`` (None
-    without: a :class:`.bars.Bars` and a :class:`.strip.Strip`, which import this module,
-    so it names them only here), and the ``clock``, on frames of ``size`` (px) of length
-    unit ``u``; the energy panel starts at ``scene_w`` (px)."""
+    """Draws the frames of one animation in the fixed palette (see the module notes), of
+    ``size`` (px): the ``panel`` (a scene's world or a space's view) with its time label,
+    and the ``bars`` and the ``strip`` (None without: a :class:`.bars.Bars` and a
+    :class:`.strip.Strip`, which import this module, so it names them only here) of the
+    ``readings`` (per frame: its time ``t``, each row's ``energy``; see
+    :class:`.bars.Readings`)."""
 
-    def __init__(self, size: tuple[int, int], u: float, scene_w: int, panel: Panel,
-                 clock: Clock, bars: Any = None, strip: Any = None, readings: Any = None
-                 ) -> None:
+    def __init__(self, size: tuple[int, int], panel: Panel, bars: Any = None,
+                 strip: Any = None, readings: Any = None) -> None:
         self.W, self.H = size
-        self.u = u
-        self.scene_w = scene_w
-        self.panel, self.clock, self.bars, self.strip = panel, clock, bars, strip
+        self.u = u = unit(*size)
+        self.scene_w = panel.width
+        self.panel, self.clock, self.bars, self.strip = panel, panel.clock, bars, strip
         #: What the bars and the strip read per frame (see :meth:`.bars.Bars.draw`).
         self.readings = readings
         self.n = panel.n

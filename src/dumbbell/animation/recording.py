@@ -25,8 +25,8 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from .bars import Bars, Readings
-from .camera import View, all_box, auto_view, fit, scene_area
-from .glyphs import TEXT_PX, TIME_PX, Stamps, font
+from .camera import View, all_box, auto_view, fit
+from .glyphs import TIME_PX, Stamps, font
 from .layout import space_layout, unit
 from .painter import SS, Clock, Painter, Rect, whole
 from .palette import INK, WHITE
@@ -51,11 +51,20 @@ class ViewPanel:
 
     fresh_every_frame = False
 
-    def __init__(self, rec: Recording, u: float, scene_w: int,
-                 area: tuple[int, int, int, int]) -> None:
-        self.rec, self.u, self.scene_w, self.area = rec, u, scene_w, area
+    def __init__(self, rec: Recording, scene_w: int, area: tuple[int, int, int, int]) -> None:
+        self.rec, self.scene_w, self.area = rec, scene_w, area
         self.W, self.H = rec.size
+        self.u = u = unit(self.W, self.H)
         self.n = rec.n
+        self.width = scene_w
+        self.t = t = np.asarray(rec.t, dtype=float)
+        self.t_decimals = time_decimals(t)
+        # The time label's box: wider when the longest label needs it (a large t0, a long
+        # time unit), so that each label is drawn over the whole of the one before.
+        longest = max((self.label(k) for k in range(rec.n)), key=len, default="")
+        stamps = Stamps(font(max(9, round(TIME_PX * u)), bold=True))
+        box = (4 * u, 2 * u, max(150 * u, stamps.width(longest) + 12 * u), 24 * u)
+        self.clock = Clock(box, self.label, on_white=True)
         self.body_px = BODY_PX * max(1.0, u)
         self._views()
         self._layer: Layer | None = None
@@ -96,6 +105,10 @@ class ViewPanel:
     def view(self) -> Box:
         """The world box of the first frame's view (x0, x1, y0, y1; y0 < y1)."""
         return self.views[0].box
+
+    def label(self, k: int) -> str:
+        """Frame ``k``'s time label."""
+        return f"t = {self.t[k]:.{self.t_decimals}f} {self.rec.time_unit}"
 
     def draw_base(self, d: ImageDraw.ImageDraw, S: int) -> None:
         pass  # the static shapes depend on the frame's view
@@ -209,36 +222,17 @@ def time_decimals(t: np.ndarray) -> int:
 
 def painter_of(rec: Recording) -> Painter:
     """The painter of ``rec``: its view panel, and with energy the bars (and the strip) of
-    its rows, with its time label."""
+    its rows."""
     W, H = rec.size
-    u = unit(W, H)
     energy = rec.energy is not None
     strip = rec.strip and energy
-    scene_w, bars_box, strip_box = space_layout(W, H, energy, strip)
-    t = np.asarray(rec.t, dtype=float)
-    e = {k: np.asarray(v, dtype=float) for k, v in (rec.energy or {}).items()}
-    bars = panel_strip = None
-    if energy:
-        values = Stamps(font(max(8, round(TEXT_PX * u))))
-        bars = Bars.of_space(bars_box, u, e, rec.labels or {}, rec.energy_title, rec.heat,
-                             values)
-        if strip:
-            panel_strip = Strip.whole_run(strip_box, u, bars.scale, t, e, rec.heat,
-                                          rec.time_unit)
-    decimals = time_decimals(t)
-
-    def label(k: int) -> str:
-        return f"t = {t[k]:.{decimals}f} {rec.time_unit}"
-
-    # The time label's box: wider when the longest label needs it (a large t0, a long time
-    # unit), so that each label is drawn over the whole of the one before.
-    longest = max((label(k) for k in range(rec.n)), key=len, default="")
-    stamps = Stamps(font(max(9, round(TIME_PX * u)), bold=True))
-    box = (4 * u, 2 * u, max(150 * u, stamps.width(longest) + 12 * u), 24 * u)
-    panel = ViewPanel(rec, u, scene_w, scene_area(W, H, energy))
-    painter = Painter((W, H), u, scene_w, panel, Clock(box, label, on_white=True), bars,
-                      panel_strip, Readings(t, e))
-    return painter
+    scene_w, area, bars_box, strip_box = space_layout(W, H, energy, strip)
+    panel = ViewPanel(rec, scene_w, area)
+    readings = Readings(panel.t, {k: np.asarray(v, dtype=float)
+                                  for k, v in (rec.energy or {}).items()})
+    bars = Bars.of_space(bars_box, rec, readings) if energy else None
+    panel_strip = Strip.whole_run(strip_box, bars.scale, rec, readings) if strip else None
+    return Painter((W, H), panel, bars, panel_strip, readings)
 
 
 def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) -> ViewPanel:

@@ -62,7 +62,6 @@ def space_document(painter: Any) -> dict[str, Any]:
 
     panel, bars, strip = painter.panel, painter.bars, painter.strip
     rec, u = panel.rec, painter.u
-    t = painter.readings.t
     views: list[Any] = []
     view_of = []
     for v in panel.views:
@@ -94,7 +93,7 @@ def space_document(painter: Any) -> dict[str, Any]:
     shape_colours = [[hex_colour(out), hex_colour(fill)] for out, fill in SHAPE_COLOURS]
     doc: dict[str, Any] = {
         "size": [painter.W, painter.H], "u": u, "title": rec.title,
-        "time_unit": rec.time_unit, "t_decimals": R.time_decimals(t),
+        "time_unit": rec.time_unit, "t_decimals": panel.t_decimals,
         "scene_w": painter.scene_w, "area": list(panel.area),
         "views": [[v.s, v.ox, v.oy, v.flip] for v in views], "view_of": view_of,
         "statics": [[list(it) for it in items] for items in rec.statics],

@@ -17,13 +17,15 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PIL import Image, ImageDraw
 
-from .bars import SPACE_INKS, EnergyScale
+from .bars import SPACE_INKS, EnergyScale, Readings
 from .frames import Frames
 from .glyphs import NOTE_PX, Stamps, fmt_tick, font, nice_step
+from .layout import unit
 from .painter import Painter, Patch, Rect
 from .palette import (
     GREY,
@@ -37,6 +39,9 @@ from .palette import (
     term_inks,
     to_palette,
 )
+
+if TYPE_CHECKING:  # for the annotations only
+    from .recorded import Recording
 
 #: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
 #: and :class:`dumbbell.spaces.Recorder`.
@@ -137,23 +142,25 @@ class Strip:
                    nice_step(window / TIME_TICKS), PAD * u)
 
     @classmethod
-    def whole_run(cls, box: tuple[int, int, int, int], u: float, scale: EnergyScale,
-                  t: np.ndarray, energy: dict[str, np.ndarray], heat: bool, unit: str
-                  ) -> Strip:
-        """A recorded space's strip in ``box``: its whole recording (frames at times ``t``,
-        in ``unit``), the rows ``energy`` (E last; with ``heat``, E + heat before it)."""
+    def whole_run(cls, box: tuple[int, int, int, int], scale: EnergyScale, rec: Recording,
+                  readings: Readings) -> Strip:
+        """A recorded space's strip in ``box``: the whole of ``rec`` (its ``readings``: the
+        frames' times, each row's energy; E last, with a heat counter E + heat before
+        it)."""
         sx0, sy0, sx1, sy1 = box
+        u, t, energy = unit(*rec.size), readings.t, readings.energy
         t0, end = float(t[0]), float(t[-1])
         window = max(float(t[-1] - t[0]), 1e-300)
         series = [(SPACE_INKS[n], energy[n]) for n in energy if n != "E"]
-        if heat:
+        if rec.heat:
             series.append((blend(SPACE_INKS["heat"], HEAT_ALPHA), energy["E"] + energy["heat"]))
         series.append((SPACE_INKS["E"], energy["E"]))
         return cls(box, u, scale, sx0 + 1, sx1 - sx0 - 1, 0, sy0 + 1, sy1 - sy0, window,
                    (sx1 - sx0 - 2) / window, sx1 - sx0 - 1, 0,
                    nice_step((end - t0) / WHOLE_TICKS) if end > t0 else 1.0,
                    WHOLE_PAD * u, False, t0, end, tuple((rgb, t, v) for rgb, v in series),
-                   WHOLE_FONT, f"t ({unit})")
+                   WHOLE_FONT, f"t ({rec.time_unit})")
+
     def y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
         _, sy0, _, sy1 = self.box

@@ -319,6 +319,8 @@ class ScenePanel:
     def __init__(self, world: World, frames: Frames) -> None:
         self.world, self.frames = world, frames
         self.n = len(frames.t)
+        self.width = world.layout.scene_w
+        self.clock = world.clock(frames)
         t, impacts = frames.t, np.asarray(frames.impacts)
         # Frames after which an impact happened since the previous frame.
         self.impact_frames = {int(k) for k in np.searchsorted(t, impacts, side="left")
@@ -346,5 +348,5 @@ def scene_painter(picture: Any, run: int = 0) -> Painter:
     imports this module): its world, its bars and its strip, on its layout."""
     frames = picture.runs[run]
     L = picture.layout
-    return Painter((L.W, L.H), L.u, L.scene_w, ScenePanel(picture.world, frames),
-                   picture.world.clock(frames), picture.bars, picture.strip, frames)
+    return Painter((L.W, L.H), ScenePanel(picture.world, frames), picture.bars, picture.strip,
+                   frames)
