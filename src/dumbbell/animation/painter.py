@@ -69,11 +69,15 @@ class Panel(Protocol):
 
     #: Frames drawn, and whether each starts from the whole background (a scene's: all of
     #: it changes anyway) or from the frame before (a space's: only what moved is drawn);
-    #: the panel's width (px: the energy panel, if any, starts there) and its time label.
+    #: the panel's width (px: the energy panel, if any, starts there) and its time label;
+    #: whether the animation's text (the time, the bars' values) is pasted straight in the
+    #: palette where its background is white (a space's; a scene's is always drawn on a
+    #: crop mapped through the palette, as its GIFs always were).
     n: int
     fresh_every_frame: bool
     width: int
     clock: Clock
+    text_on_white: bool
 
     def draw_base(self, d: ImageDraw.ImageDraw, S: int) -> None:
         """What lies under everything else, on the background ``S`` times the size."""
@@ -93,13 +97,11 @@ class Panel(Protocol):
 @dataclass(frozen=True)
 class Clock:
     """The time label, top left: frame k's ``text(k)`` (and ``note(k)`` under it, when
-    given: a scene's axis angle) on a crop of ``box`` (px), or, where that box's background
-    is white and ``on_white``, pasted straight in the palette from glyphs drawn once."""
+    given: a scene's axis angle) in ``box`` (px)."""
 
     box: Rect
     text: Callable[[int], str]
     note: Callable[[int], str | None] | None = None
-    on_white: bool = False
 
 
 #: The time label's text, this far from the frame's left and top edges (px at 640x360) ...
@@ -138,6 +140,10 @@ class Painter:
         #: What the frame on the canvas shows (the label, the bars' spans, the cursor).
         self.shown: dict[str, Any] = {}
         self.changed: Rect | None = None
+        # Made with each background: where it is white, the bars' bands, the strip's source.
+        self.white: dict[str, bool] = {}
+        self.bars_bands: list[tuple[int, int]] = []
+        self.strip_source: Any = None
 
     def _base(self) -> Image.Image:
         """The frame without its static picture: white, what lies under the panel, the line
@@ -186,7 +192,7 @@ class Painter:
     def on_white(self, name: str) -> bool:
         """Whether the text of the box ``name`` ("label", "values") is pasted straight in
         the palette: its background is white and the animation's text is drawn so."""
-        return self.clock.on_white and self.white.get(name, False)
+        return self.panel.text_on_white and self.white.get(name, False)
 
     def patch(self, img: Image.Image, box: Rect, ss: int) -> Patch:
         """An RGB crop of the background over the whole pixels that cover ``box`` (px, left,

@@ -50,6 +50,7 @@ class ViewPanel:
     are drawn again."""
 
     fresh_every_frame = False
+    text_on_white = True
 
     def __init__(self, rec: Recording, scene_w: int, area: tuple[int, int, int, int]) -> None:
         self.rec, self.scene_w, self.area = rec, scene_w, area
@@ -64,7 +65,7 @@ class ViewPanel:
         longest = max((self.label(k) for k in range(rec.n)), key=len, default="")
         stamps = Stamps(font(max(9, round(TIME_PX * u)), bold=True))
         box = (4 * u, 2 * u, max(150 * u, stamps.width(longest) + 12 * u), 24 * u)
-        self.clock = Clock(box, self.label, on_white=True)
+        self.clock = Clock(box, self.label)
         self.body_px = BODY_PX * max(1.0, u)
         self._views()
         self._layer: Layer | None = None

@@ -315,6 +315,7 @@ class ScenePanel:
     draws it, every frame drawn whole on the background."""
 
     fresh_every_frame = True
+    text_on_white = False
 
     def __init__(self, world: World, frames: Frames) -> None:
         self.world, self.frames = world, frames
