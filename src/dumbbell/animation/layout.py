@@ -18,7 +18,8 @@ from .frames import Frames
 if TYPE_CHECKING:  # for the annotations only: a recording does not read scenes
     from ..model.scene import Scene
 
-#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
+#: and :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 #: Layout of a frame, in units of ``u`` (the frame's size over the 640 x 360 reference, so a

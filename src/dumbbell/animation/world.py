@@ -1,7 +1,7 @@
 """The scene panel: the floor and the height ruler (drawn once), and per frame the dumbbell
 (particles at their true radius, the spring as a zig-zag with a constant number of coils or a
-rigid rod, the centre of mass, in 2D its axis and angle), the time and, in 2D, the axis angle
-from vertical."""
+rigid rod, the centre of mass, in 2D its axis and angle), and the time label's text (in 2D
+the axis angle from vertical under it), as the picture panel of :mod:`.painter`."""
 
 from __future__ import annotations
 
