@@ -436,13 +436,13 @@ if _at == "sweep":
         return _evaluate(*args)
     _sweep._evaluate = _marked
 elif _at == "frame":
-    from dumbbell.animation import drawing as _drawing
-    _frame = _drawing.Painter.frame
+    from dumbbell.animation import painter as _painter
+    _frame = _painter.Painter.frame
     def _marked(self, k):
         if k == 1:
             _mark(True)
         return _frame(self, k)
-    _drawing.Painter.frame = _marked
+    _painter.Painter.frame = _marked
 elif _at == "stepping":
     from dumbbell import progress as _progress
     _update = _progress._NoBar.update
@@ -1511,14 +1511,16 @@ def test_the_strip_is_drawn_in_pieces_that_match_the_whole_tape():
     in memory."""
     from PIL import Image
 
-    from dumbbell.animation.drawing import Painter
+    from dumbbell.animation.picture import describe
     from dumbbell.animation.render import frames_of
     from dumbbell.animation.strip import TAPE_CHUNK
+    from dumbbell.animation.world import scene_painter
 
     traj = dumbbell.simulate(SCENES / "textbook-1d.toml", t_end=6.0, every=20)
     frames = frames_of(traj, 10, 6.0)
-    painter = Painter.of(traj.scene, frames, (640, 360), True)
-    tape, strip = painter.tape, painter.strip
+    painter = scene_painter(describe(traj.scene, (frames,), (640, 360), True))
+    painter.background(0)
+    tape, strip = painter.strip_source, painter.strip
     whole = Image.new("P", (tape.width, tape.height))
     for c0 in range(0, tape.width, TAPE_CHUNK):
         whole.paste(tape.piece(c0), (c0, 0))

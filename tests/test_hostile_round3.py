@@ -868,12 +868,12 @@ def test_an_api_output_path_that_cannot_be_a_file_is_one_error(tmp_path, monkeyp
     path = text.format(d=tmp_path, ext=ext, u=f"{os.getpid()}-{tmp_path.name}")
     assert not path.startswith("/dev/") or not os.path.exists(path)
     call = _api_writers(short_traj)[writer]
-    from dumbbell.animation import drawing
+    from dumbbell.animation import world
 
     def no_drawing(*args, **kwargs):
         raise AssertionError("the drawing started before the path was checked")
 
-    monkeypatch.setattr(drawing, "Painter", no_drawing)
+    monkeypatch.setattr(world, "scene_painter", no_drawing)
     before = files_in(tmp_path)
     with pytest.raises(DumbbellError) as info:
         call(path)

@@ -330,7 +330,7 @@ def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium,
     path = tmp_path / "space.html"
     rec = _space_recording(path)
     r = rec.recording()
-    painter = R.Painter(r)
+    painter = R.painter_of(r)
     o = B.open_player(chromium, path)
     try:
         assert o.console == [] and o.refused == [] and o.requests == [o.url]
@@ -343,7 +343,7 @@ def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium,
                 o.wait_shown(before)
             table = o.table()
             for name in r.energy:
-                assert table[(0, name)] == painter.scale.text(float(r.energy[name][k])), (k, name)
+                assert table[(0, name)] == painter.bars.scale.text(float(r.energy[name][k])), (k, name)
             shot = tmp_path / f"space-{k}.png"
             o.page.locator("#view").screenshot(path=str(shot))
             page_rgb = np.asarray(Image.open(shot).convert("RGB"))

@@ -9,7 +9,7 @@ import pytest
 from PIL import Image, ImageSequence
 
 from dumbbell import spaces
-from dumbbell.animation.recording import TERM_INKS
+from dumbbell.animation.bars import SPACE_INKS as TERM_INKS
 
 
 def _stretched_spring(path, reference="start", size="640x360"):

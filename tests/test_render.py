@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-from dumbbell.animation.drawing import Painter
+from dumbbell.animation.painter import Painter
 from dumbbell.animation.palette import INK, TERM_RGB
+from dumbbell.animation.picture import describe
 from dumbbell.animation.render import delays_cs, render_gif, sample_every
+from dumbbell.animation.world import scene_painter
 from dumbbell.cli import main
 from dumbbell.model.scene import scene_from_dict
 from dumbbell.model.trajectory import Trajectory
@@ -231,7 +233,7 @@ def test_drawing_never_uses_the_index_kept_for_unchanged_pixels(short):
     from dumbbell.animation.render import frames_of
 
     frames = frames_of(short, 25, 1.0)
-    painter = Painter.of(short.scene, frames, (320, 180), True)
+    painter = scene_painter(describe(short.scene, (frames,), (320, 180), True))
     clear = palette()[1]
     assert all(clear not in np.asarray(painter.frame(k)) for k in range(len(frames.t)))
 
@@ -245,7 +247,7 @@ def test_strip_scrolls_with_the_cursor_and_shows_the_energy_at_its_time(textbook
 
     traj = simulate(textbook, t_end=2.0, every=sample_every(textbook.run.dt, 25, 2.0))
     frames = frames_of(traj, 25, 2.0)
-    painter = Painter.of(textbook, frames, (640, 360), True)
+    painter = scene_painter(describe(textbook, (frames,), (640, 360), True))
     strip = painter.strip
     assert strip.window == WINDOW < 2.0
     sx0, sy0, sx1, sy1 = strip.box
@@ -299,7 +301,7 @@ def test_strip_marks_a_lasting_contact_along_its_foot_and_impacts_across_it(shor
 
     traj = dataclasses.replace(short, contacts=(Contact(0.2, 0.6, "B"), Contact(0.7, 1.0, "A")))
     frames = frames_of(traj, 25, 1.0)
-    painter = Painter.of(traj.scene, frames, (640, 360), True)
+    painter = scene_painter(describe(traj.scene, (frames,), (640, 360), True))
     strip = painter.strip
     last = len(frames.t) - 1
     rgb = np.asarray(painter.frame(last).convert("RGB"))  # the cursor at t = 0.96 s
@@ -328,7 +330,7 @@ def test_the_strip_draws_what_has_not_happened_yet_faded(short):
     from dumbbell.animation.strip import FUTURE
 
     frames = frames_of(short, 25, 1.0)
-    painter = Painter.of(short.scene, frames, (640, 360), True)
+    painter = scene_painter(describe(short.scene, (frames,), (640, 360), True))
     strip = painter.strip
     sx0, sy0, sx1, sy1 = strip.box
     full = [np.array(TERM_RGB[n]) for n in ("K_cm", "K_int", "U_g", "U_spring")]

@@ -141,7 +141,7 @@ def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
 BOTH_BUSY = """
 import os, time
 import dumbbell.cli.run as r, dumbbell.cli.beside as b
-from dumbbell.animation import drawing
+from dumbbell.animation import painter
 def _mark(who):
     os.write(int(os.environ["MARK_FD"]), who.encode() + b"\\n")
     time.sleep(3600)
@@ -151,12 +151,12 @@ def waiting(files, traj, alive):
         _mark("child")
     return draw(files, traj, alive)
 r._draw_figures = waiting
-frame = drawing.Painter.frame
+frame = painter.Painter.frame
 def slow(self, k):
     if k == 1 and not b._IN_CHILD:
         _mark("parent")
     return frame(self, k)
-drawing.Painter.frame = slow
+painter.Painter.frame = slow
 """
 
 

@@ -153,14 +153,16 @@ def test_a_long_time_label_is_drawn_whole_over_the_one_before(tmp_path, monkeypa
         for k in range(1, 4):
             space.step(0.04)
             rec.capture(t=999_999_999.8 + k * 1e-5)  # "t = 999999999.80003 fortnights__"
-    whole = recording.Painter.frame
+    from dumbbell.animation import painter
+
+    whole = painter.Painter.frame
 
     def from_nothing(self, k):
         self._canvas = None
         return whole(self, k)
 
-    monkeypatch.setattr(recording.Painter, "frame", from_nothing)
-    monkeypatch.setattr(recording.Painter, "region", lambda self, k: None)
+    monkeypatch.setattr(painter.Painter, "frame", from_nothing)
+    monkeypatch.setattr(painter.Painter, "region", lambda self, k: None)
     recording.write(tmp_path / "b.gif", rec.recording())
     assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
 
@@ -711,7 +713,7 @@ def test_bars_show_changes_from_the_start_in_the_spaces_units(tmp_path):
     assert rec2.recording().energy["U_g"][0] == pytest.approx(2 * 900 * body.position.y)
     # On the pixels: the last frame's K bar and dU_g bar are as long as each other.
     last = _frames(tmp_path / "a.gif")[-1]
-    from dumbbell.animation.recording import TERM_INKS
+    from dumbbell.animation.bars import SPACE_INKS as TERM_INKS
 
     lengths = [((last[:200] == TERM_INKS[n]).all(axis=2)).sum(axis=1).max()
                for n in ("K_trans", "U_g")]

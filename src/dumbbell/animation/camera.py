@@ -27,7 +27,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .layout import unit
 from .recorded import Box, Recording
 
 #: No public names: the camera behind :class:`dumbbell.spaces.Recorder`.
@@ -278,12 +277,3 @@ class View:
     def px(self, x: float, y: float) -> tuple[float, float]:
         """Pixel of world point (x, y)."""
         return self.ox + x * self.s, self.oy + self.flip * y * self.s
-
-
-def scene_area(width: int, height: int, energy: bool) -> tuple[int, int, int, int]:
-    """Where the view is drawn on a ``width`` x ``height`` frame (px: left, top, width,
-    height): under the time label, left of the energy panel if there is one."""
-    u = unit(width, height)
-    scene_w = round(0.56 * width) if energy else width
-    top = round(30 * u)
-    return round(8 * u), top, scene_w - round(16 * u), height - top - round(8 * u)

@@ -12,7 +12,8 @@ from PIL import Image, ImageDraw, ImageFont
 
 from .palette import INK, WHITE, to_palette
 
-#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
+#: and :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 #: Font sizes in px on the 640 x 360 reference frame (scaled by the frame's unit ``u``).

@@ -18,7 +18,8 @@ from .frames import Frames
 if TYPE_CHECKING:  # for the annotations only: a recording does not read scenes
     from ..model.scene import Scene
 
-#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
+#: and :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 #: Layout of a frame, in units of ``u`` (the frame's size over the 640 x 360 reference, so a
@@ -113,3 +114,34 @@ def layout(scene: Scene, runs: Sequence[Frames], size: tuple[int, int], strip: b
                  W - round(STRIP_RIGHT * u), H - round(STRIP_BOTTOM * u))
     return Layout(W, H, u, s, ox, oy, (x0, x1, y0, y1), round(ruler - RULER_INSET * u), scene_w,
                   bars_box, strip_box)
+
+
+#: A recorded space's frame, in units of u or shares of W and H: the picture panel takes
+#: this share of W when there are energy bars, its view starting this far from the top
+#: (under the time label); the bars' panel ends at this share of H when a strip follows,
+#: which starts at this share of H, this far right of the bars' panel and this far from
+#: the right edge.
+SPACE_SCENE_SHARE = 0.56
+SPACE_VIEW_TOP = 30
+SPACE_BARS_SHARE = 0.55
+SPACE_STRIP_TOP_SHARE = 0.62
+SPACE_STRIP_RIGHT = 12
+
+Box = tuple[int, int, int, int]
+
+
+def space_layout(W: int, H: int, energy: bool, strip: bool
+                 ) -> tuple[int, Box, Box, Box]:
+    """Where the panels of a recorded space's ``W`` x ``H`` frame go (px): the picture
+    panel's width, the area its view is drawn in (left, top, width, height), the energy
+    bars' box and the strip's box (left, top, right, bottom)."""
+    u = unit(W, H)
+    scene_w = round(SPACE_SCENE_SHARE * W) if energy else W
+    top = round(SPACE_VIEW_TOP * u)
+    area = (round(EDGE * u), top, scene_w - round(2 * EDGE * u), H - top - round(EDGE * u))
+    right = scene_w + round(PANEL_GAP * u)
+    bars_box = (right, round(EDGE * u), W - round(EDGE * u),
+                round(SPACE_BARS_SHARE * H) if strip else H - round(EDGE * u))
+    strip_box = (right + round(STRIP_LEFT * u), round(SPACE_STRIP_TOP_SHARE * H),
+                 W - round(SPACE_STRIP_RIGHT * u), H - round(STRIP_BOTTOM * u))
+    return scene_w, area, bars_box, strip_box

@@ -14,7 +14,8 @@ from PIL import Image
 
 from ..colours import COLOURS
 
-#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
+#: and :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 WHITE = (255, 255, 255)

@@ -11,8 +11,8 @@ import math
 import numpy as np
 from PIL import Image, ImageDraw
 
-from .backdrop import SS
 from .camera import SHAPES, View
+from .painter import SS, union_px
 from .palette import GREY, INK, SPRING, TERM_RGB, blend, ink_index
 from .recorded import Group, Shapes
 from .world import LEAD
@@ -510,12 +510,6 @@ class Layer:
         """Draw the primitives that meet ``rect`` (frame px) on ``d``, whose pixel (0, 0) is
         the frame's pixel ``corner`` (see :meth:`Pixels.draw`; flat when the layer is)."""
         self.px.draw(d, corner, self.px.within(rect), self.flat)
-
-
-def union_px(boxes: list[tuple[float, float, float, float]]
-              ) -> tuple[float, float, float, float]:
-    return (min(b[0] for b in boxes), min(b[1] for b in boxes), max(b[2] for b in boxes),
-            max(b[3] for b in boxes))
 
 
 def _merge(rects: list[tuple[float, float, float, float]]

@@ -9,7 +9,7 @@ scale; which terms it draws as bands), the colours and label texts, and the runs
 (:class:`~.frames.Frames`: the values per frame; several runs share one layout and one energy
 scale, so they can be shown together). :func:`describe` makes it.
 
-The GIF painter (:mod:`.drawing`) draws from it; :meth:`Picture.document` gives the same
+The GIF painter (:mod:`.painter`, with the scene's panel of :mod:`.world`) draws from it; :meth:`Picture.document` gives the same
 record as plain data (JSON), with the pixel factors each piece draws with (the named
 constants of :mod:`.world`, :mod:`.bars`, :mod:`.strip`, :mod:`.glyphs` and
 :mod:`.palette`), which the player page (:mod:`.player`) draws from. Neither side has a
@@ -103,15 +103,14 @@ class Picture:
             "size": [L.W, L.H],
             "layout": _plain(L),
             "world": _plain(self.world, skip=("layout",)),
-            "bars": _plain(self.bars),
-            "strip": None if self.strip is None else _plain(self.strip),
+            "bars": _plain(self.bars, skip=Bars.PAGE_SKIPS),
+            "strip": None if self.strip is None else _plain(self.strip, skip=Strip.PAGE_SKIPS),
             "names": list(self.names),
             "labels": list(self.labels),
             "bands": [dict(b) for b in self.bands],
             "title": self.title,
             "colours": colours(),
-            "factors": {group: {name: _value(getattr(_module(group), name))
-                                for name in names}
+            "factors": {group: {name: _value(_factor(group, name)) for name in names}
                         for group, names in FACTORS.items()},
         }
         if self.strip is not None:
@@ -124,14 +123,26 @@ class Picture:
         return doc
 
 
+def _factor(group: str, name: str) -> Any:
+    """The constant ``name`` of :data:`FACTORS`'s ``group``: its module's (the world's time
+    label's, TIME_AT and ANGLE_AT, are the painter's, which draws every time label)."""
+    module = _module(group)
+    if not hasattr(module, name):
+        from . import painter
+
+        module = painter
+    return getattr(module, name)
+
+
 def _module(group: str) -> Any:
     """The module whose constants :data:`FACTORS` names under ``group``."""
-    from . import backdrop
     from . import layout as layout_module
+    from . import painter
 
+    # (The supersampling factor is the painter's; the page knows its group as "backdrop".)
     return {"world": world_module, "bars": bars_module, "strip": strip_module,
             "glyphs": glyphs, "palette": palette_module, "layout": layout_module,
-            "backdrop": backdrop, "picture": sys.modules[__name__]}[group]
+            "backdrop": painter, "picture": sys.modules[__name__]}[group]
 
 
 def colours() -> dict[str, Any]:

@@ -69,19 +69,18 @@ class Player:
     Raises
     ------
     UsageError
-        A page that is not a str, or a size that is not allowed.
+        A page that is not a str; a size not allowed.
 
     Examples
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
-    >>> page = dumbbell.player(traj, fps=10, size="320x180")
+    >>> page = dumbbell.player(dumbbell.simulate(scenes_dir() / "textbook-1d.toml",
+    ...                                          t_end=1.0), fps=10, size="320x180")
     >>> page.save("textbook.html").name
     'textbook.html'
-    >>> page.html.startswith("<!DOCTYPE html>")
-    True
+    >>> page.html.startswith("<!DOCTYPE html>"), page.size
+    (True, (320, 180))
     """
 
     def __init__(self, html_text: str, size: tuple[int, int] = (640, 360)) -> None:
@@ -106,22 +105,23 @@ class Player:
                 'sandbox="allow-scripts"></iframe>')
 
     def save(self, path: str | Path) -> Path:
-        """Write the page, whole or not at all.
+        """Write the page to an HTML file, whole or not at all: it needs nothing else (no
+        network, no other file) to play.
 
         Parameters
         ----------
         path : str or pathlib.Path
-            The HTML file.
+            The HTML file; a name ending in '/' is a folder, refused.
 
         Returns
         -------
-        pathlib.Path
-            The file written.
+        saved : pathlib.Path
+            The page's file.
 
         Raises
         ------
         UsageError
-            A path that cannot be written (one line saying why).
+            A path that cannot be written, in one line naming why.
         """
         from ..files import atomic_output, writable_path
 
@@ -360,15 +360,14 @@ def player(source: Any, *, fps: int | None = None, size: str | tuple[int, int] |
     Raises
     ------
     UsageError
-        A source or an argument that is not allowed.
+        A source or an argument not allowed, named in one line.
 
     Examples
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
-    >>> runs = [traj, dumbbell.simulate(scene, solver="verlet", t_end=1.0, dt=1e-3)]
+    >>> runs = [dumbbell.simulate(scenes_dir() / "textbook-1d.toml", solver=name, t_end=1.0,
+    ...                           dt=1e-3) for name in ("exact", "verlet")]
     >>> dumbbell.player(runs, labels=["exact", "verlet"], fps=10).save("two.html").name
     'two.html'
     """

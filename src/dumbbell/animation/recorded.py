@@ -12,7 +12,8 @@ for static)::
 
 **Sizes.** Whatever the view, every moving body is drawn at least :data:`BODY_PX` across
 whichever way it turns (:meth:`Shapes.at_least`): a smaller one is drawn larger than to
-scale, and the painter says which (``Painter.grown``, named in the recorder's note).
+scale, and the view panel says which (``ViewPanel.grown`` of :mod:`.recording`, named in
+the recorder's note).
 """
 
 from __future__ import annotations

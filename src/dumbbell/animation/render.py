@@ -211,13 +211,12 @@ class Gif(bytes):
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj = dumbbell.simulate(scenes_dir() / "tilted-2d.toml", t_end=0.5)
     >>> gif = dumbbell.render_gif(traj, fps=10, size="320x180", quiet=True)
     >>> gif[:6], type(gif).__name__
     (b'GIF89a', 'Gif')
-    >>> gif.save("textbook.gif").name
-    'textbook.gif'
+    >>> dumbbell.Gif(gif.data) == gif, gif.save("tilted.gif").name
+    (True, 'tilted.gif')
     """
 
     def __new__(cls, data: bytes | bytearray | memoryview = b"") -> Self:
@@ -249,22 +248,23 @@ class Gif(bytes):
         return out.getvalue()
 
     def save(self, path: str | Path) -> Path:
-        """Write the GIF, whole or not at all.
+        """Write the GIF to a file, whole or not at all: a stop signal or a full disk leaves
+        no partial file behind.
 
         Parameters
         ----------
         path : str or pathlib.Path
-            The file.
+            The GIF file (``.gif`` is usual), replaced only once the whole GIF is written.
 
         Returns
         -------
-        pathlib.Path
-            The file written.
+        written : pathlib.Path
+            ``path``, as a ``Path``.
 
         Raises
         ------
         UsageError
-            A path that cannot be written (one line saying why).
+            A folder, or a path that cannot be written, said in one line.
         """
         from ..files import writable_path
         from .writer import binary_output
@@ -331,8 +331,7 @@ def render_gif(
     --------
     >>> import dumbbell
     >>> from dumbbell.model.scene import scenes_dir
-    >>> scene = dumbbell.load_scene(scenes_dir() / "textbook-1d.toml")
-    >>> traj = dumbbell.simulate(scene, solver="exact", t_end=1.0, dt=1e-3)
+    >>> traj = dumbbell.simulate(scenes_dir() / "textbook-1d.toml", solver="exact", t_end=1.0)
     >>> dumbbell.render_gif(traj, "textbook.gif", fps=10, size=(320, 180), quiet=True).name
     'textbook.gif'
     >>> dumbbell.render_gif(traj, fps=100)
@@ -369,16 +368,14 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
     settings on the way from ``dumbbell run``, checked when the scene was read."""
     from .. import progress
     from ..model.sizes import pixel_size
-    from .drawing import Painter
-    from .gif import write_frames
     from .picture import describe
+    from .world import scene_painter
     from .writer import binary_output
 
     (width, height), fps, strip, t_end = pixel_size(gif.size), gif.fps, gif.strip, gif.t_end
     t0 = time.perf_counter()
     frames = _frames_of(traj, fps, t_end)
-    painter = Painter(describe(traj.scene, (frames,), (width, height), strip))
-    delays = _delays(len(frames.t), fps)
+    painter = scene_painter(describe(traj.scene, (frames,), (width, height), strip))
     stats = {"setup": time.perf_counter() - t0, "draw": 0.0, "encode": 0.0, "frames": 0}
     label = f"render {Path(path).name}" if path is not None else "render GIF"
     with contextlib.ExitStack() as stack:
@@ -387,8 +384,7 @@ def _render_gif(traj: Trajectory, path: Path | None, gif: GifSettings, quiet: bo
         else:
             fh = stack.enter_context(binary_output(path))
         pbar = stack.enter_context(progress.bar(len(frames.t), label, "frame", quiet))
-        stats["draw"], stats["encode"] = write_frames(fh, (width, height), painter.frame, delays,
-                                                      on_frame=lambda: pbar.update(1))
+        stats["draw"], stats["encode"] = painter.write_gif(fh, fps, on_frame=lambda: pbar.update(1))
         result = Gif(fh.getvalue()) if path is None else Path(path)
     stats["frames"] = len(frames.t)
     if timing is not None:

@@ -1,8 +1,8 @@
 """The player page of a recorded pymunk space: what ``spaces.Recorder(space, "run.html")``
 writes.
 
-The page is :mod:`.player`'s, drawing a recorded space's frame as the recording's GIF painter
-(:class:`~.recording.Painter`) draws it, from that painter's own numbers: the frame's layout,
+The page is :mod:`.player`'s, drawing a recorded space's frame as the GIF's painter
+(:func:`.recording.painter_of`) draws it, from that painter's own numbers: the frame's layout,
 the camera's views, the shapes (each set in its bodies' coordinates, grown as the painter
 grows them, a pose per body and frame), the constraints, the energy rows and the strip.
 """
@@ -18,7 +18,8 @@ import numpy as np
 
 from ..files import atomic_output
 from . import recording as R
-from .backdrop import SS
+from .bars import HEAT_ALPHA, SPACE_INKS
+from .painter import SS
 from .palette import GREY, INK, LIGHT, SPRING, WHITE, blend
 from .pens import COILS, FLAT_MANY, SHAPE_COLOURS, SPRING_WIDTH
 from .picture import hex_colour
@@ -32,35 +33,38 @@ from .world import LEAD
 __all__: list[str] = []
 
 
-def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) -> R.Painter:
+def write(path: Path, rec: Recording, timing: dict[str, float] | None = None) -> R.ViewPanel:
     """Write the player page of ``rec`` to ``path`` (atomically); ``timing`` receives the
-    seconds spent. Returns the painter (its ``view``), as :func:`.recording.write` does."""
+    seconds spent. Returns the view panel (its ``view``), as :func:`.recording.write`
+    does."""
     t0 = time.perf_counter()
-    painter = R.Painter(rec)
+    painter = R.painter_of(rec)
     text = space_page(painter)
     # What the GIF's painter counts as it draws (which bodies each frame holds and shows,
     # for the recorder's note), counted without drawing.
+    panel = painter.panel
     for k in range(painter.n):
-        painter._count(painter.layer(k))
+        panel._count(panel.layer(k))
     with atomic_output(path) as tmp:
         Path(tmp).write_text(text, encoding="utf-8")
     if timing is not None:
         timing.update(frames=painter.n, total=time.perf_counter() - t0)
-    return painter
+    return panel
 
 def space_document(painter: Any) -> dict[str, Any]:
     """The page's data for a recorded space, from the painter of its GIF
-    (:class:`~.recording.Painter`): the frame's layout, the camera's views, the static and
+    (:func:`~.recording.painter_of`): the frame's layout, the camera's views, the static and
     moving shapes (each moving set in its bodies' coordinates, a pose per body and frame),
     the constraints per frame, the energy rows with their labels, scale and values, and the
     strip of the whole run. The page draws what the painter draws, from the painter's own
     numbers."""
     from .picture import colours
 
-    rec, u = painter.rec, painter.u
+    panel, bars, strip = painter.panel, painter.bars, painter.strip
+    rec, u = panel.rec, painter.u
     views: list[Any] = []
     view_of = []
-    for v in painter.views:
+    for v in panel.views:
         if not views or views[-1] is not v:
             views.append(v)
         view_of.append(len(views) - 1)
@@ -69,7 +73,7 @@ def space_document(painter: Any) -> dict[str, Any]:
         # As the painter draws them: each body at least its least size across.
         first = next((k for k, s in enumerate(rec.shape_of) if s == i), None)
         if first is not None:
-            shapes = painter._shapes(i, painter.views[first])
+            shapes = panel._shapes(i, panel.views[first])
         kinds = [""] * shapes.n
         npts = [0] * shapes.n
         local: list[list[float]] = [[] for _ in range(shapes.n)]
@@ -89,8 +93,8 @@ def space_document(painter: Any) -> dict[str, Any]:
     shape_colours = [[hex_colour(out), hex_colour(fill)] for out, fill in SHAPE_COLOURS]
     doc: dict[str, Any] = {
         "size": [painter.W, painter.H], "u": u, "title": rec.title,
-        "time_unit": rec.time_unit, "t_decimals": painter.t_decimals,
-        "scene_w": painter.scene_w, "area": list(painter.area),
+        "time_unit": rec.time_unit, "t_decimals": panel.t_decimals,
+        "scene_w": painter.scene_w, "area": list(panel.area),
         "views": [[v.s, v.ox, v.oy, v.flip] for v in views], "view_of": view_of,
         "statics": [[list(it) for it in items] for items in rec.statics],
         "static_of": list(rec.static_of),
@@ -103,31 +107,29 @@ def space_document(painter: Any) -> dict[str, Any]:
         "factors": {"COILS": COILS, "SPRING_WIDTH": SPRING_WIDTH, "LEAD": LEAD,
                     "SS": SS, "FUTURE": _strip_future(), "STACK_BELOW": _stack_below(),
                     "FLAT_MANY": FLAT_MANY},
-        "label_box": list(painter.label_box), "colours": colours(),
+        "label_box": list(painter.clock.box), "colours": colours(),
     }
-    if painter.energy:
-        labels = rec.labels or {}
+    if bars is not None:
         doc["bars"] = {
-            "box": list(painter.bars_box), "rows": [list(r) for r in painter.rows],
-            "labels": {n: labels.get(n, n) for n in painter.names},
-            "title": rec.energy_title, "scale": {"lo": painter.scale.lo,
-                                                "hi": painter.scale.hi,
-                                                "decimals": painter.scale.decimals},
-            "left": painter.bar_left, "right": painter.bar_right, "zero": painter.bar_zero,
-            "px_per_j": painter.bar_scale, "heat": rec.heat,
-            "inks": {n: hex_colour(R.TERM_INKS[n]) for n in painter.names},
-            "heat_ink": hex_colour(blend(R.TERM_INKS["heat"], 0.6)),
+            "box": list(bars.box), "rows": [list(r) for r in bars.rows],
+            "labels": {n: bars.labels.get(n, n) for n in bars.names},
+            "title": bars.title, "scale": {"lo": bars.scale.lo, "hi": bars.scale.hi,
+                                          "decimals": bars.scale.decimals},
+            "left": bars.left, "right": bars.right, "zero": bars.zero,
+            "px_per_j": bars.px_per_j, "heat": bars.heat,
+            "inks": {n: hex_colour(SPACE_INKS[n]) for n in bars.names},
+            "heat_ink": hex_colour(blend(SPACE_INKS["heat"], HEAT_ALPHA)),
         }
-        if painter.strip:
-            from .glyphs import fmt_tick, nice_step
+        if strip is not None:
+            from .glyphs import fmt_tick
 
-            t0, end = float(painter.t[0]), float(painter.t[-1])
-            tstep = nice_step((end - t0) / 4) if end > t0 else 1.0
-            ticks = range(math.ceil(t0 / tstep - 1e-9), math.floor(end / tstep + 1e-9) + 1)
-            doc["strip"] = {"box": list(painter.strip_box), "pad": 3 * u, "t0": t0,
-                            "span": painter.t_end,
-                            "ticks": [[v, fmt_tick(v)] for v in painter.scale.ticks()],
-                            "time_ticks": [[k * tstep, fmt_tick(k * tstep)] for k in ticks]}
+            step = strip.t_step
+            ticks = range(math.ceil(strip.t0 / step - 1e-9),
+                          math.floor(strip.t_last / step + 1e-9) + 1)
+            doc["strip"] = {"box": list(strip.box), "pad": strip.pad, "t0": strip.t0,
+                            "span": strip.window,
+                            "ticks": [[v, fmt_tick(v)] for v in bars.scale.ticks()],
+                            "time_ticks": [[k * step, fmt_tick(k * step)] for k in ticks]}
     return doc
 
 
@@ -145,11 +147,13 @@ def _stack_below() -> int:
 
 def space_page(painter: Any) -> str:
     """The player page of a recorded space (see :func:`space_document`)."""
-    rec = painter.rec
-    decimals = painter.scale.decimals if painter.energy else 2
-    run = {"label": rec.title or "", "note": "", "t": b64_array(np.asarray(painter.t), "f8"),
-           "energy": {name: energy_array(painter.e[name], decimals) for name in painter.names}}
-    doc = {"kind": "space", "fps": rec.fps, "t_end": float(painter.t[-1]),
+    rec, bars, t = painter.panel.rec, painter.bars, painter.readings.t
+    decimals = bars.scale.decimals if bars is not None else 2
+    names = bars.names if bars is not None else ()
+    run = {"label": rec.title or "", "note": "", "t": b64_array(np.asarray(t), "f8"),
+           "energy": {name: energy_array(painter.readings.energy[name], decimals)
+                      for name in names}}
+    doc = {"kind": "space", "fps": rec.fps, "t_end": float(t[-1]),
            "picture": space_document(painter), "runs": [run],
            "units": {"energy": _energy_unit(rec), "time": rec.time_unit, "L_cm": ""}}
     return page(doc, rec.title or "pymunk space")

@@ -1,11 +1,14 @@
-"""The strip of the energy time series: a window of :data:`WINDOW` s that scrolls with a
-cursor (time ticks and labels move with it; faint lines mark the impacts, and a thin bar in a
-particle's colour along the strip's foot the time it rests or rolls on the floor), on the
-energy panel's fixed scale.
+"""The strip of the energy time series, on the energy panel's fixed scale, with a cursor at
+the frame's time and what lies after it faded, for a scene and for a recorded space.
 
-The curves of the whole animation lie on a long 'tape', drawn in pieces as the frames reach
-them (only the pieces under the current window are kept, so memory does not grow with the
-run's length); a frame pastes the window it shows, its time labels and the cursor.
+A scene's strip is a window of :data:`WINDOW` s that scrolls with the cursor (time ticks and
+labels move with it; faint lines mark the impacts, and a thin bar in a particle's colour
+along the strip's foot the time it rests or rolls on the floor). Its curves lie on a long
+'tape', drawn in pieces as the frames reach them (only the pieces under the current window
+are kept, so memory does not grow with the run's length); a frame pastes the window it
+shows, its time labels and the cursor. A recorded space's strip shows the whole recording at
+once, drawn with the background (:meth:`Strip.whole_run`): a frame moves the cursor and
+fades the columns after it (:class:`Sheet`).
 """
 
 from __future__ import annotations
@@ -14,37 +17,52 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PIL import Image, ImageDraw
 
-from .backdrop import Patch
-from .bars import EnergyScale
+from .bars import SPACE_INKS, EnergyScale, Readings
 from .frames import Frames
-from .glyphs import Stamps, fmt_tick, nice_step
-from .palette import GREY, LIGHT, TERM_RGB, WHITE, blend, palette, term_inks, to_palette
+from .glyphs import NOTE_PX, Stamps, fmt_tick, font, nice_step
+from .layout import unit
+from .painter import Painter, Patch, Rect
+from .palette import (
+    GREY,
+    INK,
+    LIGHT,
+    TERM_RGB,
+    WHITE,
+    blend,
+    ink_index,
+    palette,
+    term_inks,
+    to_palette,
+)
 
-#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`.
+if TYPE_CHECKING:  # for the annotations only
+    from .recorded import Recording
+
+#: No public names: a piece of the painter behind :func:`dumbbell.animation.render.render_gif`
+#: and :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 #: Seconds of the energy time series the strip shows at once. The textbook spring's energy
 #: terms oscillate at 20 Hz: over 1 s and ~390 px each oscillation is ~20 px wide and reads
 #: as a line (over 2 s they merge into a hatched band; over the whole run, a pale band).
 WINDOW = 1.0
-#: Fraction of the strip's window after the cursor (what comes next).
-AHEAD = 0.25
-#: Opacity of what lies after the cursor (over white): it has not happened yet at the
-#: frame's time, so it is drawn faded.
-FUTURE = 0.25
+#: The share of the strip's window after the cursor (what comes next), and the opacity of
+#: what lies there (over white): it has not happened yet at the frame's time, so it is
+#: drawn faded.
+AHEAD, FUTURE = 0.25, 0.25
 #: Width (px) of the pieces the strip's tape is drawn in.
 TAPE_CHUNK = 1024
 #: Time ticks per window (about).
 TIME_TICKS = 5
-#: A term whose range within one pixel column is mostly wider than this (px) changes faster
-#: than a column can show: it is drawn as a pale band of that range, not as a line.
-BAND_PX = 3
-#: Opacity of such a band.
-BAND_ALPHA = 0.45
+#: A term whose range within one pixel column is mostly wider than BAND_PX (px) changes
+#: faster than a column can show: it is drawn as a pale band of that range, at opacity
+#: BAND_ALPHA, not as a line.
+BAND_PX, BAND_ALPHA = 3, 0.45
 GRID = (238, 238, 238)     # the energy grid lines
 IMPACT = (216, 216, 216)   # the impacts' faint lines
 #: The names of the strip's axes: energy (left) and time (under it).
@@ -60,6 +78,13 @@ LINE = 2         # width of the curves (at least 1 px)
 CURSOR = 1.5     # width of the cursor (at least 1 px)
 LABEL_OVERHANG = 3  # time labels may start this far left of the strip's frame
 LABEL_EDGE = 2   # and end this far from the frame's right edge
+#: A recorded space's strip, in units of u: the curves keep this far from the frame (the
+#: scene's: PAD), its labels' font (the scene's: NOTE_PX), its time labels this far under
+#: the strip, about this many time ticks over the whole recording, its curves and its
+#: cursor this wide.
+WHOLE_PAD, WHOLE_FONT, WHOLE_LABEL_GAP, WHOLE_TICKS, WHOLE_LINE, WHOLE_CURSOR = 3, 10, 5, 4, 1.5, 1.2
+#: Opacity of E + heat's curve (a recorded space's, with a heat counter).
+HEAT_ALPHA = 0.6
 
 
 @dataclass(frozen=True)
@@ -68,7 +93,12 @@ class Strip:
     ``scale``; inside its frame it starts at ``inner_x`` and is ``inner_w`` wide (px); the
     tape is ``tape_w`` x ``tape_h`` px, pasted at ``tape_y``; it shows ``window`` s at
     ``px_per_s``, the cursor stops at ``cursor_px`` from the left, time ticks every
-    ``t_step`` s, ``tick_len`` px long."""
+    ``t_step`` s, ``tick_len`` px long; the curves keep ``pad`` px from the frame.
+
+    A recorded space's (``scrolls`` False: :meth:`whole_run`) shows its whole recording,
+    from ``t0`` to ``t_last``, its ``lines`` ((colour, times, values), ...) drawn with
+    the background, its labels in a font of ``font_px`` u, the time axis named
+    ``time_axis``."""
 
     box: tuple[int, int, int, int]
     u: float
@@ -83,6 +113,17 @@ class Strip:
     tape_w: int
     cursor_px: int
     t_step: float
+    pad: float = 0.0
+    scrolls: bool = True
+    t0: float = 0.0
+    t_last: float = 0.0
+    lines: tuple[tuple[tuple[int, int, int], np.ndarray, np.ndarray], ...] = ()
+    font_px: float = NOTE_PX
+    time_axis: str = TIME_AXIS
+
+    #: The fields a page (:meth:`.picture.Picture.document`) is not given: the scene's
+    #: strip draws with the constants the page has.
+    PAGE_SKIPS = ("pad", "scrolls", "t0", "t_last", "lines", "font_px", "time_axis")
 
     @classmethod
     def build(cls, box: tuple[int, int, int, int], u: float, scale: EnergyScale,
@@ -98,14 +139,39 @@ class Strip:
                    sy1 + tick_len - sy0, window, px_per_s,
                    max(inner_w, math.ceil(t_end * px_per_s) + 1),
                    round((1 - AHEAD) * (inner_w - 1)) if window < t_end else 0,
-                   nice_step(window / TIME_TICKS))
+                   nice_step(window / TIME_TICKS), PAD * u)
+
+    @classmethod
+    def whole_run(cls, box: tuple[int, int, int, int], scale: EnergyScale, rec: Recording,
+                  readings: Readings) -> Strip:
+        """A recorded space's strip in ``box``: the whole of ``rec`` (its ``readings``: the
+        frames' times, each row's energy; E last, with a heat counter E + heat before
+        it)."""
+        sx0, sy0, sx1, sy1 = box
+        u, t, energy = unit(*rec.size), readings.t, readings.energy
+        t0, end = float(t[0]), float(t[-1])
+        window = max(float(t[-1] - t[0]), 1e-300)
+        series = [(SPACE_INKS[n], energy[n]) for n in energy if n != "E"]
+        if rec.heat:
+            series.append((blend(SPACE_INKS["heat"], HEAT_ALPHA), energy["E"] + energy["heat"]))
+        series.append((SPACE_INKS["E"], energy["E"]))
+        return cls(box, u, scale, sx0 + 1, sx1 - sx0 - 1, 0, sy0 + 1, sy1 - sy0, window,
+                   (sx1 - sx0 - 2) / window, sx1 - sx0 - 1, 0,
+                   nice_step((end - t0) / WHOLE_TICKS) if end > t0 else 1.0,
+                   WHOLE_PAD * u, False, t0, end, tuple((rgb, t, v) for rgb, v in series),
+                   WHOLE_FONT, f"t ({rec.time_unit})")
 
     def y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
         _, sy0, _, sy1 = self.box
-        pad = PAD * self.u
+        pad = self.pad
         lo, hi = self.scale.lo, self.scale.hi
         return sy1 - pad - (sy1 - sy0 - 2 * pad) * (value - lo) / (hi - lo)
+
+    def x(self, t):
+        """Pixel x of time ``t`` (s, a float or an array) in a whole run's strip."""
+        sx0, _, sx1, _ = self.box
+        return sx0 + 1 + (sx1 - sx0 - 2) * (t - self.t0) / self.window
 
     def offset(self, t: float) -> tuple[int, int]:
         """For a frame at ``t`` (s): the tape column at the strip's left edge and the cursor's
@@ -114,20 +180,42 @@ class Strip:
         x = round(t * self.px_per_s)
         return min(max(0, x - self.cursor_px), self.tape_w - self.inner_w), x
 
-    def draw_static(self, d: ImageDraw.ImageDraw, S: int, fs) -> None:
+    def draw_static(self, d: ImageDraw.ImageDraw, S: int) -> None:
         """The parts of the strip that do not scroll, on a background ``S`` times the size:
-        the frame (one crisp pixel on each side), the energy ticks and the axis names."""
+        the frame (one crisp pixel on each side), the energy ticks and the axis names; a
+        whole run's grid, time ticks and curves too."""
         u = self.u
         sx0, sy0, sx1, sy1 = self.box
+        fs = font(round(self.font_px * u) * S)
         d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
         for v in self.scale.ticks():
             y = self.y(v)
+            if not self.scrolls:
+                d.line([((sx0 + 1) * S, y * S), ((sx1 - 1) * S, y * S)], fill=GRID, width=S)
             d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(v), font=fs, fill=GREY,
                    anchor="rm")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS, font=fs,
-               fill=GREY, anchor="rs")
-        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), TIME_AXIS, font=fs,
-               fill=GREY, anchor="rt")
+        if self.scrolls:
+            d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS,
+                   font=fs, fill=GREY, anchor="rs")
+            d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), TIME_AXIS,
+                   font=fs, fill=GREY, anchor="rt")
+            return
+        step = self.t_step
+        for k in range(math.ceil(self.t0 / step - 1e-9), math.floor(self.t_last / step + 1e-9) + 1):
+            x = self.x(k * step) * S
+            d.line([(x, sy1 * S), (x, (sy1 + TICK * u) * S)], fill=GREY, width=S)
+            d.text((x, (sy1 + WHOLE_LABEL_GAP * u) * S), fmt_tick(k * step), font=fs,
+                   fill=GREY, anchor="mt")
+        d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + WHOLE_LABEL_GAP * u) * S), self.time_axis,
+               font=fs, fill=GREY, anchor="rt")
+        width = max(1, round(WHOLE_LINE * u * S))
+        for rgb, t, v in self.lines:
+            xs, ys = self.x(t) * S, self.y(v) * S
+            ok = np.isfinite(ys)
+            if ok.sum() < 2:
+                continue
+            d.line(list(zip(xs[ok].tolist(), ys[ok].tolist(), strict=True)), fill=rgb,
+                   width=width, joint="curve")
 
     def curves(self, frames: Frames, names: Sequence[str]
                ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], dict[str, bool]]:
@@ -158,8 +246,22 @@ class Strip:
         strip's time scale, from which each frame crops the window it shows."""
         return Tape(self, frames, names)
 
-    def draw(self, img: Image.Image, t: float, tape: Tape,
-             patch: Callable[[tuple[int, int, int, int]], Patch], stamps: Stamps) -> None:
+    def source(self, bg: Image.Image, frames: Frames, names: Sequence[str]) -> Tape | Sheet:
+        """What the frames crop the strip's pixels from, for the background ``bg``: a
+        scene's :class:`Tape` of ``names`` of ``frames``, a whole run's :class:`Sheet`."""
+        return self.tape(frames, names) if self.scrolls else Sheet(self, bg)
+
+    def draw(self, painter: Painter, img: Image.Image, k: int) -> list[Rect]:
+        """Frame ``k``'s strip on ``img``; the boxes touched."""
+        t = float(painter.readings.t[k])
+        source = painter.strip_source
+        if isinstance(source, Sheet):
+            return source.cursor(painter, img, t)
+        self.scroll(img, t, source, lambda box: painter.patch(img, box, 1), painter.note)
+        return [(self.box[0] - LABEL_OVERHANG * self.u, self.box[1], img.width, img.height)]
+
+    def scroll(self, img: Image.Image, t: float, tape: Tape,
+               patch: Callable[[tuple[int, int, int, int]], Patch], stamps: Stamps) -> None:
         """The window of ``tape`` a frame at ``t`` (s) shows, its time labels (on a crop from
         ``patch``, reaching to the frame's right edge) and the cursor."""
         left, x = self.offset(t)
@@ -187,6 +289,46 @@ class Strip:
         xc = self.inner_x + x - left
         ImageDraw.Draw(img).line([(xc, self.tape_y), (xc, sy1 - 1)], fill=term_inks()["ink"],
                                  width=max(1, round(CURSOR * u)))
+
+
+class Sheet:
+    """A whole run's strip as the background holds it (inside its frame: every curve), and
+    the same faded, which a frame shows after its cursor (what has not happened yet)."""
+
+    def __init__(self, strip: Strip, bg: Image.Image) -> None:
+        self.strip = strip
+        sx0, sy0, sx1, sy1 = (round(v) for v in strip.box)
+        self.inner = (sx0 + 1, sy0 + 1, sx1, sy1)
+        self.past = bg.crop(self.inner)
+        self.future = self.past.point(fade_table())
+
+    def cursor(self, painter: Painter, img: Image.Image, t: float) -> list[Rect]:
+        """Move the cursor to ``t`` if it moved, the curves after it faded; the boxes
+        touched."""
+        strip = self.strip
+        u = strip.u
+        _, sy0, _, sy1 = strip.box
+        x = round(float(strip.x(t)))
+        before = painter.shown.get("cursor")
+        if before == x:
+            return []
+        painter.shown["cursor"] = x
+        half = 2 * u + 1
+        boxes: list[Rect] = [(x - half, sy0, x + half, sy1)]
+        if before is not None:
+            boxes.append(painter.restore((before - half, sy0, before + half, sy1)))
+        # The columns between the two cursors turn from future to past (or back).
+        ix0, iy0, ix1, iy1 = self.inner
+        lo = ix0 if before is None else max(ix0, math.floor(min(before, x) - half) - 1)
+        hi = ix1 if before is None else min(ix1, math.ceil(max(before, x) + half) + 2)
+        for a, b, src in ((lo, min(hi, x + 1), self.past), (max(lo, x + 1), hi, self.future)):
+            if b > a:
+                img.paste(src.crop((a - ix0, 0, b - ix0, iy1 - iy0)), (a, iy0))
+        if hi > lo:
+            boxes.append((lo, iy0, hi, iy1))
+        ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=ink_index(INK),
+                                 width=max(1, round(WHOLE_CURSOR * u)))
+        return boxes
 
 
 @lru_cache(maxsize=1)

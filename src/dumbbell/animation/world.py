@@ -1,21 +1,22 @@
 """The scene panel: the floor and the height ruler (drawn once), and per frame the dumbbell
 (particles at their true radius, the spring as a zig-zag with a constant number of coils or a
-rigid rod, the centre of mass, in 2D its axis and angle), the time and, in 2D, the axis angle
-from vertical."""
+rigid rod, the centre of mass, in 2D its axis and angle), and the time label's text (in 2D
+the axis angle from vertical under it), as the picture panel of :mod:`.painter`."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from PIL import ImageDraw
+import numpy as np
+from PIL import Image, ImageDraw
 
-from .backdrop import SS, Patch
 from .frames import Frames
-from .glyphs import Stamps, fmt_tick, nice_step
+from .glyphs import NOTE_PX, Stamps, fmt_tick, font, nice_step
 from .layout import Layout
+from .painter import SS, Clock, Painter, Patch, Rect
 from .palette import BLACK, FLOOR, GREY, INK, LIGHT, SPRING, TERM_RGB, WHITE
 
 if TYPE_CHECKING:  # for the annotations only: a recording does not read scenes
@@ -61,8 +62,8 @@ ARC = 20              # radius of the angle's arc; its vertical line is 1.25 tim
 ARC_LINE = 1.3        # the arc's width (at least 1 px)
 TIME_BOX = (4, 2)     # the time label's crop: from the left and top edges ...
 TIME_BOTTOM_1D, TIME_BOTTOM_2D = 22, 34  # ... down to here (2D: the angle's line too)
-TIME_AT = 6           # the time label, this far from the left and top edges
-ANGLE_AT = 24         # the angle's line, this far from the top edge
+# (Where the time label and the angle's line are drawn, TIME_AT and ANGLE_AT, are the
+# painter's: it draws every animation's time label.)
 #: The ruler's title, the word under an impact's mark, and the time and angle labels (the
 #: time's format: its decimals; the angle's: the text around its value in degrees).
 RULER_NAME = "height (m)"
@@ -184,7 +185,7 @@ class World:
                fill=GREY, anchor="ls")
 
     def draw_dumbbell(self, frames: Frames, k: int, impact: bool,
-                      patch: Callable[[tuple[float, float, float, float]], Patch],
+                      patch: Callable[[Rect], Patch],
                       stamps: tuple[Stamps, Stamps]) -> None:
         """Frame ``k``'s dumbbell (``impact``: with the mark of an impact since the previous
         frame) on a crop from ``patch`` at :data:`SS` times the size; ``stamps`` (the letters,
@@ -289,21 +290,64 @@ class World:
         d.arc([x - rv * S, y - rv * S, x + rv * S, y + rv * S], start, end, fill=GREY,
               width=max(1, round(ARC_LINE * u * S)))
 
-    def draw_time(self, frames: Frames, k: int,
-                  patch: Callable[[tuple[float, float, float, float]], Patch],
-                  time: Stamps, note: Stamps) -> None:
-        """Frame ``k``'s time and, in 2D, its axis angle from vertical, top left."""
+    def clock(self, frames: Frames) -> Clock:
+        """The time label of ``frames``: the time and, in 2D, the axis angle from vertical
+        under it, top left."""
         L, u = self.layout, self.layout.u
         two_d = self.dimensions == 2
         box = (round(TIME_BOX[0] * u), round(TIME_BOX[1] * u), L.scene_w - round(TIME_BOX[0] * u),
                round((TIME_BOTTOM_2D if two_d else TIME_BOTTOM_1D) * u))
-        crop, (cx, cy), done = patch(box)
-        time.draw(crop, (TIME_AT * u - cx, TIME_AT * u - cy), f"t = {frames.t[k]:.{TIME_DECIMALS}f} s", INK,
-                  "lt")
-        if two_d:
+
+        def angle(k: int) -> str | None:
             (ax, ay), (bx, by) = frames.A[k].tolist(), frames.B[k].tolist()
             if all(math.isfinite(v) for v in (ax, ay, bx, by)) and (ax, ay) != (bx, by):
                 theta = axis_angle(L.px(ax, ay), L.px(bx, by))
-                note.draw(crop, (TIME_AT * u - cx, ANGLE_AT * u - cy),
-                          f"{ANGLE_TEXT[0]}{theta:+.0f}{ANGLE_TEXT[1]}", GREY, "lt")
-        done()
+                return f"{ANGLE_TEXT[0]}{theta:+.0f}{ANGLE_TEXT[1]}"
+            return None
+
+        return Clock(box, lambda k: f"t = {frames.t[k]:.{TIME_DECIMALS}f} s",
+                     angle if two_d else None)
+
+
+class ScenePanel:
+    """The picture panel of a scene's frames (for :class:`~.painter.Painter`): the floor
+    and the ruler under everything, and per frame the dumbbell of ``frames`` as ``world``
+    draws it, every frame drawn whole on the background."""
+
+    fresh_every_frame = True
+    text_on_white = False
+
+    def __init__(self, world: World, frames: Frames) -> None:
+        self.world, self.frames = world, frames
+        self.n = len(frames.t)
+        self.width = world.layout.scene_w
+        self.clock = world.clock(frames)
+        t, impacts = frames.t, np.asarray(frames.impacts)
+        # Frames after which an impact happened since the previous frame.
+        self.impact_frames = {int(k) for k in np.searchsorted(t, impacts, side="left")
+                              if 0 < k < len(t)}
+
+    def draw_base(self, d: ImageDraw.ImageDraw, S: int) -> None:
+        self.world.draw_static(d, S, font(round(NOTE_PX * self.world.layout.u) * S))
+
+    def static_key(self, k: int) -> object:
+        return 0  # one background for every frame
+
+    def draw_static(self, img: Image.Image, k: int) -> None:
+        pass  # everything static is in the base
+
+    def draw(self, painter: Painter, img: Image.Image, k: int, fresh: bool
+             ) -> list[Rect] | None:
+        self.world.draw_dumbbell(self.frames, k, k in self.impact_frames,
+                                 lambda box: painter.patch(img, box, SS),
+                                 (painter.letters, painter.small))
+        return None
+
+
+def scene_painter(picture: Any, run: int = 0) -> Painter:
+    """The painter of run ``run`` of ``picture`` (a :class:`~.picture.Picture`, which
+    imports this module): its world, its bars and its strip, on its layout."""
+    frames = picture.runs[run]
+    L = picture.layout
+    return Painter((L.W, L.H), ScenePanel(picture.world, frames), picture.bars, picture.strip,
+                   frames)

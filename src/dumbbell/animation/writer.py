@@ -4,19 +4,21 @@ file, as for every output: :mod:`dumbbell.files`)."""
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
 from ..errors import DumbbellError
 from ..files import atomic_output
-from .gif import write_frames
 from .palette import palette
-from .timing import _delays
 
-#: No public names: the writer behind :class:`dumbbell.spaces.Recorder`.
+if TYPE_CHECKING:  # for the annotations only
+    from PIL import Image
+
+#: No public names: the files behind :func:`dumbbell.animation.render.render_gif` and
+#: :class:`dumbbell.spaces.Recorder`.
 __all__: list[str] = []
 
 
@@ -29,23 +31,6 @@ def binary_output(path: Path) -> Iterator[BinaryIO]:
         yield fh
 
 
-def save(path: Path, painter: Any, fps: int) -> dict[str, float]:
-    """Write ``painter``'s frames (``W`` x ``H`` px, ``n`` of them, ``frame(k)`` and
-    ``region(k)``) to ``path`` at ``fps``: a GIF, or an MP4 through imageio's ffmpeg plugin
-    when the name ends in .mp4; atomically, a stop signal removing the partial file. Returns
-    the seconds spent drawing and encoding (GIF only). A stop signal while the file is
-    written removes the partial file (:mod:`dumbbell.files` does, for every output)."""
-    stats: dict[str, float] = {}
-    if path.suffix.lower() == ".mp4":
-        _write_mp4(path, painter, fps)
-    else:
-        with binary_output(path) as fh:
-            stats["draw"], stats["encode"] = write_frames(
-                fh, (painter.W, painter.H), painter.frame, _delays(painter.n, fps),
-                region=painter.region)
-    return stats
-
-
 def mp4_problem() -> str | None:
     """Why an MP4 cannot be written here (the optional extra is missing), or None."""
     import importlib.util
@@ -56,7 +41,10 @@ def mp4_problem() -> str | None:
     return None
 
 
-def _write_mp4(path: Path, painter: Any, fps: int) -> None:
+def write_mp4(path: Path, size: tuple[int, int], n: int,
+              frame: Callable[[int], Image.Image], fps: int) -> None:
+    """Write the ``n`` frames ``frame(k)`` (palette images of ``size`` px) to ``path`` as an
+    MP4 at ``fps``, through imageio's ffmpeg plugin; atomically."""
     problem = mp4_problem()
     if problem is not None:
         raise DumbbellError(f"{path}: {problem}")
@@ -69,8 +57,9 @@ def _write_mp4(path: Path, painter: Any, fps: int) -> None:
                                     ffmpeg_log_level="error")
         try:
             # yuv420p needs even sizes: an odd edge gets one more row or column of itself.
-            pad = ((0, painter.H % 2), (0, painter.W % 2), (0, 0))
-            for k in range(painter.n):
-                writer.append_data(np.pad(lut[np.asarray(painter.frame(k))], pad, mode="edge"))
+            width, height = size
+            pad = ((0, height % 2), (0, width % 2), (0, 0))
+            for k in range(n):
+                writer.append_data(np.pad(lut[np.asarray(frame(k))], pad, mode="edge"))
         finally:
             writer.close()
