@@ -608,12 +608,12 @@ class Recorder:
         if self.path.suffix.lower() in (".html", ".htm"):  # the interactive player
             from ..animation import space_player
 
-            painter = space_player.write(self.path, self.recording(), self.timing)
+            panel = space_player.write(self.path, self.recording(), self.timing)
         else:
-            painter = recording.write(self.path, self.recording(), self.timing)
-        x0, x1, y0, y1 = painter.view
-        self.view = (x0, x1, y0, y1) if painter.rec.y_up else (x0, x1, y1, y0)
-        self.note = self._note(painter)
+            panel = recording.write(self.path, self.recording(), self.timing)
+        x0, x1, y0, y1 = panel.view
+        self.view = (x0, x1, y0, y1) if panel.rec.y_up else (x0, x1, y1, y0)
+        self.note = self._note(panel)
         return self.path
 
     def _name(self, bodies: list[Any]) -> None:
@@ -627,17 +627,17 @@ class Recorder:
                 i = place.get(id(b))
                 self._names[number(b)] = "a body not in the space" if i is None else f"body {i}"
 
-    def _note(self, painter: Any) -> str:
-        """The note on the picture (see :attr:`note`)."""
+    def _note(self, panel: Any) -> str:
+        """The note on the picture (see :attr:`note`), from the view panel that drew it."""
         lines = [self.orientation]
         name = self._names.get
-        if painter.grown:
-            grown = sorted(painter.grown)
-            lines.append(f"drawn larger than to scale, to be {painter.body_px:g} px across: "
+        if panel.grown:
+            grown = sorted(panel.grown)
+            lines.append(f"drawn larger than to scale, to be {panel.body_px:g} px across: "
                          f"{_listed([name(n, f'body #{n}') for n in grown])} "
                          f"({len(grown)} of {len(self._names)} moving bodies; camera=<a body> "
                          "follows one at a larger scale)")
-        seen, shown = painter.frames_in, painter.frames_shown
+        seen, shown = panel.frames_in, panel.frames_shown
         out = np.flatnonzero(shown < seen).tolist()
         if out:
             lines.append("outside the picture (or not drawable) in some frames: " + _listed(
