@@ -31,8 +31,6 @@ from ._records import Step
 
 __all__ = ["Contacts", "UnknownBody", "arbiters_address"]
 
-#: The x, y and angular components of a row's impulse, in :meth:`Contacts.work`'s sums.
-_XYW = np.arange(3)[:, None, None]
 #: (-ny, nx) from (nx, ny) reversed: the normal's perpendicular, as the tangent impulse uses.
 _PERP = np.array([[-1.0], [1.0]])
 
@@ -100,17 +98,19 @@ class Contacts:
         # (7, m): body_a, body_b, contacts, n.x, n.y, the words of count and state
         A = self.words.take(self._arb_at)
         count = A[5].view(np.uint32)[L.count::2]
-        if not count.all():  # arbiters without contacts: left out
+        fewest = count.min()
+        if not fewest:  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
             A, count = A[:, keep], count[keep]
+            fewest = count.min()
         self._rows(table, A[0:2], pairs)
         n = A[3:5].view(np.float64)
         self.nx, self.ny = n[0], n[1]
         self.n, self.perp = n, n[::-1] * _PERP
         self.first = A[6].view(np.uint32)[L.state::2] == 0
-        self.single = None if count.min() > 1 else count < 2
+        self.single = None if fewest > 1 else count < 2
         at = L.contact + (A[2] >> 3)  # (7, 2, m): each field of both contacts
         if self.single is not None:  # no second contact: it reads the zeros
             at[:, 1, self.single] = self._zero_at
@@ -121,9 +121,11 @@ class Contacts:
         if coef != 1.0:
             self.carried = slice(None)
             self.j0 = self.floats.take(at[0:2]) * (1.0 - np.where(self.first, 0.0, coef))
-        elif self.first.any():  # all of it (x 1.0)
-            self.carried = np.nonzero(self.first)[0]
-            self.j0 = self.floats.take(at[0:2, :, self.carried])  # (2, 2, k): jn, jt
+        else:  # all of a first contact's (x 1.0)
+            carried = self.first.nonzero()[0]
+            if len(carried):
+                self.carried = carried
+                self.j0 = self.floats.take(at[0:2, :, carried])  # (2, 2, k): jn, jt
         return True
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
@@ -141,7 +143,7 @@ class Contacts:
         self.rows = rows
         free = table.lin_free_f.take(rows)
         self.sign = free[1] - free[0]
-        self.rows3 = rows + table.rows * _XYW
+        self.rows3 = rows + table.xyw
         self._ends_key = (table, pairs, key)
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray

@@ -180,6 +180,8 @@ class Table:
         t.drives[n: n + k] = True
         t.drives[:n] = ~t.finite
         t.any_driven = bool(t.drives.any())
+        # Offsets of the x, y and angular sums of a row's impulses (:mod:`._contacts`).
+        t.xyw = t.rows * np.arange(3)[:, None, None]
 
     #: Most rows for which their pairs' slots are looked up in a dense map of rows (4 bytes
     #: each: 16 MB at most).
@@ -234,7 +236,8 @@ class Table:
             return self.pair_slots(ra, rb, pairs)
         if not hasattr(self, "_pairmap"):
             self._pairmap = np.full((self.rows + 1, self.rows + 1), -1, dtype=np.int32)
-        slots = self._pairmap[ra, rb]
+        # One flat take (row -1 wraps to the last row or column, all -1).
+        slots = self._pairmap.ravel().take(ra * (self.rows + 1) + rb)
         if slots.min() < 0:
             if rows.min() < 0:
                 raise UnknownBody
