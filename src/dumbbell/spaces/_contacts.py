@@ -130,8 +130,7 @@ class Contacts:
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
         """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), its
-        pair's slot and the sign of the push on its ends, through the table's maps; and
-        where each end's impulse adds up per row (``rows3``: x, y and angular). The same
+        pair's slot and the sign of the push on its ends, through the table's maps. The same
         bodies in the same order as the last step's, on the same table, keep them."""
         key = ends.tobytes()
         last = self._ends_key
@@ -143,7 +142,7 @@ class Contacts:
         self.rows = rows
         free = table.lin_free_f.take(rows)
         self.sign = free[1] - free[0]
-        self.rows3 = rows + table.xyw
+        self.ends = rows.ravel()  # a's rows, then b's: the order of each end's sums
         self._ends_key = (table, pairs, key)
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
@@ -176,14 +175,14 @@ class Contacts:
         rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
         n = table.rows
-        # Per row: linear (x + y), y alone (unused) and angular.
-        per_row = np.bincount(self.rows3.ravel(), weights=imp.ravel(),
-                              minlength=3 * n).reshape(3, n)
+        # Per row: linear (x + y) and angular, each summed in the order of the ends.
+        lin_rows = np.bincount(self.ends, weights=lin.ravel(), minlength=n)
+        ang_rows = np.bincount(self.ends, weights=ang.ravel(), minlength=n)
         work = step.work
-        work += per_row[::2]
+        work[0] += lin_rows
+        work[1] += ang_rows
         total = float(rel.sum())
         if table.any_driven:
-            lin_rows, ang_rows = per_row[0], per_row[2]
             # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
             # bodies of infinite moment): what the relative work leaves out of theirs.
             driven = -(np.where(table.lin_free, 0.0, lin_rows)

@@ -180,8 +180,6 @@ class Table:
         t.drives[n: n + k] = True
         t.drives[:n] = ~t.finite
         t.any_driven = bool(t.drives.any())
-        # Offsets of the x, y and angular sums of a row's impulses (:mod:`._contacts`).
-        t.xyw = t.rows * np.arange(3)[:, None, None]
 
     #: Most rows for which their pairs' slots are looked up in a dense map of rows (4 bytes
     #: each: 16 MB at most).
