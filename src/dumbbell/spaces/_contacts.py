@@ -137,8 +137,10 @@ class Contacts:
         if last is not None and last[0] is table and last[1] is pairs and last[2] == key:
             return
         self._ends_key = None
-        rows = table.rows_of(ends)
-        self.slots = table.slots_of(rows, pairs)  # raises UnknownBody on a row -1
+        # As numpy's index type once: each take and bincount would cast them again.
+        rows = table.rows_of(ends).astype(np.intp, copy=False)
+        slots = table.slots_of(rows, pairs)  # raises UnknownBody on a row -1
+        self.slots = slots.astype(np.intp, copy=False)
         self.rows = rows
         free = table.lin_free_f.take(rows)
         self.sign = free[1] - free[0]
