@@ -536,7 +536,13 @@ def _changed_settings(b: Build, space: Any) -> str:
     """What changed since the build in gravity, the springs' settings and the custom
     velocity functions ('' when nothing)."""
     t = b.table
-    if tuple(space.gravity) != b.gravity:
+    cspace = getattr(space, "_space", None)  # a pymunk Space (or what one held)
+    if cspace is not None:  # Chipmunk's getter, as pymunk's property calls it
+        g = mem._lib().cpSpaceGetGravity(cspace)
+        now = (g.x, g.y)
+    else:
+        now = tuple(space.gravity)
+    if now != b.gravity:
         return "space.gravity"
     for g in b.springs:
         if g.changed():
