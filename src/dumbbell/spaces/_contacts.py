@@ -31,8 +31,6 @@ from ._records import Step
 
 __all__ = ["Contacts", "UnknownBody", "arbiters_address"]
 
-#: The x, y and angular components of a row's impulse, in :meth:`Contacts.work`'s sums.
-_XYW = np.arange(3)[:, None, None]
 #: (-ny, nx) from (nx, ny) reversed: the normal's perpendicular, as the tangent impulse uses.
 _PERP = np.array([[-1.0], [1.0]])
 
@@ -100,17 +98,19 @@ class Contacts:
         # (7, m): body_a, body_b, contacts, n.x, n.y, the words of count and state
         A = self.words.take(self._arb_at)
         count = A[5].view(np.uint32)[L.count::2]
-        if not count.all():  # arbiters without contacts: left out
+        fewest = count.min()
+        if not fewest:  # arbiters without contacts: left out
             keep = count > 0
             if not keep.any():
                 return False
             A, count = A[:, keep], count[keep]
+            fewest = count.min()
         self._rows(table, A[0:2], pairs)
         n = A[3:5].view(np.float64)
         self.nx, self.ny = n[0], n[1]
         self.n, self.perp = n, n[::-1] * _PERP
         self.first = A[6].view(np.uint32)[L.state::2] == 0
-        self.single = None if count.min() > 1 else count < 2
+        self.single = None if fewest > 1 else count < 2
         at = L.contact + (A[2] >> 3)  # (7, 2, m): each field of both contacts
         if self.single is not None:  # no second contact: it reads the zeros
             at[:, 1, self.single] = self._zero_at
@@ -121,27 +121,30 @@ class Contacts:
         if coef != 1.0:
             self.carried = slice(None)
             self.j0 = self.floats.take(at[0:2]) * (1.0 - np.where(self.first, 0.0, coef))
-        elif self.first.any():  # all of it (x 1.0)
-            self.carried = np.nonzero(self.first)[0]
-            self.j0 = self.floats.take(at[0:2, :, self.carried])  # (2, 2, k): jn, jt
+        else:  # all of a first contact's (x 1.0)
+            carried = self.first.nonzero()[0]
+            if len(carried):
+                self.carried = carried
+                self.j0 = self.floats.take(at[0:2, :, carried])  # (2, 2, k): jn, jt
         return True
 
     def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
         """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), its
-        pair's slot and the sign of the push on its ends, through the table's maps; and
-        where each end's impulse adds up per row (``rows3``: x, y and angular). The same
+        pair's slot and the sign of the push on its ends, through the table's maps. The same
         bodies in the same order as the last step's, on the same table, keep them."""
         key = ends.tobytes()
         last = self._ends_key
         if last is not None and last[0] is table and last[1] is pairs and last[2] == key:
             return
         self._ends_key = None
-        rows = table.rows_of(ends)
-        self.slots = table.slots_of(rows, pairs)  # raises UnknownBody on a row -1
+        # As numpy's index type once: each take and bincount would cast them again.
+        rows = table.rows_of(ends).astype(np.intp, copy=False)
+        slots = table.slots_of(rows, pairs)  # raises UnknownBody on a row -1
+        self.slots = slots.astype(np.intp, copy=False)
         self.rows = rows
         free = table.lin_free_f.take(rows)
         self.sign = free[1] - free[0]
-        self.rows3 = rows + table.rows * _XYW
+        self.ends = rows.ravel()  # a's rows, then b's: the order of each end's sums
         self._ends_key = (table, pairs, key)
 
     def work(self, step: Step, table: Table, pairs: Pairs, drive: np.ndarray
@@ -174,14 +177,14 @@ class Contacts:
         rel = lin[0] + lin[1] + ang[0] + ang[1]
         pairs.work += np.bincount(self.slots, weights=rel, minlength=len(pairs.work))
         n = table.rows
-        # Per row: linear (x + y), y alone (unused) and angular.
-        per_row = np.bincount(self.rows3.ravel(), weights=imp.ravel(),
-                              minlength=3 * n).reshape(3, n)
+        # Per row: linear (x + y) and angular, each summed in the order of the ends.
+        lin_rows = np.bincount(self.ends, weights=lin.ravel(), minlength=n)
+        ang_rows = np.bincount(self.ends, weights=ang.ravel(), minlength=n)
         work = step.work
-        work += per_row[::2]
+        work[0] += lin_rows
+        work[1] += ang_rows
         total = float(rel.sum())
         if table.any_driven:
-            lin_rows, ang_rows = per_row[0], per_row[2]
             # Work of driven ends (kinematic bodies, bodies outside the space, the spin of
             # bodies of infinite moment): what the relative work leaves out of theirs.
             driven = -(np.where(table.lin_free, 0.0, lin_rows)

@@ -234,7 +234,8 @@ class Table:
             return self.pair_slots(ra, rb, pairs)
         if not hasattr(self, "_pairmap"):
             self._pairmap = np.full((self.rows + 1, self.rows + 1), -1, dtype=np.int32)
-        slots = self._pairmap[ra, rb]
+        # One flat take (row -1 wraps to the last row or column, all -1).
+        slots = self._pairmap.ravel().take(ra * (self.rows + 1) + rb)
         if slots.min() < 0:
             if rows.min() < 0:
                 raise UnknownBody
@@ -535,7 +536,13 @@ def _changed_settings(b: Build, space: Any) -> str:
     """What changed since the build in gravity, the springs' settings and the custom
     velocity functions ('' when nothing)."""
     t = b.table
-    if tuple(space.gravity) != b.gravity:
+    cspace = getattr(space, "_space", None)  # a pymunk Space (or what one held)
+    if cspace is not None:  # Chipmunk's getter, as pymunk's property calls it
+        g = mem._lib().cpSpaceGetGravity(cspace)
+        now = (g.x, g.y)
+    else:
+        now = tuple(space.gravity)
+    if now != b.gravity:
         return "space.gravity"
     for g in b.springs:
         if g.changed():

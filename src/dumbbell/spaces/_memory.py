@@ -419,13 +419,14 @@ class Reader:
         if np.any(at % np.uint64(8)):
             raise LayoutError(f"{kind}: a struct not 8-byte aligned")
         rel = at - np.uint64(self.span.lo)
+        # Indices as numpy's own index type: a take casts any other type on every call.
         if floats:
             self.fi = np.stack([(rel + np.uint64(offset(kind, *f.split(".")))) >> np.uint64(3)
-                                for f in floats])
+                                for f in floats]).astype(np.intp)
         if ptrs:
             shift = np.uint64(self.span.pshift)
             self.pi = np.stack([(rel + np.uint64(offset(kind, *f.split(".")))) >> shift
-                                for f in ptrs])
+                                for f in ptrs]).astype(np.intp)
 
     def floats(self) -> np.ndarray:
         if self.span is None:
