@@ -494,7 +494,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.accounting.SpaceEnergy": lambda f: fields(f.space_energy),
     "dumbbell.spaces.accounting.BodyEnergy": lambda f: fields(f.space_energy.bodies[0]),
     "dumbbell.spaces.accounting.SpringEnergy": lambda f: fields(f.space_energy.springs[0]),
-    "dumbbell.spaces.accounting.Skipped": lambda f: {"subject": "body 0", "reason": "static"},
+    "dumbbell.spaces._what_counts.Skipped": lambda f: {"subject": "body 0", "reason": "static"},
     # dumbbell.spaces.guard
     "dumbbell.spaces.guard.check": lambda f: {"space": f.space(), "dt": 1e-3, "speeds": "both",
                                               "tolerance": 0.01, "units": "m"},

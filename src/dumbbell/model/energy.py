@@ -488,7 +488,7 @@ def partition_from_terms(
 ) -> dict[str, np.ndarray]:
     """The dumbbell's energy columns (J, :func:`energy_columns` order) from the general
     accounting of its bodies over the same samples (``terms``: K_cm, K_int, K_rot (the bodies'
-    own spin), U_g, U_spring, E, as :func:`dumbbell.spaces.accounting.evaluate` gives them);
+    own spin), U_g, U_spring, E, as :func:`dumbbell.spaces._evaluation.evaluate` gives them);
     ``t``, ``state`` and ``events`` as for :func:`partition`.
 
     K_cm, K_int (1D), U_g, U_spring and E are the accounting's. In 2D the internal motion is

@@ -255,7 +255,8 @@ def _energy(
 ) -> dict[str, np.ndarray]:
     """The energy columns (J) from the general accounting of pymunk's own bodies, springs and
     gravity (:mod:`dumbbell.spaces.accounting`), evaluated over all samples at once."""
-    from ..spaces.accounting import State, evaluate, inventory
+    from ..spaces._evaluation import State, evaluate
+    from ..spaces._what_counts import inventory
 
     inv = inventory(world.space)
     n = len(t)

@@ -63,8 +63,8 @@ from .._pymunk import spring_function
 from ..errors import UsageError
 from ..model import args
 from ..model.energy import rotational_ke, spring_potential, translational_ke
+from ._refusals import settings_problem
 from ._scan import DYNAMIC, KINEMATIC, Scan, scan, world_outline
-from .accounting import settings_problem
 
 __all__ = ["Reach", "reach"]
 

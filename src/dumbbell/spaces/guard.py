@@ -52,8 +52,8 @@ import numpy as np
 from ..errors import UsageError
 from ..model import args
 from ._finding import _FAILS, Finding
+from ._refusals import settings_problem
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
-from .accounting import settings_problem
 from .estimates import Estimates, estimate, length_unit, percent, state_problem
 
 __all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",

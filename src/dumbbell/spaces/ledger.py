@@ -198,7 +198,8 @@ class Ledger(Changes):
         from pymunk._chipmunk_cffi import lib
 
         from ..errors import UsageError
-        from .accounting import check_finite, energy
+        from ._refusals import check_finite
+        from .accounting import energy
 
         if lib.cpSpaceIsLocked(space._space):
             raise UsageError("space: attach the ledger between steps, not from a callback",

@@ -386,7 +386,8 @@ class Recorder:
         self.options = draw_options()
         self._no_frames()
         if self.energy:
-            from .accounting import _Sampler, refuse_settings
+            from ._refusals import refuse_settings
+            from ._sampler import _Sampler
 
             refuse_settings(self.space)
             self._sampler = _Sampler(self.space)
