@@ -30,7 +30,7 @@ class Scan:
     bottom, right, top), ``size`` (thinnest extent), ``reach`` (farthest point from its body's
     centre of gravity), ``sensor``, ``group``, ``categories``, ``mask``, ``elasticity``. Per
     shape of a fixed body (static or kinematic), ``rest``: the world points of its outline
-    (for the floors under falling bodies, see :mod:`.estimates`)."""
+    (for the floors under falling bodies, see :mod:`._floors`)."""
 
     space: Any
     bodies: list[Any]
