@@ -509,12 +509,13 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
                                                    "units": "m"},
     "dumbbell.spaces.guard.report": lambda f: {"space": f.space(), "dt": 1e-2, "speeds": "both",
                                                "tolerance": 0.01, "units": "px"},
-    "dumbbell.spaces.guard.energy_swing": lambda f: {"w_dt": 0.5},
+    "dumbbell.spaces._springs_dt.energy_swing": lambda f: {"w_dt": 0.5},
     "dumbbell.spaces.estimates.reach": lambda f: {"space": f.space(), "dt": 1e-3, "units": "m"},
     "dumbbell.spaces.estimates.Reach": lambda f: fields(
         importlib.import_module("dumbbell.spaces").reach(f.space(), 1e-3)[0]),
     "dumbbell.spaces.stepping.step": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": 2},
-    "dumbbell.spaces.guard.spring_omega": lambda f: {"spring": next(iter(f.space().constraints))},
+    "dumbbell.spaces._springs_dt.spring_omega": lambda f: {
+        "spring": next(iter(f.space().constraints))},
     "dumbbell.spaces.guard.shape_size": lambda f: {"shape": next(iter(f.space().shapes))},
     "dumbbell.spaces._finding.Finding": lambda f: fields(f.finding),
     "dumbbell.spaces.stepping.Driver": lambda f: {"space": f.space(), "dt": 1e-2, "substeps": None,
