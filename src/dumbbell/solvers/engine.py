@@ -444,7 +444,7 @@ def solve(scene: Scene, options: RunOptions) -> Trajectory:
                 j += 1
                 row = read()
                 out[j] = row
-                heat[j] = counter._total  # no program here replaces its callbacks: no look
+                heat[j] = counter.total
                 verdict = watch.verdict(row, j * every * dt, dt)
                 if verdict is not None:
                     if verdict.status == "unstable":

@@ -148,7 +148,7 @@ class HeatCounter:
     def _look(self) -> None:
         """Notice callbacks the program set over the counters' since they last ran."""
         d = self._dispatch()
-        if d is not None and self._stopped is None:
+        if d is not None and not d.sealed and self._stopped is None:
             d.check()
 
     @property
