@@ -23,7 +23,7 @@ from ..model.energy import BOOKKEEPING
 from .glyphs import SMALL_PX, TEXT_PX, TITLE_PX, Stamps, font, nice_step
 from .layout import unit
 from .painter import SS, Painter, Patch, Rect
-from .palette import GREY, INK, TERM_RGB, blend, ink_index
+from .palette import GREY, INK, TERM_RGB, TINT, blend, ink_index
 
 if TYPE_CHECKING:  # for the annotations only
     from .recorded import Recording
@@ -250,8 +250,6 @@ class Bars:
     def _inks(self) -> tuple[dict[str, int], dict[str, int]]:
         """Each row's palette index, and its pale one (opacity :data:`TINT` over white; a
         space's heat: :data:`HEAT_ALPHA`)."""
-        from .palette import TINT
-
         inks = {name: ink_index(rgb) for name, rgb in self.inks.items()}
         inks["grey"] = ink_index(GREY)
         tints = {name: ink_index(blend(rgb, HEAT_ALPHA if self.heat else TINT))

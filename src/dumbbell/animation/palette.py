@@ -100,8 +100,3 @@ def term_inks() -> dict[str, int]:
     out.update({"ink": ink_index(INK), "grey": ink_index(GREY)})
     return out
 
-
-@lru_cache(maxsize=1)
-def term_tints() -> dict[str, int]:
-    """Palette index of each term's pale colour (opacity :data:`TINT`) by name."""
-    return {name: ink_index(blend(rgb, TINT)) for name, rgb in TERM_RGB.items()}
