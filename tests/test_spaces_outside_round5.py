@@ -1,0 +1,140 @@
+"""dumbbell.spaces on a fifth round of programs written as outside pymunk programs are (issue
+28's cases, varied): each defect found there, against an independent measurement through
+pymunk's public API."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import pymunk
+import pytest
+
+from dumbbell import spaces
+
+
+def _kinetic(body: pymunk.Body) -> float:
+    return (0.5 * body.mass * body.velocity.length_squared
+            + 0.5 * body.moment * body.angular_velocity ** 2)
+
+
+def _energy(space: pymunk.Space) -> float:
+    """Kinetic, gravitational and the default springs' energy, from pymunk's getters."""
+    gx, gy = space.gravity
+    out = []
+    for b in space.bodies:
+        if b.body_type == pymunk.Body.DYNAMIC:
+            p = b.local_to_world(b.center_of_gravity)
+            out.append(_kinetic(b) - b.mass * (gx * p[0] + gy * p[1]))
+    for c in space.constraints:
+        if isinstance(c, pymunk.DampedSpring):
+            d = (c.a.local_to_world(c.anchor_a) - c.b.local_to_world(c.anchor_b)).length
+            out.append(0.5 * c.stiffness * (d - c.rest_length) ** 2)
+    return math.fsum(out)
+
+
+def _sum(bal: spaces.Balance, kind: str) -> float:
+    return math.fsum(t.energy for t in bal.terms if t.kind == kind)
+
+
+@pytest.mark.parametrize("event", ["begin", "pre_solve", "separate"])
+def test_a_velocity_set_by_a_callback_before_the_solver_is_booked_as_it_changed_energy(event):
+    # Balls dropping on an elastic floor, a handler halving (typed) or kicking (wildcard)
+    # the ball it touches. These callbacks run after pymunk moved the bodies with the
+    # velocity the last step left: the program term is the kinetic energy the callback
+    # changed, not that plus a teleport inferred from the new velocity (before round 5
+    # it was 2-10 % off, the difference hidden in gravity's step error).
+    space = pymunk.Space()
+    space.gravity = (0, -900)
+    floor = pymunk.Segment(space.static_body, (-500, 0), (500, 0), 5)
+    floor.collision_type, floor.elasticity = 2, 0.8
+    space.add(floor)
+    for i in range(3):
+        b = pymunk.Body(1 + i, 100 * (1 + i))
+        b.position, b.velocity = (-300 + 150 * i, 30 + 20 * i), (10 * i, -200)
+        c = pymunk.Circle(b, 20)
+        c.collision_type, c.elasticity, c.friction = 1, 0.9, 0.5
+        space.add(b, c)
+    ledger = spaces.Ledger(space)
+    measured = [0.0]
+
+    def halve(arbiter, space, data):
+        for s in arbiter.shapes:
+            if s.body is not None and s.body.body_type == pymunk.Body.DYNAMIC:
+                e = _kinetic(s.body)
+                s.body.velocity *= 0.5
+                s.body.angular_velocity *= 0.5
+                measured[0] += _kinetic(s.body) - e
+
+    def kick(arbiter, space, data):
+        for s in arbiter.shapes:
+            if s.body is not None and s.body.body_type == pymunk.Body.DYNAMIC:
+                e = _kinetic(s.body)
+                s.body.apply_impulse_at_local_point((30, 40), (5, 0))
+                measured[0] += _kinetic(s.body) - e
+
+    space.on_collision(1, 2, **{event: halve})
+    space.on_collision(None, None, **{event: kick})
+    E0 = _energy(space)
+    for _ in range(120):
+        space.step(1 / 120)
+    bal = ledger.balance()
+    assert measured[0] != 0.0
+    assert abs(_sum(bal, "program") - measured[0]) <= 1e-9 * bal.scale
+    assert abs((_energy(space) - E0) - (bal.E - bal.E0)) <= 1e-9 * bal.scale
+    assert abs(bal.closure) <= 1e-12 * bal.scale and bal.complete is False
+
+
+def _boxes_and_a_kinematic(cog_after_position: bool = False) -> pymunk.Space:
+    space = pymunk.Space()
+    space.gravity = (0, -9.81)
+    space.add(pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.1))
+    boxes = []
+    for i in range(3):
+        b = pymunk.Body(1 + i, 0.1 * (1 + i))
+        if not cog_after_position:
+            b.center_of_gravity = (0.1, -0.05 * i)
+        b.position, b.velocity = (-3 + 3 * i, 1 + i), (i, -2)
+        if cog_after_position:
+            b.center_of_gravity = (0.1, -0.05 * i)
+        space.add(b, pymunk.Poly.create_box(b, (0.5, 0.3)))
+        boxes.append(b)
+    k = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+    k.position, k.velocity = (10, 0.5), (-1, 0)
+    space.add(k, pymunk.Circle(k, 0.3))
+    space.add(pymunk.DampedSpring(boxes[0], boxes[1], (0, 0), (0, 0), 2.5, 30, 0.2))
+    return space
+
+
+def test_the_public_api_ledger_counts_a_space_with_a_kinematic_body():
+    # The fallback ledger took the springs' kicks out of every row with the dynamic rows'
+    # inverse masses: with a kinematic body it stopped at step 0 (a numpy broadcast error).
+    from dumbbell.spaces.ledger import PublicLedger
+
+    space = _boxes_and_a_kinematic()
+    ledger = PublicLedger(space, units="m")
+    E0 = _energy(space)
+    for _ in range(60):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert bal.complete is True and abs(bal.closure) <= 1e-12 * bal.scale
+    assert abs((_energy(space) - E0) - (bal.E - bal.E0)) <= 1e-9 * bal.scale
+
+
+def test_a_centre_of_gravity_set_after_the_position_keeps_the_full_ledger():
+    # Chipmunk keeps p (the centre of gravity's world position) when center_of_gravity is
+    # set; until the next step pymunk's transform still puts the old centre there. The
+    # ledger's check of its reads compared p with the transform's, refused the space and
+    # fell back to the public API ledger (which then stopped: the test above).
+    space = _boxes_and_a_kinematic(cog_after_position=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ledger = spaces.Ledger(space, units="m")
+    assert type(ledger) is spaces.Ledger
+    space.step(1 / 60)
+    E1, bal1 = _energy(space), ledger.balance()  # the transform follows p after a step
+    for _ in range(60):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert bal.complete is True and abs(bal.closure) <= 1e-12 * bal.scale
+    assert abs((_energy(space) - E1) - (bal.E - bal1.E)) <= 1e-9 * bal.scale
