@@ -257,7 +257,8 @@ def pre(self: Any) -> None:
     coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
     kicks = _spring_kicks(b, F[0:3], dt)
     vel_r = F[3:6].copy()
-    vel0 = vel_r - kicks * t.inv3 if t.rows else vel_r
+    vel0 = vel_r.copy()  # kinematic rows (past the dynamic ones) take no spring's kick
+    vel0[:, :n] -= kicks[:, :n] * t.inv3
     # Bodies no spring kicked keep their velocity bit for bit; a kick taken back out
     # leaves a few roundings, which are not the program's.
     vel0 = np.where(phys.same(vel0, s.vel), s.vel, vel0)
