@@ -164,3 +164,22 @@ def test_pygame_util_draws_y_the_way_its_flag_says_whatever_the_gravity(tmp_path
     space.add(ball, pymunk.Circle(ball, 10))
     rec = spaces.Recorder(space, tmp_path / "a.gif", energy=False)
     assert rec.orientation.startswith(f"y {'up' if up else 'down'}: ")
+
+
+def test_a_kind_the_ledger_never_writes_is_refused_by_sources():
+    # sources(kind="contacts") (a misspelt kind) gave [] as if nothing had happened.
+    from dumbbell.errors import UsageError
+    from dumbbell.spaces.balance import KINDS
+
+    space = pymunk.Space()
+    space.gravity = (0, -9.81)
+    ball = pymunk.Body(1, 1)
+    space.add(ball, pymunk.Circle(ball, 0.1))
+    ledger = spaces.Ledger(space)
+    space.step(0.01)
+    bal = ledger.balance()
+    assert {t.kind for t in bal.terms} <= set(KINDS)
+    assert [t.kind for t in bal.sources("step error")] == ["step error"]
+    for bad in ("contacts", 5):
+        with pytest.raises(UsageError, match=r"^kind = .*: must be None \(every kind\) or one of"):
+            bal.sources(kind=bad)
