@@ -183,3 +183,51 @@ def test_a_kind_the_ledger_never_writes_is_refused_by_sources():
     for bad in ("contacts", 5):
         with pytest.raises(UsageError, match=r"^kind = .*: must be None \(every kind\) or one of"):
             bal.sources(kind=bad)
+
+
+@pytest.mark.parametrize("change", ["add a dense shape", "remove a dense shape", "set a mass"])
+def test_a_mass_changed_from_a_callback_is_the_callbacks_not_the_programs(change):
+    # A post-step callback (asked for from a collision's begin) adding or removing a shape
+    # with a density, or setting a mass: the change came from inside the step, so all of
+    # it is 'unattributed' (a callback). Before round 5 the mass's part was booked as the
+    # program's ('program: a mass, ...') at the next step, the move of the centre of
+    # gravity as the callback's.
+    space = pymunk.Space()
+    space.gravity = (0, -900)
+    space.add(pymunk.Segment(space.static_body, (-300, 0), (300, 0), 5))
+    a = pymunk.Body()
+    a.position, a.velocity, a.angular_velocity = (0, 100), (30, -50), 2
+    disc, wedge = pymunk.Circle(a, 10), pymunk.Poly(a, [(0, 0), (-20, 0), (-20, -8)])
+    disc.density, wedge.density = 0.01, 0.03
+    b = pymunk.Body(1, 100)
+    b.position, b.velocity = (80, 150), (0, -100)
+    space.add(a, disc, wedge, b, pymunk.Poly.create_box(b, (20, 20)), pymunk.PinJoint(a, b))
+    ledger = spaces.Ledger(space)
+    measured, asked = [0.0], []
+
+    def act(space, key):
+        e = _energy(space)
+        if change == "add a dense shape":
+            extra = pymunk.Poly(a, [(0, 0), (30, 0), (30, 10)])
+            extra.density = 0.02
+            space.add(extra)
+        elif change == "remove a dense shape":
+            space.remove(wedge)
+        else:
+            b.mass = 3.0
+        measured[0] += _energy(space) - e
+
+    def begin(arbiter, space, data):
+        if not asked:
+            asked.append(space.add_post_step_callback(act, "act"))
+        return True
+
+    space.on_collision(None, None, begin=begin)
+    E0 = _energy(space)
+    for _ in range(120):
+        space.step(1 / 120)
+    bal = ledger.balance()
+    assert asked and measured[0] != 0.0
+    assert not [t for t in bal.terms if t.kind == "program"]
+    assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale
+    assert abs((_energy(space) - E0) - (bal.E - bal.E0)) <= 1e-9 * bal.scale

@@ -71,7 +71,7 @@ from . import _physics as phys
 from . import _public
 from ._changes import Changes
 from ._contacts import UnknownBody
-from ._inventory import Names, Pairs, changed, declared
+from ._inventory import Names, Pairs, changed, declared, settings_changed
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
@@ -574,9 +574,8 @@ class Ledger(Changes):
         self._worst = max(self._worst, abs(step))  # relative to the scale when shown
 
     def _end(self) -> None:
-        """At the end of the step (pymunk's post-step callbacks): what changed since the
-        solver was changed inside the step by a callback, bodies added or removed from one
-        included."""
+        """At the end of the step (pymunk's post-step callbacks): what a callback changed
+        since the solver (bodies added or removed and masses set by one included)."""
         if not self._awaiting_end:
             return
         self._awaiting_end = False
@@ -590,6 +589,9 @@ class Ledger(Changes):
         elif tuple(self.space.constraints) != t.constraint_key:
             _quietly(lambda: self._restructure("constraints added or removed inside the "
                                                "step", None, "unattributed"))
+        elif settings_changed(t, F):  # a shape with mass added or removed, a mass set
+            _quietly(lambda: self._restructure("a mass, moment, centre of gravity or body type "
+                                               "set inside the step", None, "unattributed"))
 
 
 @np.errstate(invalid="ignore", over="ignore", divide="ignore")
