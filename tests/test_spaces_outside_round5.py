@@ -231,3 +231,34 @@ def test_a_mass_changed_from_a_callback_is_the_callbacks_not_the_programs(change
     assert not [t for t in bal.terms if t.kind == "program"]
     assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale
     assert abs((_energy(space) - E0) - (bal.E - bal.E0)) <= 1e-9 * bal.scale
+
+
+@pytest.mark.parametrize("change", ["gravity", "stiffness", "rest_length"])
+def test_gravity_or_a_spring_set_from_a_post_solve_callback_is_the_callbacks(change):
+    # Booked as 'program: space.gravity' (or a spring's settings) at the next step before.
+    space = pymunk.Space()
+    space.gravity = (0, -900)
+    space.add(pymunk.Segment(space.static_body, (-300, 0), (300, 0), 5))
+    ball = pymunk.Body(1, 100)
+    ball.position, ball.velocity = (0, 40), (0, -300)
+    spring = pymunk.DampedSpring(space.static_body, ball, (0, 200), (0, 0), 180, 30, 0.1)
+    space.add(ball, pymunk.Circle(ball, 10), spring)
+    ledger = spaces.Ledger(space)
+    measured = []
+
+    def post_solve(arbiter, space, data):
+        if not measured:
+            e = _energy(space)
+            if change == "gravity":
+                space.gravity = (0, -500)
+            else:
+                setattr(spring, change, 80 if change == "stiffness" else 20)
+            measured.append(_energy(space) - e)
+
+    space.on_collision(None, None, post_solve=post_solve)
+    for _ in range(120):
+        space.step(1 / 120)
+    bal = ledger.balance()
+    assert measured and measured[0] != 0.0
+    assert not [t for t in bal.terms if t.kind == "program"]
+    assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale

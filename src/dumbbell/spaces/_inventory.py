@@ -527,7 +527,7 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "a mass, moment, centre of gravity or body type"
     if P[1:3, : t.n].tobytes() != b.funcs_bytes and not (P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
-    return _changed_settings(b, space)
+    return changed_settings(b, space)
 
 
 def settings_changed(t: Any, F: np.ndarray) -> bool:
@@ -540,7 +540,7 @@ def settings_changed(t: Any, F: np.ndarray) -> bool:
                     t.n == t.rows or (F[13, t.n:] == t.idle).all()))
 
 
-def _changed_settings(b: Build, space: Any) -> str:
+def changed_settings(b: Build, space: Any) -> str:
     """What changed since the build in gravity, the springs' settings and the custom
     velocity functions ('' when nothing)."""
     t = b.table
