@@ -154,32 +154,6 @@ def test_a_centre_of_gravity_set_after_the_position_keeps_the_full_ledger():
     assert abs((_energy(space) - E1) - (bal.E - bal1.E)) <= 1e-9 * bal.scale
 
 
-@pytest.mark.parametrize("flag, g, up", [(False, -900.0, False), (False, 900.0, False),
-                                         (False, 0.0, False), (True, -900.0, True),
-                                         (True, 900.0, True)])
-def test_pygame_util_draws_y_the_way_its_flag_says_whatever_the_gravity(tmp_path, monkeypatch,
-                                                                       flag, g, up):
-    # A program drawing with pymunk.pygame_util (positive_y_is_up False, its default) and
-    # gravity (0, -900) shows its bodies falling up; the recorder drew it y up (the rule
-    # for a program flipping y by hand, which does not import pygame_util).
-    import sys
-    import types
-
-    for name in ("pygame", "pymunk.pygame_util", "pyglet", "arcade", "kivy"):
-        monkeypatch.delitem(sys.modules, name, raising=False)
-    util = types.ModuleType("pymunk.pygame_util")
-    util.positive_y_is_up = flag
-    monkeypatch.setitem(sys.modules, "pygame", types.ModuleType("pygame"))
-    monkeypatch.setitem(sys.modules, "pymunk.pygame_util", util)
-    space = pymunk.Space()
-    space.gravity = (0, g)
-    ball = pymunk.Body(1, 10)
-    ball.position = (100, 100)
-    space.add(ball, pymunk.Circle(ball, 10))
-    rec = spaces.Recorder(space, tmp_path / "a.gif", energy=False)
-    assert rec.orientation.startswith(f"y {'up' if up else 'down'}: ")
-
-
 def test_a_kind_the_ledger_never_writes_is_refused_by_sources():
     # sources(kind="contacts") (a misspelt kind) gave [] as if nothing had happened.
     from dumbbell.errors import UsageError

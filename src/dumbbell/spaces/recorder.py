@@ -18,9 +18,8 @@ nothing else of the space.
 **Orientation.** ``y_up=None`` draws y the way the program's window does, decided when the
 recorder is made from what the program has imported (:func:`_window_y_up`): y up when
 ``pymunk.pygame_util.positive_y_is_up`` is True; with pygame imported, y down (pygame's
-window), unless gravity points to -y without ``pymunk.pygame_util`` imported (the program
-then flips y itself, as pymunk's ``newtons_cradle`` does: in a y-down window its bodies would
-fall up; pygame_util with the flag False draws y down); with pyglet, arcade or
+window), unless gravity points to -y (the program then flips y itself, as pymunk's
+``newtons_cradle`` does: in a y-down window its bodies would fall up); with pyglet, arcade or
 kivy imported (and not pygame), y up; with no window library (or both kinds), up against
 gravity, and up without vertical gravity. ``y_up=True`` or False says it; a ``world`` box
 (left, right, bottom, top) with bottom > top is y down. ``rec.orientation`` says which way
@@ -92,7 +91,7 @@ def _window_y_up(space: Any) -> tuple[bool, str]:
     pygame = modules.get("pygame") is not None
     up = [name for name in Y_UP_WINDOWS if modules.get(name) is not None]
     if pygame and not up:
-        if gy < 0 and util is None:
+        if gy < 0:
             return True, ("pygame is imported (its window has y down) and gravity points to "
                           "-y, so the program flips y itself (else its bodies would fall up); "
                           "give y_up=False if it does not")
