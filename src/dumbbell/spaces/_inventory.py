@@ -125,7 +125,9 @@ class Table:
         self.at = mem.addresses(self.bodies, "_body")
         self.pre = mem.Reader("body", self.at, PRE, PTRS)
         self.post = mem.Reader("body", self.at, POST, ("root",))
-        self.state = mem.Reader("body", self.at, PRE[:6])
+        # What the end of a step reads: positions, velocities, and what changes a body's
+        # energy from a callback without moving it (mass, moment, centre, body type).
+        self.state = mem.Reader("body", self.at, PRE)
         first = self.pre.floats()
         self.settings = first[9:13].copy()
         self.static = np.isinf(first[13])
@@ -521,18 +523,24 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
-    # The same bytes are the same values; other bytes may be too (-0 and +0): compared
-    # as numbers then.
-    if not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
-            ) and not ((F[9:13] == t.settings).all() and (
-                t.n == t.rows or (F[13, t.n:] == t.idle).all())):
+    if settings_changed(t, F):
         return "a mass, moment, centre of gravity or body type"
     if P[1:3, : t.n].tobytes() != b.funcs_bytes and not (P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
-    return _changed_settings(b, space)
+    return changed_settings(b, space)
 
 
-def _changed_settings(b: Build, space: Any) -> str:
+def settings_changed(t: Any, F: np.ndarray) -> bool:
+    """Whether a mass, moment, centre of gravity or body type changed since the table
+    ``t`` was built, from its floats ``F`` read now (rows as :data:`PRE`)."""
+    # The same bytes are the same values; other bytes may be too (-0 and +0): compared
+    # as numbers then.
+    return not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
+                ) and not ((F[9:13] == t.settings).all() and (
+                    t.n == t.rows or (F[13, t.n:] == t.idle).all()))
+
+
+def changed_settings(b: Build, space: Any) -> str:
     """What changed since the build in gravity, the springs' settings and the custom
     velocity functions ('' when nothing)."""
     t = b.table

@@ -196,6 +196,9 @@ def _moved_how(b: Build, s: Snapshot, move: Move, moving: np.ndarray
     other = np.all(same(pos, np.where(flipped, s.pos + shift, s.pos)), axis=0)
     moving = np.where(~ok & other, flipped, moving)
     ok |= other
+    # Moved with the velocity the last step left, set anew after the move: a collision's
+    # begin, pre_solve or separate callback (the velocity alone changed, not the position).
+    ok |= ~ok & moving & np.all(same(pos, s.pos + (s.vel + s.bias) * dt), axis=0)
     step = np.where(moving, dt, 0.0)
     start = np.where(ok, s.pos, pos - (vel + s.bias) * step)
     return moving, start

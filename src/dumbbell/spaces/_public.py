@@ -234,7 +234,12 @@ def rebuild(self: Any) -> None:
     self._b = public_build(self.space, self._names)
     t = self._b.table
     self._sums.reset(t.n, t.rows, 0)
-    self._touching = np.zeros(t.rows, dtype=bool)
+    # The bodies that touched something in the last step still do (their move this step
+    # has the contacts' position correction), whatever came or went.
+    touching = self.__dict__.get("_touching")
+    had = old.table.uid[touching] if old is not None and touching is not None and len(
+        touching) == old.table.rows else ()
+    self._touching = np.isin(t.uid, had)
 
 
 def pre(self: Any) -> None:
@@ -257,13 +262,17 @@ def pre(self: Any) -> None:
     coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
     kicks = _spring_kicks(b, F[0:3], dt)
     vel_r = F[3:6].copy()
-    vel0 = vel_r - kicks * t.inv3 if t.rows else vel_r
+    vel0 = vel_r.copy()  # kinematic rows (past the dynamic ones) take no spring's kick
+    vel0[:, :n] -= kicks[:, :n] * t.inv3
     # Bodies no spring kicked keep their velocity bit for bit; a kick taken back out
     # leaves a few roundings, which are not the program's.
     vel0 = np.where(phys.same(vel0, s.vel), s.vel, vel0)
     moving = t.moves & ~np.concatenate([P[0, :n].astype(bool), np.zeros(t.k, bool)])
     expected = np.where(moving, s.pos + vel0 * dt, s.pos)
     beyond = ~np.all(phys.same(F[0:3], expected), axis=0)
+    # Moved with the velocity the last step left, set anew after the move (a collision's
+    # begin, pre_solve or separate callback): where it was, not a position the program set.
+    beyond &= ~np.all(phys.same(F[0:3], np.where(moving, s.pos + s.vel * dt, s.pos)), axis=0)
     corrected = beyond & self._touching & moving
     start = np.where(beyond & ~corrected, F[0:3] - np.where(moving, vel0 * dt, 0.0), s.pos)
     total = 0.0

@@ -15,6 +15,10 @@ __all__ = ["Balance", "Term"]
 
 #: Kinds of terms that are heat (energy turned into heat, negative when energy leaves).
 HEAT_KINDS = ("contact", "spring damping", "damping")
+#: Every kind of term the ledgers write (the full one, and the fallback's lumped term).
+KINDS = ("contact", "correction", "constraint", "spring damping", "custom spring",
+         "kinematic", "damping", "force", "step error", "velocity_func", "program",
+         "entered", "left", "unattributed", "rounding", "contacts and joints")
 #: Longest text of a source, note or reason printed by :meth:`Balance.table`.
 TEXT_CHARS = 120
 
@@ -227,6 +231,11 @@ class Balance:
         from ..model import args
 
         at_least = args.real(at_least, "at_least", self.unit, lo=0.0)
+        if kind is not None and (not isinstance(kind, str) or kind not in KINDS):
+            from ..errors import UsageError
+
+            raise UsageError(f"kind = {kind!r}: must be None (every kind) or one of "
+                             f"{', '.join(KINDS)}", param="kind")
         chosen = [t for t in self.terms if (kind is None or t.kind == kind)
                   and abs(t.energy) >= at_least]
         return sorted(chosen, key=lambda t: -abs(t.energy))

@@ -71,7 +71,7 @@ from . import _physics as phys
 from . import _public
 from ._changes import Changes
 from ._contacts import UnknownBody
-from ._inventory import Names, Pairs, changed, declared
+from ._inventory import Names, Pairs, changed, changed_settings, declared, settings_changed
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
@@ -574,9 +574,8 @@ class Ledger(Changes):
         self._worst = max(self._worst, abs(step))  # relative to the scale when shown
 
     def _end(self) -> None:
-        """At the end of the step (pymunk's post-step callbacks): what changed since the
-        solver was changed inside the step by a callback, bodies added or removed from one
-        included."""
+        """At the end of the step (pymunk's post-step callbacks): what a callback changed
+        since the solver, bodies or constraints, masses, gravity or springs' settings too."""
         if not self._awaiting_end:
             return
         self._awaiting_end = False
@@ -584,12 +583,13 @@ class Ledger(Changes):
         F, s = t.state.floats(), self._snap
         if not (F[0:3].tobytes() == s.pos.tobytes() and F[3:6].tobytes() == s.vel.tobytes()):
             _quietly(lambda: self._catch_up(F, "unattributed"))
-        if tuple(self.space.bodies) != t.body_key:
-            _quietly(lambda: self._restructure("bodies added or removed inside the step",
-                                               None, "unattributed"))
-        elif tuple(self.space.constraints) != t.constraint_key:
-            _quietly(lambda: self._restructure("constraints added or removed inside the "
-                                               "step", None, "unattributed"))
+        space = self.space
+        what = ("bodies added or removed" if tuple(space.bodies) != t.body_key
+                else "constraints added or removed" if tuple(space.constraints) != t.constraint_key
+                else "a mass, moment, centre of gravity or body type set"
+                if settings_changed(t, F) else changed_settings(self._b, space))
+        if what:
+            _quietly(lambda: self._restructure(f"{what} inside the step", None, "unattributed"))
 
 
 @np.errstate(invalid="ignore", over="ignore", divide="ignore")
