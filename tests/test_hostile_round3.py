@@ -738,40 +738,71 @@ SOLVERS_NO_JIT = [("textbook-1d", "euler-cromer"), ("textbook-1d", "verlet"),
                   ("tilted-2d", "verlet"), ("tilted-2d", "reference"), ("rigid-2d", "exact")]
 
 
-@pytest.mark.parametrize("scene,solver", SOLVERS_NO_JIT)
-def test_numba_disabled_gives_the_same_numbers(tmp_path, scene, solver):
-    """`NUMBA_DISABLE_JIT=1 dumbbell simulate` (euler-cromer, verlet) raised
-    `NotImplementedError: <intrinsic to_fixed_tuple>`: the loops run as Python, the same
-    samples and impacts byte for byte as compiled."""
+def _simulate_argv(scene: str, solver: str, folder: Path, stem: str) -> list[str]:
+    """`dumbbell simulate` of a case of :data:`SOLVERS_NO_JIT` (0.3 s at dt = 1e-4 s), its
+    CSV and events into ``folder`` as STEM.csv and STEM-e.csv."""
+    return ["simulate", str(SCENES / f"{scene}.toml"), "--solver", solver, "--t-end", "0.3",
+            "--dt", "1e-4", "--every", "10", "-o", str(folder / f"{stem}.csv"), "--events",
+            str(folder / f"{stem}-e.csv"), "-q"]
+
+
+#: Run in one process with NUMBA_DISABLE_JIT=1, for each case (argv[1], JSON: scene,
+#: solver, the command's argv): the command (its status and what it wrote on stderr), then
+#: the Python API (its energies); all of it as JSON on stdout.
+NO_JIT = """
+import contextlib, io, json, sys
+import dumbbell
+from dumbbell.cli import main
+out = []
+for scene, solver, argv in json.loads(sys.argv[1]):
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        status = main(argv)
+    t = dumbbell.simulate(scene, solver, t_end=0.3, dt=1e-4, every=10)
+    out.append([status, err.getvalue(), repr(t["E"].tolist())])
+print(json.dumps(out))
+"""
+
+
+@pytest.fixture(scope="module")
+def without_jit(tmp_path_factory):
+    """Every case of :data:`SOLVERS_NO_JIT` run as Python (NUMBA_DISABLE_JIT=1), in one
+    process of its own (numba reads the variable when it is imported): (scene, solver) ->
+    (the command's status, its stderr, the API's energies as repr, its folder)."""
+    import json
     import sys
 
     from tests.hostile import SRC, run_group
 
-    argv = ["simulate", SCENES / f"{scene}.toml", "--solver", solver, "--t-end", "0.3",
-            "--dt", "1e-4", "--every", "10", "-o", tmp_path / "jit.csv", "--events",
-            tmp_path / "jit-e.csv", "-q"]
-    status, _, err = cli(*argv)
-    assert status == 0, err
-    # One process without the JIT runs the command (its own stderr, which must stay empty)
-    # and then the Python API (its energies on stdout).
-    code = ("import sys, dumbbell\n"
-            "from dumbbell.cli import main\n"
-            "status = main(sys.argv[3:])\n"
-            "sys.stderr.write(f'status {status}\\n')\n"
-            "t = dumbbell.simulate(sys.argv[1], sys.argv[2], t_end=0.3, dt=1e-4, every=10)\n"
-            "sys.stdout.write(repr(t['E'].tolist()))\n")
-    nojit = [str(a).replace("jit", "nojit") for a in argv]
-    done = run_group([sys.executable, "-c", code, SCENES / f"{scene}.toml", solver, *nojit],
-                     cwd=tmp_path, text=True,
+    folder = tmp_path_factory.mktemp("nojit")
+    cases = [(str(SCENES / f"{scene}.toml"), solver,
+              _simulate_argv(scene, solver, folder, f"{scene}-{solver}"))
+             for scene, solver in SOLVERS_NO_JIT]
+    done = run_group([sys.executable, "-c", NO_JIT, json.dumps(cases)], cwd=folder, text=True,
                      env={**os.environ, "PYTHONPATH": SRC, "CI": "1", "NUMBA_DISABLE_JIT": "1"})
-    assert done.returncode == 0 and done.stderr == "status 0\n", done.stderr[-800:]
-    for name in ("jit.csv", "jit-e.csv"):
-        assert (tmp_path / name).read_bytes() == (tmp_path / f"no{name}").read_bytes()
+    assert done.returncode == 0 and done.stderr == "", done.stderr[-800:]
+    return {case: (*ran, folder) for case, ran in zip(SOLVERS_NO_JIT, json.loads(done.stdout),
+                                                     strict=True)}
+
+
+@pytest.mark.parametrize("scene,solver", SOLVERS_NO_JIT)
+def test_numba_disabled_gives_the_same_numbers(tmp_path, without_jit, scene, solver):
+    """`NUMBA_DISABLE_JIT=1 dumbbell simulate` (euler-cromer, verlet) raised
+    `NotImplementedError: <intrinsic to_fixed_tuple>`: the loops run as Python, the same
+    samples and impacts byte for byte as compiled. (The runs without the JIT, every case's,
+    are made in one process: :func:`without_jit`.)"""
+    status, _, err = cli(*_simulate_argv(scene, solver, tmp_path, "jit"))
+    assert status == 0, err
+    nojit_status, nojit_err, nojit_energy, folder = without_jit[scene, solver]
+    assert nojit_status == 0 and nojit_err == "", nojit_err
+    for suffix in (".csv", "-e.csv"):
+        assert (tmp_path / f"jit{suffix}").read_bytes() == \
+            (folder / f"{scene}-{solver}{suffix}").read_bytes()
     # The Python API too.
     import dumbbell
 
     jit = dumbbell.simulate(SCENES / f"{scene}.toml", solver, t_end=0.3, dt=1e-4, every=10)
-    assert done.stdout == repr(jit["E"].tolist())
+    assert nojit_energy == repr(jit["E"].tolist())
 
 
 @pytest.mark.parametrize("example", ["pendulum", "slope", "newtons_cradle"])
