@@ -26,28 +26,6 @@ def load_tool(name: str):
     return sys.modules[name]
 SCENES = ROOT / "scenes"
 
-#: The slowest test modules and their rough cost (s: the sum of their tests' durations,
-#: ``pytest --durations=0`` on a quiet 2-core machine). pytest-xdist hands each worker one
-#: module at a time (``--dist loadscope``), in the order collected (``--no-loadscope-reorder``):
-#: these go first, the slowest first, so that the last module a worker starts is a short one
-#: and both workers end together. The other modules follow in their own order. Only the order
-#: changes; a module missing here, or a cost grown stale, only balances the workers worse.
-SLOW_MODULES = {
-    "test_hostile_round3.py": 120, "test_figures.py": 65, "test_hostile.py": 60,
-    "test_docs_run.py": 50, "test_showcase.py": 45, "test_spaces_guard_corpus.py": 33,
-    "test_run_beside.py": 28, "test_notebook.py": 25, "test_docstrings.py": 21,
-    "test_doc_numbers.py": 21, "test_rotation_chapter.py": 21, "test_outside_corpus.py": 20,
-    "test_spaces_ledger_safety.py": 19, "test_player.py": 19, "test_api_border.py": 14,
-    "test_spaces_recorder.py": 13, "test_engine.py": 13, "test_site.py": 13,
-    "test_spaces_recorder_corpus.py": 13, "test_spaces_guard_joints.py": 12,
-}
-
-
-def pytest_collection_modifyitems(config, items):
-    """The modules of :data:`SLOW_MODULES` first, the slowest first; each module's tests kept
-    together and in their order (a stable sort by their module's cost)."""
-    items.sort(key=lambda item: -SLOW_MODULES.get(item.path.name, 0))
-
 
 @pytest.fixture(autouse=True)
 def _no_process_outlives_its_test():
