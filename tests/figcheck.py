@@ -5,7 +5,8 @@
     assert problems(fig) == []          # findings and missing units, as lines of text
     assert outside_axes(ax) == []       # a figure drawn on the user's axes stays inside them
 
-It draws the figure once (``fig.canvas.draw()``) and reads every artist's window extent (px):
+It lays the figure out and draws it once without painting (unless that was done since it last
+changed, as the package leaves its figures) and reads every artist's window extent (px):
 
 - **text on text**: any two pieces of text overlap (titles, axis labels, tick labels, offset
   texts such as ``1e-6``, annotations (their words: an arrow may reach the data), figure
@@ -158,8 +159,12 @@ def _texts_and_legends(fig: Any, renderer: Any) -> tuple[list[_Box], list[_Box]]
 
 
 def _draw(fig: Any) -> None:
-    """Lay the figure out and place every artist as a draw does, without painting pixels."""
-    fig.draw_without_rendering()
+    """Lay the figure out and place every artist as a draw does, without painting pixels,
+    unless it was laid out and drawn since it last changed (not stale: every artist set
+    since marks it stale): as the package's figures leave :func:`dumbbell.plot.style.finish`,
+    and as it saves them (without laying them out again), they are read as they are."""
+    if fig.stale:
+        fig.draw_without_rendering()
 
 
 def _grown(bbox: Any, by: float, vertical: float | None = None) -> Any:

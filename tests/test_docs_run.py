@@ -90,3 +90,32 @@ def test_a_repr_a_page_shows_is_the_code_s(tmp_path):
     assert errors[0] == (1, "")
     assert errors[1][0] == 7 and "shows 'Fraction(1, 4)'" in errors[1][1]
     assert errors[2][0] == 11 and "line 10: the page shows 'P(x=1.23...)'" in results[2].error
+
+
+def test_a_command_two_pages_run_runs_once_and_both_pages_get_its_files(tmp_path, monkeypatch):
+    """A ``dumbbell`` command line two blocks run, on the same inputs, runs once: the second
+    page's folder gets the files it wrote and its block the status and output. Other
+    inputs (a changed scene) run it again."""
+    import dumbbell.cli
+    from tests.hostile import SHORT_SCENE
+
+    (tmp_path / "scenes").mkdir()
+    (tmp_path / "scenes" / "short.toml").write_text(SHORT_SCENE)
+    (tmp_path / "docs").mkdir()
+    line = "dumbbell simulate scenes/short.toml -o short.csv"
+    check = "```python\nfrom pathlib import Path\n" \
+            "assert Path('short.csv').read_text().startswith('t,xA,vA')\n```\n"
+    (tmp_path / "README.md").write_text(f"```sh\n{line}\n```\n\n{check}")
+    (tmp_path / "docs" / "a.md").write_text(f"```console\n$ {line}\n$ echo $?\n0\n```\n\n{check}")
+    (tmp_path / "docs" / "b.md").write_text(
+        f"```sh\nsed -i s/200.0/300.0/ scenes/short.toml\n{line}\n```\n\n{check}")
+    assert docblocks.repeated(tmp_path) == {line}
+    calls = []
+    main = dumbbell.cli.main
+    monkeypatch.setattr(dumbbell.cli, "main", lambda argv: calls.append(argv) or main(argv))
+    monkeypatch.setattr(docblocks, "_RAN", {})
+    for page in ("README.md", "docs/a.md", "docs/b.md"):
+        results, _, _ = docblocks.run_file(tmp_path / page, tmp_path)
+        assert [r.error for r in results] == [None, None], page
+    # README.md and a.md share the run; b.md's scene differs: it runs again.
+    assert len(calls) == 2

@@ -441,8 +441,10 @@ STREAM_COMMANDS = {
     "render": ["render", "SCENE", "--t-end", "0.04", "-o", "OUT/x.gif"],
     "play": ["play", "SCENE", "--t-end", "0.04", "-o", "OUT/x.html"],
     "simulate": ["simulate", "SCENE", "-o", "OUT/x.csv", "--events", "OUT/e.csv"],
+    # One solver: the others' timed runs (each point timed for half a second) take seconds
+    # and print and write through the same lines.
     "bench": ["bench", "SCENE", "--dts", "1e-3", "--t-end", "0.05", "--window", "0.05",
-              "--repeat", "1", "--out", "OUT"],
+              "--repeat", "1", "--solvers", "euler-cromer", "--out", "OUT"],
     "sweep": ["sweep", "SCENE", "--grid", "k=100,200", "--workers", "1", "--out", "OUT"],
     "stability": ["stability", "--cases", "CASES", "--solvers", "euler-cromer", "--workers",
                   "1", "--out", "OUT"],
@@ -561,12 +563,15 @@ def test_a_stream_that_fails_later_is_dropped_not_fatal(tmp_path, stream_inputs,
 #: The two pieces kept: a `run` with its GIF and figures, and `compare` (another command,
 #: with figures of its own; the cheapest after it, some 9 s against restitution's 20).
 KEPT = (("run", "textbook-1d"), ("compare", "textbook-1d"))
-#: Run before ``main``: the showcase cut to the pieces :data:`KEPT`, so that `run --all`'s
-#: own loop is tested in seconds, not the whole showcase's minutes (each piece's command is
-#: tested alone above).
+#: Run before ``main``: the showcase cut to the pieces :data:`KEPT`, and the shipped scene
+#: they load cut to its first 0.5 s (of 10: the same outputs, the same lines that write
+#: them), so that `run --all`'s own loop is tested in seconds, not the whole showcase's
+#: minutes (each piece's command is tested alone above).
 TWO_PIECES = f"""
 from dumbbell.cli import showcase as _showcase
 _showcase.PIECES = tuple(p for p in _showcase.PIECES if p.argv[:2] in {KEPT!r})
+_load = _showcase.load_packaged
+_showcase.load_packaged = lambda name: _load(name).with_values({{"run.t_end": 0.5}})
 """
 
 
@@ -680,16 +685,24 @@ def test_a_title_with_dollars_is_text_in_run_and_compare(tmp_path, title):
 
 
 @pytest.mark.parametrize("title", MATH_TITLES[:1])  # every text checked for a bare '$'
-def test_a_title_with_dollars_is_text_in_every_figure_of_the_api(tmp_path, title):
+def test_a_title_with_dollars_is_text_in_every_figure_of_the_api(tmp_path, monkeypatch, title):
     """`plot.positions(t).figure.savefig()` raised too: every figure that shows a user's
     text (a title, a scene's file name, a solver name given to the figure) draws it as
-    text; the title on the figure is the title, with no '$' left for mathtext."""
+    text; the title on the figure is the title, with no '$' left for mathtext.
+
+    The figures' texts do not depend on how long the data took: the benchmark's points are
+    timed once each (not for half a second), and the pymunk runs of the topple and the
+    rigid drop are at dt = 1e-4 s over what their figures show (tests/test_figures.py's
+    light inputs)."""
     import io
 
     import dumbbell
     from dumbbell import plot
+    from dumbbell.analysis import bench as bench_module
     from dumbbell.analysis.contact import about_contact
     from dumbbell.analysis.topple import closed_form, measure
+
+    monkeypatch.setattr(bench_module, "MIN_TIMED", 0.0)
 
     scene = dumbbell.load_scene(_titled(tmp_path, title, name="m$x$"))
     traj = dumbbell.simulate(scene)
@@ -702,9 +715,9 @@ def test_a_title_with_dollars_is_text_in_every_figure_of_the_api(tmp_path, title
                                                  workers=1)))
     bench = dumbbell.bench(scene, dts=[1e-3], t_end=0.05, window=0.05, repeat=1)
     figures += [plot.work_precision(bench), plot.convergence(bench)]
-    topple = dumbbell.simulate(SCENES / "topple-2d.toml", t_end=0.5, every=100)
+    topple = dumbbell.simulate(SCENES / "topple-2d.toml", t_end=0.5, dt=1e-4, every=10)
     figures.append(plot.topple(closed_form(topple.scene), measure(topple), solver=title)[0])
-    rigid = dumbbell.simulate(SCENES / "rigid-2d.toml", "pymunk", every=10)
+    rigid = dumbbell.simulate(SCENES / "rigid-2d.toml", "pymunk", t_end=0.6, dt=1e-4)
     figures.append(plot.contact_momentum(about_contact(rigid), solver=title))
     for ax in figures:
         fig = ax.figure
@@ -725,37 +738,71 @@ SOLVERS_NO_JIT = [("textbook-1d", "euler-cromer"), ("textbook-1d", "verlet"),
                   ("tilted-2d", "verlet"), ("tilted-2d", "reference"), ("rigid-2d", "exact")]
 
 
-@pytest.mark.parametrize("scene,solver", SOLVERS_NO_JIT)
-def test_numba_disabled_gives_the_same_numbers(tmp_path, scene, solver):
-    """`NUMBA_DISABLE_JIT=1 dumbbell simulate` (euler-cromer, verlet) raised
-    `NotImplementedError: <intrinsic to_fixed_tuple>`: the loops run as Python, the same
-    samples and impacts byte for byte as compiled."""
-    import subprocess
+def _simulate_argv(scene: str, solver: str, folder: Path, stem: str) -> list[str]:
+    """`dumbbell simulate` of a case of :data:`SOLVERS_NO_JIT` (0.3 s at dt = 1e-4 s), its
+    CSV and events into ``folder`` as STEM.csv and STEM-e.csv."""
+    return ["simulate", str(SCENES / f"{scene}.toml"), "--solver", solver, "--t-end", "0.3",
+            "--dt", "1e-4", "--every", "10", "-o", str(folder / f"{stem}.csv"), "--events",
+            str(folder / f"{stem}-e.csv"), "-q"]
+
+
+#: Run in one process with NUMBA_DISABLE_JIT=1, for each case (argv[1], JSON: scene,
+#: solver, the command's argv): the command (its status and what it wrote on stderr), then
+#: the Python API (its energies); all of it as JSON on stdout.
+NO_JIT = """
+import contextlib, io, json, sys
+import dumbbell
+from dumbbell.cli import main
+out = []
+for scene, solver, argv in json.loads(sys.argv[1]):
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        status = main(argv)
+    t = dumbbell.simulate(scene, solver, t_end=0.3, dt=1e-4, every=10)
+    out.append([status, err.getvalue(), repr(t["E"].tolist())])
+print(json.dumps(out))
+"""
+
+
+@pytest.fixture(scope="module")
+def without_jit(tmp_path_factory):
+    """Every case of :data:`SOLVERS_NO_JIT` run as Python (NUMBA_DISABLE_JIT=1), in one
+    process of its own (numba reads the variable when it is imported): (scene, solver) ->
+    (the command's status, its stderr, the API's energies as repr, its folder)."""
+    import json
     import sys
 
-    from tests.hostile import SRC
+    from tests.hostile import SRC, run_group
 
-    argv = ["simulate", SCENES / f"{scene}.toml", "--solver", solver, "--t-end", "0.3",
-            "--dt", "1e-4", "--every", "10", "-o", tmp_path / "jit.csv", "--events",
-            tmp_path / "jit-e.csv", "-q"]
-    status, _, err = cli(*argv)
+    folder = tmp_path_factory.mktemp("nojit")
+    cases = [(str(SCENES / f"{scene}.toml"), solver,
+              _simulate_argv(scene, solver, folder, f"{scene}-{solver}"))
+             for scene, solver in SOLVERS_NO_JIT]
+    done = run_group([sys.executable, "-c", NO_JIT, json.dumps(cases)], cwd=folder, text=True,
+                     env={**os.environ, "PYTHONPATH": SRC, "CI": "1", "NUMBA_DISABLE_JIT": "1"})
+    assert done.returncode == 0 and done.stderr == "", done.stderr[-800:]
+    return {case: (*ran, folder) for case, ran in zip(SOLVERS_NO_JIT, json.loads(done.stdout),
+                                                     strict=True)}
+
+
+@pytest.mark.parametrize("scene,solver", SOLVERS_NO_JIT)
+def test_numba_disabled_gives_the_same_numbers(tmp_path, without_jit, scene, solver):
+    """`NUMBA_DISABLE_JIT=1 dumbbell simulate` (euler-cromer, verlet) raised
+    `NotImplementedError: <intrinsic to_fixed_tuple>`: the loops run as Python, the same
+    samples and impacts byte for byte as compiled. (The runs without the JIT, every case's,
+    are made in one process: :func:`without_jit`.)"""
+    status, _, err = cli(*_simulate_argv(scene, solver, tmp_path, "jit"))
     assert status == 0, err
-    with started(*[str(a).replace("jit", "nojit") for a in argv], cwd=tmp_path,
-                 env={"NUMBA_DISABLE_JIT": "1"}) as proc:
-        _, err = finish(proc)
-    assert proc.returncode == 0 and err == "", err
-    for name in ("jit.csv", "jit-e.csv"):
-        assert (tmp_path / name).read_bytes() == (tmp_path / f"no{name}").read_bytes()
+    nojit_status, nojit_err, nojit_energy, folder = without_jit[scene, solver]
+    assert nojit_status == 0 and nojit_err == "", nojit_err
+    for suffix in (".csv", "-e.csv"):
+        assert (tmp_path / f"jit{suffix}").read_bytes() == \
+            (folder / f"{scene}-{solver}{suffix}").read_bytes()
     # The Python API too.
-    code = ("import dumbbell, sys; t = dumbbell.simulate(sys.argv[1], sys.argv[2], "
-            "t_end=0.3, dt=1e-4, every=10); sys.stdout.write(repr(t['E'].tolist()))")
-    api = subprocess.run([sys.executable, "-c", code, str(SCENES / f"{scene}.toml"), solver],
-                         env={**os.environ, "PYTHONPATH": SRC, "NUMBA_DISABLE_JIT": "1"},
-                         capture_output=True, text=True, timeout=600, check=False)
     import dumbbell
 
     jit = dumbbell.simulate(SCENES / f"{scene}.toml", solver, t_end=0.3, dt=1e-4, every=10)
-    assert api.returncode == 0 and api.stdout == repr(jit["E"].tolist()), api.stderr[-500:]
+    assert nojit_energy == repr(jit["E"].tolist())
 
 
 @pytest.mark.parametrize("example", ["pendulum", "slope", "newtons_cradle"])

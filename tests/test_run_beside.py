@@ -70,11 +70,27 @@ def outputs_of(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
 
 
-def test_forked_and_one_process_write_the_same_bytes(scene, tmp_path):
-    forked = run("run", scene, "--out", tmp_path / "forked", fork=True)
-    alone = run("run", scene, "--out", tmp_path / "alone", fork=False)
+#: The modules whose import the runs below report (on stdout, after the command).
+CHECKED = "matplotlib.pyplot scipy.linalg numba matplotlib"
+
+
+@pytest.fixture(scope="module")
+def both(tmp_path_factory):
+    """The command run once forked and once in one process (the same scene, every output),
+    each reporting the modules :data:`CHECKED` it imported: {fork: (run, its folder)}.
+    The tests below read these two runs instead of making them again each."""
+    tmp = tmp_path_factory.mktemp("beside")
+    path = tmp / "beside.toml"
+    path.write_text(SCENE)
+    return {fork: (run("run", path, "--out", tmp / name, fork=fork, check=CHECKED),
+                   tmp / name)
+            for fork, name in ((True, "forked"), (False, "alone"))}
+
+
+def test_forked_and_one_process_write_the_same_bytes(both):
+    (forked, forked_out), (alone, alone_out) = both[True], both[False]
     assert forked.returncode == alone.returncode == 0, (forked.stderr, alone.stderr)
-    a, b = outputs_of(tmp_path / "forked"), outputs_of(tmp_path / "alone")
+    a, b = outputs_of(forked_out), outputs_of(alone_out)
     assert sorted(a) == ["beside-impacts.csv", "beside-kinetic.png", "beside-positions.png",
                          "beside-potential.png", "beside.csv", "beside.gif"]
     assert a == b
@@ -85,10 +101,9 @@ def test_forked_and_one_process_write_the_same_bytes(scene, tmp_path):
         "beside-impacts.csv", "beside.gif"]
 
 
-def test_the_command_loads_neither_pyplot_nor_scipy_linalg(scene, tmp_path):
+def test_the_command_loads_neither_pyplot_nor_scipy_linalg(both):
     for fork in (True, False):
-        done = run("run", scene, "-q", "--out", tmp_path / str(fork), fork=fork,
-                   check="matplotlib.pyplot scipy.linalg numba matplotlib")
+        done = both[fork][0]
         assert done.returncode == 0, done.stderr
         loaded = dict(line.split() for line in done.stdout.splitlines())
         assert loaded["matplotlib.pyplot"] == loaded["scipy.linalg"] == "False"
@@ -122,7 +137,7 @@ def test_a_crash_in_the_child_is_raised_with_its_traceback(scene, tmp_path):
     assert not out.exists() or files_in(out) == []
 
 
-def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
+def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path, both):
     # The child kills itself the moment it would draw: the parent draws instead.
     patch = ("import os, signal, dumbbell.cli.run as r, dumbbell.cli.beside as b\n"
              "draw = r._draw_figures\n"
@@ -131,9 +146,9 @@ def test_a_child_that_dies_leaves_its_work_to_the_parent(scene, tmp_path):
              "    return draw(files, traj, alive)\n"
              "r._draw_figures = dying\n")
     died = run("run", scene, "--out", tmp_path / "died", fork=True, patch=patch)
-    alone = run("run", scene, "--out", tmp_path / "alone", fork=False)
+    alone, alone_out = both[False]
     assert died.returncode == alone.returncode == 0, died.stderr
-    assert outputs_of(tmp_path / "died") == outputs_of(tmp_path / "alone")
+    assert outputs_of(tmp_path / "died") == outputs_of(alone_out)
 
 
 #: The child waits in its first figure, the parent in the GIF's second frame, each after a

@@ -123,14 +123,15 @@ def _rounding_errors(markdown: str) -> list[float]:
 
 
 class _Once:
-    """A solver class whose ``solve`` runs once and then returns that run again."""
+    """A solver class whose ``_solve`` (what the benchmark's ``_measure`` calls, for its
+    warm-up run and each timed run) runs once and then returns that run again."""
 
     def __init__(self, cls):
         self.cls, self.last = cls, None
 
-    def solve(self, scene, options, **keywords):
+    def _solve(self, scene, options, **keywords):
         if self.last is None:
-            self.last = self.cls.solve(scene, options, **keywords)
+            self.last = self.cls._solve(scene, options, **keywords)
         return self.last
 
     def __getattr__(self, name):

@@ -8,7 +8,9 @@ fail.
 The pages are shared between two processes (forked); each Markdown file is one session, in
 a fresh temporary folder holding a copy of the
 repository's ``scenes/`` (what a reader who cloned the repository has beside them), run
-against the installed ``dumbbell``:
+against the installed ``dumbbell``. A ``dumbbell`` command line that two blocks run (on two
+pages: README.md's compare and solvers.md's) runs once, in one process, on the same inputs:
+the second block gets its status, output and files, and checks them as its own.
 
 - ```` ```python ```` blocks run in order in one namespace per file, as in a notebook; a
   line that is an expression followed by a comment showing a result's repr
@@ -135,6 +137,8 @@ class Session:
     folder: Path
     namespace: dict = field(default_factory=lambda: {"__name__": "__docs__"})
     status: int = 0
+    #: ``dumbbell`` command lines that more than one block of the docs runs (:func:`repeated`).
+    repeats: frozenset = frozenset()
 
     # -- Python ---------------------------------------------------------------------------
 
@@ -188,21 +192,42 @@ class Session:
 
     def _one(self, argv: list[str]) -> tuple[int, str]:
         if argv[0] == "dumbbell":
-            from dumbbell.cli import main
-
-            out, err = io.StringIO(), io.StringIO()
-            with _in(self.folder), contextlib.redirect_stdout(out), \
-                    contextlib.redirect_stderr(err):
-                try:
-                    status = main(argv[1:])
-                except SystemExit as exc:  # --help, --version and argparse's errors
-                    status = exc.code if isinstance(exc.code, int) else 1
-                finally:
-                    _close_figures()
-            return status, out.getvalue() + err.getvalue()
+            return self._dumbbell(argv)
         if argv[0] in ("python", "python3", "python3.11"):
             argv = [sys.executable, *argv[1:]]
         return self._process(argv)
+
+    def _dumbbell(self, argv: list[str]) -> tuple[int, str]:
+        """``dumbbell ARGV`` in this process: its status and what it printed. A command line
+        another page already ran on the same inputs (:func:`_inputs`) is not run again: the
+        package's outputs are reproducible, so this session gets that run's status, printed
+        text and files (written into its own folder), and the page checks them as its own."""
+        key = _inputs(self.folder, argv) if " ".join(argv) in self.repeats else None
+        if key in _RAN:
+            status, printed, files = _RAN[key]
+            for name, data in files.items():
+                (self.folder / name).parent.mkdir(parents=True, exist_ok=True)
+                (self.folder / name).write_bytes(data)
+            return status, printed
+        from dumbbell.cli import main
+
+        before = _stamps(self.folder) if key is not None else {}
+        out, err = io.StringIO(), io.StringIO()
+        with _in(self.folder), contextlib.redirect_stdout(out), \
+                contextlib.redirect_stderr(err):
+            try:
+                status = main(argv[1:])
+            except SystemExit as exc:  # --help, --version and argparse's errors
+                status = exc.code if isinstance(exc.code, int) else 1
+            finally:
+                _close_figures()
+        printed = out.getvalue() + err.getvalue()
+        written = {name: (self.folder / name).read_bytes()
+                   for name, stamp in _stamps(self.folder).items()
+                   if key is not None and before.get(name) != stamp}
+        if key is not None:
+            _RAN[key] = (status, printed, written)
+        return status, printed
 
     def _bash(self, line: str) -> tuple[int, str]:
         return self._process(["bash", "-c", line])
@@ -232,6 +257,49 @@ class Session:
     def run(self, block: Block) -> None:
         {"python": self.python, "sh": self.shell, "bash": self.shell,
          "console": self.console}[block.lang](block)
+
+
+#: ``dumbbell`` commands run in this process, by their inputs (:func:`_inputs`): (exit
+#: status, what they printed, the files they wrote or changed, relative name -> bytes).
+_RAN: dict[tuple, tuple[int, str, dict[str, bytes]]] = {}
+
+
+def _stamps(folder: Path) -> dict[str, tuple[int, int]]:
+    """Every file under ``folder`` (relative name) with its size and modification time."""
+    out = {}
+    for path in folder.rglob("*"):
+        if path.is_file():
+            st = path.stat()
+            out[str(path.relative_to(folder))] = (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def _digest(path: Path) -> str:
+    import hashlib
+
+    h = hashlib.sha256()
+    for item in sorted(path.rglob("*")) if path.is_dir() else [path]:
+        if item.is_file():
+            h.update(str(item.relative_to(path) if path.is_dir() else item.name).encode())
+            h.update(item.read_bytes())
+    return h.hexdigest()
+
+
+def _inputs(folder: Path, argv: list[str]) -> tuple:
+    """What a ``dumbbell ARGV`` run in ``folder`` reads: the command line, the session's
+    scenes/ (each page starts from the same copy; a block may change it), every argument
+    that names a file or folder there, and standard input's absence (a page cannot give
+    one)."""
+    named = []
+    for arg in argv[1:]:
+        path = folder / arg
+        try:
+            exists = path.exists()
+        except OSError:  # a name too long for the file system
+            exists = False
+        if exists:
+            named.append((arg, _digest(path)))
+    return (tuple(argv), _digest(folder / "scenes"), tuple(named))
 
 
 #: A comment that shows a repr: a name and an opening parenthesis (``# Impact(t=...``).
@@ -370,7 +438,21 @@ def commands(root: Path = ROOT, paths: list[Path] | None = None) -> set[str]:
     """Every command line the runnable shell and console blocks of ``paths`` (default: every
     doc file) run, comments dropped and white space normalised (what the showcase's test
     leaves to the docs' run)."""
-    out = set()
+    return set(_command_lines(root, paths))
+
+
+def repeated(root: Path = ROOT) -> frozenset[str]:
+    """The ``dumbbell`` command lines that more than one runnable block of the docs runs:
+    the one run of each is shared (:meth:`Session._dumbbell`)."""
+    from collections import Counter
+
+    counts = Counter(_command_lines(root, None))
+    return frozenset(c for c, n in counts.items() if n > 1 and c.startswith("dumbbell "))
+
+
+def _command_lines(root: Path, paths: list[Path] | None) -> list[str]:
+    """:func:`commands`, each as often as a block runs it."""
+    out = []
     for path in doc_files(root) if paths is None else paths:
         for block in blocks(path, root):
             if not block.runs or block.lang == "python":
@@ -382,7 +464,7 @@ def commands(root: Path = ROOT, paths: list[Path] | None = None) -> set[str]:
                     tokens = list(_lexer(line))
                 except ValueError:
                     continue
-                out.update(" ".join(argv) for argv in _split(tokens, {"&&", ";"}))
+                out.extend(" ".join(argv) for argv in _split(tokens, {"&&", ";"}))
     return out
 
 
@@ -393,7 +475,7 @@ def run_file(path: Path, root: Path = ROOT) -> tuple[list[Result], list[str], se
     with tempfile.TemporaryDirectory(prefix="docblocks-") as tmp:
         folder = Path(tmp)
         shutil.copytree(root / "scenes", folder / "scenes")
-        session = Session(folder)
+        session = Session(folder, repeats=repeated(root))
         for block in blocks(path, root):
             result = Result(block)
             if block.lang not in RUN | DATA:
@@ -415,9 +497,12 @@ def run_file(path: Path, root: Path = ROOT) -> tuple[list[Result], list[str], se
     return results, left, written
 
 
-#: Rough seconds each page's blocks take on 2 cores, to share the pages between processes.
-COST = {"README.md": 10, "physics.md": 7, "rotation.md": 5, "solvers.md": 4,
-        "measurements.md": 3, "api.md": 2, "stability.md": 2, "rendering.md": 1.5}
+#: Rough seconds each page's blocks take (``python tools/docblocks.py -v``, a quiet 2-core
+#: machine; solvers.md without the compare that README.md runs), to share the pages between
+#: processes.
+COST = {"rotation.md": 19, "physics.md": 12, "README.md": 11, "solvers.md": 10, "cli.md": 10,
+        "measurements.md": 7, "api.md": 5, "spaces-reference.md": 4, "stability.md": 3,
+        "rendering.md": 2, "scenes.md": 2, "player.md": 1}
 
 
 def run_files(paths: list[Path], root: Path = ROOT, processes: int = 2
@@ -431,10 +516,11 @@ def run_files(paths: list[Path], root: Path = ROOT, processes: int = 2
         return {path: run_file(path, root) for path in paths}
     groups: list[list[Path]] = [[] for _ in range(processes)]
     loads = [0.0] * processes
-    for path in sorted(paths, key=lambda q: -COST.get(q.name, 0.5)):
+    for unit in sorted(_sharing(paths, root), key=lambda u: -sum(COST.get(q.name, 0.5)
+                                                                 for q in u)):
         i = loads.index(min(loads))
-        groups[i].append(path)
-        loads[i] += COST.get(path.name, 0.5)
+        groups[i] += unit
+        loads[i] += sum(COST.get(q.name, 0.5) for q in unit)
     context = multiprocessing.get_context("fork")
     children = []
     for group in groups[1:]:
@@ -451,6 +537,21 @@ def run_files(paths: list[Path], root: Path = ROOT, processes: int = 2
             out.update({path: run_file(path, root) for path in group})
         child.join()
     return {path: out[path] for path in paths}
+
+
+def _sharing(paths: list[Path], root: Path) -> list[list[Path]]:
+    """``paths`` in groups that run in one process: pages that run a :func:`repeated`
+    command together (its one run is shared within a process), each page alone otherwise."""
+    repeats = repeated(root)
+    units: list[tuple[set[str], list[Path]]] = []
+    for path in paths:
+        mine = commands(root, [path]) & repeats
+        joined = [u for u in units if u[0] & mine]
+        for u in joined:
+            units.remove(u)
+        units.append((mine.union(*(u[0] for u in joined)),
+                      [q for u in joined for q in u[1]] + [path]))
+    return [unit for _, unit in units]
 
 
 def _run_group(send, paths: list[Path], root: Path) -> None:

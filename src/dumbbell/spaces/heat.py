@@ -50,6 +50,9 @@ from typing import Any
 __all__ = ["HeatCounter"]
 
 _PHASES = ("pre_solve", "post_solve")
+#: pymunk's compiled declarations (``pymunk._chipmunk_cffi.ffi``), set by the first counter:
+#: pymunk is imported only when a counter is made.
+_FFI: Any = None
 
 
 class HeatCounter:
@@ -91,6 +94,10 @@ class HeatCounter:
     >>> heat.detach()
     """
 
+    #: True for a counter made by :meth:`_on`: its space's dispatcher is sealed, so reading
+    #: its counts needs no look (the pymunk solver reads ``total`` at every sample).
+    _sealed = False
+
     def __init__(self, space: Any, units: Any = None) -> None:
         from ..model import args
         from .units import check_units
@@ -106,10 +113,15 @@ class HeatCounter:
         not looked at again at every contact (a third of a contact-rich run's time)."""
         self = cls.__new__(cls)
         self._start(space)
-        _DISPATCH[space].sealed = True
+        _DISPATCH[space].sealed = self._sealed = True
         return self
 
     def _start(self, space: Any) -> None:
+        global _FFI
+        if _FFI is None:
+            from pymunk._chipmunk_cffi import ffi
+
+            _FFI = ffi
         self.space = space
         self._total = 0.0
         self._steps = 0
@@ -147,6 +159,8 @@ class HeatCounter:
 
     def _look(self) -> None:
         """Notice callbacks the program set over the counters' since they last ran."""
+        if self._sealed:
+            return
         d = self._dispatch()
         if d is not None and not d.sealed and self._stopped is None:
             d.check()
@@ -232,8 +246,6 @@ class HeatCounter:
         return out
 
     def _pre_solve(self, arbiter: Any, space: Any) -> None:
-        from pymunk._chipmunk_cffi import ffi
-
         if self._after is not None:
             # A post_solve ran and this step is another: the last one's end (_end_step) was
             # cut short by an exception raised inside a callback (a stop signal's handler).
@@ -245,12 +257,13 @@ class HeatCounter:
         # accumulator's growth from here plus the part applied at the start.
         carried = 0.0 if arbiter.is_first_contact else (
             space.current_time_step / self._last_dt if self._last_dt else 1.0)
-        key = int(ffi.cast("uintptr_t", raw))
-        before = [
-            (ux, uy, raw.contacts[i].jnAcc * (1.0 - carried),
-             raw.contacts[i].jtAcc * (1.0 - carried))
-            for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb))
-        ]
+        key = int(_FFI.cast("uintptr_t", raw))
+        kept = 1.0 - carried
+        contacts = raw.contacts
+        before = []
+        for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb)):
+            c = contacts[i]
+            before.append((ux, uy, c.jnAcc * kept, c.jtAcc * kept))
         # The bodies first: a stop signal raised between these two lines (its handler runs
         # inside this callback) leaves a pair whose post_solve counts nothing, never a
         # contact whose bodies the first post_solve's snapshot of velocities lacks.
@@ -272,21 +285,24 @@ class HeatCounter:
         self._last_dt = space.current_time_step
 
     def _post_solve(self, arbiter: Any, space: Any) -> None:
-        from pymunk._chipmunk_cffi import ffi
-
-        raw, ba, bb = self._relative(arbiter)
-        before = self._before.pop(int(ffi.cast("uintptr_t", raw)), None)
+        raw = arbiter._arbiter
+        key = int(_FFI.cast("uintptr_t", raw))
+        before = self._before.pop(key, None)
         if self._after is None:
             # The step's first post_solve: every program's post_solve runs after it (the
             # counters run first in every handler), so these are the solver's velocities.
             self._after = {id(b): (*b.velocity, b.angular_velocity)
                            for pair in self._ends.values() for b in pair}
         if before is not None and len(before) == raw.count:
+            # The bodies its pre_solve took (the arbiter's own, whichever way a handler
+            # sees it): a pair with ``before`` has them.
+            ba, bb = self._ends[key]
             nx, ny = raw.n.x, raw.n.y
+            contacts = raw.contacts
             work = 0.0
             for i, (ux1, uy1) in enumerate(self._velocities(raw, ba, bb, self._after)):
                 ux0, uy0, jn0, jt0 = before[i]
-                c = raw.contacts[i]
+                c = contacts[i]
                 jn, jt = c.jnAcc - jn0, c.jtAcc - jt0
                 # Impulse on b: n jn + t jt with t = perp(n); -that on a.
                 jx, jy = nx * jn - ny * jt, ny * jn + nx * jt
@@ -311,6 +327,7 @@ class _Phase:
     def __init__(self, dispatch: _Dispatch, phase: str, user: Any) -> None:
         self.dispatch = dispatch
         self.phase = phase
+        self.method = f"_{phase}"  # the counters' method for the phase
         self.user = user
 
     def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
@@ -318,7 +335,7 @@ class _Phase:
             self.dispatch.check()
         for counter in self.dispatch.counters:
             if counter._stopped is None:
-                getattr(counter, f"_{self.phase}")(arbiter, space)
+                getattr(counter, self.method)(arbiter, space)
         if self.user is not None:
             return self.user(arbiter, space, data)
         return None
