@@ -227,6 +227,12 @@ class Balance:
         -------
         list of Term
             Largest first.
+
+        Raises
+        ------
+        UsageError
+            A ``kind`` the ledger never writes (one line naming it and the kinds there
+            are), or ``at_least`` negative or not a number.
         """
         from ..model import args
 
@@ -234,8 +240,8 @@ class Balance:
         if kind is not None and (not isinstance(kind, str) or kind not in KINDS):
             from ..errors import UsageError
 
-            raise UsageError(f"kind = {kind!r}: must be None (every kind) or one of "
-                             f"{', '.join(KINDS)}", param="kind")
+            raise UsageError(f"kind = {args.show(kind)}: must be None (every kind) or one of "
+                             f"{', '.join(map(repr, KINDS))}", param="kind")
         chosen = [t for t in self.terms if (kind is None or t.kind == kind)
                   and abs(t.energy) >= at_least]
         return sorted(chosen, key=lambda t: -abs(t.energy))
