@@ -515,29 +515,25 @@ def _groups(t: Table, current: dict[str, str]) -> tuple[dict[str, Group], list[G
     return groups, springs
 
 
-def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray) -> str:
+def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) -> str:
     """What changed in ``space`` since the build ``b`` ('' when nothing); ``F`` and ``P``
-    the table's floats and pointers read now."""
+    the table's floats and pointers read now (``P`` None: the velocity and position
+    functions are not looked at, as at the end of a step, which reads floats only)."""
     t = b.table
     if tuple(space.bodies) != t.body_key:
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
-    if settings_changed(t, F):
-        return "a mass, moment, centre of gravity or body type"
-    if P[1:3, : t.n].tobytes() != b.funcs_bytes and not (P[1:3, : t.n] == b.funcs).all():
-        return "a velocity_func or position_func"
-    return changed_settings(b, space)
-
-
-def settings_changed(t: Any, F: np.ndarray) -> bool:
-    """Whether a mass, moment, centre of gravity or body type changed since the table
-    ``t`` was built, from its floats ``F`` read now (rows as :data:`PRE`)."""
     # The same bytes are the same values; other bytes may be too (-0 and +0): compared
     # as numbers then.
-    return not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
-                ) and not ((F[9:13] == t.settings).all() and (
-                    t.n == t.rows or (F[13, t.n:] == t.idle).all()))
+    if not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
+            ) and not ((F[9:13] == t.settings).all() and (
+                t.n == t.rows or (F[13, t.n:] == t.idle).all())):
+        return "a mass, moment, centre of gravity or body type"
+    if P is not None and P[1:3, : t.n].tobytes() != b.funcs_bytes and not (
+            P[1:3, : t.n] == b.funcs).all():
+        return "a velocity_func or position_func"
+    return changed_settings(b, space)
 
 
 def changed_settings(b: Build, space: Any) -> str:

@@ -198,7 +198,7 @@ def _moved_how(b: Build, s: Snapshot, move: Move, moving: np.ndarray
     ok |= other
     # Moved with the velocity the last step left, set anew after the move: a collision's
     # begin, pre_solve or separate callback (the velocity alone changed, not the position).
-    ok |= ~ok & moving & np.all(same(pos, s.pos + (s.vel + s.bias) * dt), axis=0)
+    ok |= moving & np.all(same(pos, s.pos + (s.vel + s.bias) * dt), axis=0)
     step = np.where(moving, dt, 0.0)
     start = np.where(ok, s.pos, pos - (vel + s.bias) * step)
     return moving, start

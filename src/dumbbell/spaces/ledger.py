@@ -71,7 +71,7 @@ from . import _physics as phys
 from . import _public
 from ._changes import Changes
 from ._contacts import UnknownBody
-from ._inventory import Names, Pairs, changed, changed_settings, declared, settings_changed
+from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
 from .balance import Balance, Term, notes, order
@@ -583,11 +583,7 @@ class Ledger(Changes):
         F, s = t.state.floats(), self._snap
         if not (F[0:3].tobytes() == s.pos.tobytes() and F[3:6].tobytes() == s.vel.tobytes()):
             _quietly(lambda: self._catch_up(F, "unattributed"))
-        space = self.space
-        what = ("bodies added or removed" if tuple(space.bodies) != t.body_key
-                else "constraints added or removed" if tuple(space.constraints) != t.constraint_key
-                else "a mass, moment, centre of gravity or body type set"
-                if settings_changed(t, F) else changed_settings(self._b, space))
+        what = changed(self._b, self.space, F)  # the floats only: no function pointers
         if what:
             _quietly(lambda: self._restructure(f"{what} inside the step", None, "unattributed"))
 
