@@ -211,7 +211,7 @@ class Session:
             return status, printed
         from dumbbell.cli import main
 
-        before = _stamps(self.folder) if key is not None else {}
+        before = _stamps(self.folder) if key is not None else None
         out, err = io.StringIO(), io.StringIO()
         with _in(self.folder), contextlib.redirect_stdout(out), \
                 contextlib.redirect_stderr(err):
@@ -222,11 +222,10 @@ class Session:
             finally:
                 _close_figures()
         printed = out.getvalue() + err.getvalue()
-        written = {name: (self.folder / name).read_bytes()
-                   for name, stamp in _stamps(self.folder).items()
-                   if key is not None and before.get(name) != stamp}
-        if key is not None:
-            _RAN[key] = (status, printed, written)
+        if key is not None:  # a shared run: the files it wrote or changed, for the other page
+            _RAN[key] = (status, printed, {name: (self.folder / name).read_bytes()
+                                           for name, stamp in _stamps(self.folder).items()
+                                           if before.get(name) != stamp})
         return status, printed
 
     def _bash(self, line: str) -> tuple[int, str]:
