@@ -1007,3 +1007,44 @@ def test_a_recording_imports_neither_the_figures_nor_matplotlib(tmp_path):
                          check=True)
     assert (tmp_path / "a.gif").stat().st_size > 0
     assert out.stdout.split() == []
+
+
+@pytest.mark.parametrize("g, units, unit, power", [
+    # K at the end of 1 s of free fall: m (g t)^2 / 2, and U_g goes down as much.
+    (900.0, "px", "kg px²/s²", 3),          # 8.1e5 kg px²/s²: ticks in 1e5
+    (9e4, ("cm", "g", "s"), "g cm²/s²", 9),  # 8.1e9 g cm²/s²
+    (9.8, "m", "J", 0),                      # 96 J: the labels as they are
+    (9.8e-5, "m", "J", -9),                  # 9.6e-9 J
+])
+def test_the_strip_names_its_unit_and_its_tick_labels_fit_beside_it(tmp_path, g, units, unit,
+                                                                     power):
+    """A recorded space's strip: the energy unit above its axis (with the power of ten the
+    tick labels are divided by), at least two ticks, and no tick label reaching the line
+    between the picture and the energy panel."""
+    from dumbbell.animation import recording as R
+    from dumbbell.animation.painter import SS
+    from dumbbell.animation.strip import LABEL_GAP, WHOLE_ENERGY_TICKS, tick_power
+
+    space = pymunk.Space()
+    space.gravity = (0.0, -g)
+    ball = pymunk.Body(2.0, pymunk.moment_for_circle(2.0, 0, 10))
+    ball.position = (0.0, 0.0)
+    space.add(ball, pymunk.Circle(ball, 10))
+    with spaces.Recorder(space, tmp_path / "a.gif", units=units) as rec:
+        for _ in range(25):
+            space.step(1 / 25)
+            rec.capture()
+    painter = R.painter_of(rec.recording())
+    strip = painter.strip
+    ticks = strip.scale.ticks(WHOLE_ENERGY_TICKS, least=2)
+    assert strip.energy_axis == unit and len(ticks) >= 2
+    assert tick_power(ticks) == power
+    assert 10 ** power <= max(abs(v) for v in ticks) < 10 ** (power + 4)
+    base = np.asarray(painter.base.reduce(SS).convert("L"))
+    sx0, sy0, _, sy1 = strip.box
+    # Ink above the strip's top left corner (the unit), and none in the gutter's left part
+    # (the tick labels end LABEL_GAP from the strip and stay right of the separating line).
+    above = base[sy0 - round(LABEL_GAP * strip.u) - 12:sy0 - 1, sx0:sx0 + 40]
+    assert (above < 200).any()
+    gutter = base[sy0:sy1, painter.scene_w + 2:painter.scene_w + 6]
+    assert (gutter > 250).all()

@@ -98,11 +98,15 @@ class EnergyScale:
         """hi - lo (J)."""
         return self.hi - self.lo
 
-    def ticks(self) -> list[float]:
-        """Round energies (J) about two steps apart across the scale."""
-        step = nice_step((self.hi - self.lo) / 2)
-        lo, hi = math.ceil(self.lo / step - 1e-9), math.floor(self.hi / step + 1e-9)
-        return [k * step for k in range(lo, hi + 1)]
+    def ticks(self, parts: int = 2, least: int = 1) -> list[float]:
+        """Round energies (J) about ``parts`` steps apart across the scale, at least ``least``
+        of them (a smaller round step when the first gives fewer)."""
+        step = nice_step((self.hi - self.lo) / parts)
+        while True:
+            lo, hi = math.ceil(self.lo / step - 1e-9), math.floor(self.hi / step + 1e-9)
+            if hi - lo + 1 >= least or not step > 0:
+                return [k * step for k in range(lo, hi + 1)]
+            step = nice_step(step / 2.1)  # the next round step down (1, 2, 5 x 10^n)
 
     def text(self, value: float) -> str:
         """``value`` (J) as printed beside its bar."""

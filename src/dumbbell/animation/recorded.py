@@ -234,6 +234,15 @@ class Recording:
         """Number of frames."""
         return len(self.t)
 
+    @property
+    def energy_unit(self) -> str:
+        """The energy's unit, as the bars' title gives it in parentheses ('Energy (J)');
+        '' when the title names none."""
+        title = self.energy_title or ""
+        if "(" not in title or ")" not in title:
+            return ""
+        return title[title.find("(") + 1:title.rfind(")")]
+
     def items(self, k: int) -> list[tuple]:
         """Frame ``k``'s moving primitives (its shapes, then its extras)."""
         return [*self.shapes[self.shape_of[k]].items(self.poses[k]), *self.extras[k]]

@@ -155,11 +155,5 @@ def space_page(painter: Any) -> str:
                       for name in names}}
     doc = {"kind": "space", "fps": rec.fps, "t_end": float(t[-1]),
            "picture": space_document(painter), "runs": [run],
-           "units": {"energy": _energy_unit(rec), "time": rec.time_unit, "L_cm": ""}}
+           "units": {"energy": rec.energy_unit, "time": rec.time_unit, "L_cm": ""}}
     return page(doc, rec.title or "pymunk space")
-
-
-def _energy_unit(rec: Any) -> str:
-    """The energy's unit, as the bars' title gives it in parentheses ('Energy (J)')."""
-    title = rec.energy_title or ""
-    return title[title.find("(") + 1:title.rfind(")")] if "(" in title and ")" in title else ""

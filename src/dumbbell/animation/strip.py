@@ -83,6 +83,12 @@ LABEL_EDGE = 2   # and end this far from the frame's right edge
 #: the strip, about this many time ticks over the whole recording, its curves and its
 #: cursor this wide.
 WHOLE_PAD, WHOLE_FONT, WHOLE_LABEL_GAP, WHOLE_TICKS, WHOLE_LINE, WHOLE_CURSOR = 3, 10, 5, 4, 1.5, 1.2
+#: A recorded space's energy axis: about this many steps between its ticks; its tick labels
+#: are divided by a power of ten (named with the unit above the axis) when the largest is
+#: 10**WHOLE_SCALED[1] or more, or under 10**(WHOLE_SCALED[0] + 1), so that they fit beside
+#: it.
+WHOLE_ENERGY_TICKS, WHOLE_SCALED = 3, (-3, 4)
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
 #: Opacity of E + heat's curve (a recorded space's, with a heat counter).
 HEAT_ALPHA = 0.6
 
@@ -120,10 +126,12 @@ class Strip:
     lines: tuple[tuple[tuple[int, int, int], np.ndarray, np.ndarray], ...] = ()
     font_px: float = NOTE_PX
     time_axis: str = TIME_AXIS
+    energy_axis: str = ENERGY_AXIS
 
     #: The fields a page (:meth:`.picture.Picture.document`) is not given: the scene's
     #: strip draws with the constants the page has.
-    PAGE_SKIPS = ("pad", "scrolls", "t0", "t_last", "lines", "font_px", "time_axis")
+    PAGE_SKIPS = ("pad", "scrolls", "t0", "t_last", "lines", "font_px", "time_axis",
+                  "energy_axis")
 
     @classmethod
     def build(cls, box: tuple[int, int, int, int], u: float, scale: EnergyScale,
@@ -159,7 +167,7 @@ class Strip:
                    (sx1 - sx0 - 2) / window, sx1 - sx0 - 1, 0,
                    nice_step((end - t0) / WHOLE_TICKS) if end > t0 else 1.0,
                    WHOLE_PAD * u, False, t0, end, tuple((rgb, t, v) for rgb, v in series),
-                   WHOLE_FONT, f"t ({rec.time_unit})")
+                   WHOLE_FONT, f"t ({rec.time_unit})", rec.energy_unit)
 
     def y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
@@ -188,12 +196,24 @@ class Strip:
         sx0, sy0, sx1, sy1 = self.box
         fs = font(round(self.font_px * u) * S)
         d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
-        for v in self.scale.ticks():
+        if self.scrolls:
+            ticks, power = self.scale.ticks(), 0
+        else:
+            ticks = self.scale.ticks(WHOLE_ENERGY_TICKS, least=2)
+            power = tick_power(ticks)
+        for v in ticks:
             y = self.y(v)
             if not self.scrolls:
                 d.line([((sx0 + 1) * S, y * S), ((sx1 - 1) * S, y * S)], fill=GRID, width=S)
-            d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(v), font=fs, fill=GREY,
-                   anchor="rm")
+            d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(round(v / 10.0 ** power, 9)),
+                   font=fs, fill=GREY, anchor="rm")
+        if not self.scrolls:  # the unit (and the power of ten) above the axis
+            name = " ".join(p for p in (
+                f"×10{str(power).translate(_SUPERSCRIPT)}" if power else "", self.energy_axis)
+                if p)
+            if name:
+                d.text((sx0 * S, (sy0 - LABEL_GAP * u) * S), name, font=fs, fill=GREY,
+                       anchor="ls")
         if self.scrolls:
             d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS,
                    font=fs, fill=GREY, anchor="rs")
@@ -329,6 +349,17 @@ class Sheet:
         ImageDraw.Draw(img).line([(x, sy0 + 1), (x, sy1 - 1)], fill=ink_index(INK),
                                  width=max(1, round(WHOLE_CURSOR * u)))
         return boxes
+
+
+def tick_power(ticks: Sequence[float]) -> int:
+    """The power of ten a whole run's energy tick labels are divided by: 0 unless the
+    largest is 10 000 or more or under 0.01 (:data:`WHOLE_SCALED`); a multiple of 3 then,
+    as an engineer writes it (×10³, ×10⁶, ×10⁻³)."""
+    top = max((abs(v) for v in ticks), default=0.0)
+    if not (top > 0 and math.isfinite(top)):
+        return 0
+    e = math.floor(math.log10(top))
+    return 3 * math.floor(e / 3) if not WHOLE_SCALED[0] < e < WHOLE_SCALED[1] else 0
 
 
 @lru_cache(maxsize=1)
