@@ -103,3 +103,22 @@ def test_clip_bounds_each_echoed_word_and_the_whole_message():
     long_but_fine = "word " * (MAX_ECHO - 1)  # 995 characters: left whole
     assert clip(long_but_fine) == long_but_fine
     assert len(one_line("line\n" * 100_000)) <= 5 * MAX_ECHO
+
+
+@pytest.mark.parametrize("argv", [
+    ["compare", TEXTBOOK, "--solvers", "pymunk", "pymunk"],
+    ["compare", TEXTBOOK, "--solvers", "pymunk,euler-cromer,pymunk"],
+    ["bench", TEXTBOOK, "--solvers", "euler-cromer", "euler-cromer"],
+    ["stability", "--solvers", "euler-cromer", "pymunk", "euler-cromer"],
+    ["play", TEXTBOOK, "--solvers", "pymunk", "pymunk", "-o", "PAGE"],
+])
+def test_a_solver_named_twice_is_refused_by_every_command(tmp_path, capsys, argv):
+    """Each command's --solvers refuses a name given twice (compare once ran it once without
+    a word, while play refused it), before any work: one line, exit 2, nothing written."""
+    out = tmp_path / "out"
+    argv = [str(out / "p.html") if a == "PAGE" else a for a in argv]
+    extra = [] if argv[0] == "play" else ["--out", str(out)]
+    assert exit_code([*argv, *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "named twice" in err and "Traceback" not in err
+    assert not out.exists()

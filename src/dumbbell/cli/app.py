@@ -569,6 +569,18 @@ def _file_backend(process_ends: bool = False) -> Iterator[None]:
                 os.environ[name] = value
 
 
+def _check_solvers(args: argparse.Namespace) -> None:
+    """Every command's ``--solvers`` names each solver once (commas also separate names):
+    a name given twice is refused, not run once without a word."""
+    from ..errors import UsageError
+
+    names = [s.strip() for item in getattr(args, "solvers", None) or ()
+             for s in str(item).split(",") if s.strip()]
+    twice = next((name for i, name in enumerate(names) if name in names[:i]), None)
+    if twice is not None:
+        raise UsageError(f"--solvers: {_shown(twice)} named twice; give each solver once")
+
+
 def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> int:
     from ..files import output_transaction
 
@@ -580,6 +592,7 @@ def _run(args: argparse.Namespace, command: str, state: dict[str, object]) -> in
         with output_transaction() as transaction:
             state["outputs"] = args.outputs = transaction
             _check_paths(args, transaction)
+            _check_solvers(args)
             status = int(args.func(args) or 0)
             if _stopping.signum is not None:  # a stop something swallowed: keep nothing
                 raise Stopped(_stopping.signum)

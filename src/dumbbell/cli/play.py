@@ -67,9 +67,6 @@ def run(args: argparse.Namespace) -> int:
                 runnable(solver_class(name), scene)
             except UsageError as exc:
                 raise UsageError(f"--solvers: {exc}") from None
-    twice = next((name for i, name in enumerate(solvers) if name in solvers[:i]), None)
-    if twice is not None:
-        raise UsageError(f"--solvers: {twice} named twice; give each solver once")
     from .app import plan_outputs
 
     if not args.output:  # -o itself was checked with the other flags
