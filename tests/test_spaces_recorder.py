@@ -1048,3 +1048,11 @@ def test_the_strip_names_its_unit_and_its_tick_labels_fit_beside_it(tmp_path, g,
     assert (above < 200).any()
     gutter = base[sy0:sy1, painter.scene_w + 2:painter.scene_w + 6]
     assert (gutter > 250).all()
+    # The interactive player's page draws the same ticks and names the same axis.
+    from dumbbell.animation.space_player import space_document
+
+    labels, axis = strip.energy_ticks()
+    assert axis.endswith(unit) and (axis.startswith("×10") == (power != 0))
+    page = space_document(painter)["strip"]
+    assert page["axis"] == axis and page["ticks"] == [list(t) for t in labels]
+    assert [v for v, _ in labels] == ticks

@@ -640,6 +640,7 @@
         line(c, [[sx0 + 1, y], [sx1 - 1, y]], P.grid, 1);
         text(c, label, sx0 - 4 * u, y, "rm", fSmall, P.grey);
       }
+      if (S.axis) text(c, S.axis, sx0, sy0 - 4 * u, "ls", fSmall, P.grey);  // unit, power of ten
       for (const [tk, label] of S.time_ticks) {
         const x = stripX(tk);
         line(c, [[x, sy1], [x, sy1 + 3 * u]], P.grey, 1);

@@ -126,9 +126,10 @@ def space_document(painter: Any) -> dict[str, Any]:
             step = strip.t_step
             ticks = range(math.ceil(strip.t0 / step - 1e-9),
                           math.floor(strip.t_last / step + 1e-9) + 1)
+            energy_ticks, axis = strip.energy_ticks()  # as the GIF's strip shows them
             doc["strip"] = {"box": list(strip.box), "pad": strip.pad, "t0": strip.t0,
                             "span": strip.window,
-                            "ticks": [[v, fmt_tick(v)] for v in bars.scale.ticks()],
+                            "ticks": [[v, label] for v, label in energy_ticks], "axis": axis,
                             "time_ticks": [[k * step, fmt_tick(k * step)] for k in ticks]}
     return doc
 

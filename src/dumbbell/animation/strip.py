@@ -169,6 +169,22 @@ class Strip:
                    WHOLE_PAD * u, False, t0, end, tuple((rgb, t, v) for rgb, v in series),
                    WHOLE_FONT, f"t ({rec.time_unit})", rec.energy_unit)
 
+    def energy_ticks(self) -> tuple[list[tuple[float, str]], str]:
+        """The energy axis: each tick's value (J) and label, and the axis' name. A scene's
+        (scrolling) strip: about two steps, labelled as they are, named J beside the axis; a
+        recorded space's: at least two of about :data:`WHOLE_ENERGY_TICKS` steps, labelled
+        divided by :func:`tick_power`'s power of ten, named by the unit and that power
+        ('×10³ kg px²/s²'; '' when the space's unit is not named and no power is needed),
+        written above the axis."""
+        if self.scrolls:
+            return [(v, fmt_tick(v)) for v in self.scale.ticks()], ENERGY_AXIS
+        ticks = self.scale.ticks(WHOLE_ENERGY_TICKS, least=2)
+        power = tick_power(ticks)
+        name = " ".join(part for part in (
+            f"×10{str(power).translate(_SUPERSCRIPT)}" if power else "", self.energy_axis)
+            if part)
+        return [(v, fmt_tick(round(v / 10.0 ** power, 9))) for v in ticks], name
+
     def y(self, value):
         """Pixel y of energy ``value`` (J, a float or an array) in the strip."""
         _, sy0, _, sy1 = self.box
@@ -196,24 +212,14 @@ class Strip:
         sx0, sy0, sx1, sy1 = self.box
         fs = font(round(self.font_px * u) * S)
         d.rectangle([sx0 * S, sy0 * S, sx1 * S + S - 1, sy1 * S + S - 1], outline=LIGHT, width=S)
-        if self.scrolls:
-            ticks, power = self.scale.ticks(), 0
-        else:
-            ticks = self.scale.ticks(WHOLE_ENERGY_TICKS, least=2)
-            power = tick_power(ticks)
-        for v in ticks:
+        ticks, name = self.energy_ticks()
+        for v, label in ticks:
             y = self.y(v)
             if not self.scrolls:
                 d.line([((sx0 + 1) * S, y * S), ((sx1 - 1) * S, y * S)], fill=GRID, width=S)
-            d.text(((sx0 - LABEL_GAP * u) * S, y * S), fmt_tick(round(v / 10.0 ** power, 9)),
-                   font=fs, fill=GREY, anchor="rm")
-        if not self.scrolls:  # the unit (and the power of ten) above the axis
-            name = " ".join(p for p in (
-                f"×10{str(power).translate(_SUPERSCRIPT)}" if power else "", self.energy_axis)
-                if p)
-            if name:
-                d.text((sx0 * S, (sy0 - LABEL_GAP * u) * S), name, font=fs, fill=GREY,
-                       anchor="ls")
+            d.text(((sx0 - LABEL_GAP * u) * S, y * S), label, font=fs, fill=GREY, anchor="rm")
+        if not self.scrolls and name:  # the unit (and the power of ten) above the axis
+            d.text((sx0 * S, (sy0 - LABEL_GAP * u) * S), name, font=fs, fill=GREY, anchor="ls")
         if self.scrolls:
             d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS,
                    font=fs, fill=GREY, anchor="rs")
