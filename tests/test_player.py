@@ -352,6 +352,10 @@ def test_a_recorded_space_plays_with_its_own_values_at_the_gifs_pixels(chromium,
             got = _centre(page_rgb[:, :round(painter.scene_w * factor)], fill) / factor
             assert np.hypot(*(got - want)) <= 2.0, (k, got, want)
         assert o.console == []
+        # A space has no impacts to jump to: both impact buttons are disabled and say so.
+        assert o.page.evaluate("['prev-impact', 'next-impact'].map(i => [document."
+                               "getElementById(i).disabled, document.getElementById(i)."
+                               "title])") == [[True, "No impacts in this run"]] * 2
     finally:
         o.page.close()
 

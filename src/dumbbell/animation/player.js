@@ -873,10 +873,22 @@
   $("forward").addEventListener("click", function () { pause(); frameStep(1, false); });
   $("prev-impact").addEventListener("click", function () { jumpImpact(-1); });
   $("next-impact").addEventListener("click", function () { jumpImpact(1); });
+  // A run without impacts (a recorded space, a run that ends before the first) has nothing
+  // to jump to: its impact buttons are disabled, and say why.
+  function impactButtons() {
+    const none = runs[state.run].impacts.length === 0;
+    for (const id of ["prev-impact", "next-impact"]) {
+      const b = $(id);
+      if (b.dataset.title === undefined) b.dataset.title = b.title;
+      b.disabled = none;
+      b.title = none ? "No impacts in this run" : b.dataset.title;
+    }
+  }
+  impactButtons();
   slider.addEventListener("input", function () { seek(parseFloat(slider.value)); });
   $("speed").addEventListener("change", function (e) { state.speed = parseFloat(e.target.value); });
   $("loop").addEventListener("change", function (e) { state.loop = e.target.checked; });
-  runSelect.addEventListener("change", function (e) { state.run = parseInt(e.target.value, 10); render(true); });
+  runSelect.addEventListener("change", function (e) { state.run = parseInt(e.target.value, 10); impactButtons(); render(true); });
   document.addEventListener("keydown", function (e) {
     if (e.altKey || e.ctrlKey || e.metaKey) return;
     const tag = e.target && e.target.tagName;
