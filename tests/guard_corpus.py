@@ -341,8 +341,14 @@ def advice(case: str, steps: int = ADVICE_STEPS) -> Advice:
     if any(k in SPRINGS for k in kinds):
         steps = min(steps, max(10, REFERENCE_STEPS // (4 * n)))
         err = []
+        references: dict[tuple, tuple[list[float], list[float]]] = {}
         for m, setting in runs:
-            ref, scale = _series(case, steps, 4 * n, setting)
+            # The reference of both runs is one run when the advice gives no setting (None
+            # and {} apply nothing): made once.
+            key = tuple(sorted((setting or {}).items()))
+            if key not in references:
+                references[key] = _series(case, steps, 4 * n, setting)
+            ref, scale = references[key]
             e, _ = _series(case, steps, m, setting)
             diff = max(abs(a - b) for a, b in zip(e, ref, strict=True))
             err.append(diff / max(scale) if max(scale) > 0 else diff)

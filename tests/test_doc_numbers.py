@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import dumbbell
-from tests.conftest import ROOT, SCENES
+from tests.conftest import ROOT, SCENES, rotation_table
 
 G = 9.8
 
@@ -229,16 +229,6 @@ def _e_notation(value: float, digits: int) -> str:
     return f"{m}e{int(exp)}"
 
 
-@cache
-def restitution_result(e: float):
-    """What ``dumbbell restitution scenes/tilted-2d.toml --theta 0,30,45,60,80 --elasticity
-    E`` computes, for E = ``e`` (the analysis the command runs)."""
-    from dumbbell.analysis.restitution import restitution
-
-    return restitution(scene("tilted-2d").with_values({"floor.elasticity": e}),
-                       [0.0, 30.0, 45.0, 60.0, 80.0])
-
-
 def _table(page: str, first_line: str) -> list[list[str]]:
     """The cells of the Markdown table of ``page`` whose header row starts with
     ``first_line``, header included, separator left out."""
@@ -270,7 +260,7 @@ def test_the_rotation_page_s_tables_are_the_command_s_every_cell(e):
             for line in text[start:].splitlines()
             if line.startswith("|") and not line.startswith("|---")][:6]
     assert rows[0][:4] == ["θ", "formula", "truth", "pymunk"]
-    result = restitution_result(e)
+    result = rotation_table(e)  # the command's analysis, shared with test_rotation_chapter
     springs = [result.springs[k] for k in (200.0, 2e3, 2e4)]
     for i, (theta, formula, truth, pymunk, *spring_cells) in enumerate(rows[1:]):
         assert float(theta.rstrip("°")) == result.theta[i]

@@ -4,8 +4,13 @@ the ones below it, so data flows one way, and no two files import each other."""
 from __future__ import annotations
 
 import ast
+import functools
 import re
+from collections import deque
+from collections.abc import Iterator
 from pathlib import Path
+
+import pytest
 
 import dumbbell
 
@@ -53,12 +58,10 @@ def imports(path: Path, local: bool = True, root: Path = ROOT) -> tuple[str, lis
     import m`` names the module ``p.m`` when there is one. With ``local`` False, only those at
     module level (not inside a function)."""
     module, package = _module(path, root)
-    tree = ast.parse(path.read_text())
-    inside = {id(n) for f in ast.walk(tree)
-              if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)) for n in ast.walk(f)}
+    tree = _parsed(path.read_text())
     found = []
-    for node in ast.walk(tree):
-        if not local and id(node) in inside:
+    for node, inside in _walk(tree):
+        if not local and inside:
             continue
         if isinstance(node, ast.Call):
             target = _dynamic(node, module)
@@ -79,6 +82,30 @@ def imports(path: Path, local: bool = True, root: Path = ROOT) -> tuple[str, lis
             subs = [f"{target}.{a.name}" for a in node.names]
             found += [s for s in subs if _exists(s, root)] or [target]
     return module, found
+
+
+@functools.cache
+def _parsed(source: str) -> ast.Module:
+    """``ast.parse(source)``, once per source text: the two tests of the package's own files
+    read the same trees (the parse is most of their time). Nothing changes a tree."""
+    return ast.parse(source)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _forget_the_trees():
+    yield
+    _parsed.cache_clear()  # some 60 MB of trees
+
+
+def _walk(tree: ast.AST) -> Iterator[tuple[ast.AST, bool]]:
+    """Every node of ``tree`` in :func:`ast.walk`'s order, with whether it is inside a
+    function (a ``def`` or ``async def``, the function's own node included): one pass."""
+    todo = deque([(tree, False)])
+    while todo:
+        node, inside = todo.popleft()
+        inside = inside or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+        todo.extend((child, inside) for child in ast.iter_child_nodes(node))
+        yield node, inside
 
 
 def _dynamic(call: ast.Call, module: str) -> str | None:
