@@ -35,8 +35,11 @@ them, and no counter.
 Everything is set through pymunk's public API (``Space.on_collision``, the handler's
 ``pre_solve``/``post_solve`` properties and its ``data`` dict) and nothing is stored on the
 space; pymunk 7 has no public getter for a handler, so the wildcard one is read from
-``Space._handlers`` (checked to be pymunk's ``CollisionHandler``). Impulses are read from
-pymunk's contact structs (``Arbiter._arbiter``, through pymunk's own compiled declarations).
+``Space._handlers`` (checked to be pymunk's ``CollisionHandler``). Impulses and the
+arbiter's bodies are read from pymunk's contact structs (``Arbiter._arbiter``, through
+pymunk's own compiled declarations: the contact points' fields unpacked in one call from
+their bytes, each field checked to be a double), the bodies' velocities and the step's time
+stamp through Chipmunk's C getters (the space's struct is ``Space._space``, checked).
 :class:`dumbbell.spaces.Ledger` counts the same contact heat per pair of bodies, with every
 other source of energy.
 """
@@ -50,9 +53,10 @@ from typing import Any
 __all__ = ["HeatCounter"]
 
 _PHASES = ("pre_solve", "post_solve")
-#: pymunk's compiled declarations (``pymunk._chipmunk_cffi.ffi``), set by the first counter:
-#: pymunk is imported only when a counter is made.
+#: pymunk's compiled declarations and functions (``pymunk._chipmunk_cffi.ffi`` and ``lib``),
+#: set by the first counter: pymunk is imported only when a counter is made.
 _FFI: Any = None
+_LIB: Any = None
 
 
 class HeatCounter:
@@ -117,21 +121,34 @@ class HeatCounter:
         return self
 
     def _start(self, space: Any) -> None:
-        global _FFI
+        global _FFI, _LIB
         if _FFI is None:
-            from pymunk._chipmunk_cffi import ffi
+            from pymunk._chipmunk_cffi import ffi, lib
 
-            _FFI = ffi
+            _FFI, _LIB = ffi, lib
+            try:
+                for count in (1, 2):  # Chipmunk's most contact points per arbiter: 2
+                    _UNPACK[count] = _unpacker(count)
+            except Exception:
+                _FFI = None
+                raise
         self.space = space
         self._total = 0.0
         self._steps = 0
         self._stopped: str | None = None
-        self._before: dict[int, list[tuple[float, float, float, float]]] = {}
-        # The bodies of each arbiter counted in the step, and their velocities at the
-        # solver's end (taken at the step's first post_solve, before any program's).
-        self._ends: dict[int, tuple[Any, Any]] = {}
-        self._after: dict[int, tuple[float, float, float]] | None = None
+        # Keyed by the arbiter's pointer (pymunk's cdata: equal and hashed by address).
+        self._before: dict[Any, list[tuple[float, float, float, float]]] = {}
+        # The bodies (Chipmunk's pointers) of each arbiter counted in the step, and their
+        # velocities at the solver's end (taken at the step's first post_solve, before any
+        # program's).
+        self._ends: dict[Any, tuple[Any, Any]] = {}
+        self._after: dict[Any, tuple[float, float, float]] | None = None
         self._last_dt: float | None = None
+        # The step of the last pre_solve (the space's time stamp) and, for that step, the
+        # share of the impulses carried from the last one that pymunk applies at its start.
+        self._stamp: int | None = None
+        self._carried = 1.0
+        self._cp_space = _cp_space(space)
         _Dispatch.of(space).add(self)
 
     @property
@@ -207,7 +224,7 @@ class HeatCounter:
         # second space would claim.
         state = dict(self.__dict__)
         state["_before"], state["_ends"], state["_after"] = {}, {}, None
-        state["space"] = None
+        state["space"] = state["_cp_space"] = state["_stamp"] = None
         if state["_stopped"] is None:
             state["_stopped"] = "a copy: it does not count"
         return state
@@ -219,58 +236,61 @@ class HeatCounter:
         other.space = memo.get(id(self.space))
         return other
 
-    def _relative(self, arbiter: Any) -> tuple[Any, Any, Any]:
-        raw = arbiter._arbiter
-        shapes = arbiter.shapes
-        a, b = (shapes[1], shapes[0]) if raw.swapped else shapes
-        return raw, a.body, b.body
-
-    @staticmethod
-    def _velocities(raw: Any, ba: Any, bb: Any,
-                    at: dict[int, tuple[float, float, float]] | None = None
-                    ) -> list[tuple[float, float]]:
-        """The relative velocity at each contact point of ``raw``: from the bodies' own
-        velocities, or from those taken in ``at`` (by id)."""
-        if at is None:
-            (vax, vay), wa = ba.velocity, ba.angular_velocity
-            (vbx, vby), wb = bb.velocity, bb.angular_velocity
-        else:
-            vax, vay, wa = at[id(ba)]
-            vbx, vby, wb = at[id(bb)]
-        out = []
-        for i in range(raw.count):
-            c = raw.contacts[i]
-            r1, r2 = c.r1, c.r2
-            out.append(((vbx - wb * r2.y) - (vax - wa * r1.y),
-                        (vby + wb * r2.x) - (vay + wa * r1.x)))
-        return out
-
     def _pre_solve(self, arbiter: Any, space: Any) -> None:
-        if self._after is not None:
-            # A post_solve ran and this step is another: the last one's end (_end_step) was
-            # cut short by an exception raised inside a callback (a stop signal's handler).
-            self._forget()
-        raw, ba, bb = self._relative(arbiter)
-        # pymunk starts a step from the impulse accumulated in the last one, applied scaled by
-        # dt / previous dt ("warm starting"); on a first contact it keeps an impulse cached
-        # from an earlier touch there without applying it. What the step applies is the
-        # accumulator's growth from here plus the part applied at the start.
-        carried = 0.0 if arbiter.is_first_contact else (
-            space.current_time_step / self._last_dt if self._last_dt else 1.0)
-        key = int(_FFI.cast("uintptr_t", raw))
-        kept = 1.0 - carried
-        contacts = raw.contacts
+        raw = arbiter._arbiter
+        lib = _LIB
+        stamp = lib.cpSpaceGetTimestamp(self._cp_space)
+        if stamp != self._stamp:
+            # The step's first contact.
+            if self._after is not None or self._ends:
+                # What the counter took of the last step, whose end (_end_step) was cut
+                # short by an exception raised inside a callback (a stop signal's handler).
+                self._forget()
+            self._stamp = stamp
+            # pymunk starts a step from the impulse accumulated in the last one, applied
+            # scaled by dt / previous dt ("warm starting").
+            self._carried = (space.current_time_step / self._last_dt if self._last_dt
+                             else 1.0)
+            # A contact whose post_solve never comes (the user rejected it) must not linger.
+            space.add_post_step_callback(self._end_step, self)
+        # The arbiter's bodies: a's and b's (its shapes in Chipmunk's order; pymunk's
+        # Arbiter.shapes gives them swapped when ``raw.swapped``).
+        ba, bb = raw.body_a, raw.body_b
+        first = lib.cpArbiterIsFirstContact(raw)
+        if first and (lib.cpShapeGetBody(raw.a) != ba or lib.cpShapeGetBody(raw.b) != bb):
+            self._refuse("pymunk's arbiter does not hold its shapes' bodies where pymunk 7 "
+                         "does")
+            return
+        # On a first contact pymunk keeps an impulse cached from an earlier touch there
+        # without applying it. What the step applies is the accumulator's growth from here
+        # plus the part applied at the start.
+        kept = 1.0 - (0.0 if first else self._carried)
+        v = lib.cpBodyGetVelocity(ba)
+        vax, vay, wa = v.x, v.y, lib.cpBodyGetAngularVelocity(ba)
+        v = lib.cpBodyGetVelocity(bb)
+        vbx, vby, wb = v.x, v.y, lib.cpBodyGetAngularVelocity(bb)
+        points = _points(raw)
         before = []
-        for i, (ux, uy) in enumerate(self._velocities(raw, ba, bb)):
-            c = contacts[i]
-            before.append((ux, uy, c.jnAcc * kept, c.jtAcc * kept))
+        for k in range(0, len(points), 6):
+            r1x, r1y, r2x, r2y, jn, jt = points[k:k + 6]
+            # The relative velocity at the point, and the impulses the step starts from.
+            before.append(((vbx - wb * r2y) - (vax - wa * r1y),
+                           (vby + wb * r2x) - (vay + wa * r1x),
+                           jn * kept, jt * kept))
         # The bodies first: a stop signal raised between these two lines (its handler runs
         # inside this callback) leaves a pair whose post_solve counts nothing, never a
         # contact whose bodies the first post_solve's snapshot of velocities lacks.
-        self._ends[key] = (ba, bb)
-        self._before[key] = before
-        # A contact whose post_solve never comes (the user rejected it) must not linger.
-        space.add_post_step_callback(self._end_step, self)
+        self._ends[raw] = (ba, bb)
+        self._before[raw] = before
+
+    def _refuse(self, why: str) -> None:
+        """Stop counting (warning once) on a pymunk whose structs are not what this reads."""
+        from ._memory import pymunk_version
+
+        self._forget()
+        self._stopped = f"pymunk {pymunk_version()}: {why}: contact heat is not counted"
+        warnings.warn(f"dumbbell.spaces.HeatCounter stopped counting: {self._stopped}",
+                      RuntimeWarning, stacklevel=2)
 
     def _forget(self) -> None:
         """Drop what the counter took of the step (its pairs and the solver's velocities)."""
@@ -280,35 +300,91 @@ class HeatCounter:
 
     def _end_step(self, space: Any, key: Any) -> None:
         self._forget()
+        self._stamp = None
         # Arbiters that carry impulses into the next step had contacts in this one, so this
         # is the 'previous dt' pymunk scales them by.
         self._last_dt = space.current_time_step
 
     def _post_solve(self, arbiter: Any, space: Any) -> None:
         raw = arbiter._arbiter
-        key = int(_FFI.cast("uintptr_t", raw))
-        before = self._before.pop(key, None)
-        if self._after is None:
+        before = self._before.pop(raw, None)
+        after = self._after
+        if after is None:
             # The step's first post_solve: every program's post_solve runs after it (the
             # counters run first in every handler), so these are the solver's velocities.
-            self._after = {id(b): (*b.velocity, b.angular_velocity)
-                           for pair in self._ends.values() for b in pair}
+            lib, after = _LIB, {}
+            for pair in self._ends.values():
+                for b in pair:
+                    if b not in after:
+                        v = lib.cpBodyGetVelocity(b)
+                        after[b] = (v.x, v.y, lib.cpBodyGetAngularVelocity(b))
+            self._after = after
         if before is not None and len(before) == raw.count:
             # The bodies its pre_solve took (the arbiter's own, whichever way a handler
             # sees it): a pair with ``before`` has them.
-            ba, bb = self._ends[key]
-            nx, ny = raw.n.x, raw.n.y
-            contacts = raw.contacts
+            ba, bb = self._ends[raw]
+            vax, vay, wa = after[ba]
+            vbx, vby, wb = after[bb]
+            n = raw.n
+            nx, ny = n.x, n.y
+            points = _points(raw)
             work = 0.0
-            for i, (ux1, uy1) in enumerate(self._velocities(raw, ba, bb, self._after)):
-                ux0, uy0, jn0, jt0 = before[i]
-                c = contacts[i]
-                jn, jt = c.jnAcc - jn0, c.jtAcc - jt0
+            for i, (ux0, uy0, jn0, jt0) in enumerate(before):
+                r1x, r1y, r2x, r2y, jn, jt = points[6 * i:6 * i + 6]
+                ux1 = (vbx - wb * r2y) - (vax - wa * r1y)
+                uy1 = (vby + wb * r2x) - (vay + wa * r1x)
+                jn, jt = jn - jn0, jt - jt0
                 # Impulse on b: n jn + t jt with t = perp(n); -that on a.
                 jx, jy = nx * jn - ny * jt, ny * jn + nx * jt
                 work += 0.5 * (jx * (ux0 + ux1) + jy * (uy0 + uy1))
             self._total -= work
             self._steps += 1
+
+
+#: Per number of contact points: how to unpack their r1.x, r1.y, r2.x, r2.y, jnAcc, jtAcc
+#: from an arbiter's array of ``cpContact`` (see :func:`_points`).
+_UNPACK: dict[int, Any] = {}
+
+
+def _points(raw: Any) -> tuple[float, ...]:
+    """r1.x, r1.y, r2.x, r2.y, jnAcc and jtAcc of each of ``raw``'s contact points, unpacked
+    in one call from the bytes of its ``cpContact`` array: the doubles the struct's fields
+    read, where pymunk's compiled declarations place them."""
+    count = raw.count
+    unpack = _UNPACK.get(count)
+    if unpack is None:
+        unpack = _UNPACK[count] = _unpacker(count)
+    return unpack.unpack_from(_FFI.buffer(raw.contacts, unpack.size)) if count else ()
+
+
+def _unpacker(count: int) -> Any:
+    """A ``struct.Struct`` reading the fields :func:`_points` gives from ``count`` contacts,
+    laid out by pymunk's compiled declarations (each checked to be a double)."""
+    import struct
+
+    from ..errors import DumbbellError
+
+    ffi = _FFI
+    contact = ffi.typeof("struct cpContact")
+    double = ffi.typeof("double")
+    fields = [("r1", "x"), ("r1", "y"), ("r2", "x"), ("r2", "y"), ("jnAcc",), ("jtAcc",)]
+    kinds = dict(contact.fields)
+    vect = dict(kinds["r1"].type.fields)
+    for field in fields:
+        kind = kinds[field[0]].type if len(field) == 1 else vect[field[1]].type
+        if kind != double or (len(field) == 2 and kinds[field[0]].type != kinds["r1"].type):
+            raise DumbbellError(f"dumbbell.spaces.HeatCounter: pymunk's cpContact."
+                                f"{'.'.join(field)} is not a double")
+    offsets = [k * ffi.sizeof(contact) + ffi.offsetof(contact, *field)
+               for k in range(count) for field in fields]
+    fmt, at = "=", 0
+    for offset in offsets:  # ascending: r1, r2 and the impulses are in this order
+        if offset < at:
+            raise DumbbellError("dumbbell.spaces.HeatCounter: pymunk's cpContact does not "
+                                "hold r1, r2, jnAcc and jtAcc in this order")
+        fmt += f"{offset - at}xd" if offset > at else "d"
+        at = offset + 8
+    return struct.Struct(fmt)
 
 
 #: Each space's dispatcher (held weakly: the space keeps none of this).
@@ -327,21 +403,43 @@ class _Phase:
     def __init__(self, dispatch: _Dispatch, phase: str, user: Any) -> None:
         self.dispatch = dispatch
         self.phase = phase
-        self.method = f"_{phase}"  # the counters' method for the phase
+        self.method = getattr(HeatCounter, f"_{phase}")  # the counters' method for the phase
         self.user = user
 
     def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
-        if not self.dispatch.sealed:
-            self.dispatch.check()
-        for counter in self.dispatch.counters:
-            if counter._stopped is None:
-                getattr(counter, self.method)(arbiter, space)
+        dispatch = self.dispatch
+        if not dispatch.sealed:
+            dispatch.check()
+        method = self.method
+        for ref in dispatch.refs:
+            counter = ref()
+            if counter is not None and counter._stopped is None:
+                method(counter, arbiter, space)
         if self.user is not None:
             return self.user(arbiter, space, data)
         return None
 
     def __reduce__(self) -> tuple[Any, ...]:
         return (_same, (self.user,)) if self.user is not None else (type(None), ())
+
+
+def _cp_space(space: Any) -> Any:
+    """The space's Chipmunk struct (``Space._space``: pymunk 7 has no public getter for it),
+    checked to be a ``cpSpace`` whose (integer) settings Chipmunk's getters read as pymunk's
+    public ones do. The counters read only the step's time stamp from it, through Chipmunk's own
+    getter."""
+    from ..errors import DumbbellError
+
+    ptr = getattr(space, "_space", None)
+    lib = _LIB
+    if not (isinstance(ptr, _FFI.CData) and _FFI.typeof(ptr) == _FFI.typeof("cpSpace *")
+            and lib.cpSpaceGetIterations(ptr) == space.iterations
+            and lib.cpSpaceGetCollisionPersistence(ptr) == space.collision_persistence):
+        from ._memory import pymunk_version
+
+        raise DumbbellError(f"dumbbell.spaces.HeatCounter: pymunk {pymunk_version()} does not "
+                            "keep its space's Chipmunk struct where pymunk 7 does")
+    return ptr
 
 
 def _wildcard(space: Any) -> Any:
@@ -370,7 +468,8 @@ class _Dispatch:
 
     def __init__(self, space: Any) -> None:
         self._space = weakref.ref(space)
-        self._counters: list[weakref.ref[HeatCounter]] = []
+        #: The counters, weakly, in the order they attached.
+        self.refs: tuple[weakref.ref[HeatCounter], ...] = ()
         #: True where the space's owner made every handler before the counter attached and
         #: replaces none (HeatCounter._on): check() is then never needed.
         self.sealed = False
@@ -387,23 +486,42 @@ class _Dispatch:
         # The post_solve callbacks the program set for particular collision types, run
         # after the counters (see :meth:`wrap`).
         self.specific: list[tuple[weakref.ref[Any], _Phase]] = []
+        # What the last look saw: how many handlers the space had, and each typed one with
+        # its post_solve (so that a look finding the same costs no scan).
+        self._known = -1
+        self._typed: list[tuple[weakref.ref[Any], Any]] = []
         self.wrap()
 
     def wrap(self) -> None:
         """Run the counters before every post_solve the program set for particular
         collision types (pymunk calls the most specific handler first, then the wildcard
         one): a callback there that changes a velocity is the program's, not a contact's
-        heat. The handlers are read from ``Space._handlers``, as the wildcard one is."""
+        heat. The handlers are read from ``Space._handlers``, as the wildcard one is; the
+        space is scanned again only when it has a new handler or a typed handler's
+        post_solve is not the one the last scan left (pymunk never removes a handler)."""
         space = self._space()
         if space is None:
             return
-        for key, handler in list(getattr(space, "_handlers", {}).items()):
-            user = getattr(handler, "post_solve", None)
-            if key == (None, None) or user is None or isinstance(user, _Phase):
+        handlers = getattr(space, "_handlers", {})
+        if len(handlers) == self._known:
+            for ref, seen in self._typed:
+                handler = ref()
+                if handler is not None and handler.post_solve is not seen:
+                    break
+            else:
+                return
+        self._known = len(handlers)
+        typed = []
+        for key, handler in list(handlers.items()):
+            if key == (None, None):
                 continue
-            phase = _Phase(self, "post_solve", user)
-            self.specific.append((weakref.ref(handler), phase))
-            handler.post_solve = phase
+            user = getattr(handler, "post_solve", None)
+            if user is not None and not isinstance(user, _Phase):
+                phase = _Phase(self, "post_solve", user)
+                self.specific.append((weakref.ref(handler), phase))
+                handler.post_solve = user = phase
+            typed.append((weakref.ref(handler), user))
+        self._typed = typed
 
     @classmethod
     def of(cls, space: Any) -> _Dispatch:
@@ -415,14 +533,15 @@ class _Dispatch:
     @property
     def counters(self) -> list[HeatCounter]:
         """The counters attached, still alive."""
-        return [c for c in (ref() for ref in self._counters) if c is not None]
+        return [c for c in (ref() for ref in self.refs) if c is not None]
 
     def add(self, counter: HeatCounter) -> None:
-        self._counters.append(weakref.ref(counter))
+        # A new tuple, never changed in place: a callback going through it is not disturbed.
+        self.refs = (*self.refs, weakref.ref(counter))
 
     def remove(self, counter: HeatCounter) -> None:
-        self._counters = [ref for ref in self._counters if ref() not in (None, counter)]
-        if not self._counters:
+        self.refs = tuple(ref for ref in self.refs if ref() not in (None, counter))
+        if not self.refs:
             self.uninstall()
 
     def uninstall(self) -> None:
@@ -452,7 +571,11 @@ class _Dispatch:
         if handler is None:
             return
         self.wrap()
-        for phase, mine in self.phases.items():
+        phases = self.phases
+        if (handler.pre_solve is phases["pre_solve"]
+                and handler.post_solve is phases["post_solve"]):
+            return
+        for phase, mine in phases.items():
             new = getattr(handler, phase)
             if new is mine:
                 continue
