@@ -397,24 +397,40 @@ def _same(value: Any) -> Any:
 
 class _Phase:
     """The callback a space's wildcard handler calls for one phase: every counter, then
-    the user's callback that was there before. Copied or pickled, it is that callback
-    (or nothing): a copy of the space has no counter."""
+    the user's callback that was there before (``typed``: the post_solve of a handler for
+    particular collision types, see :meth:`_Dispatch.wrap`). Copied or pickled, it is that
+    callback (or nothing): a copy of the space has no counter."""
 
-    def __init__(self, dispatch: _Dispatch, phase: str, user: Any) -> None:
+    def __init__(self, dispatch: _Dispatch, phase: str, user: Any, typed: bool = False) -> None:
         self.dispatch = dispatch
         self.phase = phase
         self.method = getattr(HeatCounter, f"_{phase}")  # the counters' method for the phase
         self.user = user
+        self.typed = typed
+        # The wildcard post_solve, which pymunk calls right after a typed one for the same
+        # arbiter.
+        self.wild_post = phase == "post_solve" and not typed
 
     def __call__(self, arbiter: Any, space: Any, data: Any) -> Any:
         dispatch = self.dispatch
         if not dispatch.sealed:
             dispatch.check()
-        method = self.method
-        for ref in dispatch.refs:
-            counter = ref()
-            if counter is not None and counter._stopped is None:
-                method(counter, arbiter, space)
+        run = True
+        if self.wild_post:
+            counted, dispatch.counted = dispatch.counted, None
+            # Counted already in the arbiter's typed post_solve (where nothing is left for
+            # the counters: their pre_solve's record of it is gone).
+            run = counted is None or counted != arbiter._arbiter
+        elif not self.typed:
+            dispatch.counted = None  # a pre_solve: the step's post_solves are to come
+        if run:
+            method = self.method
+            for ref in dispatch.refs:
+                counter = ref()
+                if counter is not None and counter._stopped is None:
+                    method(counter, arbiter, space)
+            if self.typed:
+                dispatch.counted = arbiter._arbiter
         if self.user is not None:
             return self.user(arbiter, space, data)
         return None
@@ -468,6 +484,9 @@ class _Dispatch:
 
     def __init__(self, space: Any) -> None:
         self._space = weakref.ref(space)
+        #: The arbiter (pointer) the counters last counted in a typed post_solve, until the
+        #: wildcard post_solve that follows it or the next pre_solve.
+        self.counted: Any = None
         #: The counters, weakly, in the order they attached.
         self.refs: tuple[weakref.ref[HeatCounter], ...] = ()
         #: True where the space's owner made every handler before the counter attached and
@@ -517,7 +536,7 @@ class _Dispatch:
                 continue
             user = getattr(handler, "post_solve", None)
             if user is not None and not isinstance(user, _Phase):
-                phase = _Phase(self, "post_solve", user)
+                phase = _Phase(self, "post_solve", user, typed=True)
                 self.specific.append((weakref.ref(handler), phase))
                 handler.post_solve = user = phase
             typed.append((weakref.ref(handler), user))
