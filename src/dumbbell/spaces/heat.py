@@ -114,7 +114,7 @@ class HeatCounter:
     def _on(cls, space: Any) -> HeatCounter:
         """A counter on a space already checked and set up whole (the pymunk solver's own,
         its collision handlers all made): no program can replace its callbacks, so they are
-        not looked at again at every contact (a third of a contact-rich run's time)."""
+        not looked at again at every contact."""
         self = cls.__new__(cls)
         self._start(space)
         _DISPATCH[space].sealed = self._sealed = True
