@@ -255,3 +255,86 @@ def test_an_unreadable_force_function_is_a_version_error():
     with pytest.raises(PymunkVersionError, match=r"pymunk .*: dumbbell cannot tell which "
                                                  r"force_func a _Forgetful uses"):
         _pymunk._reader(_Forgetful, "force_func")
+
+
+# --- pymunk 7.0.x: a body's velocity_func and position_func have a setter only ---------------
+
+def _body_setter_7_0(name, default_c):
+    """7.0.x's setter: a custom function is kept as ``_<name>`` and pymunk's callback set; the
+    default sets Chipmunk's own function back and leaves the kept function in place."""
+    from pymunk._chipmunk_cffi import ffi, lib
+
+    installed = getattr(pymunk.Body, name).fset
+    default = pymunk.Body.update_velocity if name == "velocity_func" else \
+        pymunk.Body.update_position
+    set_c = lib.cpBodySetVelocityUpdateFunc if name == "velocity_func" else \
+        lib.cpBodySetPositionUpdateFunc
+
+    def setter(self, func):
+        if func == default:
+            set_c(self._body, ffi.addressof(lib, default_c))
+        else:
+            installed(self, func)
+
+    return property(fset=setter)
+
+
+@contextlib.contextmanager
+def bodies_7_0():
+    with pytest.MonkeyPatch.context() as m:
+        m.setattr(pymunk.Body, "velocity_func",
+                  _body_setter_7_0("velocity_func", "cpBodyUpdateVelocity"))
+        m.setattr(pymunk.Body, "position_func",
+                  _body_setter_7_0("position_func", "cpBodyUpdatePosition"))
+        yield
+
+
+def pendulum_with_a_field(custom):
+    """A pendulum on a PinJoint whose bob has a velocity_func of half gravity (``custom``
+    True), had one and was given pymunk's own back (False), or never had one (None)."""
+    space = pymunk.Space()
+    space.gravity = (0.0, -9.8)
+    bob = pymunk.Body(1.0, 0.01)
+    bob.position = (1.0, 0.0)
+    space.add(bob, pymunk.Circle(bob, 0.05),
+              pymunk.PinJoint(space.static_body, bob, (0, 0), (0, 0)))
+
+    def half(body, gravity, damping, dt):
+        pymunk.Body.update_velocity(body, (gravity[0] / 2, gravity[1] / 2), damping, dt)
+
+    if custom is not None:
+        bob.velocity_func = half
+    if custom is False:
+        bob.velocity_func = pymunk.Body.update_velocity
+    return space, bob, half
+
+
+def what_the_tools_say(custom):
+    from dumbbell.spaces._layout import body_function
+
+    space, bob, half = pendulum_with_a_field(custom)
+    func = body_function(bob, "velocity_func")
+    report = spaces.report(space, 1 / 60)
+    ledger = spaces.Ledger(space)
+    for _ in range(30):
+        space.step(1 / 60)
+    balance = ledger.balance()
+    return (func is half, func is None, report, balance.complete,
+            [t.source for t in balance.terms if t.kind == "velocity_func"],
+            tuple(bob.velocity))
+
+
+def test_a_bodys_velocity_func_on_7_0_is_read_as_the_getter_reads_it():
+    """report (whose joint probe copies the bodies), the ledger and the velocity function
+    read the same with 7.0.x's setter-only properties as with the installed getters, a
+    function set back to pymunk's own included (7.0.x keeps the old one as
+    ``_velocity_func``: the body's own function pointer says it is not called). report
+    stopped with an AttributeError on 7.0.0 and 7.0.1 before."""
+    public = {custom: what_the_tools_say(custom) for custom in (True, False, None)}
+    assert public[True][:2] == (True, False) and public[True][4]
+    assert public[False][:2] == public[None][:2] == (False, True)
+    with bodies_7_0():
+        with pytest.raises(AttributeError):
+            pymunk.Body(1.0, 1.0).velocity_func  # noqa: B018 - 7.0.x: no getter
+        on_7_0 = {custom: what_the_tools_say(custom) for custom in (True, False, None)}
+    assert on_7_0 == public

@@ -9,6 +9,9 @@ from __future__ import annotations
 
 from typing import Any
 
+from .._pymunk import spring_function
+from ._layout import body_function
+
 
 class Uncopyable(Exception):
     """The space holds something the probe cannot copy (the message says what)."""
@@ -50,10 +53,12 @@ class Copy:
         if kind == pymunk.Body.DYNAMIC:
             c = pymunk.Body(b.mass, b.moment)
             c.center_of_gravity = b.center_of_gravity
-            if b.velocity_func is not pymunk.Body.update_velocity:
-                c.velocity_func = b.velocity_func
-            if b.position_func is not pymunk.Body.update_position:
-                c.position_func = b.position_func
+            velocity, position = (body_function(b, "velocity_func"),
+                                  body_function(b, "position_func"))
+            if velocity is not None:
+                c.velocity_func = velocity
+            if position is not None:
+                c.position_func = position
             if b.force != (0, 0) or b.torque != 0:
                 self.pushes.append((c, b.force, b.torque))
         else:
@@ -94,15 +99,17 @@ class Copy:
 def _spring(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
     new = pymunk.DampedSpring(a, b, c.anchor_a, c.anchor_b, c.rest_length, c.stiffness,
                               c.damping)
-    if c.force_func is not pymunk.DampedSpring.spring_force:
-        new.force_func = c.force_func
+    func = spring_function(c)  # pymunk 7.0.x's force_func has no getter
+    if func is not None:
+        new.force_func = func
     return new
 
 
 def _rotary_spring(pymunk: Any, c: Any, a: Any, b: Any) -> Any:
     new = pymunk.DampedRotarySpring(a, b, c.rest_angle, c.stiffness, c.damping)
-    if c.torque_func is not pymunk.DampedRotarySpring.spring_torque:
-        new.torque_func = c.torque_func
+    func = spring_function(c)  # pymunk 7.0.x's torque_func has no getter
+    if func is not None:
+        new.torque_func = func
     return new
 
 

@@ -453,7 +453,8 @@ def build(space: Any, names: Names, potentials: list[tuple[Any, Callable[..., An
     vf, pf = ptrs[1, :n].copy(), ptrs[2, :n].copy()
     custom = ~np.isin(vf, np.array(sorted(vel_default), dtype=np.uint64))
     custom_pos = ~np.isin(pf, np.array(sorted(pos_default), dtype=np.uint64))
-    vel_funcs = [t.bodies[i].velocity_func if custom[i] else None for i in range(n)]
+    vel_funcs = [layout.body_function(t.bodies[i], "velocity_func") if custom[i] else None
+                 for i in range(n)]
     fields: list[Field] = []
     declared = np.zeros(n, dtype=bool)
     for key, potential, label in potentials:
@@ -554,7 +555,7 @@ def changed_settings(b: Build, space: Any) -> str:
     if b.any_custom:
         bodies = t.bodies
         for i in np.nonzero(b.custom)[0]:
-            if bodies[i].velocity_func is not b.vel_funcs[i]:
+            if layout.body_function(bodies[i], "velocity_func") is not b.vel_funcs[i]:
                 return "a velocity_func"
     return ""
 

@@ -52,6 +52,7 @@ import numpy as np
 
 from ..model.energy import spring_potential
 from ._copy import MAKERS, Copy, Uncopyable
+from ._layout import body_function
 from ._probe_parts import _End, _on_groove, _Part, _replace_end, _solved, _springs
 from ._scan import batch
 
@@ -286,7 +287,9 @@ class _Run:
 
     def _wrap(self, body: Any, i: int) -> None:
         """Record the kick ``body``'s velocity update gives it each step."""
-        inner = body.velocity_func
+        import pymunk
+
+        inner = body_function(body, "velocity_func") or pymunk.Body.update_velocity
         kicks = self.kicks
 
         def recorded(b: Any, gravity: Any, damping: float, dt: float) -> None:

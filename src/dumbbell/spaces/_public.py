@@ -30,6 +30,7 @@ import numpy as np
 from .._pymunk import spring_function
 from . import _physics as phys
 from ._inventory import Build, Names
+from ._layout import body_function
 from ._records import Before, Move, Potentials
 
 #: What the fallback says about what it lumps.
@@ -72,8 +73,8 @@ class _Getters:
         for j, b in enumerate(self.bodies):
             out[0, j] = b.body_type == pymunk.Body.DYNAMIC and b.is_sleeping
             if not self.post:
-                out[1, j] = b.velocity_func != pymunk.Body.update_velocity
-                out[2, j] = b.position_func != pymunk.Body.update_position
+                out[1, j] = body_function(b, "velocity_func") is not None
+                out[2, j] = body_function(b, "position_func") is not None
         return out
 
 
@@ -165,7 +166,8 @@ def public_build(space: Any, names: Names) -> Build:
     for i in np.nonzero(t.unsteppable)[0]:
         current[labels[i]] = "a dynamic body of mass or moment 0: pymunk cannot step it"
     gravity = tuple(float(g) for g in space.gravity)
-    funcs = [t.bodies[i].velocity_func if custom[i] else None for i in range(n)]
+    funcs = [body_function(t.bodies[i], "velocity_func") if custom[i] else None
+             for i in range(n)]
     return Build(t, {}, springs, [], gravity, vf, pf, custom, np.zeros(n, dtype=bool), funcs,
                  current)
 

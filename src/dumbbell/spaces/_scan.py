@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from ._layout import body_function
+
 #: pymunk's body types.
 DYNAMIC, KINEMATIC, STATIC = 0, 1, 2
 
@@ -106,10 +108,9 @@ class Scan:
 
 
 def _body_row(body: Any) -> tuple[float, float, float, float, bool]:
-    import pymunk
 
     cog = body.center_of_gravity
-    field = body._velocity_func is not None and body.velocity_func is not pymunk.Body.update_velocity
+    field = body._velocity_func is not None and body_function(body, "velocity_func") is not None
     return (float(body.mass), float(body.moment), float(cog.x), float(cog.y), bool(field))
 
 
