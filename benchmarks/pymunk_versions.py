@@ -15,8 +15,9 @@ a venv already there is reused). On each, the script runs:
   bytes are identical, else the largest difference of a value;
 - in that venv's Python (``--probe``), only through the public API of ``dumbbell.spaces``:
   ``energy`` and ``report`` on a space holding every constraint kind and contacts;
-  whether ``energy`` and ``Ledger`` tell a spring with a custom force function (and a
-  rotary spring with a custom torque function) from one with pymunk's own; a ``Ledger``
+  whether ``energy``, ``report`` and ``Ledger`` tell a spring with a custom force function
+  (a rotary spring with a custom torque function, a body with a custom ``velocity_func``)
+  from one with pymunk's own (a body's set back to pymunk's own after a custom one); a ``Ledger``
   over that space for 240 steps: ``balance().complete``, its relative closure, and whether
   it ran the full ledger or fell back to its public-API ledger (said by a warning naming
   pymunk; every warning is printed below the table);
@@ -152,17 +153,30 @@ def probe(out: Path) -> dict:
         return {"value": hashlib.sha256(text.encode()).hexdigest(), "detail": f"{len(text)} chars"}
 
     def custom():
-        named = {}
+        import pymunk
+
+        def half(body, gravity, damping, dt):
+            pymunk.Body.update_velocity(body, (gravity[0] / 2, gravity[1] / 2), damping, dt)
+
+        named, reports = {}, []
         for flag in (True, False):
             space = custom_spring_space(flag)
+            # A body's custom velocity_func too; pymunk's own set back after one (7.0.x's
+            # setter keeps the replaced function on the body).
+            body = next(iter(space.bodies))
+            body.velocity_func = half
+            if not flag:
+                body.velocity_func = pymunk.Body.update_velocity
             e = spaces.energy(space)
+            reports.append(spaces.report(space, 0.01))  # its joint probe copies the bodies
             ledger = spaces.Ledger(space)
             for _ in range(20):
                 space.step(0.01)
             bal = ledger.balance()
             named[flag] = (len(e.unknown), len(bal.unaccounted))
-        ok = named[True][0] == 2 and named[True][1] >= 2 and named[False] == (0, 0)
-        return {"ok": ok, "value": named[True],
+        ok = named[True][0] == 3 and named[True][1] >= 3 and named[False] == (0, 0)
+        digest = hashlib.sha256("".join(reports).encode()).hexdigest()[:16]
+        return {"ok": ok, "value": [*named[True], *named[False], digest],
                 "detail": f"custom: energy names {named[True][0]}, ledger {named[True][1]}; "
                           f"pymunk's own: {named[False][0]}, {named[False][1]}"}
 

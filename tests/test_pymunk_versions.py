@@ -259,9 +259,11 @@ def test_an_unreadable_force_function_is_a_version_error():
 
 # --- pymunk 7.0.x: a body's velocity_func and position_func have a setter only ---------------
 
-def _body_setter_7_0(name, default_c):
-    """7.0.x's setter: a custom function is kept as ``_<name>`` and pymunk's callback set; the
-    default sets Chipmunk's own function back and leaves the kept function in place."""
+def _body_setter_7_0(name, default_c, getter):
+    """7.0.x's setter (and 7.1.0-7.3.0's): a custom function is kept as ``_<name>`` and
+    pymunk's callback set; the default sets Chipmunk's own function back and leaves the kept
+    function in place. ``getter``: with 7.1.0-7.3.0's getter, which gives the kept function
+    (pymunk's own when none is kept); else none, as on 7.0.x."""
     from pymunk._chipmunk_cffi import ffi, lib
 
     installed = getattr(pymunk.Body, name).fset
@@ -276,16 +278,20 @@ def _body_setter_7_0(name, default_c):
         else:
             installed(self, func)
 
-    return property(fset=setter)
+    def get(self):
+        kept = getattr(self, f"_{name}")
+        return default if kept is None else kept
+
+    return property(get if getter else None, setter)
 
 
 @contextlib.contextmanager
-def bodies_7_0():
+def bodies_7_0(getter=False):
     with pytest.MonkeyPatch.context() as m:
         m.setattr(pymunk.Body, "velocity_func",
-                  _body_setter_7_0("velocity_func", "cpBodyUpdateVelocity"))
+                  _body_setter_7_0("velocity_func", "cpBodyUpdateVelocity", getter))
         m.setattr(pymunk.Body, "position_func",
-                  _body_setter_7_0("position_func", "cpBodyUpdatePosition"))
+                  _body_setter_7_0("position_func", "cpBodyUpdatePosition", getter))
         yield
 
 
@@ -321,20 +327,25 @@ def what_the_tools_say(custom):
     balance = ledger.balance()
     return (func is half, func is None, report, balance.complete,
             [t.source for t in balance.terms if t.kind == "velocity_func"],
-            tuple(bob.velocity))
+            tuple(bob.velocity),
+            sum("velocity_func" in s.reason for s in spaces.energy(space).unknown))
 
 
-def test_a_bodys_velocity_func_on_7_0_is_read_as_the_getter_reads_it():
-    """report (whose joint probe copies the bodies), the ledger and the velocity function
-    read the same with 7.0.x's setter-only properties as with the installed getters, a
-    function set back to pymunk's own included (7.0.x keeps the old one as
-    ``_velocity_func``: the body's own function pointer says it is not called). report
-    stopped with an AttributeError on 7.0.0 and 7.0.1 before."""
+@pytest.mark.parametrize("getter", [False, True], ids=["7.0.x", "7.1.0-7.3.0"])
+def test_a_bodys_velocity_func_is_read_as_pymunk_calls_it(getter):
+    """report (whose joint probe copies the bodies), energy, the ledger and the velocity
+    function read the same with older releases' properties as with the installed ones, a
+    function set back to pymunk's own included: 7.0.x has no getter, and up to 7.3.0 the
+    setter keeps the replaced function (the getter gives it), so the body's own function
+    pointer says it is not called. report stopped with an AttributeError on 7.0.0 and 7.0.1
+    before, and energy named a replaced function as the body's up to 7.3.0."""
     public = {custom: what_the_tools_say(custom) for custom in (True, False, None)}
-    assert public[True][:2] == (True, False) and public[True][4]
+    assert public[True][:2] == (True, False) and public[True][4] and public[True][6] == 1
     assert public[False][:2] == public[None][:2] == (False, True)
-    with bodies_7_0():
-        with pytest.raises(AttributeError):
-            pymunk.Body(1.0, 1.0).velocity_func  # noqa: B018 - 7.0.x: no getter
-        on_7_0 = {custom: what_the_tools_say(custom) for custom in (True, False, None)}
-    assert on_7_0 == public
+    assert public[False][6] == public[None][6] == 0
+    with bodies_7_0(getter):
+        if not getter:
+            with pytest.raises(AttributeError):
+                pymunk.Body(1.0, 1.0).velocity_func  # noqa: B018 - 7.0.x: no getter
+        older = {custom: what_the_tools_say(custom) for custom in (True, False, None)}
+    assert older == public

@@ -289,26 +289,27 @@ def body_function(body: Any, name: str) -> Any:
     """The ``velocity_func`` or ``position_func`` (``name``) that pymunk calls for ``body``
     instead of Chipmunk's own; None when the body uses the default.
 
-    pymunk 7.1 and later read it back through the property, which gives the default unless
-    one was set. pymunk 7.0.x's property has only a setter. That setter keeps a custom
-    function as ``_velocity_func`` / ``_position_func`` and does not forget it when the
-    default is set again. So on 7.0.x the body's own function pointer says whether pymunk
-    calls the kept function; the pointer is read through the checked declarations when
-    they read this build right."""
+    pymunk 7.1 and later read it back through the property. pymunk 7.0.x's property has only
+    a setter, which keeps a custom function as ``_velocity_func`` / ``_position_func``. Up to
+    7.3.0 the setter does not forget that function when pymunk's own is set again: the getter
+    (or the kept attribute) then names a function pymunk no longer calls. So a custom
+    function is confirmed by the body's own function pointer, read through the checked
+    declarations when they read this build right."""
     import pymunk
 
     velocity = name == "velocity_func"
+    default = pymunk.Body.update_velocity if velocity else pymunk.Body.update_position
     try:
         func = getattr(body, name)
     except AttributeError:  # pymunk 7.0.x: a setter only
         func = getattr(body, f"_{name}", None)
-        if func is not None and readable():
-            at = address(getattr(view("body", address(body._body)), name))
-            if at in default_funcs()[0 if velocity else 1]:
-                return None
-        return func
-    default = pymunk.Body.update_velocity if velocity else pymunk.Body.update_position
-    return None if func is default else func
+    if func is None or func is default:
+        return None
+    if readable():
+        at = address(getattr(view("body", address(body._body)), name))
+        if at in default_funcs()[0 if velocity else 1]:
+            return None
+    return func
 
 
 def readable() -> bool:

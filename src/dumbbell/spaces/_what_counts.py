@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .._pymunk import spring_function
+from ._layout import body_function
 
 #: Joints that hold no energy and, ideally, do no work.
 _WORKLESS = ("PinJoint", "SlideJoint", "PivotJoint", "GrooveJoint", "GearJoint",
@@ -117,11 +118,12 @@ def inventory(space: Any) -> Inventory:
 
     springs, unknown, notes = _constraints(space, index)
     for b, label in zip(dyn, labels[: len(dyn)], strict=True):
-        if b._velocity_func is not None:
+        # pymunk 7.0.x keeps a replaced function: body_function says whether it is called.
+        if b._velocity_func is not None and body_function(b, "velocity_func") is not None:
             unknown.append(Skipped(label, "custom velocity_func: the energy of the field it "
                                           "applies is not in E (declare its potential to a "
                                           "spaces.Ledger)"))
-        if b._position_func is not None:
+        if b._position_func is not None and body_function(b, "position_func") is not None:
             notes.append(f"{label} has a custom position_func: it moves the body its own way")
     if any(kind == pymunk.Body.KINEMATIC for kind in types):
         notes.append("kinematic bodies do work on what they push or pull (spaces.Ledger "
