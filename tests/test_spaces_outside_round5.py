@@ -120,6 +120,19 @@ def _boxes_and_a_kinematic(cog_after_position: bool = False) -> pymunk.Space:
     return space
 
 
+def _booked_to_the_callbacks(space, ledger, measured: list[float]) -> spaces.Balance:
+    """Step ``space`` 120 times at 1/120 s: what its callbacks changed, measured by hand
+    (``measured[0]``, not zero), is the ledger's ``unattributed``, and nothing is booked as
+    the program's. Returns the balance."""
+    for _ in range(120):
+        space.step(1 / 120)
+    bal = ledger.balance()
+    assert measured and measured[0] != 0.0
+    assert not [t for t in bal.terms if t.kind == "program"]
+    assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale
+    return bal
+
+
 def _counts_a_second(space, ledger, E_hand: float, E_ledger: float) -> None:
     """Step ``space`` 60 times at 1/60: the ledger closes to rounding and its change of E
     from ``E_ledger`` is the hand computation's from ``E_hand``."""
@@ -213,12 +226,8 @@ def test_a_mass_changed_from_a_callback_is_the_callbacks_not_the_programs(change
 
     space.on_collision(None, None, begin=begin)
     E0 = _energy(space)
-    for _ in range(120):
-        space.step(1 / 120)
-    bal = ledger.balance()
-    assert asked and measured[0] != 0.0
-    assert not [t for t in bal.terms if t.kind == "program"]
-    assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale
+    bal = _booked_to_the_callbacks(space, ledger, measured)
+    assert asked
     assert abs((_energy(space) - E0) - (bal.E - bal.E0)) <= 1e-9 * bal.scale
 
 
@@ -245,9 +254,4 @@ def test_gravity_or_a_spring_set_from_a_post_solve_callback_is_the_callbacks(cha
             measured.append(_energy(space) - e)
 
     space.on_collision(None, None, post_solve=post_solve)
-    for _ in range(120):
-        space.step(1 / 120)
-    bal = ledger.balance()
-    assert measured and measured[0] != 0.0
-    assert not [t for t in bal.terms if t.kind == "program"]
-    assert abs(_sum(bal, "unattributed") - measured[0]) <= 1e-9 * bal.scale
+    _booked_to_the_callbacks(space, ledger, measured)

@@ -115,7 +115,7 @@ class Picture:
         }
         if self.strip is not None:
             S = self.strip
-            doc["strip"]["ticks"] = [[v, glyphs.fmt_tick(v)] for v in S.scale.ticks()]
+            doc["strip"]["ticks"] = [list(tick) for tick in S.energy_ticks()[0]]
             # The time ticks of the whole tape, one beyond its end, and their labels.
             last = math.floor(S.tape_w / S.px_per_s / S.t_step + 1e-9) + 1
             doc["strip"]["time_ticks"] = [[k * S.t_step, glyphs.fmt_tick(k * S.t_step)]

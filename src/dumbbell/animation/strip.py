@@ -221,7 +221,7 @@ class Strip:
         if not self.scrolls and name:  # the unit (and the power of ten) above the axis
             d.text((sx0 * S, (sy0 - LABEL_GAP * u) * S), name, font=fs, fill=GREY, anchor="ls")
         if self.scrolls:
-            d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), ENERGY_AXIS,
+            d.text(((sx0 - LABEL_GAP * u) * S, (sy0 - LABEL_GAP * u) * S), name,
                    font=fs, fill=GREY, anchor="rs")
             d.text(((sx0 - LABEL_GAP * u) * S, (sy1 + LABEL_GAP * u) * S), TIME_AXIS,
                    font=fs, fill=GREY, anchor="rt")

@@ -569,13 +569,18 @@ def _file_backend(process_ends: bool = False) -> Iterator[None]:
                 os.environ[name] = value
 
 
+def solver_names(values: Any) -> list[str]:
+    """The solver names a ``--solvers`` flag gives (``values``: its words, or None); commas
+    also separate names."""
+    return [s.strip() for item in values or () for s in str(item).split(",") if s.strip()]
+
+
 def _check_solvers(args: argparse.Namespace) -> None:
     """Every command's ``--solvers`` names each solver once (commas also separate names):
     a name given twice is refused, not run once without a word."""
     from ..errors import UsageError
 
-    names = [s.strip() for item in getattr(args, "solvers", None) or ()
-             for s in str(item).split(",") if s.strip()]
+    names = solver_names(getattr(args, "solvers", None))
     twice = next((name for i, name in enumerate(names) if name in names[:i]), None)
     if twice is not None:
         raise UsageError(f"--solvers: {_shown(twice)} named twice; give each solver once")

@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .app import _shown, add_out, add_quiet, add_scene, positive_float, read_scene
+from .app import _shown, add_out, add_quiet, add_scene, positive_float, read_scene, solver_names
 
 #: What ``dumbbell compare --help`` says the command does.
 DESCRIPTION = """\
@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     scene = read_scene(args.scene)
     solvers = None
     if args.solvers:
-        solvers = [s.strip() for item in args.solvers for s in item.split(",") if s.strip()]
+        solvers = solver_names(args.solvers)
         unknown = [s for s in solvers if s not in available()]
         if unknown or not solvers:
             raise UsageError(f"--solvers {_shown(' '.join(args.solvers))}: must name solvers among "

@@ -61,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
     if out.suffix.lower() not in (".html", ".htm"):
         raise UsageError(f"-o {out}: must end in .html")
     solvers = args.solvers or [None]
-    for name in dict.fromkeys(solvers):
+    for name in solvers:  # each once: the CLI's border refused a name given twice
         if name is not None:
             try:
                 runnable(solver_class(name), scene)

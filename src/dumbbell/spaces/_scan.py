@@ -108,7 +108,6 @@ class Scan:
 
 
 def _body_row(body: Any) -> tuple[float, float, float, float, bool]:
-
     cog = body.center_of_gravity
     field = body._velocity_func is not None and body_function(body, "velocity_func") is not None
     return (float(body.mass), float(body.moment), float(cog.x), float(cog.y), bool(field))

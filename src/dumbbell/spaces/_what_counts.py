@@ -118,7 +118,8 @@ def inventory(space: Any) -> Inventory:
 
     springs, unknown, notes = _constraints(space, index)
     for b, label in zip(dyn, labels[: len(dyn)], strict=True):
-        # pymunk 7.0.x keeps a replaced function: body_function says whether it is called.
+        # pymunk up to 7.3.0 keeps a replaced function: body_function says whether it is
+        # called.
         if b._velocity_func is not None and body_function(b, "velocity_func") is not None:
             unknown.append(Skipped(label, "custom velocity_func: the energy of the field it "
                                           "applies is not in E (declare its potential to a "
