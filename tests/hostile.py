@@ -78,6 +78,13 @@ def interruptible(then=None):
 #: machine makes them slower, not wrong.
 HANG_S = 600.0
 
+#: A child that waits for the test's signal does so in a loop of short sleeps (``while True:
+#: time.sleep(0.01)``), never in one long ``time.sleep``: Python's C-level handler only sets
+#: a flag, so a signal that lands between the interpreter's last look at that flag and the
+#: start of the sleep is not acted on until the sleep ends. On a loaded machine the child is
+#: preempted in that window often enough (once in a suite beside two CPU burners: an hour's
+#: sleep, and the test's 600 s bound). A short sleep looks at the flag again each time.
+
 
 def end_group(proc: subprocess.Popen) -> None:
     """Kill ``proc``'s whole process group (its pool workers, its forked figure process;

@@ -426,7 +426,7 @@ import os, time
 def _mark(wait):
     os.write(int(os.environ["MARK_FD"]), b"marked\\n")
     if wait:
-        time.sleep(3600)
+        while True: time.sleep(0.01)
 _at = os.environ["MARK"]
 if _at == "sweep":
     from dumbbell.analysis import sweep as _sweep
@@ -1224,7 +1224,7 @@ if how == "transaction":
         with atomic_output(out / "b.csv") as tmp:
             tmp.write_text("b")
             print("ready", flush=True)
-            time.sleep(3600)
+            while True: time.sleep(0.01)
 elif how == "exit":
     manager = atomic_output(out / "a.csv")
     tmp = manager.__enter__()
@@ -1235,7 +1235,7 @@ else:
     with atomic_output(out / "a.csv") as tmp:
         tmp.write_text("a")
         print("ready", flush=True)
-        time.sleep(3600)
+        while True: time.sleep(0.01)
 """
 
 
