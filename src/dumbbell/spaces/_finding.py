@@ -17,11 +17,12 @@ _QUANTITY = {"spring": "w dt = ", "rotary-spring": "w dt = ", "spring-network": 
 @dataclass(frozen=True)
 class Finding:
     """One check: ``kind`` (spring, rotary-spring, spring-network, tunnelling, slop, bias,
-    state), the ``subject`` it is about, the measured ``value`` and its ``limit`` (w*dt for
-    springs, length units moved per step for tunnelling, length units for slop, the bias for
-    bias), the ``relation`` a good value keeps to the limit ('<', '<=' or '>='; 'finite' for a
-    state no step fixes), the ``fix`` with its reason in words, the largest step that clears it,
-    ``dt_max`` (s; None when no step can), and the ``unit`` of value and limit ('' if none).
+    threads, joint, state), the ``subject`` it is about, the measured ``value`` and its
+    ``limit`` (w*dt for springs, length units moved per step for tunnelling, length units for
+    slop, the bias for bias, the number of threads for threads), the ``relation`` a good
+    value keeps to the limit ('<', '<=' or '>='; 'finite' for a state no step fixes), the
+    ``fix`` with its reason in words, the largest step that clears it, ``dt_max`` (s; None
+    when no step can), and the ``unit`` of value and limit ('' if none).
     A constraint's row (kind ``joint``) may instead be ``relation`` 'measured' (a number
     with no limit: a motor's work, a loss the step does not change; ok) or 'unchecked' (not
     measured: ``fix`` says why; not ok, and not a failure :func:`check` lists); ``note`` says

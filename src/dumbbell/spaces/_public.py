@@ -249,6 +249,8 @@ def pre(self: Any) -> None:
     changes, the move, and the springs' kicks taken back out of the velocities."""
     from ._inventory import changed
 
+    if self._threaded:
+        self._note_threads()
     self._awaiting_end = False
     dt = float(self.space.current_time_step)
     t = self._b.table

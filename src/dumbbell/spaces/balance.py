@@ -256,7 +256,8 @@ class Balance:
 
     def table(self, top: int = 4) -> str:
         """The ledger as text: totals per kind with the ``top`` largest sources of each,
-        then the check.
+        then the check, and what is unaccounted for (sources with the same reason on one
+        line, ``top`` of them named).
 
         Parameters
         ----------
@@ -286,8 +287,15 @@ class Balance:
                      f"{self.worst_step:.2e})")
         for note in self.notes:
             lines.append(f"  note: {shown(note, 400)}")
+        # Sources with the same reason on one line (a threaded solver names every body).
+        grouped: dict[str, list[str]] = {}
         for source, why in self.unaccounted:
-            lines.append(f"  unaccounted: {shown(source)}: {shown(why, 400)}")
+            grouped.setdefault(why, []).append(shown(source))
+        for why, sources in grouped.items():
+            named = ", ".join(sources[:max(top, 1)])
+            if len(sources) > max(top, 1):
+                named += f" and {len(sources) - max(top, 1)} more"
+            lines.append(f"  unaccounted: {named}: {shown(why, 400)}")
         lines.append(f"  complete: {self.complete}")
         return "\n".join(lines)
 

@@ -23,6 +23,9 @@ the fix and the reason for it):
 - ``slop``: ``space.collision_slop`` is the overlap pymunk leaves between touching shapes;
 - ``bias``: with ``space.collision_bias`` < 1 pymunk pushes overlapping shapes apart, which
   adds energy at elastic contacts (flagged where any contact is elastic);
+- ``threads``: a space made with ``pymunk.Space(threaded=True)`` and ``space.threads = 2``
+  runs the solver on two threads that apply impulses to the same bodies at once, without
+  locks: impulses can be lost (energy no source explains; runs that do not repeat);
 - ``joint``: every constraint that is not a spring, its energy drift per second at this
   step against ``tolerance`` of the energy scale a second, measured on a copy of the space
   (:mod:`._probe`; a row past it is measured again at dt/2, to say which step clears it, or
@@ -35,9 +38,9 @@ Lengths are in the space's own unit: pymunk has none. ``units`` names it in the 
 ('m', 'px'); without it they say 'units'. Times are in seconds.
 
 :func:`suggest_dt` returns a step (dt divided into whole sub-steps) that clears every finding
-a step can clear; slop and bias are settings, not steps. :class:`Driver` steps a space at a
-fixed frame step in sub-steps (:mod:`.stepping`). Each check reads the space once
-(:mod:`._scan`), so the guard costs time linear in bodies and shapes.
+a step can clear; slop, bias and threads are settings, not steps. :class:`Driver` steps a
+space at a fixed frame step in sub-steps (:mod:`.stepping`). Each check reads the space
+once (:mod:`._scan`), so the guard costs time linear in bodies and shapes.
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ from ._finding import _FAILS, Finding
 from ._refusals import settings_problem
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from ._springs_dt import _networks, _springs, energy_swing, spring_omega
+from ._threaded import hazard
 from .estimates import Estimates, estimate, length_unit, percent, state_problem
 
 __all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",
@@ -203,6 +207,18 @@ def _contact_settings(sc: Scan, dt: float, unit: str) -> list[Finding]:
     return rows
 
 
+def _threads(space: Any) -> list[Finding]:
+    """A space made with ``pymunk.Space(threaded=True)``: its ``threads`` (pymunk's public
+    property), 1 keeping each step as the serial solver's."""
+    if not getattr(space, "threaded", False):
+        return []
+    n = int(space.threads)
+    fix = (f"{hazard(n)}: energy then changes by what no source explains; set "
+           "space.threads = 1 (pymunk's default) when the numbers matter" if n > 1 else
+           f"keep space.threads = 1 (pymunk's default): at 2, {hazard(2)}")
+    return [Finding("threads", "space.threads", float(n), 1.0, fix, None, "<=")]
+
+
 @dataclass(frozen=True)
 class _Advice:
     rows: list[Finding]
@@ -229,7 +245,8 @@ def _advise(space: Any, dt: float, speeds: str, tolerance: float, unit: str) -> 
     rows_of_joints, probed = joint_rows(space, dt, tolerance, unit)
     joints = rows_of_joints
     rows = (_springs(space, dt, tolerance) + _networks(space, sc, dt, tolerance) + joints
-            + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit))
+            + _tunnelling(sc, est, dt, speeds, unit) + _contact_settings(sc, dt, unit)
+            + _threads(space))
     failing = [f for f in rows if not f.ok and f.dt_max is not None]
     tightest = min(failing, key=lambda f: f.dt_max) if failing else None
     n: int | None = 1

@@ -74,6 +74,7 @@ from ._contacts import UnknownBody
 from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
 from ._terms import Sums, pair_terms
+from ._threaded import hazard
 from .balance import Balance, Term, notes, order
 from .units import check_units, energy_unit
 
@@ -191,6 +192,9 @@ class Ledger(Changes):
         self._push: tuple[np.ndarray, np.ndarray] | None = None
         self._awaiting_end = False
         self._dt_prev = float(space.current_time_step)
+        # A space made with pymunk.Space(threaded=True): the most threads a counted step ran on.
+        self._threaded = bool(getattr(space, "threaded", False))
+        self._threads = 1
         self._attach()
 
     def _refuse_now(self, space: Any) -> None:
@@ -355,9 +359,7 @@ class Ledger(Changes):
         limit = self.tolerance * self._scale
         for t in terms:
             if t.kind == "unattributed" and abs(t.energy) > limit:
-                unacc.setdefault(t.source, "changed inside pymunk's step by something no "
-                                 "source explains (a callback: a constraint's pre_solve or "
-                                 "post_solve, a collision's post_solve, a post-step callback)")
+                unacc.setdefault(t.source, _inside(self._threads))
             elif t.kind == "program" and abs(t.energy) > limit:
                 unacc.setdefault(t.source, "changed by the program between steps (a velocity, "
                                  "position, impulse or setting; or a collision begin or "
@@ -445,10 +447,17 @@ class Ledger(Changes):
 
     # -- the step ----------------------------------------------------------------------
 
+    def _note_threads(self) -> None:
+        """On a threaded space: the threads this step runs on (``space.threads``)."""
+        n = int(self.space.threads)
+        self._threads = max(self._threads, n)
+
     def _pre(self) -> None:
         """Before the constraints are prepared: positions have moved, velocities are the
         step's start. Count the program's changes and the move's energy; read the impulses
         carried in."""
+        if self._threaded:
+            self._note_threads()
         self._awaiting_end = False
         dt = float(self.space.current_time_step)
         t = self._b.table
@@ -586,6 +595,18 @@ class Ledger(Changes):
         what = changed(self._b, self.space, F)  # the floats only: no function pointers
         if what:
             _quietly(lambda: self._restructure(f"{what} inside the step", None, "unattributed"))
+
+
+def _inside(threads: int) -> str:
+    """Why a body's energy changed inside the step with no source to explain it: a callback,
+    or (a space that stepped on more than one thread) pymunk's threaded solver."""
+    callback = ("a callback: a constraint's pre_solve or post_solve, a collision's "
+                "post_solve, a post-step callback")
+    if threads <= 1:
+        return f"changed inside pymunk's step by something no source explains ({callback})"
+    return (f"changed inside pymunk's step by something no source explains: the space "
+            f"steps with space.threads = {threads}, and {hazard(threads)} (space.threads = "
+            f"1, pymunk's default, avoids it); or {callback}")
 
 
 @np.errstate(invalid="ignore", over="ignore", divide="ignore")
