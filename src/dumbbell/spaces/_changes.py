@@ -39,6 +39,9 @@ class Changes:
     def _end(self) -> None:  # pragma: no cover - the ledger's own
         raise NotImplementedError
 
+    def _flush(self) -> None:  # pragma: no cover - the ledger's own
+        raise NotImplementedError
+
     def _rebuild(self) -> None:
         """(Re)read what the space holds. What could not be accounted for while steps were
         taken stays named."""
@@ -70,6 +73,7 @@ class Changes:
         rebuild, and count the energy that entered or left with bodies, and what the change
         itself did (``kind``: 'program' or 'unattributed'). ``dt`` is the step under way
         (None between steps): bodies new in it start where they were before its move."""
+        self._flush()
         b0 = self._b
         old = phys.energy(b0, self._snap)
         old_dyn = b0.table.uid[: b0.table.n].copy()

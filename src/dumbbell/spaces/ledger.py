@@ -13,8 +13,9 @@ callbacks and the post-step callbacks.
 
 The ledger hooks into every step three times (:mod:`._hook`): before the constraints are
 prepared (velocities v0, positions after the move, applied forces), after the solver
-(velocities v1, every impulse the step applied: :mod:`._physics`, :mod:`._contacts`), and at
-the end of the step (what callbacks changed after the solver). It reads bodies, joints and
+(velocities v1, every impulse the step applied: :mod:`._physics`, :mod:`._contacts`, which
+does the contacts' share for a batch of steps at once), and at the end of the step (what
+callbacks changed after the solver). It reads bodies, joints and
 contacts in bulk from pymunk's C structs (:mod:`._memory`), and rebuilds what it reads when
 the space changes (:mod:`._inventory`). The terms:
 
@@ -189,7 +190,6 @@ class Ledger(Changes):
         self._bad: str | None = None
         self._frozen: Balance | None = None
         self._before: Before | None = None
-        self._push: tuple[np.ndarray, np.ndarray] | None = None
         self._awaiting_end = False
         self._dt_prev = float(space.current_time_step)
         # A space made with pymunk.Space(threaded=True): the most threads a counted step ran on.
@@ -346,6 +346,7 @@ class Ledger(Changes):
             from ..errors import DumbbellError
 
             raise DumbbellError(self._bad)
+        self._flush()
         self._sync()
         self._sums.fold(self._b, self._scale)
         u = self.unit
@@ -495,7 +496,7 @@ class Ledger(Changes):
             total += float(np.sum(per_body)) + springs
         g_int, g_rows, corr = phys.gravity_over(b, s, move)
         pots, corr = phys.potentials_over(b, s, move, corr)
-        total, corr = self._carried_push(dt, total, corr)
+        self._contacts.next_dt(dt, self._pairs, self._sums)
         if corr:
             self._sums.add("position correction", "correction", corr,
                            "potential energy the contacts' position correction adds (beyond "
@@ -507,18 +508,12 @@ class Ledger(Changes):
                               [g.before.floats() for g in b.groups.values()], contacts,
                               total + corr)
 
-    def _carried_push(self, dt: float, total: float, corr: float) -> tuple[float, float]:
-        """Gravity's part of the position correction per pair, from the bias impulses of
-        the last step (moving the bodies over this step's dt), moved from the correction
-        ``corr`` to the pairs and the ``total``."""
-        if self._push is None:
-            return total, corr
-        slots, work = self._push
-        share = work * dt
-        self._pairs.push += np.bincount(slots, weights=share, minlength=len(self._pairs.push))
-        pushed = float(share.sum())
-        self._push = None
-        return total + pushed, corr - pushed
+    def _flush(self) -> None:
+        """Do the held steps' contact work (:meth:`._contacts.Contacts.flush`): before the
+        sums are folded or the table changes."""
+        contacts = self.__dict__.get("_contacts")
+        if contacts is not None:
+            contacts.flush(self._b.table, self._pairs, self._sums, self._b)
 
     def _post(self) -> None:
         """After the solver: every impulse of the step is applied. Count each source's work
@@ -542,14 +537,12 @@ class Ledger(Changes):
         for g, initial in zip(b.groups.values(), p.initial, strict=True):
             total += phys.constraint_work(t, g, g.after.floats(), initial, step)
         if p.contacts:
-            work, push = self._contacts.work(step, t, self._pairs, self._sums.kin)
-            total += work
-            if push.any():
-                c = self._contacts
-                # Gravity's work per unit time of each arbiter's push on its ends.
-                gx, gy = b.gravity
-                nx, ny = c.normals
-                self._push = (c.slots, -(gx * nx + gy * ny) * push)
+            # The contacts' work is done a batch of steps at a time; until then it is in
+            # the unexplained impulses' sums (which the batch takes it out of), and the
+            # step's total counts it through them.
+            self._contacts.record(step.u)
+            if self._contacts.due:
+                self._contacts.flush(t, self._pairs, self._sums, b)
         lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
         total += phys.unexplained(b, step, p, (lin, ang, w_g), self._sums)
