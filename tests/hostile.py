@@ -59,14 +59,20 @@ def spawn(*argv: object, cwd: Path | None = None, prelude: str = "",
                             start_new_session=True, **popen)
 
 
+#: The stop signals the tests send a child.
+SENT = (signal.SIGINT, signal.SIGHUP, signal.SIGTERM)
+
+
 def interruptible(then=None):
-    """A ``preexec_fn`` giving the child SIGINT's default action, then calling ``then``: a
-    test run in the background by a shell without job control (``pytest ... &`` in a
-    script) has SIGINT ignored, which its children inherit, and the command keeps an
-    ignored signal ignored, as it must under ``nohup``; the tests that send SIGINT mean a
-    process that has it."""
+    """A ``preexec_fn`` giving the child the default action of every stop signal the tests
+    send (:data:`SENT`), then calling ``then``: a test run in the background by a shell
+    without job control (``pytest ... &`` in a script) has SIGINT ignored, one run under
+    ``nohup`` has SIGHUP ignored, and children inherit both; the command keeps an ignored
+    signal ignored, as it must under ``nohup`` (tested, with ``then`` ignoring it again), so
+    the tests that send these signals mean a process that has them."""
     def child() -> None:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        for sig in SENT:
+            signal.signal(sig, signal.SIG_DFL)
         if then is not None:
             then()
 

@@ -481,6 +481,26 @@ def test_a_signal_stops_a_sweep_and_its_workers(tmp_path, sig):
     assert not out.exists() or files_in(out) == []
 
 
+def test_under_nohup_sighup_is_ignored_and_sigterm_still_stops(tmp_path):
+    """`nohup dumbbell render ...`: the command keeps nohup's ignored SIGHUP ignored. Sent
+    SIGHUP then SIGTERM while it writes the GIF (waiting there), it stops by SIGTERM: had
+    SIGHUP acted, it would have stopped by it, the lower signal, delivered first."""
+    scene = short_scene(tmp_path, "nohup.toml")
+    out = tmp_path / "out"
+    out.mkdir()
+    nohup = lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    with marker_pipe() as (r, w), started("render", scene, "--t-end", "60", "--fps", "10",
+                                          "-o", out / "x.gif", prelude=AT_MARK,
+                                          pass_fds=(w,), preexec_fn=nohup,
+                                          env={"MARK": "frame", "MARK_FD": str(w)}) as proc:
+        wait_mark(proc, r)
+        proc.send_signal(signal.SIGHUP)
+        proc.send_signal(signal.SIGTERM)
+        _, err = finish(proc)
+    line = refused(proc.returncode, err, out, code=128 + signal.SIGTERM)
+    assert "SIGTERM" in line and "SIGHUP" not in line
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
 def test_a_signal_while_the_gif_is_written_leaves_no_part_file(tmp_path, sig):
     scene = short_scene(tmp_path, "render-signal.toml")
