@@ -96,7 +96,7 @@ class Contacts:
         self._zero_at = L.fields + zero  # (7, 1)
         # What the last step's arbiters gave (the same arbiters touch step after step).
         self._arb_key: bytes | None = None
-        self._ends_key: tuple[Table, Pairs, bytes] | None = None
+        self._ends_key: tuple[Table, bytes] | None = None
         # Steps whose work waits for a batch (:meth:`record`), the dt of the step after
         # each (None until it begins), and a push whose next dt came after its batch.
         self._held: list[tuple[np.ndarray, ...]] = []
@@ -104,7 +104,7 @@ class Contacts:
         self._held_m = 0
         self._carry: tuple[np.ndarray, np.ndarray] | None = None
 
-    def before(self, table: Table, pairs: Pairs, coef: float) -> bool:
+    def before(self, table: Table, coef: float) -> bool:
         """Read the step's contacts and the impulses they carry in; False if none. Raises
         :class:`UnknownBody` when a contact touches a body not in ``table``."""
         arr = self.arr
@@ -127,34 +127,33 @@ class Contacts:
                 return False
             A, count = A[:, keep], count[keep]
             fewest = count.min()
-        self._rows(table, A[0:2], pairs)
+        self._rows(table, A[0:2])
         self.n = A[3:5].view(np.float64)
-        self.first = A[6].view(np.uint32)[L.state::2] == 0
-        self.single = None if fewest > 1 else count < 2
+        first = A[6].view(np.uint32)[L.state::2] == 0
         at = L.contact + (A[2] >> 3)  # (7, 2, m): each field of both contacts
-        if self.single is not None:  # no second contact: it reads the zeros
-            at[:, 1, self.single] = self._zero_at
+        if fewest < 2:  # no second contact: it reads the zeros
+            at[:, 1, count < 2] = self._zero_at
         self.at = at
         # The impulses carried in that the step does not apply: all of a first contact's,
         # (1 - coef) of the others' (none when dt did not change).
         self.carried = None
         if coef != 1.0:
             self.carried = slice(None)
-            self.j0 = self.floats.take(at[0:2]) * (1.0 - np.where(self.first, 0.0, coef))
+            self.j0 = self.floats.take(at[0:2]) * (1.0 - np.where(first, 0.0, coef))
         else:  # all of a first contact's (x 1.0)
-            carried = self.first.nonzero()[0]
+            carried = first.nonzero()[0]
             if len(carried):
                 self.carried = carried
                 self.j0 = self.floats.take(at[0:2, :, carried])  # (2, 2, k): jn, jt
         return True
 
-    def _rows(self, table: Table, ends: np.ndarray, pairs: Pairs) -> None:
+    def _rows(self, table: Table, ends: np.ndarray) -> None:
         """The rows of each arbiter's bodies (``ends``: their addresses, (2, m)), through
         the table's map; raises :class:`UnknownBody` on a body not in ``table``. The same
         bodies in the same order as the last step's, on the same table, keep them."""
         key = ends.tobytes()
         last = self._ends_key
-        if last is not None and last[0] is table and last[1] is pairs and last[2] == key:
+        if last is not None and last[0] is table and last[1] == key:
             return
         self._ends_key = None
         # As numpy's index type once: each take and bincount would cast them again.
@@ -162,7 +161,7 @@ class Contacts:
         if rows.min() < 0:
             raise UnknownBody
         self.rows = rows
-        self._ends_key = (table, pairs, key)
+        self._ends_key = (table, key)
 
     # -- the work, in batches of steps ----------------------------------------------------
 
@@ -208,9 +207,10 @@ class Contacts:
         rows = np.concatenate([h[2] for h in held], axis=1)
         k = len(held)
         R = table.rows
+        counts = [h[0].shape[2] for h in held]  # each held step's arbiters
         # Each end's velocity in its own step: (3, k * rows), indexed by step * rows + row.
         u = np.stack([h[3] for h in held], axis=1).reshape(3, k * R)
-        step_of = np.repeat(np.arange(k) * R, [h[0].shape[2] for h in held])
+        step_of = np.repeat(np.arange(k) * R, counts)
         # Each contact's impulse on b, in world axes (2, 2, m): n jn + (-ny, nx) jt.
         q = n[:, None] * f[0]
         q += perp[:, None] * f[1]
@@ -251,7 +251,7 @@ class Contacts:
             last = step_of == (k - 1) * R
             self._carry = (slots[last], work[last])
             dts[-1] = 0.0
-        span = np.repeat(np.array(dts, dtype=float), [h[0].shape[2] for h in held])
+        span = np.repeat(np.array(dts, dtype=float), counts)
         _pushed(pairs, sums, slots, work * span)
 
 

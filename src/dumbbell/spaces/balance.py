@@ -291,10 +291,11 @@ class Balance:
         grouped: dict[str, list[str]] = {}
         for source, why in self.unaccounted:
             grouped.setdefault(why, []).append(shown(source))
+        most = max(top, 1)
         for why, sources in grouped.items():
-            named = ", ".join(sources[:max(top, 1)])
-            if len(sources) > max(top, 1):
-                named += f" and {len(sources) - max(top, 1)} more"
+            named = ", ".join(sources[:most])
+            if len(sources) > most:
+                named += f" and {len(sources) - most} more"
             lines.append(f"  unaccounted: {named}: {shown(why, 400)}")
         lines.append(f"  complete: {self.complete}")
         return "\n".join(lines)

@@ -472,7 +472,7 @@ class Ledger(Changes):
         coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
         for attempt in (0, 1):
             try:
-                contacts = self._contacts.before(self._b.table, self._pairs, coef)
+                contacts = self._contacts.before(self._b.table, coef)
                 break
             except UnknownBody:
                 if attempt:
