@@ -63,7 +63,10 @@ class Copy:
                 self.pushes.append((c, b.force, b.torque))
         else:
             c = pymunk.Body(body_type=kind)
-        c.position, c.angle = b.position, b.angle
+        # The angle first: pymunk turns a body about its centre of gravity, so an angle set
+        # after the position would move the body's origin away from the original's.
+        c.angle = b.angle
+        c.position = b.position
         if kind != pymunk.Body.STATIC:
             c.velocity, c.angular_velocity = b.velocity, b.angular_velocity
         self.body[id(b)] = c
