@@ -1056,3 +1056,54 @@ def test_the_strip_names_its_unit_and_its_tick_labels_fit_beside_it(tmp_path, g,
     page = space_document(painter)["strip"]
     assert page["axis"] == axis and page["ticks"] == [list(t) for t in labels]
     assert [v for v, _ in labels] == ticks
+
+
+@pytest.mark.parametrize("how", ["space.copy", "pickle", "copy.copy"])
+@pytest.mark.parametrize("setting", ["plain", "energy", "follow"])
+def test_a_recorder_kept_on_its_space_copies_and_pickles_frozen(tmp_path, how, setting):
+    # A program keeps its recorder on the space (space.rec = ...): space.copy() and pickling
+    # the space worked with a Ledger or a HeatCounter there, and failed with a Recorder
+    # (pymunk's draw options hold C memory). The copy is what was captured so far: it does
+    # not capture, and writes those frames; the original records on as if never copied.
+    import copy
+    import pickle
+
+    def recorder(space, name):
+        kw = {"energy": setting == "energy"}
+        if setting == "follow":
+            kw["camera"] = list(space.bodies)[-1]  # the ball
+        return spaces.Recorder(space, tmp_path / name, fps=10, **kw)
+
+    space, twin = _space(), _space()
+    space.rec = recorder(space, "a.gif")
+    alone = recorder(twin, "b.gif")
+
+    def frame():
+        for s in (space, twin):
+            s.step(0.1)
+        space.rec.capture()
+        alone.capture()
+
+    for _ in range(3):
+        frame()
+    other = {"space.copy": lambda: space.copy().rec,
+             "pickle": lambda: pickle.loads(pickle.dumps(space)).rec,
+             "copy.copy": lambda: copy.copy(space.rec)}[how]()
+    assert other.frames == 4 and other.times == space.rec.times
+    with pytest.raises(DumbbellError, match=r"a\.gif: this recorder is a copy"):
+        other.capture()
+    for _ in range(2):
+        frame()
+    space.rec.write()
+    alone.write()
+    assert (tmp_path / "a.gif").read_bytes() == (tmp_path / "b.gif").read_bytes()
+    # The copy writes the four frames it holds: what the original wrote of them.
+    other.path = tmp_path / "copy.gif"
+    other.write()
+    short = recorder(_space(), "short.gif")
+    for _ in range(3):
+        short.space.step(0.1)
+        short.capture()
+    short.write()
+    assert other.frames == 4
+    assert (tmp_path / "copy.gif").read_bytes() == (tmp_path / "short.gif").read_bytes()

@@ -245,6 +245,21 @@ def _check_reference(reference: Any, unit: str = "energy units") -> str | dict[s
             for k, v in reference.items()}
 
 
+#: What a copy of a :class:`Recorder` keeps beside its frozen recording (see
+#: ``Recorder.__reduce__``): its settings, its frames' times, what it wrote and why.
+_KEPT_BY_A_COPY = frozenset({
+    "path", "fps", "W", "H", "units", "energy", "strip", "world", "span", "y_up", "_up",
+    "orientation", "reference", "t0", "title", "about", "timing", "view", "note", "_names",
+    "_captured", "t"})
+
+
+def _frozen_recorder(state: dict[str, Any]) -> Recorder:
+    """A copy of a recorder (see ``Recorder.__reduce__``)."""
+    rec = object.__new__(Recorder)
+    rec.__dict__.update(state)
+    return rec
+
+
 class Recorder:
     """Records ``space`` into ``path`` (.gif, or .mp4 with the ``[mp4]`` extra) at ``fps``
     frames per second: step the space yourself and call :meth:`capture` once per frame; the
@@ -430,6 +445,16 @@ class Recorder:
     def __enter__(self) -> Self:
         return self
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Copied or pickled (alone, or with its space: space.copy(), copy.deepcopy), a
+        # recorder is what it captured so far, frozen: the copy does not capture, and
+        # writes those frames. (The draw options it captures through hold C memory, and
+        # number this space's bodies only.)
+        state = {k: v for k, v in self.__dict__.items() if k in _KEPT_BY_A_COPY}
+        state.update(t=list(self.t), timing=dict(self.timing), _names=dict(self._names),
+                     _frozen=self.recording())
+        return (_frozen_recorder, (state,))
+
     def __exit__(self, exc_type: object, exc: object, tb: object) -> None:
         if exc_type is None:
             self.write()
@@ -461,9 +486,14 @@ class Recorder:
         ------
         UsageError
             A time that is not a finite number within the allowed range.
+        DumbbellError
+            A copy of a recorder (copying or pickling a recorder or its space freezes it).
         """
         from ..model import args
 
+        if "_frozen" in self.__dict__:
+            raise DumbbellError(f"{self.path}: this recorder is a copy (of a recorder, or of "
+                                "its space): it does not capture; make a new Recorder")
         previous = self.t[-1]
         if t is not None:
             t = args.real(t, "t", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
@@ -557,6 +587,9 @@ class Recorder:
         from ..animation.camera import item_box
         from ..animation.recorded import Recording
 
+        frozen = self.__dict__.get("_frozen")
+        if frozen is not None:
+            return frozen
         kw: dict[str, Any] = {}
         if self.energy:
             rows, labels = self._rows()
