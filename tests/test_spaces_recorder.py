@@ -572,7 +572,7 @@ def test_every_body_is_drawn_at_least_4_px_and_far_static_shapes_change_nothing(
     # The note names the parts drawn larger than to scale, and not the chassis.
     grown = rec.note.splitlines()[1]
     assert grown.startswith("drawn larger than to scale, to be 4 px across: ")
-    assert "body 1, body 2, body 3, body 4 (4 of 5 moving bodies; " in grown
+    assert "bodies 1-4 (4 of 5 moving bodies; " in grown
     assert len(rec.note.splitlines()) == 2  # nothing outside the picture
 
 
@@ -1107,3 +1107,34 @@ def test_a_recorder_kept_on_its_space_copies_and_pickles_frozen(tmp_path, how, s
     short.write()
     assert other.frames == 4
     assert (tmp_path / "copy.gif").read_bytes() == (tmp_path / "short.gif").read_bytes()
+
+
+@pytest.mark.parametrize("every", [1, 2, 3])
+def test_the_note_names_every_body_drawn_larger_than_to_scale(tmp_path, every):
+    # 14 balls 1,000 px apart in a row (y down, no gravity): at 640 px across, a ball of
+    # 1 px radius is 0.09 px, one of 400 px is 36 px. Every ``every``-th ball is small and
+    # drawn 4 px across: the note names each of them, however many (the names once stopped
+    # at 8 and "3 more").
+    space = pymunk.Space()
+    small = []
+    for i in range(14):
+        body = pymunk.Body(1.0, 10.0)
+        body.position = (1000.0 * i, 0.0)
+        tiny = i % every == 0
+        space.add(body, pymunk.Circle(body, 1.0 if tiny else 400.0))
+        if tiny:
+            small.append(i)
+    with spaces.Recorder(space, tmp_path / "row.gif", fps=5, y_up=False) as rec:
+        space.step(0.1)
+        rec.capture()
+    grown = rec.note.splitlines()[1]
+    named = grown.split("across: ", 1)[1].split(" (", 1)[0]
+    listed = set()
+    for part in named.split(", "):
+        if part.startswith("bodies "):
+            a, b = map(int, part[len("bodies "):].split("-"))
+            listed.update(range(a, b + 1))
+        else:
+            listed.add(int(part.removeprefix("body ")))
+    assert listed == set(small)
+    assert f"({len(small)} of 14 moving bodies;" in grown and "more" not in grown

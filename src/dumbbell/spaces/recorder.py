@@ -222,6 +222,25 @@ def _check_camera(camera: Any, world: Any) -> Any:
     return camera
 
 
+def _every_body(names: list[str]) -> str:
+    """Every name of ``names``, bodies named by their place ("body 3") in order and runs of
+    three or more consecutive ones as one range ("bodies 3-9"): the note names each body
+    drawn larger than to scale, however many (a gas of 10,000 particles is "bodies 0-9999")."""
+    import re
+
+    places = sorted({int(m.group(1)) for n in names if (m := re.fullmatch(r"body (\d+)", n))})
+    parts: list[str] = []
+    start = 0
+    for k in range(1, len(places) + 1):
+        if k < len(places) and places[k] == places[k - 1] + 1:
+            continue
+        run = places[start:k]
+        parts += ([f"bodies {run[0]}-{run[-1]}"] if len(run) >= 3 else
+                  [f"body {i}" for i in run])
+        start = k
+    return ", ".join(parts + [n for n in names if not re.fullmatch(r"body \d+", n)])
+
+
 def _listed(names: list[str], most: int = 8) -> str:
     """``names`` joined by commas, the first ``most`` of them and how many more."""
     shown = ", ".join(names[:most])
@@ -668,7 +687,7 @@ class Recorder:
         if panel.grown:
             grown = sorted(panel.grown)
             lines.append(f"drawn larger than to scale, to be {panel.body_px:g} px across: "
-                         f"{_listed([name(n, f'body #{n}') for n in grown])} "
+                         f"{_every_body([name(n, f'body #{n}') for n in grown])} "
                          f"({len(grown)} of {len(self._names)} moving bodies; camera=<a body> "
                          "follows one at a larger scale)")
         seen, shown = panel.frames_in, panel.frames_shown
