@@ -242,6 +242,36 @@ def test_callbacks_after_the_solver_are_unattributed_and_measured():
     assert abs(bal.closure) <= 1e-12 * bal.scale
 
 
+@pytest.mark.parametrize("when", ["begin", "separate"])
+def test_callbacks_before_the_ledger_s_first_look_are_the_program_s_and_say_so(when):
+    # A collision's begin and separate callbacks run in the step before the ledger first
+    # looks: a velocity they set cannot be told from one the program set between steps. The
+    # term is still what the callback changed, measured around it, and the reason names the
+    # callback among the possible causes (it once named begin and pre_solve only).
+    g = (0.0, -10.0)
+    space = pymunk.Space()
+    space.gravity = g
+    _floor(space, e=1.0)
+    ball = _ball(space, pos=(0.0, 1.0), v=(0.5, -3.0), e=1.0)
+    changed = [0.0]
+
+    def halve(arbiter, space_, data):
+        before = _energy(ball, g)
+        ball.velocity *= 0.5
+        changed[0] += _energy(ball, g) - before
+
+    space.on_collision(None, None, **{when: halve})
+    ledger = spaces.Ledger(space)
+    for _ in range(240):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert changed[0] < 0
+    assert _terms(bal, "program")["program: body 0"] == pytest.approx(changed[0], rel=1e-12)
+    why = dict(bal.unaccounted)["program: body 0"]
+    assert "begin, pre_solve or separate callback" in why and bal.complete is False
+    assert abs(bal.closure) <= 1e-12 * bal.scale
+
+
 def test_bodies_removed_and_added_from_callbacks_carry_their_measured_energy():
     # A pool table's pocket: a ball touching the pocket is removed from a post_solve
     # callback (pymunk removes it at the end of the step), and a fresh ball is added.

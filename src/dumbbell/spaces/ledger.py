@@ -363,8 +363,8 @@ class Ledger(Changes):
                 unacc.setdefault(t.source, _inside(self._threads))
             elif t.kind == "program" and abs(t.energy) > limit:
                 unacc.setdefault(t.source, "changed by the program between steps (a velocity, "
-                                 "position, impulse or setting; or a collision begin or "
-                                 "pre_solve callback)")
+                                 "position, impulse or setting; or a collision's begin, "
+                                 "pre_solve or separate callback)")
         return Balance(E0=self._E0, E=self._E, terms=tuple(sorted(terms, key=order)),
                        closure=self._E - self._E0 - total,
                        worst_step=self._worst / self._scale if self._scale > 0 else 0.0,
