@@ -31,6 +31,8 @@ class Changes:
     _names: Any
     _potentials: list[Any]
     _scale: float
+    _size: float
+    _floor: float
     _Uref: np.ndarray
     _E: float
     steps: int
@@ -79,7 +81,7 @@ class Changes:
         old_dyn = b0.table.uid[: b0.table.n].copy()
         springs_what, bodies_what = _what_changed(b0, self.space, reason)
         old_rows = self._snap_uid.copy()
-        self._sums.fold(b0, self._scale)
+        self._sums.fold(b0, self._scale, self._floor)
         self._rebuild()
         snap = self._remap(self._snap)
         t = self._b.table
@@ -119,6 +121,7 @@ class Changes:
                                "energy changed by what was changed in the space")
         self._Uref[1] += e.Us - old.Us
         self._E = e.E
+        self._size = max(self._size, *phys.magnitudes(e))
 
     def _catch_up(self, F: np.ndarray, kind: str, rows: np.ndarray | None = None) -> None:
         """Count, per body, what changed from the snapshot to the state read now (``F``,
@@ -141,7 +144,9 @@ class Changes:
                       else "springs stretched by moved bodies (a callback)")
             self._sums.add(source, kind, springs)
         self._snap = phys.snapshot(self._b, pos, vel, s.bias, s.sleeping)
-        self._E = phys.energy(self._b, self._snap).E
+        e = phys.energy(self._b, self._snap)
+        self._E = e.E
+        self._size = max(self._size, *phys.magnitudes(e))
 
     def _gone(self) -> np.ndarray:
         """The dynamic rows whose bodies are no longer in the space (pymunk does not move

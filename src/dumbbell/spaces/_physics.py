@@ -119,6 +119,12 @@ def energy(b: Build, s: Snapshot) -> Energy:
     return Energy(k + ug + ud + Us, k, ug, Us, ud, K + Ug + Ud, Ug, Ud)
 
 
+def magnitudes(e: Energy) -> tuple[float, ...]:
+    """The magnitudes of E and its parts at an :class:`._records.Energy`, whose largest
+    sets the energies' own rounding."""
+    return abs(e.E), e.K, abs(e.Ug), abs(e.Us), abs(e.Ud)
+
+
 def totals(b: Build, s: Snapshot) -> tuple[float, float, float, float, float]:
     """E and its parts at ``s`` (E, K, U_g, U_springs, U_fields), in totals only: what the
     ledger needs at each step's end (:func:`energy` gives each body's too)."""

@@ -211,6 +211,7 @@ def start(self: Any) -> None:
     self._E0 = self._E = e.E
     self._Uref = np.array([e.Ug, e.Us, e.Ud])
     self._scale = e.K
+    self._size = max(phys.magnitudes(e))
 
 
 def attach(self: Any, calls: Any) -> None:

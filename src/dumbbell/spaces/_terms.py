@@ -13,6 +13,10 @@ from ._inventory import PAIR, Build, Group, Pairs
 _INSIDE = "changed inside the step by something no source explains (a callback)"
 #: Below this fraction of the energy scale, a body's unexplained impulse work is rounding.
 ROUNDING = 1e-12
+#: The energies' own rounding, as a fraction of the largest magnitude of E and its parts seen
+#: (64 roundings of a double): below it nothing is measurable, whatever the scale (a stack
+#: at rest has a scale of 1e-11 and an E of 45,000, whose last bit is 7e-12).
+ROUNDED = 64 * float(np.finfo(float).eps)
 
 
 class Sums:
@@ -37,10 +41,11 @@ class Sums:
         if note:
             self.notes[key] = note
 
-    def fold(self, b: Build, scale: float) -> None:
-        """Move the running sums of build ``b`` into the named terms (and zero them)."""
+    def fold(self, b: Build, scale: float, floor: float = 0.0) -> None:
+        """Move the running sums of build ``b`` into the named terms (and zero them);
+        ``floor``: the energies' own rounding (:data:`ROUNDED`)."""
         labels, n = b.table.labels, b.table.n
-        self._fold_bodies(labels, scale)
+        self._fold_bodies(labels, scale, floor)
         for j, f in enumerate(b.fields):
             if self.field[j]:
                 self.add(f.label, "step error", self.field[j],
@@ -55,7 +60,7 @@ class Sums:
         for g in b.groups.values():
             self._fold_group(g, labels, n)
 
-    def _fold_bodies(self, labels: list[str], scale: float) -> None:
+    def _fold_bodies(self, labels: list[str], scale: float, floor: float = 0.0) -> None:
         """The per-body sums: forces, unexplained impulses (rounding apart), the program's
         changes and custom velocity functions."""
         kinds = {"force": ("force on {}", "force", "work of Body.force"),
@@ -66,7 +71,7 @@ class Sums:
             if name == "unattributed":
                 # What the solver's sums round off (1e-16 of the impulses) is one term;
                 # a body whose residual is more than that is named.
-                tiny = np.abs(acc) <= ROUNDING * max(scale, 1e-300)
+                tiny = np.abs(acc) <= max(ROUNDING * max(scale, 1e-300), floor)
                 if tiny.any():
                     self.add("rounding", "rounding", float(acc[tiny].sum()),
                              "what the solver's and the ledger's sums round off")

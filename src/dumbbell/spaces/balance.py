@@ -114,6 +114,10 @@ class Balance:
         The energy unit.
     time_unit : str, default 's'
         The time unit.
+    rounding : float, default 0.0
+        The energies' own rounding: 64 roundings of a double of the largest magnitude of E
+        and its parts seen. A closure (or a term) within it is rounding, whatever the
+        scale: a pile at rest moves nothing, and E's last bit is all its closure.
 
     Examples
     --------
@@ -158,12 +162,14 @@ class Balance:
     notes: tuple[str, ...] = ()
     unit: str = "J"
     time_unit: str = "s"
+    rounding: float = 0.0
 
     def __post_init__(self) -> None:
         # Plain numbers only (numpy scalars neither print nor serialise as numbers).
         from ..model import args
 
-        for name in ("E0", "E", "closure", "worst_step", "scale", "tolerance", "t"):
+        for name in ("E0", "E", "closure", "worst_step", "scale", "tolerance", "t",
+                     "rounding"):
             unit = self.time_unit if name == "t" else "-" if name in (
                 "worst_step", "tolerance") else self.unit
             value = args.real(getattr(self, name), name, unit, positive=False)
@@ -195,9 +201,9 @@ class Balance:
     @property
     def complete(self) -> bool:
         """True when every joule is accounted for: nothing in ``unaccounted`` and the
-        closure within ``tolerance`` of ``scale``."""
+        closure within ``tolerance`` of ``scale`` (or within the energies' ``rounding``)."""
         return bool(not self.unaccounted
-                    and abs(self.closure) <= self.tolerance * self.scale)
+                    and abs(self.closure) <= max(self.tolerance * self.scale, self.rounding))
 
     def by_kind(self) -> dict[str, float]:
         """Energy per kind of term.
@@ -282,9 +288,12 @@ class Balance:
                          f"{'' if len(terms) == 1 else 's'})")
             for t in terms[:top]:
                 lines.append(f"      {shown(t.source):40s} {t.energy:+.6g}")
+        rounding = ("; within the energies' rounding, "
+                    f"{self.rounding:.2g} {u}" if self.tolerance * self.scale
+                    < abs(self.closure) <= self.rounding else "")
         lines.append(f"  closure E(t) - E(0) - sum = {self.closure:+.3g} "
                      f"({self.relative_closure:.2e} of the scale; worst step "
-                     f"{self.worst_step:.2e})")
+                     f"{self.worst_step:.2e}{rounding})")
         for note in self.notes:
             lines.append(f"  note: {shown(note, 400)}")
         # Sources with the same reason on one line (a threaded solver names every body).

@@ -53,7 +53,9 @@ fields' potential. ``closure`` = E(t) - E(0) - the sum of all terms is the ledge
 above that say so, beyond ``tolerance`` times the energy ``scale``) and the closure is within
 ``tolerance`` of the scale: the largest of the kinetic energy and of the change of each
 potential (gravity, springs, fields) from its start, over the steps seen. The potentials'
-zero is arbitrary (pixel spaces put U_g near -1e8), so |E(0)| is no scale.
+zero is arbitrary (pixel spaces put U_g near -1e8), so |E(0)| is no scale; but below the
+energies' own last bits (``Balance.rounding``) nothing is measurable, and a closure or a
+term within them is rounding whatever the scale (a pile at rest).
 """
 
 from __future__ import annotations
@@ -74,7 +76,7 @@ from ._changes import Changes
 from ._contacts import UnknownBody
 from ._inventory import Names, Pairs, changed, declared
 from ._records import Before, Snapshot, Step
-from ._terms import Sums, pair_terms
+from ._terms import ROUNDED, Sums, pair_terms
 from ._threaded import hazard
 from .balance import Balance, Term, notes, order
 from .units import check_units, energy_unit
@@ -298,7 +300,7 @@ class Ledger(Changes):
                              param="potential")
         key, label = declared(target, potential, name, self.steps, self._names)
         self._sync()
-        self._sums.fold(self._b, self._scale)
+        self._sums.fold(self._b, self._scale, self._floor)
         self._potentials.append((key, potential, label))
         try:
             self._rebuild()
@@ -348,7 +350,7 @@ class Ledger(Changes):
             raise DumbbellError(self._bad)
         self._flush()
         self._sync()
-        self._sums.fold(self._b, self._scale)
+        self._sums.fold(self._b, self._scale, self._floor)
         u = self.unit
         terms = [Term(src, kind, val, self._sums.notes.get((src, kind), ""), u)
                  for (src, kind), val in self._sums.terms.items() if val != 0.0]
@@ -357,7 +359,7 @@ class Ledger(Changes):
         unacc = {**self._unaccounted, **self._b.current}
         if self._error is not None:
             unacc["ledger"] = self._error
-        limit = self.tolerance * self._scale
+        limit = max(self.tolerance * self._scale, self._floor)
         for t in terms:
             if t.kind == "unattributed" and abs(t.energy) > limit:
                 unacc.setdefault(t.source, _inside(self._threads))
@@ -370,7 +372,8 @@ class Ledger(Changes):
                        worst_step=self._worst / self._scale if self._scale > 0 else 0.0,
                        scale=self._scale, tolerance=self.tolerance,
                        unaccounted=tuple(sorted(unacc.items())), steps=self.steps, t=self.t,
-                       notes=notes(terms, self._scale, u), unit=u, time_unit=self.units[2])
+                       notes=notes(terms, self._scale, u), unit=u, time_unit=self.units[2],
+                       rounding=self._floor)
 
     # -- copies ------------------------------------------------------------------------
 
@@ -421,6 +424,12 @@ class Ledger(Changes):
             self._error = f"stopped counting at step {self.steps}: {type(e).__name__}: {e}"
             warnings.warn(f"dumbbell.spaces.Ledger {self._error}", RuntimeWarning,
                           stacklevel=2)
+
+    @property
+    def _floor(self) -> float:
+        """The energies' own rounding (:data:`._terms.ROUNDED` of the largest magnitude of E
+        and its parts seen): what the closure and a term may be and still be rounding."""
+        return ROUNDED * self._size
 
     def _stop(self, why: str) -> None:
         self._bad = self._error = why
@@ -573,6 +582,7 @@ class Ledger(Changes):
         self._awaiting_end = True
         ref = self._Uref
         self._scale = max(self._scale, K, abs(Ug - ref[0]), abs(Us - ref[1]), abs(Ud - ref[2]))
+        self._size = max(self._size, abs(E), K, abs(Ug), abs(Us), abs(Ud))
         self._worst = max(self._worst, abs(step))  # relative to the scale when shown
 
     def _end(self) -> None:
