@@ -145,13 +145,30 @@ class Hook:
         self._cspace = None
 
 
-    def _last(self) -> bool:
-        """The hook is the last constraint of the space (through Chipmunk's iterator)."""
+    def order(self) -> list[int]:
+        """The addresses of the space's constraints in its C array's order (the solver's),
+        this hook's among them (through Chipmunk's iterator, its public C API)."""
         ffi, lib = self._ffi, self._lib
         items: list[Any] = []
         lib.cpSpaceEachConstraint(self._cspace, lib.ext_cpSpaceConstraintIteratorFunc,
                                   ffi.new_handle(items))
-        return bool(items) and int(ffi.cast("uintptr_t", items[-1])) == self.at
+        return [int(ffi.cast("uintptr_t", item)) for item in items]
+
+    def _last(self) -> bool:
+        """The hook is the last constraint of the space."""
+        order = self.order()
+        return bool(order) and order[-1] == self.at
+
+    def to_last(self) -> None:
+        """Put a hook that was added last (``first`` False) last again, between steps:
+        removing a constraint moves the space's last one into its place
+        (``cpSpaceRemoveConstraint``), and a program removing its own puts the hook there.
+        Taken out, the space's last constraint takes the hook's place, where a space without
+        the hook has it; added again, the hook is appended (Chipmunk's public C API)."""
+        if self._first or not self.inside or self.locked() or self._last():
+            return
+        self._lib.cpSpaceRemoveConstraint(self._cspace, self._c)
+        self._lib.cpSpaceAddConstraint(self._cspace, self._c)
 
 
 @cache

@@ -47,6 +47,18 @@ PAIR = 1 << 31
 NAME_CHARS = 60
 
 
+def other_ends(constraints: tuple[Any, ...], seen: set[int]) -> list[Any]:
+    """The bodies ``constraints`` join that are not among ``seen`` (their ids, which this
+    extends), in the order first met: the static body, bodies outside the space."""
+    out = []
+    for c in constraints:
+        for b in (c.a, c.b):
+            if id(b) not in seen:
+                seen.add(id(b))
+                out.append(b)
+    return out
+
+
 class UnknownBody(Exception):
     """A contact touches a body that is not in the ledger's table (one pymunk made since:
     the space's static body, say): the table must be built again."""
@@ -111,11 +123,7 @@ class Table:
                 seen.add(id(shape.body))
                 other.append(shape.body)
         self.constraint_key = tuple(space.constraints)
-        for c in self.constraint_key:
-            for b in (c.a, c.b):
-                if id(b) not in seen:
-                    seen.add(id(b))
-                    other.append(b)
+        other += other_ends(self.constraint_key, seen)
         self.bodies = [*dyn, *kin, *other]
         self.body_key = tuple(bodies)
         n, k = len(dyn), len(kin)

@@ -8,8 +8,9 @@ gave and the getters do not is lumped:
 - the solver's impulses (contacts, joints, spring damping, and any constraint callback):
   one ``contacts and joints`` term, the work of every body's change of velocity in the
   solver less gravity's, its forces' and damping's; no heat per pair;
-- the springs: their elastic kicks (computed from their settings, as Munk2D prepares them)
-  and their potential's change over the moves, one ``springs`` step error;
+- the springs (to the static body too): their elastic kicks (computed from their settings,
+  as Munk2D prepares them; working on the step's mean velocity, as every impulse does) and
+  their potential's change over the moves, one ``springs`` step error;
 - the contacts' position correction: the bias velocities are not public, so a body's move
   beyond its velocity is the correction when it touched something in the last step (and is
   named in ``unaccounted`` when it matters: a position the program set cannot be told from
@@ -29,7 +30,7 @@ import numpy as np
 
 from .._pymunk import spring_function
 from . import _physics as phys
-from ._inventory import Build, Names
+from ._inventory import Build, Names, other_ends
 from ._layout import body_function
 from ._records import Before, Move, Potentials
 
@@ -89,11 +90,14 @@ class _Table:
         bodies = list(space.bodies)
         dyn = [b for b in bodies if b.body_type == pymunk.Body.DYNAMIC]
         kin = [b for b in bodies if b.body_type == pymunk.Body.KINEMATIC]
-        self.bodies = [*dyn, *kin]
-        self.body_key = tuple(bodies)
         self.constraint_key = tuple(space.constraints)
+        # Past the moving rows, the other ends of the constraints (a spring to the static
+        # body, say), as the struct-read table has them: a spring's potential needs both.
+        other = other_ends(self.constraint_key, {id(b) for b in (*dyn, *kin)})
+        self.bodies = [*dyn, *kin, *other]
+        self.body_key = tuple(bodies)
         n, k = len(dyn), len(kin)
-        self.n, self.k, self.rows = n, k, n + k
+        self.n, self.k, self.rows = n, k, len(self.bodies)
         self.uid = np.array([names.uid(b) for b in self.bodies], dtype=np.int64)
         self.labels = [names.labels[u] for u in self.uid.tolist()]
         self.pre = _Getters(self.bodies, post=False)
@@ -104,6 +108,9 @@ class _Table:
         self.static = np.isinf(first[13])
         self.idle = first[13, n:].copy()
         Table._derive(self, first)  # the arrays the struct-read table derives
+        for r in range(n + k, self.rows):  # a body outside the space moves with none
+            self.drives[r] = self.bodies[r].body_type != pymunk.Body.STATIC
+        self.any_driven = bool(self.drives.any())
 
 
 class _Spring:
@@ -148,7 +155,7 @@ def public_build(space: Any, names: Names) -> Build:
             springs.append(_Spring(c, "spring" if isinstance(c, pymunk.DampedSpring)
                                    else "rotary_spring", rows[id(c.a)], rows[id(c.b)], label))
         elif spring:
-            current[label] = f"{LUMPED}: a spring with a custom force or a static end"
+            current[label] = f"{LUMPED}: a spring with a custom force"
         joints += not spring
         if c.pre_solve is not None or c.post_solve is not None:
             current[label] = (f"{LUMPED}: its pre_solve or post_solve callback acts inside the "
@@ -172,12 +179,14 @@ def public_build(space: Any, names: Names) -> Build:
                  current)
 
 
-def _spring_kicks(b: Build, pos: np.ndarray, dt: float) -> np.ndarray:
-    """The impulses (3, rows) the springs applied when the step prepared them: their force
-    at the positions ``pos``, clamped to ``max_force``, times dt (Munk2D's preStep)."""
+def _spring_kicks(b: Build, pos: np.ndarray, dt: float, springs: list[Any] | None = None
+                  ) -> np.ndarray:
+    """The impulses (3, rows) the springs (``springs``, default all) applied when the step
+    prepared them: their force at the positions ``pos``, clamped to ``max_force``, times dt
+    (Munk2D's preStep)."""
     t = b.table
     out = np.zeros((3, t.rows))
-    for g in b.springs:
+    for g in b.springs if springs is None else springs:
         ia, ib = int(g.a[0]), int(g.b[0])
         rest, k, _, max_force = g.settings[:, 0]
         if g.kind == "spring":
@@ -256,6 +265,7 @@ def pre(self: Any) -> None:
     dt = float(self.space.current_time_step)
     t = self._b.table
     F, P = t.pre.floats(), t.pre.pointers()
+    ahead = None  # the springs prepared before the hook: all while it is last
     if changed(self._b, self.space, F, P):
         gone = self._gone()
         if gone.any():
@@ -263,16 +273,20 @@ def pre(self: Any) -> None:
         self._restructure("the space's bodies, constraints or settings", dt, "program")
         t = self._b.table
         F, P = t.pre.floats(), t.pre.pointers()
+        ahead = _ahead_of_hook(self)
     b, s, n = self._b, self._snap, t.n
     coef = 0.0 if self._dt_prev == 0.0 else dt / self._dt_prev
     kicks = _spring_kicks(b, F[0:3], dt)
     vel_r = F[3:6].copy()
     vel0 = vel_r.copy()  # kinematic rows (past the dynamic ones) take no spring's kick
-    vel0[:, :n] -= kicks[:, :n] * t.inv3
+    # The velocities read hold the kicks of the springs prepared before the hook: taken
+    # back out (the others kick after the read, inside the step's velocity change).
+    done = kicks if ahead is None else _spring_kicks(b, F[0:3], dt, ahead)
+    vel0[:, :n] -= done[:, :n] * t.inv3
     # Bodies no spring kicked keep their velocity bit for bit; a kick taken back out
     # leaves a few roundings, which are not the program's.
     vel0 = np.where(phys.same(vel0, s.vel), s.vel, vel0)
-    moving = t.moves & ~np.concatenate([P[0, :n].astype(bool), np.zeros(t.k, bool)])
+    moving = t.moves & ~np.concatenate([P[0, :n].astype(bool), np.zeros(t.rows - n, bool)])
     expected = np.where(moving, s.pos + vel0 * dt, s.pos)
     beyond = ~np.all(phys.same(F[0:3], expected), axis=0)
     # Moved with the velocity the last step left, set anew after the move (a collision's
@@ -303,16 +317,45 @@ def pre(self: Any) -> None:
         self._sums.add("position correction", "correction", corr,
                        "the contacts' position correction, with any position the program "
                        f"set on a body that touched something ({LUMPED})")
-    elastic = 0.5 * float(np.sum(t.mass3 * (vel_r[:, :n] ** 2 - vel0[:, :n] ** 2)))
-    self._sums.add(f"springs ({LUMPED})", "step error", elastic + spring_int,
+    # The springs' kicks work on the step's mean velocity, as every impulse of the step
+    # does (:func:`post`): their potential's change over the move now, their work then.
+    self._sums.add(f"springs ({LUMPED})", "step error", spring_int,
                    "the springs' kicks and their potential's change over the moves")
-    total += corr + elastic + spring_int
+    total += corr + spring_int
+    self._kicks = kicks
     force = F[6:9, :n]
     awake = P[0, :n] == 0
-    move = Move(F[0:3].copy(), vel_r, start, dt)
+    move = Move(F[0:3].copy(), vel0, start, dt)
     self._before = Before(dt, coef, move, force if force.any() else None,
                           None if awake.all() else awake, g_int, None,
                           Potentials([], u_end, None, s.ud), [], False, total)
+
+
+def _ahead_of_hook(self: Any) -> list[Any] | None:
+    """The springs prepared before the hook in this step (None: all, the hook being last).
+    A program that removes a constraint other than the space's last moves the hook into
+    its place (``cpSpaceRemoveConstraint``): until :func:`end` puts it last again, the
+    springs after it kick after the hook's read."""
+    hook = self._hook
+    order = hook.order()
+    if not order or order[-1] == hook.at:
+        return None
+    self._misplaced = True
+    before = set(order[: order.index(hook.at)]) if hook.at in order else set(order)
+    try:
+        return [g for g in self._b.springs
+                if int(hook._ffi.cast("uintptr_t", g.obj._constraint)) in before]
+    except AttributeError:  # a pymunk whose constraints keep their C struct elsewhere
+        return None
+
+
+def end(self: Any) -> None:
+    """At the end of a step (a post-step callback: the space is not stepping), put the hook
+    last again if a program's removal moved it (:func:`_ahead_of_hook`): the constraints
+    are then in the order a space without the hook has them."""
+    if self.__dict__.get("_misplaced") and self._hook is not None:
+        self._misplaced = False
+        self._hook.to_last()
 
 
 def post(self: Any) -> None:
@@ -327,18 +370,23 @@ def post(self: Any) -> None:
     t = b.table
     n = t.n
     Q = t.post.floats()
-    vel_r, vel1 = p.move.vel, Q[0:3]
+    vel0, vel1 = p.move.vel, Q[0:3]  # vel0: before the springs' kicks
     damping = float(self.space.damping)
-    step = Step(p.dt, p.coef, p.move.pos, vel_r, vel1, (vel_r + vel1) * 0.5,
-                np.zeros((2, t.rows)), None, [])
+    kicks = self._kicks
+    step = Step(p.dt, p.coef, p.move.pos, vel0, vel1, (vel0 + vel1) * 0.5,
+                np.zeros((2, t.rows)), kicks if damping != 1.0 else None, [])
     lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
+    # The springs' kicks' work on the dynamic bodies (kinematic and static ends take it
+    # as work leaving: they do not move by it).
+    w_k = float(np.sum(kicks[:, :n] * step.u[:, :n]))
+    self._sums.add(f"springs ({LUMPED})", "step error", w_k)
     # The solver's work: of the impulse m (v1 - v0), less the outside impulses'.
-    w_s = float(np.sum(t.mass3 * (vel1[:, :n] - vel_r[:, :n]) * step.u[:, :n])
-                - np.sum(lin) - np.sum(ang))
+    w_s = float(np.sum(t.mass3 * (vel1[:, :n] - vel0[:, :n]) * step.u[:, :n])
+                - np.sum(lin) - np.sum(ang)) - w_k
     self._sums.add(f"contacts and joints ({LUMPED})", "contacts and joints", w_s,
                    "the work of the solver's impulses: contacts, joints, spring damping")
     self._sums.add("gravity", "step error", w_g + p.g_int)
-    total = p.total + external + w_s + w_g + p.g_int
+    total = p.total + external + w_s + w_g + p.g_int + w_k
     self._close_step(Q, t.post.pointers(), p, total)
     self._touching = np.zeros(t.rows, dtype=bool)
     for r, body in enumerate(t.bodies):

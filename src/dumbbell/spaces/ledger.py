@@ -668,3 +668,7 @@ class PublicLedger(Ledger):
 
     def _post(self) -> None:
         _public.post(self)
+
+    def _end(self) -> None:
+        super()._end()
+        _public.end(self)
