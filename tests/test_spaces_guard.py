@@ -463,6 +463,23 @@ def test_bad_dt_is_one_clear_error():
             spaces.report(_pixels(), 0.1, units=bad)
 
 
+@pytest.mark.parametrize("call", ["check", "survey", "report", "suggest_dt", "reach", "step"])
+@pytest.mark.parametrize("dt", [1e6 * (1 + 1e-12), 1e7, 1e154, 1e300])
+def test_every_guard_function_takes_the_steps_a_space_can_take(call, dt):
+    # spaces.step and Driver refused a frame past 1e6 s, the others took any: reach then
+    # gave a fall's speed of 9e152 at 1e150 s and 278 (the free fall, its lag lost to an
+    # overflow) from 1e154 s on. Every function has the one border now.
+    space = pymunk.Space()
+    space.gravity = (0.0, -900.0)
+    body, shape = _ball(1.0, 10.0, 1.0)
+    body.position = (0.0, 53.0)
+    space.add(body, shape, pymunk.Segment(space.static_body, (-100, 0), (100, 0), 0.0))
+    with pytest.raises(UsageError, match=r"^dt = .*: must be a finite number > 0 and <= 1e\+06"):
+        getattr(spaces, call)(space, dt)
+    (fall,) = spaces.reach(space, 1e6)
+    assert fall.speed == pytest.approx(900.0 * 1e6, rel=1e-9)  # at the border: g dt
+
+
 # --- states no step fixes (issue 24) -----------------------------------------------------------
 
 

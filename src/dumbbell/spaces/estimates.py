@@ -65,6 +65,21 @@ from ._bodies import Bodies, Joints, Link
 from ._refusals import settings_problem
 from ._scan import DYNAMIC, Scan, scan
 
+#: Longest step (s) the guard looks at and :func:`.stepping.step` takes: past it (11.6 days) a
+#: pymunk space's state overflows (positions of -inf or NaN at 1e100 s and more), and so do
+#: the guard's own estimates (a fall's speed at 1e154 s).
+MAX_DT = 1e6
+
+
+def step_dt(dt: Any) -> float:
+    """``dt`` checked at the border: a finite number > 0 (s), at most :data:`MAX_DT`."""
+    dt = args.real(dt, "dt", "s")
+    if dt > MAX_DT:
+        raise UsageError(f"dt = {args.show(dt)}: must be a finite number > 0 and <= "
+                         f"{MAX_DT:g} (s): a step longer than that is not one a pymunk "
+                         "space can take (its state overflows)", param="dt")
+    return dt
+
 __all__ = ["Reach", "reach"]
 
 @dataclass(frozen=True)
@@ -167,7 +182,7 @@ def reach(space: Any, dt: float, units: str | None = None) -> tuple[Reach, ...]:
     ('body 0', 6.185, 'falls 1.9 m to the floor under it')
     """
     space = args.space(space)
-    dt = args.real(dt, "dt", "s")
+    dt = step_dt(dt)
     unit = length_unit(units)
     sc = scan(space)
     problem = settings_problem(space) or state_problem(sc, unit)

@@ -59,7 +59,7 @@ from ._refusals import settings_problem
 from ._scan import Scan, _shapes, best_other, hittable_in, scan
 from ._springs_dt import _networks, _springs, energy_swing, spring_omega
 from ._threaded import hazard
-from .estimates import Estimates, estimate, length_unit, percent, state_problem
+from .estimates import Estimates, estimate, length_unit, percent, state_problem, step_dt
 
 __all__ = ["Finding", "check", "energy_swing", "report", "shape_size", "spring_omega",
            "substeps", "suggest_dt", "survey"]
@@ -95,7 +95,7 @@ def _check(space: Any, dt: Any, speeds: Any = "both", tolerance: Any = TOLERANCE
            units: Any = None) -> tuple[Any, float, str, float, str]:
     """The guard's arguments checked at the border (UsageError naming the one that is not
     valid): a pymunk.Space, a step > 0 (s), one of :data:`SPEEDS`, a tolerance and a unit."""
-    return (args.space(space), args.real(dt, "dt", "s"), args.choice(speeds, "speeds", SPEEDS),
+    return (args.space(space), step_dt(dt), args.choice(speeds, "speeds", SPEEDS),
             _tolerance(tolerance), length_unit(units))
 
 

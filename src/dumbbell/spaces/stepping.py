@@ -24,14 +24,11 @@ import numpy as np
 from ..errors import DumbbellError, UsageError
 from ..model import args
 from ._scan import batch, scan
-from .estimates import state_problem
+from .estimates import state_problem, step_dt
 from .guard import MAX_STEPS, TOLERANCE, _advise, _check, _refuse
 
 __all__ = ["Driver", "step"]
 
-#: Longest frame step (s) :func:`step` and :class:`Driver` take: past it (11.6 days) a pymunk
-#: space's state overflows (positions of -inf or NaN at 1e100 s and more).
-MAX_DT = 1e6
 
 
 def step(space: Any, dt: float, substeps: int = 1) -> None:
@@ -81,12 +78,8 @@ def step(space: Any, dt: float, substeps: int = 1) -> None:
 
 def _frame_step(dt: Any, substeps: int) -> float:
     """The sub-step of a frame of ``dt`` (s): ``dt`` checked at the border (a finite number
-    > 0 and at most :data:`MAX_DT`), divided by ``substeps``."""
-    dt = args.real(dt, "dt", "s")
-    if dt > MAX_DT:
-        raise UsageError(f"dt = {args.show(dt)}: must be a finite number > 0 and <= "
-                         f"{MAX_DT:g} (s): a frame longer than that is not a step a pymunk "
-                         "space can take (its state overflows)", param="dt")
+    > 0 and at most :data:`.estimates.MAX_DT`), divided by ``substeps``."""
+    dt = step_dt(dt)
     if not dt / substeps > 0:
         raise UsageError(f"dt = {args.show(dt)}: must be long enough to divide into "
                          f"{substeps:,} sub-steps that are not 0 s", param="dt")
