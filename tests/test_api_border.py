@@ -532,11 +532,7 @@ VALID: dict[str, Callable[[Fixtures], dict[str, Any]]] = {
     "dumbbell.spaces.balance.Balance.sources": lambda f: {"kind": "contact", "at_least": 0.0},
     "dumbbell.spaces.balance.Balance.table": lambda f: {"top": 4},
     "dumbbell.spaces.balance.Term": lambda f: fields(f.balance.terms[0]),
-    "dumbbell.spaces.recorder.Recorder": lambda f: {
-        "space": f.space(), "path": f.tmp / "r.gif", "fps": 10, "energy": True,
-        "size": "64x64", "strip": False, "heat": f.heat(), "world": (-1.0, 1.0, -0.2, 1.0),
-        "camera": "auto", "span": None, "y_up": None, "units": ("m", "kg", "s"),
-        "reference": "start", "t0": 0.0, "title": "t", "about": (0.0, 0.0)},
+    "dumbbell.spaces.recorder.Recorder": lambda f: _recorder_args(f),
     "dumbbell.spaces.recorder.Recorder.capture": lambda f: {"t": None},
     "dumbbell.spaces._draw.PaletteDrawOptions": lambda f: {},
     "dumbbell.spaces._draw.PaletteDrawOptions.capture": lambda f: {"space": f.space()},
@@ -753,6 +749,16 @@ def _pymunk() -> Any:
     import pymunk
 
     return pymunk
+
+
+def _recorder_args(f: Fixtures) -> dict[str, Any]:
+    """Valid arguments of every parameter of spaces.Recorder: its heat counter on its space."""
+    space = f.space()
+    return {"space": space, "path": f.tmp / "r.gif", "fps": 10, "energy": True,
+            "size": "64x64", "strip": False, "heat": f.heat(space),
+            "world": (-1.0, 1.0, -0.2, 1.0), "camera": "auto", "span": None, "y_up": None,
+            "units": ("m", "kg", "s"), "reference": "start", "t0": 0.0, "title": "t",
+            "about": (0.0, 0.0)}
 
 
 WRONG_KINDS: dict[str, tuple[Callable[[Fixtures], Any], str]] = {

@@ -1138,3 +1138,48 @@ def test_the_note_names_every_body_drawn_larger_than_to_scale(tmp_path, every):
             listed.add(int(part.removeprefix("body ")))
     assert listed == set(small)
     assert f"({len(small)} of 14 moving bodies;" in grown and "more" not in grown
+
+
+@pytest.mark.parametrize("energy", [False, True])
+def test_a_long_title_is_cut_short_beside_the_time_label(tmp_path, energy):
+    # A title of 10,000 characters was drawn over the time label (overlap from about 45 on
+    # 640x360). It is cut short with an ellipsis where the label's box ends: the label's
+    # pixels are those of a recording without a title, and any title too long is cut at
+    # the same place.
+    def first_frame(title, name):
+        space = _space()
+        with spaces.Recorder(space, tmp_path / name, fps=10, title=title,
+                             energy=energy) as rec:
+            space.step(0.1)
+            rec.capture()
+        gif = Image.open(tmp_path / name)
+        gif.seek(0)
+        return np.asarray(gif.convert("RGB"))
+
+    plain = first_frame("", "plain.gif")
+    longest = first_frame("W" * 10_000, "long.gif")
+    long = first_frame("W" * 200, "200.gif")
+    assert np.array_equal(longest, long)  # cut at the same place
+    assert not np.array_equal(longest, plain)  # and drawn
+    label = (slice(0, 24), slice(0, 160))  # the time label's box at 640x360
+    assert np.array_equal(longest[label], plain[label])
+
+
+@pytest.mark.parametrize("title", ["two\nlines", "a\ttab", "bell\a"])
+def test_a_title_of_more_than_one_line_is_refused(tmp_path, title):
+    # A newline reached Pillow ("anchor not supported for multiline text") when the block
+    # ended, as a traceback from inside the writer.
+    with pytest.raises(UsageError, match=r"^title = .*: must be one line \(no newline"):
+        spaces.Recorder(_space(), tmp_path / "t.gif", title=title)
+
+
+def test_a_heat_counter_or_a_camera_of_another_space_is_refused(tmp_path):
+    # The bars showed another space's heat (46,656 against 0), and the camera followed a
+    # body no frame held.
+    space, other = _space(), _space()
+    with pytest.raises(UsageError, match=r"^heat: a HeatCounter of another space"):
+        spaces.Recorder(space, tmp_path / "h.gif", energy=True, heat=spaces.HeatCounter(other))
+    with pytest.raises(UsageError, match=r"^camera: the body to follow is not in the space"):
+        spaces.Recorder(space, tmp_path / "c.gif", camera=list(other.bodies)[-1])
+    with pytest.raises(UsageError, match=r"^camera: the body to follow is not in the space"):
+        spaces.Recorder(space, tmp_path / "c.gif", camera=pymunk.Body(1.0, 1.0))

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from PIL import Image, ImageDraw
@@ -40,6 +41,18 @@ __all__: list[str] = []
 #: The title, this far left of the picture panel's right edge and from the top (px at
 #: 640x360), in bold of this size.
 TITLE_AT, TITLE_PX = (8, 6), 12
+
+
+def _fitted(text: str, face: Any, room: float) -> str:
+    """``text``, cut short with an ellipsis if it is longer than ``room`` (px) in ``face``
+    (the title, beside the time label: never over it)."""
+    if face.getlength(text) <= room:
+        return text
+    lo, hi = 0, len(text)  # the longest prefix that fits with the ellipsis: in [lo, hi)
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if face.getlength(text[:mid] + "\u2026") <= room else (lo, mid)
+    return text[:lo].rstrip() + "\u2026" if lo else ""
 
 
 class ViewPanel:
@@ -126,8 +139,12 @@ class ViewPanel:
                         self.u).draw(ImageDraw.Draw(scene), (0, 0))
         img.paste(scene, (0, 0))
         if self.rec.title:
-            ImageDraw.Draw(img).text(((self.scene_w - TITLE_AT[0] * u) * S, TITLE_AT[1] * u * S),
-                                     self.rec.title, font=font(round(TITLE_PX * u) * S, True),
+            face = font(round(TITLE_PX * u) * S, True)
+            right = (self.scene_w - TITLE_AT[0] * u) * S
+            x, _, w, _ = self.clock.box
+            room = right - (x + w + TITLE_AT[0] * u) * S  # right of the time label's box
+            ImageDraw.Draw(img).text((right, TITLE_AT[1] * u * S),
+                                     _fitted(self.rec.title, face, room), font=face,
                                      fill=INK, anchor="rt")
 
     def draw(self, painter: Painter, img: Image.Image, k: int, fresh: bool

@@ -164,6 +164,10 @@ def _constraints(space: Any, index: Callable[[Any], int]
     for i, c in enumerate(space.constraints):
         name = type(c).__name__
         label = f"{name} {i}"
+        if any(b.space is not space and b.body_type != pymunk.Body.STATIC for b in (c.a, c.b)):
+            notes.append(f"{label} joins a body that is not in the space: its impulses change "
+                         "that body's velocity, whose energy is not in E (what leaves with it: "
+                         "spaces.Ledger counts it)")
         if isinstance(c, pymunk.DampedSpring | pymunk.DampedRotarySpring):
             spring = _spring(c, label, index)
             if isinstance(spring, Skipped):

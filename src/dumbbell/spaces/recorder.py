@@ -202,9 +202,9 @@ def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, f
     return x0, x1, y0, y1
 
 
-def _check_camera(camera: Any, world: Any) -> Any:
-    """``camera`` checked: 'auto', 'all' or a moving pymunk.Body to follow; with a fixed
-    ``world`` box, 'auto' only."""
+def _check_camera(camera: Any, world: Any, space: Any) -> Any:
+    """``camera`` checked: 'auto', 'all' or a moving pymunk.Body of ``space`` to follow;
+    with a fixed ``world`` box, 'auto' only."""
     import pymunk
 
     from ..model import args
@@ -213,6 +213,9 @@ def _check_camera(camera: Any, world: Any) -> Any:
         if camera.body_type == pymunk.Body.STATIC:
             raise UsageError("camera: a static body cannot be followed; give a moving "
                              "body, 'auto' or 'all'", param="camera")
+        if camera.space is not space:
+            raise UsageError("camera: the body to follow is not in the space recorded (add "
+                             "it first, or follow one of the space's bodies)", param="camera")
     elif not (isinstance(camera, str) and camera in ("auto", "all")):
         raise UsageError(f"camera = {args.show(camera)}: must be 'auto', 'all' or a "
                          "pymunk.Body to follow", param="camera")
@@ -392,8 +395,12 @@ class Recorder:
         self.strip = args.flag(strip, "strip") and self.energy
         self.heat = None if heat is None else args.instance(
             heat, "heat", HeatCounter, "a dumbbell.spaces.HeatCounter or None")
+        if self.heat is not None and self.heat.__dict__.get("space") is not self.space:
+            raise UsageError("heat: a HeatCounter of another space (or a copy, which counts "
+                             "nothing): give the one attached to the space recorded",
+                             param="heat")
         self.world = None if world is None else _check_world(world, self.units[0])
-        self.camera: Any = _check_camera(camera, self.world)
+        self.camera: Any = _check_camera(camera, self.world, self.space)
         self.span = None if span is None else args.real(span, "span", self.units[0])
         if self.span is not None and not isinstance(self.camera, pymunk.Body):
             raise UsageError(f"span = {args.show(span)}: only for a followed body "
@@ -416,6 +423,9 @@ class Recorder:
         self.reference = _check_reference(reference, _energy_unit(self.units))
         self.t0 = args.real(t0, "t0", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         self.title = args.text(title, "title", "a str (written at the top)")
+        if any(ord(c) < 32 or ord(c) == 127 for c in self.title):
+            raise UsageError(f"title = {args.show(self.title)}: must be one line (no newline "
+                             "or other control character)", param="title")
         self.about = args.pair(about, "about", self.units[0])
         self.options = draw_options()
         self._no_frames()
