@@ -121,7 +121,7 @@ class Changes:
                                "energy changed by what was changed in the space")
         self._Uref[1] += e.Us - old.Us
         self._E = e.E
-        self._size = max(self._size, *phys.magnitudes(e))
+        self._size = max(self._size, phys.magnitude(*e[:5]))
 
     def _catch_up(self, F: np.ndarray, kind: str, rows: np.ndarray | None = None) -> None:
         """Count, per body, what changed from the snapshot to the state read now (``F``,
@@ -146,7 +146,7 @@ class Changes:
         self._snap = phys.snapshot(self._b, pos, vel, s.bias, s.sleeping)
         e = phys.energy(self._b, self._snap)
         self._E = e.E
-        self._size = max(self._size, *phys.magnitudes(e))
+        self._size = max(self._size, phys.magnitude(*e[:5]))
 
     def _gone(self) -> np.ndarray:
         """The dynamic rows whose bodies are no longer in the space (pymunk does not move

@@ -119,10 +119,10 @@ def energy(b: Build, s: Snapshot) -> Energy:
     return Energy(k + ug + ud + Us, k, ug, Us, ud, K + Ug + Ud, Ug, Ud)
 
 
-def magnitudes(e: Energy) -> tuple[float, ...]:
-    """The magnitudes of E and its parts at an :class:`._records.Energy`, whose largest
-    sets the energies' own rounding."""
-    return abs(e.E), e.K, abs(e.Ug), abs(e.Us), abs(e.Ud)
+def magnitude(E: float, K: float, Ug: float, Us: float, Ud: float) -> float:
+    """The largest magnitude of E and its parts (as :func:`totals` gives them, and an
+    :class:`._records.Energy` begins): what sets the energies' own rounding."""
+    return max(abs(E), K, abs(Ug), abs(Us), abs(Ud))
 
 
 def totals(b: Build, s: Snapshot) -> tuple[float, float, float, float, float]:

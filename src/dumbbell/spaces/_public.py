@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .._pymunk import spring_function
+from . import _memory as mem
 from . import _physics as phys
 from ._inventory import Build, Names, other_ends
 from ._layout import body_function
@@ -220,7 +221,7 @@ def start(self: Any) -> None:
     self._E0 = self._E = e.E
     self._Uref = np.array([e.Ug, e.Us, e.Ud])
     self._scale = e.K
-    self._size = max(phys.magnitudes(e))
+    self._size = phys.magnitude(*e[:5])
 
 
 def attach(self: Any, calls: Any) -> None:
@@ -343,8 +344,7 @@ def _ahead_of_hook(self: Any) -> list[Any] | None:
     self._misplaced = True
     before = set(order[: order.index(hook.at)]) if hook.at in order else set(order)
     try:
-        return [g for g in self._b.springs
-                if int(hook._ffi.cast("uintptr_t", g.obj._constraint)) in before]
+        return [g for g in self._b.springs if mem.address(g.obj._constraint) in before]
     except AttributeError:  # a pymunk whose constraints keep their C struct elsewhere
         return None
 

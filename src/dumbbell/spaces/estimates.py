@@ -65,6 +65,8 @@ from ._bodies import Bodies, Joints, Link
 from ._refusals import settings_problem
 from ._scan import DYNAMIC, Scan, scan
 
+__all__ = ["Reach", "reach"]
+
 #: Longest step (s) the guard looks at and :func:`.stepping.step` takes: past it (11.6 days) a
 #: pymunk space's state overflows (positions of -inf or NaN at 1e100 s and more), and so do
 #: the guard's own estimates (a fall's speed at 1e154 s).
@@ -80,7 +82,6 @@ def step_dt(dt: Any) -> float:
                          "space can take (its state overflows)", param="dt")
     return dt
 
-__all__ = ["Reach", "reach"]
 
 @dataclass(frozen=True)
 class Reach:

@@ -551,7 +551,7 @@ class Ledger(Changes):
             # step's total counts it through them.
             self._contacts.record(step.u)
             if self._contacts.due:
-                self._contacts.flush(t, self._pairs, self._sums, b)
+                self._flush()
         lin, ang, w_g, external = phys.external(b, step, p, damping, self._sums)
         total += external
         total += phys.unexplained(b, step, p, (lin, ang, w_g), self._sums)
@@ -582,7 +582,7 @@ class Ledger(Changes):
         self._awaiting_end = True
         ref = self._Uref
         self._scale = max(self._scale, K, abs(Ug - ref[0]), abs(Us - ref[1]), abs(Ud - ref[2]))
-        self._size = max(self._size, abs(E), K, abs(Ug), abs(Us), abs(Ud))
+        self._size = max(self._size, phys.magnitude(E, K, Ug, Us, Ud))
         self._worst = max(self._worst, abs(step))  # relative to the scale when shown
 
     def _end(self) -> None:

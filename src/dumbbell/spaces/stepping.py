@@ -30,7 +30,6 @@ from .guard import MAX_STEPS, TOLERANCE, _advise, _check, _refuse
 __all__ = ["Driver", "step"]
 
 
-
 def step(space: Any, dt: float, substeps: int = 1) -> None:
     """Advance ``space`` by one frame of ``dt`` (s) in ``substeps`` equal steps. The forces
     and torques the program set for the frame (``Body.force``, ``Body.torque``, what
