@@ -126,6 +126,9 @@ class Table:
         other += other_ends(self.constraint_key, seen)
         self.bodies = [*dyn, *kin, *other]
         self.body_key = tuple(bodies)
+        # What stands witness that space.bodies still holds body_key (:func:`same_bodies`).
+        self.arrays = mem.BodyArrays(space)
+        self.arrays_seen = self.arrays.read(space)
         n, k = len(dyn), len(kin)
         self.n, self.k, self.rows = n, k, len(self.bodies)
         self.uid = np.array([names.uid(b) for b in self.bodies], dtype=np.int64)
@@ -529,7 +532,7 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) ->
     the table's floats and pointers read now (``P`` None: the velocity and position
     functions are not looked at, as at the end of a step, which reads floats only)."""
     t = b.table
-    if tuple(space.bodies) != t.body_key:
+    if not same_bodies(t, space):
         return "bodies added or removed"
     if tuple(space.constraints) != t.constraint_key:
         return "constraints added or removed"
@@ -543,6 +546,20 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) ->
             P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
     return changed_settings(b, space)
+
+
+def same_bodies(t: Any, space: Any) -> bool:
+    """``space.bodies`` holds the table's bodies (``body_key``). The space's C arrays of
+    bodies read the same as when it last did (:class:`._memory.BodyArrays`, a table that
+    has them) stand witness that it still does; else the bodies are compared."""
+    arrays = getattr(t, "arrays", None)
+    now = None if arrays is None else arrays.read(space)
+    if now is not None and now == t.arrays_seen:
+        return True
+    if tuple(space.bodies) != t.body_key:
+        return False
+    t.arrays_seen = now
+    return True
 
 
 def changed_settings(b: Build, space: Any) -> str:

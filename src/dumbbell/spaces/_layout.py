@@ -71,7 +71,8 @@ def check_space(space: Any) -> int:
         ("static_body", address(r.static_body),
          address(lib.cpSpaceGetStaticBody(space._space))),
         ("locked", int(r.locked > 0), int(bool(lib.cpSpaceIsLocked(space._space))))])
-    for name in ("dynamic_bodies", "constraints", "arbiters"):
+    for name in ("dynamic_bodies", "static_bodies", "sleeping_components", "constraints",
+                 "arbiters"):
         if not _plausible(address(getattr(r, name))):
             raise LayoutError(f"space.{name}: not a valid address")
     # Now the arrays: their headers, then what they hold.
@@ -79,11 +80,49 @@ def check_space(space: Any) -> int:
     known = {address(c._constraint) for c in space.constraints}
     if not known <= constraints or not constraints <= known | hooks(space):
         raise LayoutError("space.constraints: does not hold the space's constraints")
-    bodies = set(array_items(address(r.dynamic_bodies)).tolist())
-    if not bodies <= {address(b._body) for b in space.bodies}:
-        raise LayoutError("space.dynamic_bodies: holds bodies the space does not")
+    mine = {address(b._body) for b in space.bodies}
+    # Static: the space's static bodies, and those its shapes and constraints use that are
+    # not among them (pymunk's own, made lazily, Chipmunk's own).
+    used = [s.body for s in space.shapes] + [e for c in space.constraints for e in (c.a, c.b)]
+    own = getattr(space, "_static_body", None)  # read only to widen this check
+    static = mine | {address(b._body) for b in [*used, *([own] if own else [])]}
+    static.add(address(lib.cpSpaceGetStaticBody(space._space)))
+    for name, allowed in (("dynamic_bodies", mine), ("sleeping_components", mine),
+                          ("static_bodies", static)):
+        if not set(array_items(address(getattr(r, name))).tolist()) <= allowed:
+            raise LayoutError(f"space.{name}: holds bodies the space does not")
+    if not {address(b._body) for b in space.bodies if b.body_type == b.STATIC} <= set(
+            array_items(address(r.static_bodies)).tolist()):
+        raise LayoutError("space.static_bodies: lacks static bodies of the space")
     array_items(address(r.arbiters))
     return at
+
+
+@cache
+def callbacks_known() -> bool:
+    """pymunk keeps a space's collision handlers in ``Space._handlers`` and the post-step
+    callbacks a step will run in ``Space._post_step_callbacks`` (dicts, empty on a new
+    space; pymunk 7 has no public getter for either), checked once per process on a scratch
+    space: a handler set with ``on_collision`` and a callback added with
+    ``add_post_step_callback`` must show there. Read, never written, and only to know
+    that nothing can run between the solver and the end of a step (the ledger's
+    ``_quiet_end``); False (the ledger then checks every body at every step's end) if
+    anything differs."""
+    import pymunk
+
+    def nothing(*args: Any) -> None:
+        return None
+
+    try:
+        space = pymunk.Space()
+        handlers, callbacks = space._handlers, space._post_step_callbacks
+        if type(handlers) is not dict or type(callbacks) is not dict or handlers or callbacks:
+            return False
+        space.on_collision(1, 2, post_solve=nothing)
+        space.add_post_step_callback(nothing, "key")
+        return bool(space._handlers) and "key" in space._post_step_callbacks
+    except Exception:  # noqa: BLE001 - any other pymunk: not known
+        return False
 
 
 def check_body(body: Any) -> None:

@@ -74,7 +74,7 @@ from . import _physics as phys
 from . import _public
 from ._changes import Changes
 from ._contacts import UnknownBody
-from ._inventory import Names, Pairs, changed, declared
+from ._inventory import Names, Pairs, changed, declared, same_bodies
 from ._records import Before, Snapshot, Step
 from ._terms import ROUNDED, Sums, pair_terms
 from ._threaded import hazard
@@ -193,6 +193,7 @@ class Ledger(Changes):
         self._frozen: Balance | None = None
         self._before: Before | None = None
         self._awaiting_end = False
+        self._quiet_end = False
         self._dt_prev = float(space.current_time_step)
         # A space made with pymunk.Space(threaded=True): the most threads a counted step ran on.
         self._threaded = bool(getattr(space, "threaded", False))
@@ -524,6 +525,17 @@ class Ledger(Changes):
         if contacts is not None:
             contacts.flush(self._b.table, self._pairs, self._sums, self._b)
 
+    def _quiet(self) -> bool:
+        """Nothing the program wrote can run between the solver and the ledger's end of
+        this step: no constraint has a ``post_solve``, the space has no collision handler
+        and no post-step callback before the ledger's (:func:`._layout.callbacks_known`).
+        Then only pymunk's own deferred adds and removes come in between, and :meth:`_end`
+        checks those alone."""
+        space = self.space
+        return (layout.callbacks_known() and not space._handlers
+                and not space._post_step_callbacks
+                and all(c.post_solve is None for c in self._b.table.constraint_key))
+
     def _post(self) -> None:
         """After the solver: every impulse of the step is applied. Count each source's work
         and close the step."""
@@ -531,6 +543,7 @@ class Ledger(Changes):
         if p is None:
             return
         self._before = None
+        self._quiet_end = self._quiet()
         b = self._b
         t = b.table
         Q, root = t.post.both()
@@ -592,6 +605,9 @@ class Ledger(Changes):
             return
         self._awaiting_end = False
         t = self._b.table
+        if self._quiet_end and same_bodies(t, self.space) and (
+                tuple(self.space.constraints) == t.constraint_key):
+            return
         F, s = t.state.floats(), self._snap
         if not (F[0:3].tobytes() == s.pos.tobytes() and F[3:6].tobytes() == s.vel.tobytes()):
             _quietly(lambda: self._catch_up(F, "unattributed"))

@@ -1,0 +1,213 @@
+"""The ledger's two shortcuts at every step, against the long way round:
+
+- whether ``space.bodies`` still holds the bodies it knows is read from Chipmunk's arrays of
+  bodies (awake, static, sleeping components) and ``len(space.bodies)``, not a tuple of
+  every body: bodies that leave or come without changing the awake array (a lone sleeping
+  body removed, another put to sleep in the same gap, a static body swapped for another)
+  are still found, with their energy measured by hand;
+- the end of a step checks only pymunk's deferred adds and removes when nothing the program
+  wrote can run after the solver (no constraint ``post_solve``, no collision handler, no
+  post-step callback before the ledger's); a post-step callback or a constraint's
+  ``post_solve`` that changes a velocity is still measured and named, and a space where
+  those reads are not known gives the same balance bit for bit."""
+
+from __future__ import annotations
+
+import pymunk
+import pytest
+
+from dumbbell import spaces
+from dumbbell.spaces import _inventory, _layout
+
+
+def _energy(body: pymunk.Body, g: tuple[float, float]) -> float:
+    cog = body.local_to_world(body.center_of_gravity)
+    return (0.5 * body.mass * body.velocity.length_squared
+            + 0.5 * body.moment * body.angular_velocity ** 2
+            - body.mass * (g[0] * cog[0] + g[1] * cog[1]))
+
+
+def _terms(bal: spaces.Balance, kind: str) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for t in bal.terms:
+        if t.kind == kind:
+            out[t.source] = out.get(t.source, 0.0) + t.energy
+    return out
+
+
+def _box(space: pymunk.Space, x: float, y: float = 0.5) -> pymunk.Body:
+    body = pymunk.Body(2.0, pymunk.moment_for_box(2.0, (1, 1)))
+    body.position = (x, y)
+    shape = pymunk.Poly.create_box(body, (1, 1))
+    shape.friction = 1.0
+    space.add(body, shape)
+    return body
+
+
+def _sleepy_space() -> tuple[pymunk.Space, list[pymunk.Body]]:
+    space = pymunk.Space()
+    space.gravity = (0.0, -10.0)
+    space.sleep_time_threshold = 0.05
+    floor = pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.0)
+    floor.friction = 1.0
+    space.add(floor)
+    return space, [_box(space, x) for x in (-10.0, 0.0, 10.0)]
+
+
+def test_a_lone_sleeping_body_removed_leaves_with_its_energy():
+    # Three boxes at rest fall asleep alone (each its own component): none is in the awake
+    # array. Removing one changes neither the awake nor the static array; the sleeping
+    # components and len(space.bodies) tell.
+    space, boxes = _sleepy_space()
+    ledger = spaces.Ledger(space)
+    for _ in range(120):
+        space.step(1 / 60)
+    assert all(b.is_sleeping for b in boxes)
+    g = space.gravity
+    gone = _energy(boxes[1], g)
+    space.remove(boxes[1], *boxes[1].shapes)
+    space.step(1 / 60)
+    bal = ledger.balance()
+    assert _terms(bal, "left") == {"body 1": pytest.approx(-gone, rel=1e-15)}
+    # -m g.y of a box at rest, its centre 0.5 up (less the contact's slop)
+    assert gone == pytest.approx(-2.0 * -10.0 * 0.5, rel=2e-3)
+
+
+def test_a_sleeping_body_removed_and_another_put_to_sleep_in_one_gap_are_both_found():
+    # The awake array reads the same before and after: the one removed was asleep, the one
+    # added is put to sleep at once. The sleeping components differ (another root).
+    space, boxes = _sleepy_space()
+    ledger = spaces.Ledger(space)
+    for _ in range(120):
+        space.step(1 / 60)
+    g = space.gravity
+    gone = _energy(boxes[2], g)
+    space.remove(boxes[2], *boxes[2].shapes)
+    new = _box(space, 20.0)
+    new.sleep()
+    came = _energy(new, g)
+    space.step(1 / 60)
+    bal = ledger.balance()
+    assert _terms(bal, "left") == {"body 2": pytest.approx(-gone, rel=1e-15)}
+    assert _terms(bal, "entered") == {"body 3": pytest.approx(came, rel=1e-15)}
+    assert bal.complete, bal.unaccounted
+
+
+def test_a_static_body_swapped_in_one_gap_is_a_change_of_bodies():
+    # One static body removed and another added: len(space.bodies) and the awake array stay;
+    # the static array does not.
+    space = pymunk.Space()
+    old = pymunk.Body(body_type=pymunk.Body.STATIC)
+    ball = pymunk.Body(1, 1)
+    space.add(old, ball, pymunk.Circle(ball, 1))
+    ledger = spaces.Ledger(space)
+    space.step(0.01)
+    new = pymunk.Body(body_type=pymunk.Body.STATIC)
+    space.remove(old)
+    space.add(new)
+    t = ledger._b.table
+    F, P = t.pre.both()
+    assert _inventory.changed(ledger._b, space, F, P) == "bodies added or removed"
+    space.step(0.01)
+    assert new in ledger._b.table.body_key and old not in ledger._b.table.body_key
+    assert ledger.balance().complete
+
+
+def test_a_body_removed_and_added_again_in_one_gap_changes_nothing():
+    space, boxes = _sleepy_space()
+    space.sleep_time_threshold = float("inf")
+    ledger = spaces.Ledger(space)
+    for _ in range(30):
+        space.step(1 / 60)
+    space.remove(boxes[0], *boxes[0].shapes)
+    space.add(boxes[0], *boxes[0].shapes)
+    for _ in range(30):
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert "left" not in bal.by_kind() and "entered" not in bal.by_kind()
+    assert bal.complete, bal.unaccounted
+
+
+def test_pymunks_callback_dicts_are_where_the_ledger_reads_them():
+    assert _layout.callbacks_known() is True
+
+
+def _ball_space() -> tuple[pymunk.Space, pymunk.Body]:
+    space = pymunk.Space()
+    space.gravity = (0.0, -10.0)
+    floor = pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.1)
+    floor.elasticity = 1.0
+    ball = pymunk.Body(1.0, pymunk.moment_for_circle(1.0, 0, 0.5))
+    ball.position, ball.velocity = (0.0, 2.0), (1.0, 0.0)
+    shape = pymunk.Circle(ball, 0.5)
+    shape.elasticity = 1.0
+    space.add(ball, shape)
+    return space, ball
+
+
+def test_a_post_step_callback_set_between_steps_is_measured_inside_the_step():
+    # Registered by the program between steps, pymunk runs it after the solver of the next
+    # step, before the ledger's end of it: its change is the step's, unattributed.
+    space, ball = _ball_space()
+    ledger = spaces.Ledger(space)
+    changed = [0.0]
+
+    def slow(space_, key):
+        before = _energy(ball, space_.gravity)
+        ball.velocity *= 0.5
+        changed[0] += _energy(ball, space_.gravity) - before
+
+    for i in range(120):
+        if i % 10 == 3:
+            space.add_post_step_callback(slow, i)
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert changed[0] < 0
+    assert _terms(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
+    assert "program" not in bal.by_kind()
+
+
+def test_a_constraint_post_solve_is_measured_inside_the_step():
+    space, ball = _ball_space()
+    anchor = pymunk.Body(1.0, 1.0)
+    anchor.position = (5.0, 5.0)
+    joint = pymunk.SlideJoint(anchor, ball, (0, 0), (0, 0), 0.0, 100.0)
+    space.add(anchor, joint)
+    ledger = spaces.Ledger(space)
+    changed = [0.0]
+
+    def slow(constraint, space_):
+        before = _energy(ball, space_.gravity)
+        ball.angular_velocity += 0.25
+        changed[0] += _energy(ball, space_.gravity) - before
+
+    for i in range(120):
+        joint.post_solve = slow if i % 10 == 3 else None
+        space.step(1 / 60)
+    bal = ledger.balance()
+    assert changed[0] > 0
+    assert _terms(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
+
+
+def test_the_short_end_of_step_gives_the_balance_of_the_long_one(monkeypatch):
+    # A pile of boxes knocked by a ball, bodies removed and added between steps: once with
+    # the short end of step, once with every body read at every step's end.
+    def run() -> tuple:
+        space, boxes = _sleepy_space()
+        space.sleep_time_threshold = float("inf")
+        for i in range(5):
+            _box(space, 0.0, 1.5 + i)
+        ledger = spaces.Ledger(space)
+        for i in range(200):
+            if i == 50:
+                space.remove(boxes[0], *boxes[0].shapes)
+            if i == 90:
+                _box(space, -20.0, 3.0).velocity = (4.0, 1.0)
+            space.step(1 / 60)
+        bal = ledger.balance()
+        return bal.E, bal.closure, bal.terms, bal.complete
+
+    short = run()
+    monkeypatch.setattr(_layout, "callbacks_known", lambda: False)
+    assert run() == short
+    assert short[3] is True
