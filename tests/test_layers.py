@@ -18,13 +18,14 @@ ROOT = Path(dumbbell.__file__).parent
 
 #: Layer of each package: ``spaces`` (any pymunk space: energy, heat, step guard) sits with
 #: the model; its recorder (and ``_draw``, what it collects of a space as the recording's
-#: primitives) is the user's API above the animation that paints the recording
-#: (``animation/recording.py``), as the commands are. The modules directly in the package
-#: (errors, progress, parallel, frames, _lazy, _display, ...) serve every layer: layer 0;
-#: ``files`` (the one way a file is written, ``atomic_output``) with the model, below every
-#: writer (it checks paths with ``model.args``).
+#: primitives, and ``_recorder_checks``, its arguments' checks) is the user's API above the
+#: animation that paints the recording (``animation/recording.py``), as the commands are.
+#: The modules directly in the package (errors, progress, parallel, frames, _lazy, _display,
+#: ...) serve every layer: layer 0; ``files`` (the one way a file is written,
+#: ``atomic_output``) with the model, below every writer (it checks paths with
+#: ``model.args``).
 LAYERS = {"model": 1, "files": 1, "spaces": 1, "spaces.recorder": 5, "spaces._draw": 5,
-          "solvers": 2,
+          "spaces._recorder_checks": 5, "solvers": 2,
           "analysis": 3, "io": 4, "plot": 4, "animation": 4, "cli": 5, "examples": 5,
           "__main__": 5}
 

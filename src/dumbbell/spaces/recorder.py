@@ -16,14 +16,14 @@ Whether the space was stepped is learnt from a pymunk post-step callback, which 
 nothing else of the space.
 
 **Orientation.** ``y_up=None`` draws y the way the program's window does, decided when the
-recorder is made from what the program has imported (:func:`_window_y_up`): y up when
-``pymunk.pygame_util.positive_y_is_up`` is True; with pygame imported, y down (pygame's
-window), unless gravity points to -y (the program then flips y itself, as pymunk's
-``newtons_cradle`` does: in a y-down window its bodies would fall up); with pyglet, arcade or
-kivy imported (and not pygame), y up; with no window library (or both kinds), up against
-gravity, and up without vertical gravity. ``y_up=True`` or False says it; a ``world`` box
-(left, right, bottom, top) with bottom > top is y down. ``rec.orientation`` says which way
-and why.
+recorder is made from what the program has imported
+(:func:`._recorder_checks.window_y_up`): y up when ``pymunk.pygame_util.positive_y_is_up``
+is True; with pygame imported, y down (pygame's window), unless gravity points to -y (the
+program then flips y itself, as pymunk's ``newtons_cradle`` does: in a y-down window its
+bodies would fall up); with pyglet, arcade or kivy imported (and not pygame), y up; with no
+window library (or both kinds), up against gravity, and up without vertical gravity.
+``y_up=True`` or False says it; a ``world`` box (left, right, bottom, top) with bottom > top
+is y down. ``rec.orientation`` says which way and why.
 
 :class:`PaletteDrawOptions` is a ``pymunk.SpaceDebugDrawOptions``: ``space.debug_draw`` hands it
 circles, segments and polygons, which it keeps as primitives in world coordinates; it adds the
@@ -34,15 +34,24 @@ constraints itself. The painting, framing and writing are
 from __future__ import annotations
 
 import math
-import os
-import tempfile
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Self
 
 import numpy as np
 
 from ..errors import DumbbellError, UsageError
+
+# The arguments' checks, the window's orientation, the note's names, the potential terms.
+from ._recorder_checks import (
+    POTENTIALS,
+    check_camera,
+    check_path,
+    check_reference,
+    check_world,
+    every_body,
+    listed,
+    window_y_up,
+)
 
 # The units' rule, the one every printed value of a space follows.
 from .units import SI, UNIT_CHARS  # noqa: F401 - re-exported
@@ -51,8 +60,6 @@ from .units import energy_unit as _energy_unit
 
 #: Energy terms shown: the fields of :func:`dumbbell.spaces.energy` they come from.
 TERMS = ("K_trans", "K_rot", "U_g", "U_spring", "E")
-#: Potential terms, shown from a reference (their value at t0, or one you set).
-POTENTIALS = ("U_g", "U_spring")
 #: Labels of the rows when the potentials are shown from a reference.
 DELTA_LABELS = {"U_g": "ΔU_g", "U_spring": "ΔU_spring", "E": "K + ΔU"}
 #: Largest magnitude of a frame's time (``t0``, ``capture(t=...)``; the space's time unit):
@@ -67,43 +74,6 @@ def _options_class() -> type:
     from ._draw import PaletteDrawOptions
 
     return PaletteDrawOptions
-
-
-#: Libraries whose windows have y up (pyglet's, arcade's and kivy's origin is the
-#: bottom-left corner); pygame's has y down.
-Y_UP_WINDOWS = ("pyglet", "arcade", "kivy")
-
-
-def _window_y_up(space: Any) -> tuple[bool, str]:
-    """Whether y points up in the window the program draws ``space`` in, and why: read from
-    the window libraries the program has imported (``sys.modules``),
-    ``pymunk.pygame_util.positive_y_is_up`` and the space's gravity (the rule: see the
-    module docstring)."""
-    import sys
-
-    modules = sys.modules
-    gy = float(space.gravity.y)
-    gy = gy if math.isfinite(gy) else 0.0
-    util = modules.get("pymunk.pygame_util")
-    if util is not None and bool(getattr(util, "positive_y_is_up", False)):
-        return True, "pymunk.pygame_util.positive_y_is_up is True"
-    # (A name set to None in sys.modules is an import blocked, not a library imported.)
-    pygame = modules.get("pygame") is not None
-    up = [name for name in Y_UP_WINDOWS if modules.get(name) is not None]
-    if pygame and not up:
-        if gy < 0:
-            return True, ("pygame is imported (its window has y down) and gravity points to "
-                          "-y, so the program flips y itself (else its bodies would fall up); "
-                          "give y_up=False if it does not")
-        flag = "; pymunk.pygame_util.positive_y_is_up is False" if util is not None else ""
-        return False, (f"pygame is imported (its window has y down{flag}); give y_up=True if "
-                       "the program flips y itself")
-    if up and not pygame:
-        return True, f"{up[0]} is imported (its window has y up)"
-    found = f"pygame and {up[0]} are both imported" if up else "no window library is imported"
-    if gy != 0:
-        return gy < 0, f"{found}; up is against gravity"
-    return True, f"{found} and gravity has no vertical part"
 
 
 def draw_options() -> Any:
@@ -131,140 +101,6 @@ def __getattr__(name: str) -> Any:
     if name == "PaletteDrawOptions":
         return _options_class()
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-# --- arguments, checked when the recorder is made -------------------------------------------
-
-
-def _check_path(path: Any) -> Path:
-    """``path`` as a Path the recording can be written to, else a UsageError naming it and
-    what is wrong: checked before any capture, so a long run is not lost at the end."""
-    from ..animation.writer import mp4_problem
-    from ..files import check_writable, is_special
-    from ..model import args
-
-    shown = args.show(path) if isinstance(path, str | os.PathLike) else None
-    if shown is not None and "\0" in str(path):
-        raise UsageError(f"path = {shown}: a path cannot hold a NUL character", param="path")
-    text = path
-    path = args.path(path, "path")
-    suffix = path.suffix.lower()
-    if suffix not in (".gif", ".mp4", ".html", ".htm"):
-        raise UsageError(f"path {args.show(str(path))}: must end in .gif, .mp4 or .html (the "
-                         "interactive player)", param="path")
-    try:
-        # As spelt (a Path drops a final '/': 'a.gif/' names a folder, not a file).
-        check_writable(text, "path")
-    except UsageError as exc:
-        from ..cli.app import clip  # its echo of the path, bounded
-
-        raise UsageError(clip(exc.reason), param="path") from None
-    if suffix == ".mp4" and (problem := mp4_problem()) is not None:
-        raise UsageError(f"path {args.show(str(path))}: {problem}", param="path")
-    if not is_special(path):
-        # The one sure test of a folder (read-only file systems, /proc, folders only root
-        # may write): make and remove a file in it, as the writer will.
-        here = path.parent
-        while not here.exists() and here != here.parent:
-            here = here.parent
-        try:
-            fd, probe = tempfile.mkstemp(prefix=f".{path.name[:40]}.", suffix=".probe", dir=here)
-        except OSError as exc:
-            raise UsageError(f"path {args.show(str(path))}: cannot write in {here} "
-                             f"({exc.strerror or exc})", param="path") from None
-        os.close(fd)
-        os.unlink(probe)
-    return path
-
-
-def _check_world(world: Any, unit: str = "space units") -> tuple[float, float, float, float]:
-    """``world`` = (left, right, bottom, top) as floats that can be drawn (in the length
-    ``unit``), else a UsageError."""
-    from ..animation.camera import SPAN_MAX, SPAN_MIN
-    from ..model import args
-
-    allowed = ("must be four finite numbers (left, right, bottom, top) in the space's length "
-               "unit, right > left and bottom != top (bottom > top: y is down)")
-    if type(world).__name__ == "ndarray":
-        world = tuple(world.tolist()) if world.ndim == 1 else None
-    if not isinstance(world, tuple | list) or len(world) != 4:
-        raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-    x0, x1, y0, y1 = (args.real(v, "world", unit, positive=False) for v in world)
-    if not (x1 > x0 and y1 != y0):
-        raise UsageError(f"world = {args.show(world)}: {allowed}", param="world")
-    for lo, hi in ((x0, x1), (min(y0, y1), max(y0, y1))):
-        span = hi - lo
-        if not (SPAN_MIN <= span <= SPAN_MAX and span >= 1e-9 * max(abs(lo), abs(hi))):
-            raise UsageError(f"world = {args.show(world)}: each side must span between "
-                             f"{SPAN_MIN:g} and {SPAN_MAX:g} {unit}, and at least 1e-9 of its "
-                             "coordinates (else no pixel can be told from the next)",
-                             param="world")
-    return x0, x1, y0, y1
-
-
-def _check_camera(camera: Any, world: Any, space: Any) -> Any:
-    """``camera`` checked: 'auto', 'all' or a moving pymunk.Body of ``space`` to follow;
-    with a fixed ``world`` box, 'auto' only."""
-    import pymunk
-
-    from ..model import args
-
-    if isinstance(camera, pymunk.Body):
-        if camera.body_type == pymunk.Body.STATIC:
-            raise UsageError("camera: a static body cannot be followed; give a moving "
-                             "body, 'auto' or 'all'", param="camera")
-        if camera.space is not space:
-            raise UsageError("camera: the body to follow is not in the space recorded (add "
-                             "it first, or follow one of the space's bodies)", param="camera")
-    elif not (isinstance(camera, str) and camera in ("auto", "all")):
-        raise UsageError(f"camera = {args.show(camera)}: must be 'auto', 'all' or a "
-                         "pymunk.Body to follow", param="camera")
-    if world is not None and camera != "auto":
-        raise UsageError(f"camera = {args.show(camera)}: give world (a fixed box) or "
-                         "camera, not both", param="camera")
-    return camera
-
-
-def _every_body(names: list[str]) -> str:
-    """Every name of ``names``, bodies named by their place ("body 3") in order and runs of
-    three or more consecutive ones as one range ("bodies 3-9"): the note names each body
-    drawn larger than to scale, however many (a gas of 10,000 particles is "bodies 0-9999")."""
-    import re
-
-    places = sorted({int(m.group(1)) for n in names if (m := re.fullmatch(r"body (\d+)", n))})
-    parts: list[str] = []
-    start = 0
-    for k in range(1, len(places) + 1):
-        if k < len(places) and places[k] == places[k - 1] + 1:
-            continue
-        run = places[start:k]
-        parts += ([f"bodies {run[0]}-{run[-1]}"] if len(run) >= 3 else
-                  [f"body {i}" for i in run])
-        start = k
-    return ", ".join(parts + [n for n in names if not re.fullmatch(r"body \d+", n)])
-
-
-def _listed(names: list[str], most: int = 8) -> str:
-    """``names`` joined by commas, the first ``most`` of them and how many more."""
-    shown = ", ".join(names[:most])
-    return shown if len(names) <= most else f"{shown} and {len(names) - most} more"
-
-
-def _check_reference(reference: Any, unit: str = "energy units") -> str | dict[str, float]:
-    from ..model import args
-
-    allowed = ("must be 'start' (potential energies from their values at t0), 'space' (as "
-               "spaces.energy reports them) or a mapping of U_g and/or U_spring to the "
-               "energies to measure them from")
-    if isinstance(reference, str):
-        if reference not in ("start", "space"):
-            raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
-        return reference
-    if not isinstance(reference, Mapping) or not reference or not set(reference) <= set(
-            POTENTIALS):
-        raise UsageError(f"reference = {args.show(reference)}: {allowed}", param="reference")
-    return {k: args.real(v, "reference", unit, positive=False)
-            for k, v in reference.items()}
 
 
 #: What a copy of a :class:`Recorder` keeps beside its frozen recording (see
@@ -387,7 +223,7 @@ class Recorder:
         from .heat import HeatCounter
 
         self.space = args.space(space)
-        self.path = _check_path(path)
+        self.path = check_path(path)
         self.fps = check_fps(fps)
         self.W, self.H = check_size(size)
         self.units = _check_units(units)
@@ -399,8 +235,8 @@ class Recorder:
             raise UsageError("heat: a HeatCounter of another space (or a copy, which counts "
                              "nothing): give the one attached to the space recorded",
                              param="heat")
-        self.world = None if world is None else _check_world(world, self.units[0])
-        self.camera: Any = _check_camera(camera, self.world, self.space)
+        self.world = None if world is None else check_world(world, self.units[0])
+        self.camera: Any = check_camera(camera, self.world, self.space)
         self.span = None if span is None else args.real(span, "span", self.units[0])
         if self.span is not None and not isinstance(self.camera, pymunk.Body):
             raise UsageError(f"span = {args.show(span)}: only for a followed body "
@@ -416,11 +252,11 @@ class Recorder:
         elif self.y_up is not None:
             up, why = self.y_up, "y_up says so"
         else:
-            up, why = _window_y_up(self.space)
+            up, why = window_y_up(self.space)
         self._up = up
         #: Which way y points in the picture, and why (see the module docstring).
         self.orientation = f"y {'up' if up else 'down'}: {why}"
-        self.reference = _check_reference(reference, _energy_unit(self.units))
+        self.reference = check_reference(reference, _energy_unit(self.units))
         self.t0 = args.real(t0, "t0", self.units[2], lo=-TIME_MAX, hi=TIME_MAX)
         self.title = args.text(title, "title", "a str (written at the top)")
         if any(ord(c) < 32 or ord(c) == 127 for c in self.title):
@@ -697,12 +533,12 @@ class Recorder:
         if panel.grown:
             grown = sorted(panel.grown)
             lines.append(f"drawn larger than to scale, to be {panel.body_px:g} px across: "
-                         f"{_every_body([name(n, f'body #{n}') for n in grown])} "
+                         f"{every_body([name(n, f'body #{n}') for n in grown])} "
                          f"({len(grown)} of {len(self._names)} moving bodies; camera=<a body> "
                          "follows one at a larger scale)")
         seen, shown = panel.frames_in, panel.frames_shown
         out = np.flatnonzero(shown < seen).tolist()
         if out:
-            lines.append("outside the picture (or not drawable) in some frames: " + _listed(
+            lines.append("outside the picture (or not drawable) in some frames: " + listed(
                 [f"{name(n, f'body #{n}')} in {seen[n] - shown[n]} of {seen[n]}" for n in out]))
         return "\n".join(lines)
