@@ -17,7 +17,8 @@ from typing import Any
 import numpy as np
 
 from . import _inventory as inventory
-from ._inventory import Build, Group, Table
+from ._constraints import Group
+from ._inventory import Build, Table
 from ._records import Before, Energy, Move, Potentials, Snapshot, Step
 from ._terms import Sums
 

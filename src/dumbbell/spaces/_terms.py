@@ -1,14 +1,15 @@
 """The ledger's running sums, and how they become named terms: per dynamic body (forces,
 custom velocity functions, what nothing explains, the program's changes), per row (what
 driven bodies did through contacts), per declared field, per constraint (in its
-:class:`._inventory.Group`) and per pair of bodies (in :class:`._inventory.Pairs`); and
+:class:`._constraints.Group`) and per pair of bodies (in :class:`._inventory.Pairs`); and
 the named terms they are folded into, (source, kind) -> energy."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._inventory import PAIR, Build, Group, Pairs
+from ._constraints import Group
+from ._inventory import PAIR, Build, Pairs
 
 _INSIDE = "changed inside the step by something no source explains (a callback)"
 #: Below this fraction of the energy scale, a body's unexplained impulse work is rounding.
