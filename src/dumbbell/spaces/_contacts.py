@@ -242,7 +242,7 @@ class Contacts:
         # Gravity's work per unit time of each arbiter's push on its dynamic ends, over the
         # next step's dt (the last held step's next dt may not be known yet: carried).
         push = f[6, 0] + f[6, 1]
-        if not push.any():
+        if not np.count_nonzero(push):
             return
         free = table.lin_free_f.take(rows)
         gx, gy = b.gravity

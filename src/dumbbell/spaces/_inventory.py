@@ -257,6 +257,12 @@ def spans(t: Any, dt: float) -> np.ndarray:
     return _per_dt(t, "spans", dt, lambda: np.where(t.moves, dt, 0.0))
 
 
+def gravity_dt(t: Any, g: tuple[float, float], dt: float) -> np.ndarray:
+    """The velocity gravity gives in a step of ``dt``, (g.x dt, g.y dt, 0) as a column
+    (the build's gravity ``g``: a new one makes a new table)."""
+    return _per_dt(t, "gravity_dt", dt, lambda: np.array([[g[0] * dt], [g[1] * dt], [0.0]]))
+
+
 def mass_dt(t: Any, dt: float) -> np.ndarray:
     """m dt of each dynamic row of the table ``t``."""
     return _per_dt(t, "mass_dt", dt, lambda: t.m * dt)
@@ -368,6 +374,13 @@ class Build:
     @cached_property
     def any_custom(self) -> bool:
         return bool(self.custom.any())
+
+    @cached_property
+    def plain(self) -> bool:
+        """Only gravity, the contacts and the program act: no constraint, no custom
+        velocity function, no declared field, every moment finite (with no force, no
+        damping and every body awake, a step's sources are :func:`._physics.plain_step`)."""
+        return not (self.groups or self.fields or self.any_custom) and self.table.all_finite
 
     @cached_property
     def funcs(self) -> np.ndarray:

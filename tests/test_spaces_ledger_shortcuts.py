@@ -1,4 +1,4 @@
-"""The ledger's two shortcuts at every step, against the long way round:
+"""The ledger's shortcuts at every step, against the long way round:
 
 - whether ``space.bodies`` still holds the bodies it knows is read from Chipmunk's arrays of
   bodies (awake, static, sleeping components) and ``len(space.bodies)``, not a tuple of
@@ -9,7 +9,10 @@
   wrote can run after the solver (no constraint ``post_solve``, no collision handler, no
   post-step callback before the ledger's); a post-step callback or a constraint's
   ``post_solve`` that changes a velocity is still measured and named, and a space where
-  those reads are not known gives the same balance bit for bit."""
+  those reads are not known gives the same balance bit for bit;
+- a plain step (only gravity, the contacts and the program act; every body awake, no
+  force, no damping) counts gravity and what no source explains in one pass: the same
+  terms as the general one, to the last bits, and gravity's step error is 1/2 dt g . dP."""
 
 from __future__ import annotations
 
@@ -211,3 +214,52 @@ def test_the_short_end_of_step_gives_the_balance_of_the_long_one(monkeypatch):
     monkeypatch.setattr(_layout, "callbacks_known", lambda: False)
     assert run() == short
     assert short[3] is True
+
+
+def _pile_run(steps: int = 240, kick: bool = False) -> tuple[spaces.Balance, float]:
+    """Balls thrown onto a floor and onto each other (contacts, bounces, friction, a
+    program's kick between steps); the balance and the sum of dt/2 g . (P1 - P0) over the
+    steps, from pymunk's getters."""
+    g = (0.0, -9.81)
+    space = pymunk.Space()
+    space.gravity = g
+    floor = pymunk.Segment(space.static_body, (-20, 0), (20, 0), 0.1)
+    floor.friction, floor.elasticity = 0.6, 0.5
+    space.add(floor)
+    balls = []
+    for i in range(12):
+        b = pymunk.Body(1.0 + 0.1 * i, pymunk.moment_for_circle(1.0 + 0.1 * i, 0, 0.4))
+        b.position, b.velocity = (-3.0 + 0.55 * i, 1.0 + 0.9 * i), (0.3 * (i % 3 - 1), 0.0)
+        shape = pymunk.Circle(b, 0.4)
+        shape.friction, shape.elasticity = 0.6, 0.5
+        space.add(b, shape)
+        balls.append(b)
+    ledger = spaces.Ledger(space)
+    dt = 1 / 120
+    error = 0.0
+    for i in range(steps):
+        if kick and i == steps // 2:
+            balls[3].velocity += (2.0, 1.0)
+        p0 = sum((b.mass * b.velocity for b in balls), pymunk.Vec2d(0, 0))
+        space.step(dt)
+        p1 = sum((b.mass * b.velocity for b in balls), pymunk.Vec2d(0, 0))
+        error += 0.5 * dt * (g[0] * (p1.x - p0.x) + g[1] * (p1.y - p0.y))
+    return ledger.balance(), error
+
+
+@pytest.mark.parametrize("kick", [False, True])
+def test_a_plain_step_gives_the_terms_of_the_general_one(monkeypatch, kick):
+    from dumbbell.spaces._inventory import Build
+
+    short, error = _pile_run(kick=kick)
+    assert _terms(short, "step error")["gravity"] == pytest.approx(error, rel=1e-9, abs=1e-12)
+    monkeypatch.setattr(Build, "plain", property(lambda self: False))
+    long, _ = _pile_run(kick=kick)
+    assert short.E == long.E and short.complete is long.complete is (not kick)
+    assert {(t.source, t.kind) for t in short.terms} == {(t.source, t.kind) for t in long.terms}
+    def key(t):
+        return (t.source, t.kind)
+
+    for a, b in zip(sorted(short.terms, key=key), sorted(long.terms, key=key), strict=True):
+        assert a.energy == pytest.approx(b.energy, rel=0, abs=1e-13 * short.scale), a.source
+    assert abs(short.closure) <= 1e-12 * short.scale
