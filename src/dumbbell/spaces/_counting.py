@@ -161,14 +161,17 @@ class Counting(Changes):
             contacts.flush(self._b.table, self._pairs, self._sums, self._b)
 
     def _quiet(self) -> bool:
-        """Nothing the program wrote can run between the solver and the ledger's end of
-        this step: no constraint has a ``post_solve``, the space has no collision handler
-        and no post-step callback before the ledger's (:func:`._layout.callbacks_known`).
-        Then only pymunk's own deferred adds and removes come in between, and :meth:`_end`
-        checks those alone."""
+        """Nothing can change a body between the solver and the ledger's end of this step:
+        no constraint has a ``post_solve``, the space has no collision handler, no
+        post-step callback before the ledger's, and no add or remove pymunk deferred to the
+        step's end (asked for from a constraint's ``pre_solve``, a ``velocity_func`` or a
+        ``position_func``: a shape added or removed changes its body's mass)
+        (:func:`._layout.callbacks_known`). Then :meth:`_end` checks only that the bodies
+        and constraints are those it knows."""
         space = self.space
         return (layout.callbacks_known() and not space._handlers
                 and not space._post_step_callbacks
+                and not space._add_later and not space._remove_later
                 and all(c.post_solve is None for c in self._b.table.constraint_key))
 
     def _post(self) -> None:

@@ -455,9 +455,9 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) ->
 
 
 def same_bodies(t: Any, space: Any) -> bool:
-    """``space.bodies`` holds the table's bodies (``body_key``). The space's C arrays of
-    bodies read the same as when it last did (:class:`._memory.BodyArrays`, a table that
-    has them) stand witness that it still does; else the bodies are compared."""
+    """``space.bodies`` holds the table's bodies (``body_key``). While no body sleeps, the
+    space's C arrays of bodies read the same as when it last did (:class:`._memory.BodyArrays`,
+    a table that has them) stand witness that it still does; else the bodies are compared."""
     arrays = getattr(t, "arrays", None)
     now = None if arrays is None else arrays.read(space)
     if now is not None and now == t.arrays_seen:

@@ -100,14 +100,16 @@ def check_space(space: Any) -> int:
 
 @cache
 def callbacks_known() -> bool:
-    """pymunk keeps a space's collision handlers in ``Space._handlers`` and the post-step
-    callbacks a step will run in ``Space._post_step_callbacks`` (dicts, empty on a new
-    space; pymunk 7 has no public getter for either), checked once per process on a scratch
-    space: a handler set with ``on_collision`` and a callback added with
-    ``add_post_step_callback`` must show there. Read, never written, and only to know
-    that nothing can run between the solver and the end of a step (the ledger's
-    ``_quiet_end``); False (the ledger then checks every body at every step's end) if
-    anything differs."""
+    """pymunk keeps a space's collision handlers in ``Space._handlers``, the post-step
+    callbacks a step will run in ``Space._post_step_callbacks`` and the adds and removes
+    asked for inside a step (done at its end) in ``Space._add_later`` and
+    ``Space._remove_later`` (empty on a new space; pymunk 7 has no public getter for any),
+    checked once per process on a scratch space: a handler set with ``on_collision``, a
+    callback added with ``add_post_step_callback``, and a body added and another removed
+    from a constraint's ``pre_solve`` while the space steps must show there. Read, never
+    written, and only to know that nothing can change a body between the solver and the
+    end of a step (the ledger's ``_quiet_end``); False (the ledger then checks every body
+    at every step's end) if anything differs."""
     import pymunk
 
     def nothing(*args: Any) -> None:
@@ -115,8 +117,23 @@ def callbacks_known() -> bool:
 
     try:
         space = pymunk.Space()
-        handlers, callbacks = space._handlers, space._post_step_callbacks
-        if type(handlers) is not dict or type(callbacks) is not dict or handlers or callbacks:
+        held = (space._handlers, space._post_step_callbacks, space._add_later,
+                space._remove_later)
+        if [type(x) for x in held] != [dict, dict, set, dict] or any(held):
+            return False
+        a, b, c, d = (pymunk.Body(1, 1) for _ in range(4))
+        joint = pymunk.PinJoint(a, b)
+        space.add(a, b, c, joint)
+        seen = []
+
+        def defer(constraint: Any, space_: Any) -> None:
+            space_.add(d)
+            space_.remove(c)
+            seen.append(d in space_._add_later and c in space_._remove_later)
+
+        joint.pre_solve = defer
+        space.step(0.01)
+        if seen != [True] or space._add_later or space._remove_later:
             return False
         space.on_collision(1, 2, post_solve=nothing)
         space.add_post_step_callback(nothing, "key")

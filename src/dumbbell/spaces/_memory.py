@@ -329,17 +329,17 @@ def array_items(arr_at: int) -> np.ndarray:
 
 
 class BodyArrays:
-    """The bodies of the space at ``space_at`` as Chipmunk holds them: its arrays of awake
-    dynamic and kinematic bodies, of static bodies and of the sleeping components' roots
-    (places validated by :func:`._layout.check_space`), read as bytes with the number of
-    pymunk's bodies (``len(space.bodies)``).
+    """The bodies of the space as Chipmunk holds them while none sleeps: its arrays of
+    dynamic and kinematic bodies and of static bodies (places validated by
+    :func:`._layout.check_space`, with that of the sleeping components' roots, which must be
+    empty), read as bytes with the number of pymunk's bodies (``len(space.bodies)``).
 
     pymunk adds and removes a body in its Python list and in these arrays together
     (``Space.add`` and ``remove`` call ``cpSpaceAddBody`` and ``cpSpaceRemoveBody``); a body
-    leaves its array only to sleep or be removed, and a removed one the ledger still holds
-    stays allocated, so that no other body takes its address. So while :meth:`read` gives
-    what it gave when ``space.bodies`` last held the bodies the ledger knows, it still holds
-    them: a read of a few hundred bytes instead of a tuple of every body each step."""
+    awake is in one of the two arrays, and a removed one the ledger still holds stays
+    allocated, so that no other body takes its address. So while :meth:`read` gives what it
+    gave when ``space.bodies`` last held the bodies the ledger knows, it still holds them: a
+    read of a few hundred bytes instead of a tuple of every body each step."""
 
     def __init__(self, space: Any) -> None:
         p = _pymunk_ffi()
@@ -351,12 +351,17 @@ class BodyArrays:
 
     def read(self, space: Any) -> tuple[Any, ...] | None:
         """The arrays' bytes and the number of pymunk's bodies; None unless ``space`` is
-        the space these arrays are of."""
+        the space these arrays are of and no body sleeps. A sleeping component's other
+        bodies are in none of the arrays (only its root is): a body removed from it and
+        another put to sleep in it read the same."""
         if space is not self._space():
+            return None
+        dynamic, static, sleeping = self._arrays
+        if sleeping.num:
             return None
         buffer, width = self._buffer, self._width
         return (len(space.bodies),
-                *(buffer(a.arr, width * a.num)[:] if a.num else b"" for a in self._arrays))
+                *(buffer(a.arr, width * a.num)[:] if a.num else b"" for a in (dynamic, static)))
 
 
 def pointers(arr_at: int) -> np.ndarray:
