@@ -119,7 +119,9 @@ def callbacks_known() -> bool:
         space = pymunk.Space()
         held = (space._handlers, space._post_step_callbacks, space._add_later,
                 space._remove_later)
-        if [type(x) for x in held] != [dict, dict, set, dict] or any(held):
+        # (the removes are a dict from pymunk 7.0.1 on, a set in 7.0.0)
+        if not all(isinstance(x, kinds) for x, kinds in zip(
+                held, (dict, dict, (set, dict), (set, dict)), strict=True)) or any(held):
             return False
         a, b, c, d = (pymunk.Body(1, 1) for _ in range(4))
         joint = pymunk.PinJoint(a, b)
