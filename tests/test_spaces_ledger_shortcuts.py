@@ -25,24 +25,12 @@ import pytest
 from dumbbell import spaces
 from dumbbell.spaces import _inventory, _layout
 
-
-def _energy(body: pymunk.Body, g: tuple[float, float]) -> float:
-    cog = body.local_to_world(body.center_of_gravity)
-    return (0.5 * body.mass * body.velocity.length_squared
-            + 0.5 * body.moment * body.angular_velocity ** 2
-            - body.mass * (g[0] * cog[0] + g[1] * cog[1]))
+from .ledger_measure import body_energy, terms_of
 
 
-def _terms(bal: spaces.Balance, kind: str) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for t in bal.terms:
-        if t.kind == kind:
-            out[t.source] = out.get(t.source, 0.0) + t.energy
-    return out
-
-
-def _box(space: pymunk.Space, x: float, y: float = 0.5) -> pymunk.Body:
-    body = pymunk.Body(2.0, pymunk.moment_for_box(2.0, (1, 1)))
+def _box(space: pymunk.Space, x: float, y: float = 0.5, m: float = 2.0) -> pymunk.Body:
+    """A 1 x 1 box of ``m`` kg centred at (x, y)."""
+    body = pymunk.Body(m, pymunk.moment_for_box(m, (1, 1)))
     body.position = (x, y)
     shape = pymunk.Poly.create_box(body, (1, 1))
     shape.friction = 1.0
@@ -50,13 +38,20 @@ def _box(space: pymunk.Space, x: float, y: float = 0.5) -> pymunk.Body:
     return body
 
 
-def _sleepy_space() -> tuple[pymunk.Space, list[pymunk.Body]]:
+def _floored(sleep_time: float) -> pymunk.Space:
+    """A space with g = 10 down, a floor at height 0, and bodies put to sleep after
+    ``sleep_time`` s at rest."""
     space = pymunk.Space()
     space.gravity = (0.0, -10.0)
-    space.sleep_time_threshold = 0.05
+    space.sleep_time_threshold = sleep_time
     floor = pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.0)
     floor.friction = 1.0
     space.add(floor)
+    return space
+
+
+def _sleepy_space() -> tuple[pymunk.Space, list[pymunk.Body]]:
+    space = _floored(0.05)
     return space, [_box(space, x) for x in (-10.0, 0.0, 10.0)]
 
 
@@ -70,11 +65,11 @@ def test_a_lone_sleeping_body_removed_leaves_with_its_energy():
         space.step(1 / 60)
     assert all(b.is_sleeping for b in boxes)
     g = space.gravity
-    gone = _energy(boxes[1], g)
+    gone = body_energy(boxes[1], g)
     space.remove(boxes[1], *boxes[1].shapes)
     space.step(1 / 60)
     bal = ledger.balance()
-    assert _terms(bal, "left") == {"body 1": pytest.approx(-gone, rel=1e-15)}
+    assert terms_of(bal, "left") == {"body 1": pytest.approx(-gone, rel=1e-15)}
     # -m g.y of a box at rest, its centre 0.5 up (less the contact's slop)
     assert gone == pytest.approx(-2.0 * -10.0 * 0.5, rel=2e-3)
 
@@ -87,15 +82,15 @@ def test_a_sleeping_body_removed_and_another_put_to_sleep_in_one_gap_are_both_fo
     for _ in range(120):
         space.step(1 / 60)
     g = space.gravity
-    gone = _energy(boxes[2], g)
+    gone = body_energy(boxes[2], g)
     space.remove(boxes[2], *boxes[2].shapes)
     new = _box(space, 20.0)
     new.sleep()
-    came = _energy(new, g)
+    came = body_energy(new, g)
     space.step(1 / 60)
     bal = ledger.balance()
-    assert _terms(bal, "left") == {"body 2": pytest.approx(-gone, rel=1e-15)}
-    assert _terms(bal, "entered") == {"body 3": pytest.approx(came, rel=1e-15)}
+    assert terms_of(bal, "left") == {"body 2": pytest.approx(-gone, rel=1e-15)}
+    assert terms_of(bal, "entered") == {"body 3": pytest.approx(came, rel=1e-15)}
     assert bal.complete, bal.unaccounted
 
 
@@ -159,9 +154,9 @@ def test_a_post_step_callback_set_between_steps_is_measured_inside_the_step():
     changed = [0.0]
 
     def slow(space_, key):
-        before = _energy(ball, space_.gravity)
+        before = body_energy(ball, space_.gravity)
         ball.velocity *= 0.5
-        changed[0] += _energy(ball, space_.gravity) - before
+        changed[0] += body_energy(ball, space_.gravity) - before
 
     for i in range(120):
         if i % 10 == 3:
@@ -169,7 +164,7 @@ def test_a_post_step_callback_set_between_steps_is_measured_inside_the_step():
         space.step(1 / 60)
     bal = ledger.balance()
     assert changed[0] < 0
-    assert _terms(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
+    assert terms_of(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
     assert "program" not in bal.by_kind()
 
 
@@ -183,16 +178,16 @@ def test_a_constraint_post_solve_is_measured_inside_the_step():
     changed = [0.0]
 
     def slow(constraint, space_):
-        before = _energy(ball, space_.gravity)
+        before = body_energy(ball, space_.gravity)
         ball.angular_velocity += 0.25
-        changed[0] += _energy(ball, space_.gravity) - before
+        changed[0] += body_energy(ball, space_.gravity) - before
 
     for i in range(120):
         joint.post_solve = slow if i % 10 == 3 else None
         space.step(1 / 60)
     bal = ledger.balance()
     assert changed[0] > 0
-    assert _terms(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
+    assert terms_of(bal, "unattributed") == {"body 0": pytest.approx(changed[0], rel=1e-12)}
 
 
 def test_the_short_end_of_step_gives_the_balance_of_the_long_one(monkeypatch):
@@ -255,7 +250,7 @@ def test_a_plain_step_gives_the_terms_of_the_general_one(monkeypatch, kick):
     from dumbbell.spaces._inventory import Build
 
     short, error = _pile_run(kick=kick)
-    assert _terms(short, "step error")["gravity"] == pytest.approx(error, rel=1e-9, abs=1e-12)
+    assert terms_of(short, "step error")["gravity"] == pytest.approx(error, rel=1e-9, abs=1e-12)
     monkeypatch.setattr(Build, "plain", property(lambda self: False))
     long, _ = _pile_run(kick=kick)
     assert short.E == long.E and short.complete is long.complete is (not kick)
@@ -273,39 +268,25 @@ def test_a_body_swapped_inside_a_sleeping_pile_is_found():
     # root is in Chipmunk's arrays, and the pile falls asleep again inside the next step
     # (sleep_time_threshold below dt), so the arrays and the number of bodies read as before
     # the swap. 30 J leave with the 2 kg box at 1.5 m, 300 J come with the 20 kg one.
-    space = pymunk.Space()
-    space.gravity = (0, -10)
-    space.sleep_time_threshold = 0.01
-    floor = pymunk.Segment(space.static_body, (-50, 0), (50, 0), 0.0)
-    floor.friction = 1
-    space.add(floor)
-
-    def box(y: float, m: float = 2.0) -> pymunk.Body:
-        b = pymunk.Body(m, pymunk.moment_for_box(m, (1, 1)))
-        b.position = (0, y)
-        s = pymunk.Poly.create_box(b, (1, 1))
-        s.friction = 1
-        space.add(b, s)
-        return b
-
-    box(0.5)
-    top = box(1.5)
+    space = _floored(0.01)
+    _box(space, 0.0, 0.5)
+    top = _box(space, 0.0, 1.5)
     ledger = spaces.Ledger(space)
     for _ in range(200):
         space.step(1 / 60)
     assert top.is_sleeping
     g = space.gravity
-    gone = _energy(top, g)
+    gone = body_energy(top, g)
     space.remove(top, *top.shapes)
-    heavy = box(1.5, m=20.0)
+    heavy = _box(space, 0.0, 1.5, m=20.0)
     heavy.position = top.position
-    came = _energy(heavy, g)
+    came = body_energy(heavy, g)
     for _ in range(3):
         space.step(1 / 60)
     bal = ledger.balance()
     assert bal.E == pytest.approx(spaces.energy(space).E, rel=1e-12)
-    assert _terms(bal, "left") == {"body 1": pytest.approx(-gone, rel=1e-12)}
-    assert _terms(bal, "entered") == {"body 2": pytest.approx(came, rel=1e-12)}
+    assert terms_of(bal, "left") == {"body 1": pytest.approx(-gone, rel=1e-12)}
+    assert terms_of(bal, "entered") == {"body 2": pytest.approx(came, rel=1e-12)}
     assert gone == pytest.approx(30.0, rel=1e-3) and came == pytest.approx(300.0, rel=1e-3)
 
 
@@ -327,7 +308,7 @@ def test_a_body_swapped_in_a_component_put_to_sleep_by_hand_is_found():
     space.step(0.01)
     bal = ledger.balance()
     assert bal.E == spaces.energy(space).E == 50.0
-    assert _terms(bal, "entered") == {"body 2": 50.0}
+    assert terms_of(bal, "entered") == {"body 2": 50.0}
 
 
 @pytest.mark.parametrize("how", ["position_func", "pre_solve"])
@@ -370,12 +351,12 @@ def test_a_shape_removed_inside_the_step_is_the_steps_change(how):
 
     space, ball, ledger = run(True)
     _, twin, _ = run(False)
-    changed = _energy(ball, space.gravity) - _energy(twin, space.gravity)
+    changed = body_energy(ball, space.gravity) - body_energy(twin, space.gravity)
     bal = ledger.balance()
     assert bal.E == pytest.approx(spaces.energy(space).E, rel=1e-12)
-    inside = {s: e for s, e in _terms(bal, "unattributed").items() if "inside the step" in s}
+    inside = {s: e for s, e in terms_of(bal, "unattributed").items() if "inside the step" in s}
     assert inside == {"a mass, moment, centre of gravity or body type inside the step "
                       "(a callback)": pytest.approx(changed, rel=1e-12)}
     assert changed < -100
-    assert not any("mass" in s for s in _terms(bal, "program"))
+    assert not any("mass" in s for s in terms_of(bal, "program"))
     assert not bal.complete

@@ -16,22 +16,7 @@ import pytest
 from dumbbell import spaces
 from dumbbell.errors import UsageError
 
-
-def _energy(body: pymunk.Body, g: tuple[float, float]) -> float:
-    """A body's kinetic and gravitational energy, from pymunk's getters (its centre of
-    gravity in world coordinates)."""
-    cog = body.local_to_world(body.center_of_gravity)
-    return (0.5 * body.mass * body.velocity.length_squared
-            + 0.5 * body.moment * body.angular_velocity ** 2
-            - body.mass * (g[0] * cog[0] + g[1] * cog[1]))
-
-
-def _terms(bal: spaces.Balance, kind: str) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for t in bal.terms:
-        if t.kind == kind:
-            out[t.source] = out.get(t.source, 0.0) + t.energy
-    return out
+from .ledger_measure import body_energy, terms_of
 
 
 def _ball(space: pymunk.Space, pos=(0.0, 1.0), v=(0.0, 0.0), m=1.0, r=0.1,
@@ -80,18 +65,18 @@ def test_program_changes_between_steps_are_each_bodys_measured_change():
     expected = {"program: body 0": 0.0, "program: body 1": 0.0}
     for i in range(300):
         if i % 7 == 3:
-            before = _energy(a, g)
+            before = body_energy(a, g)
             a.apply_impulse_at_local_point((0.3, 0.5))
-            expected["program: body 0"] += _energy(a, g) - before
+            expected["program: body 0"] += body_energy(a, g) - before
         if i % 11 == 5:
-            before = _energy(b, g)
+            before = body_energy(b, g)
             b.position += (0.0, 0.2)
             b.velocity *= 0.5
             b.angular_velocity = 3.0
-            expected["program: body 1"] += _energy(b, g) - before
+            expected["program: body 1"] += body_energy(b, g) - before
         space.step(1 / 120)
     bal = ledger.balance()
-    found = _terms(bal, "program")
+    found = terms_of(bal, "program")
     scale = bal.scale
     for source, value in expected.items():
         assert abs(found[source] - value) <= 1e-9 * scale, source
@@ -116,7 +101,7 @@ def test_a_constraint_removed_beside_a_push_out_names_neither_as_the_program():
         space.step(1 / 60)
     bal = ledger.balance()
     assert "program" not in bal.by_kind()
-    assert _terms(bal, "correction")["pushed apart body 0 / static body"] > 0.0
+    assert terms_of(bal, "correction")["pushed apart body 0 / static body"] > 0.0
     assert bal.complete is True
     del ball
 
@@ -132,7 +117,7 @@ def test_a_groove_removed_and_an_impulse_in_the_same_gap_go_to_the_body():
     body.apply_impulse_at_local_point((3, 4))
     space.step(1 / 60)
     bal = ledger.balance()
-    assert _terms(bal, "program") == {"program: body 0": pytest.approx(12.5, rel=1e-15)}
+    assert terms_of(bal, "program") == {"program: body 0": pytest.approx(12.5, rel=1e-15)}
 
 
 def test_a_spring_added_or_removed_is_the_change_of_its_potential():
@@ -151,7 +136,7 @@ def test_a_spring_added_or_removed_is_the_change_of_its_potential():
     space.remove(spring)
     space.step(0.01)
     bal = ledger.balance()
-    found = _terms(bal, "program")
+    found = terms_of(bal, "program")
     assert found["program: constraints added or removed"] == pytest.approx(
         0.5 * 30.0 * (stretch ** 2 - now ** 2), rel=1e-12)
     assert abs(bal.closure) <= 1e-12 * bal.scale
@@ -178,8 +163,8 @@ def test_a_spring_and_a_body_changed_in_one_gap_are_each_named():
     space.add(spring, c, pymunk.Circle(c, 1))
     space.step(0.01)
     bal = ledger.balance()
-    assert _terms(bal, "program") == {"program: constraints added or removed": 36.0}
-    assert _terms(bal, "entered") == {"body 2": 25.0}
+    assert terms_of(bal, "program") == {"program: constraints added or removed": 36.0}
+    assert terms_of(bal, "entered") == {"body 2": 25.0}
     # One step on, both removed in one gap: the spring's potential leaves (pymunk moves
     # bodies before it solves: the spring's 12 N for 0.01 s on 1 kg moved each 0.0012 in
     # the second step, the stretch 6 - 0.0024) and the body's 25.
@@ -189,10 +174,10 @@ def test_a_spring_and_a_body_changed_in_one_gap_are_each_named():
     space.remove(spring, c, *c.shapes)
     space.step(0.01)
     bal = ledger.balance()
-    assert _terms(bal, "program") == {
+    assert terms_of(bal, "program") == {
         "program: constraints added or removed": pytest.approx(36.0 - 0.5 * 2.0 * stretch ** 2,
                                                                rel=1e-15)}
-    assert _terms(bal, "left") == {"body 2": pytest.approx(-25.0, rel=1e-15)}
+    assert terms_of(bal, "left") == {"body 2": pytest.approx(-25.0, rel=1e-15)}
     # Gravity set beside a body added: the change of U_g of the bodies already there is
     # gravity's, not the new body's coming.
     c.velocity = (0, 0)
@@ -207,12 +192,12 @@ def test_a_spring_and_a_body_changed_in_one_gap_are_each_named():
     space.add(d, pymunk.Circle(d, 1))
     space.step(0.01)
     bal = ledger.balance()
-    program = _terms(bal, "program")
+    program = terms_of(bal, "program")
     assert program.pop("program: space.gravity") == pytest.approx(
         10.0 * (before["body 0"] + before["body 1"]) + 2 * 10.0 * before["body 2"], rel=1e-15)
     assert program == {"program: constraints added or removed": pytest.approx(
         36.0 - 0.5 * 2.0 * stretch ** 2, rel=1e-15)}
-    assert _terms(bal, "entered")["body 3"] == 0.5  # at height 0, moving at 1
+    assert terms_of(bal, "entered")["body 3"] == 0.5  # at height 0, moving at 1
 
 
 @pytest.mark.parametrize("when", ["post_solve", "begin", "separate"])
@@ -231,9 +216,9 @@ def test_a_collision_callback_s_change_is_measured_and_named(when):
     changed = [0.0]
 
     def halve(arbiter, space_, data):
-        before = _energy(ball, g)
+        before = body_energy(ball, g)
         ball.velocity *= 0.5
-        changed[0] += _energy(ball, g) - before
+        changed[0] += body_energy(ball, g) - before
 
     space.on_collision(None, None, **{when: halve})
     ledger = spaces.Ledger(space)
@@ -242,10 +227,10 @@ def test_a_collision_callback_s_change_is_measured_and_named(when):
     bal = ledger.balance()
     assert changed[0] < 0
     if when == "post_solve":
-        assert _terms(bal, "unattributed")["body 0"] == pytest.approx(changed[0], rel=1e-12)
+        assert terms_of(bal, "unattributed")["body 0"] == pytest.approx(changed[0], rel=1e-12)
         assert "program" not in bal.by_kind() and "body 0" in dict(bal.unaccounted)
     else:
-        assert _terms(bal, "program")["program: body 0"] == pytest.approx(changed[0],
+        assert terms_of(bal, "program")["program: body 0"] == pytest.approx(changed[0],
                                                                          rel=1e-12)
         why = dict(bal.unaccounted)["program: body 0"]
         assert "begin, pre_solve or separate callback" in why
@@ -273,7 +258,7 @@ def test_bodies_removed_and_added_from_callbacks_carry_their_measured_energy():
     def measure(space_, key):
         for body in balls:
             if id(body) in gone and gone[id(body)] == 0.0:
-                gone[id(body)] = _energy(body, g)
+                gone[id(body)] = body_energy(body, g)
 
     space.on_collision(None, None, post_solve=pocket)
     ledger = spaces.Ledger(space)
@@ -282,13 +267,13 @@ def test_bodies_removed_and_added_from_callbacks_carry_their_measured_energy():
         measure(space, None)
         if i == 50:
             new = _ball(space, pos=(2.0, 1.0), v=(-0.5, 0.0))
-            came[0] = _energy(new, g)
+            came[0] = body_energy(new, g)
     bal = ledger.balance()
-    left = _terms(bal, "left")
+    left = terms_of(bal, "left")
     assert len(left) == 2
     assert sorted(left.values()) == pytest.approx(sorted(-e for e in gone.values()),
                                                   rel=1e-12)
-    entered = _terms(bal, "entered")
+    entered = terms_of(bal, "entered")
     assert list(entered.values()) == [pytest.approx(came[0], rel=1e-12)]
     assert bal.complete is True
     assert abs(bal.closure) <= 1e-12 * bal.scale
@@ -317,7 +302,7 @@ def test_a_pairs_push_and_the_correction_split_when_dt_changes(dts):
         bias = p1 - p0 - v0 * dt
         hand += -ball.mass * (g[0] * bias[0] + g[1] * bias[1])
     bal = ledger.balance()
-    correction = _terms(bal, "correction")
+    correction = terms_of(bal, "correction")
     assert hand > 1e-3 * bal.scale  # the push matters
     assert correction["pushed apart body 0 / static body"] == pytest.approx(hand, rel=1e-9)
     assert abs(correction.get("position correction", 0.0)) <= 1e-12 * bal.scale
@@ -538,12 +523,12 @@ def test_a_change_at_rest_above_the_rounding_is_still_named():
     ledger = spaces.Ledger(space)
     space.step(1 / 60)
     box = list(space.bodies)[2]
-    before = _energy(box, g)
+    before = body_energy(box, g)
     box.velocity += (1.5e-3, 0.0)
-    nudge = _energy(box, g) - before
+    nudge = body_energy(box, g) - before
     for _ in range(5):
         space.step(1 / 60)
     bal = ledger.balance()
     assert nudge > 1000 * bal.rounding
-    assert _terms(bal, "program")["program: body 2"] == pytest.approx(nudge, rel=1e-6)
+    assert terms_of(bal, "program")["program: body 2"] == pytest.approx(nudge, rel=1e-6)
     assert bal.complete is False

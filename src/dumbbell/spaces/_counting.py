@@ -20,7 +20,7 @@ from . import _layout as layout
 from . import _physics as phys
 from ._changes import Changes
 from ._contacts import UnknownBody
-from ._inventory import changed, same_bodies
+from ._inventory import came_or_went, changed
 from ._records import Before, Snapshot, Step
 from ._terms import ROUNDED
 from ._threaded import hazard
@@ -253,8 +253,7 @@ class Counting(Changes):
             return
         self._awaiting_end = False
         t = self._b.table
-        if self._quiet_end and same_bodies(t, self.space) and (
-                tuple(self.space.constraints) == t.constraint_key):
+        if self._quiet_end and not came_or_went(t, self.space):
             return
         F, s = t.state.floats(), self._snap
         if not (F[0:3].tobytes() == s.pos.tobytes() and F[3:6].tobytes() == s.vel.tobytes()):

@@ -438,10 +438,9 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) ->
     the table's floats and pointers read now (``P`` None: the velocity and position
     functions are not looked at, as at the end of a step, which reads floats only)."""
     t = b.table
-    if not same_bodies(t, space):
-        return "bodies added or removed"
-    if tuple(space.constraints) != t.constraint_key:
-        return "constraints added or removed"
+    came = came_or_went(t, space)
+    if came:
+        return came
     # The same bytes are the same values; other bytes may be too (-0 and +0): compared
     # as numbers then.
     if not (F[9:13].tobytes() == t.settings_bytes and F[13, t.n:].tobytes() == t.idle_bytes
@@ -452,6 +451,16 @@ def changed(b: Build, space: Any, F: np.ndarray, P: np.ndarray | None = None) ->
             P[1:3, : t.n] == b.funcs).all():
         return "a velocity_func or position_func"
     return changed_settings(b, space)
+
+
+def came_or_went(t: Any, space: Any) -> str:
+    """Whether bodies or constraints were added to or removed from ``space`` since the
+    table ``t`` was built ('' when neither)."""
+    if not same_bodies(t, space):
+        return "bodies added or removed"
+    if tuple(space.constraints) != t.constraint_key:
+        return "constraints added or removed"
+    return ""
 
 
 def same_bodies(t: Any, space: Any) -> bool:
